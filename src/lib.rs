@@ -1,0 +1,73 @@
+//! # wirebead
+//!
+//! Beads on wires for [Bevy](https://bevy.org): Witkin-style constrained
+//! dynamics in `f64`. A bead is kept on its wire `C(x) = 0` by a constraint
+//! force `λ∇C`, with λ chosen so that the drift obeys `C̈ = -αC - βĊ`
+//! (Baumgarte), or by post-stabilization projection, or by RATTLE, which holds
+//! the constraint to solver tolerance and keeps the energy error bounded.
+//!
+//! ## Add the plugin
+//!
+//! ```
+//! use bevy::math::DVec2;
+//! use bevy::prelude::*;
+//! use wirebead::prelude::*;
+//!
+//! fn setup(mut commands: Commands) -> Result {
+//!     let wire = commands.spawn(Wire::circle(1.0)?).id();
+//!     commands.spawn((Bead::at_rest(1.0, DVec2::new(1.0, 0.0))?, OnWire(wire)));
+//!     Ok(())
+//! }
+//!
+//! App::new()
+//!     .add_plugins((MinimalPlugins, WireBeadPlugin::default()))
+//!     .add_systems(Startup, setup)
+//!     .update();
+//! ```
+//!
+//! ## What is in the box
+//!
+//! | item | what it is |
+//! |---|---|
+//! | [`WireBeadPlugin`] | the simulation: components, parameters, the step in `FixedUpdate` |
+//! | [`WireBeadSystems`] | the step's chained sets: `Prepare → Forces → Solve → Integrate → Writeback` |
+//! | [`Wire`], [`Bead`], [`OnWire`] | a wire placed by its `Transform`; a bead on it |
+//! | [`SimParams`], [`PendingParams`], [`PendingBead`] | applied and edited parameters; [`Restart`] applies the edits |
+//! | [`DragTarget`] | the user's drag: a spring `k (target - x)` while present |
+//! | [`BeadDiagnostics`], [`Diverged`], [`BeadDiverged`] | `C`, `Ċ`, λ and energy each step; divergence reports |
+//! | [`solver`], [`wire`], [`reference`] | the pure math: eq. 1.9, the integrators, the shapes, the exact pendulum period |
+//!
+//! ## Feature flags
+//!
+//! | feature | default | what it adds |
+//! |---|---|---|
+//! | `gui` | yes | the windowed scene: rendering, picking, the egui panel and plots |
+//!
+//! With `default-features = false` the crate needs only Bevy's headless core.
+#![warn(missing_docs)]
+
+pub mod components;
+pub mod params;
+pub mod plugin;
+pub mod reference;
+pub mod solver;
+pub mod systems;
+pub mod wire;
+
+pub use components::{
+    Bead, BeadDiagnostics, DivergenceReason, Diverged, DragTarget, OnWire, Wire, WireBeads,
+};
+pub use params::{
+    BeadParams, Integrator, ParamError, PendingBead, PendingParams, SimParams, Stabilization,
+};
+pub use plugin::{BeadDiverged, Restart, WireBeadPlugin, WireBeadSystems};
+pub use wire::{ImplicitCurve, WireShape};
+
+/// The types most apps need: `use wirebead::prelude::*;`.
+pub mod prelude {
+    pub use crate::{
+        Bead, BeadDiagnostics, BeadDiverged, BeadParams, Diverged, DragTarget, ImplicitCurve,
+        Integrator, OnWire, PendingBead, PendingParams, Restart, SimParams, Stabilization, Wire,
+        WireBeadPlugin, WireBeadSystems, WireShape,
+    };
+}

@@ -1,0 +1,105 @@
+//! [`WireBeadPlugin`]: registers the components, resources and messages and
+//! schedules the step in [`FixedUpdate`].
+
+use bevy::prelude::*;
+
+use crate::components::{Bead, BeadDiagnostics, DivergenceReason, DragTarget};
+use crate::params::{ParamError, PendingBead, PendingParams, SimParams};
+use crate::systems;
+
+/// The simulation step, in order. All run in [`FixedUpdate`], chained.
+///
+/// A game adds its own forces with
+/// `app.add_systems(FixedUpdate, my_force.in_set(WireBeadSystems::Forces))`,
+/// calling [`Bead::add_force`] or [`Bead::add_spring`].
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum WireBeadSystems {
+    /// Clears each bead's force accumulator.
+    Prepare,
+    /// Accumulates external forces: gravity, the drag spring, the game's own.
+    Forces,
+    /// Solves eq. 1.9 for each bead's constraint force.
+    Solve,
+    /// Advances each bead, applies post-stabilization, checks for divergence
+    /// and updates diagnostics.
+    Integrate,
+    /// Writes each bead's `f64` position into its `Transform`.
+    Writeback,
+}
+
+/// Restarts the run: applies [`PendingParams`] and every [`PendingBead`],
+/// returns each bead to its initial state, clears divergence, and sets
+/// `Time<Fixed>` to the timestep. Handled in [`PreUpdate`], so the frame
+/// that sends it already steps with the new parameters.
+#[derive(Message, Clone, Copy, Debug, Default)]
+pub struct Restart;
+
+/// Sent when a bead diverges: which bead and why.
+#[derive(Message, Clone, Debug)]
+pub struct BeadDiverged {
+    /// The bead.
+    pub bead: Entity,
+    /// Why it stopped.
+    pub reason: DivergenceReason,
+}
+
+/// Beads on wires: the simulation, headless. Add it to any app that has
+/// `Time` (`MinimalPlugins` or `DefaultPlugins`).
+#[derive(Clone, Debug, Default)]
+pub struct WireBeadPlugin {
+    params: SimParams,
+}
+
+impl WireBeadPlugin {
+    /// The plugin with the given initial parameters, if they are valid.
+    pub fn new(params: SimParams) -> Result<Self, ParamError> {
+        params.validate()?;
+        Ok(Self { params })
+    }
+}
+
+impl Plugin for WireBeadPlugin {
+    fn build(&self, app: &mut App) {
+        if !app.world().contains_resource::<SimParams>() {
+            app.insert_resource(self.params.clone());
+        }
+        let applied = app.world().resource::<SimParams>().clone();
+        let mut pending = PendingParams::default();
+        if let Err(err) = pending.set(applied) {
+            error!("wirebead: the initial SimParams are invalid ({err}); using the defaults");
+            app.insert_resource(SimParams::default());
+        }
+        app.insert_resource(pending)
+            .add_message::<Restart>()
+            .add_message::<BeadDiverged>()
+            .register_type::<Bead>()
+            .register_type::<BeadDiagnostics>()
+            .register_type::<DragTarget>()
+            .register_type::<PendingBead>()
+            .register_type::<SimParams>()
+            .register_type::<PendingParams>()
+            .configure_sets(
+                FixedUpdate,
+                (
+                    WireBeadSystems::Prepare,
+                    WireBeadSystems::Forces,
+                    WireBeadSystems::Solve,
+                    WireBeadSystems::Integrate,
+                    WireBeadSystems::Writeback,
+                )
+                    .chain(),
+            )
+            .add_systems(Startup, systems::apply_timestep)
+            .add_systems(PreUpdate, systems::apply_restart)
+            .add_systems(
+                FixedUpdate,
+                (
+                    systems::clear_forces.in_set(WireBeadSystems::Prepare),
+                    (systems::apply_gravity, systems::apply_drag).in_set(WireBeadSystems::Forces),
+                    systems::solve_constraints.in_set(WireBeadSystems::Solve),
+                    systems::integrate.in_set(WireBeadSystems::Integrate),
+                    systems::write_transforms.in_set(WireBeadSystems::Writeback),
+                ),
+            );
+    }
+}

@@ -1,0 +1,547 @@
+//! The constraint solve and the integrators, as pure functions over plain
+//! values. Nothing here knows about the ECS.
+//!
+//! # The constraint force (seed eq. 1.9, any wire)
+//!
+//! A bead of mass `m` at `x` with velocity `ẋ` under an external force `f`
+//! is kept on `C(x) = 0` by a force `λN`, `N = ∇C`. Differentiating twice,
+//!
+//! ```text
+//! Ċ = N·ẋ,    C̈ = Ṅ·ẋ + N·ẍ,    Ṅ = H ẋ,    ẍ = (f + λN)/m.
+//! ```
+//!
+//! Asking for `C̈ = -αC - βĊ` (Baumgarte) and solving for λ:
+//!
+//! ```text
+//! λ = ( -m ẋᵀHẋ - m α C - m β N·ẋ - N·f ) / (N·N)              (1.9)
+//! ```
+//!
+//! With α = β = 0 this is the exact force that keeps `C̈ = 0`. On the seed's
+//! circle `N·N = 1` and `ẋᵀHẋ = |ẋ_t|²/|x|`, the centripetal term.
+//!
+//! # External forces
+//!
+//! Forces are accumulated once per step at the starting position `x₀` as a
+//! [`LinearForce`]: a constant part plus an isotropic stiffness, so
+//! `f(x) = F - S (x - x₀)`. Gravity is constant and the drag spring
+//! `k (target - x)` is exactly linear, so multi-stage integrators (RK4,
+//! RATTLE) evaluate the same force law the seed does at every stage.
+//!
+//! # RATTLE
+//!
+//! With `h` the step and `N₀ = ∇C(x₀)`:
+//!
+//! ```text
+//! x₁ = x₀ + h v₀ + h²/(2m) (f(x₀) + λ N₀),     C(x₁) = 0   (Newton in λ)
+//! v½ = (x₁ - x₀)/h
+//! v₁ = v½ + h/(2m) (f(x₁) + μ N₁),             N₁·v₁ = 0  (linear in μ)
+//! ```
+//!
+//! It is symmetric and symplectic, so the energy error stays bounded instead
+//! of drifting, and both constraints hold to the Newton tolerance.
+//!
+//! # Post-stabilization (projection)
+//!
+//! After an unstabilized step, Newton steps along the gradient
+//! `x ← x - C N/(N·N)` bring the position back to `C = 0`, then the normal
+//! component of the velocity is removed (Cline & Pai 2003).
+
+use bevy::math::DVec2;
+
+use crate::params::{Integrator, Stabilization};
+use crate::wire::{Geometry, ImplicitCurve};
+
+/// Position and velocity of one bead.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BeadState {
+    /// Position.
+    pub position: DVec2,
+    /// Velocity.
+    pub velocity: DVec2,
+}
+
+impl BeadState {
+    /// Both vectors finite.
+    pub fn is_finite(&self) -> bool {
+        self.position.is_finite() && self.velocity.is_finite()
+    }
+}
+
+/// An external force linearized about the step's starting position:
+/// `f(x) = force - stiffness (x - at)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LinearForce {
+    /// The force at `at`.
+    pub force: DVec2,
+    /// The isotropic stiffness `S` (a spring's k).
+    pub stiffness: f64,
+    /// Where `force` was evaluated.
+    pub at: DVec2,
+}
+
+impl LinearForce {
+    /// A force that does not depend on position.
+    pub fn constant(force: DVec2) -> Self {
+        Self {
+            force,
+            ..Self::default()
+        }
+    }
+
+    /// `f(x)`.
+    #[inline]
+    pub fn at(&self, x: DVec2) -> DVec2 {
+        self.force - self.stiffness * (x - self.at)
+    }
+}
+
+/// Why a step could not be taken.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum SolveError {
+    /// `∇C` vanishes (or is not finite) where the bead is: there is no
+    /// normal to push along.
+    #[error("the bead is at a singular point of its wire ({x}, {y}), where the normal ∇C vanishes")]
+    Singular {
+        /// x of the point.
+        x: f64,
+        /// y of the point.
+        y: f64,
+    },
+    /// The RATTLE or projection Newton iteration did not reach tolerance.
+    #[error("the constraint solve did not converge: |C| = {residual:e} after {iterations} iterations")]
+    NoConvergence {
+        /// Newton iterations taken.
+        iterations: u32,
+        /// The remaining `|C|`.
+        residual: f64,
+    },
+    /// The new state has a NaN or infinite component.
+    #[error("the state became non-finite")]
+    NonFinite,
+}
+
+/// The constants a step needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepConfig {
+    /// Step length `h` in seconds.
+    pub dt: f64,
+    /// Bead mass.
+    pub mass: f64,
+    /// Baumgarte α (used only with [`Stabilization::Baumgarte`]).
+    pub alpha: f64,
+    /// Baumgarte β (used only with [`Stabilization::Baumgarte`]).
+    pub beta: f64,
+    /// The integrator.
+    pub integrator: Integrator,
+    /// The stabilization.
+    pub stabilization: Stabilization,
+}
+
+impl StepConfig {
+    /// The (α, β) that enter eq. 1.9: the configured ones under Baumgarte,
+    /// zero otherwise.
+    pub fn gains(&self) -> (f64, f64) {
+        match self.stabilization {
+            Stabilization::Baumgarte => (self.alpha, self.beta),
+            Stabilization::Projection | Stabilization::None => (0.0, 0.0),
+        }
+    }
+}
+
+/// The constraint force at one state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Solved {
+    /// λ of eq. 1.9.
+    pub lambda: f64,
+    /// `λN`.
+    pub constraint_force: DVec2,
+    /// `(f + λN)/m`.
+    pub acceleration: DVec2,
+}
+
+/// The result of one step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepOutput {
+    /// The new state.
+    pub state: BeadState,
+    /// The constraint multiplier the step applied (for RATTLE the mean of
+    /// its position and velocity multipliers).
+    pub lambda: f64,
+    /// The constraint force the step applied.
+    pub constraint_force: DVec2,
+}
+
+/// Relative tolerance on `|C|` for the Newton solves (RATTLE, projection),
+/// in units of the wire's scale.
+pub const NEWTON_TOLERANCE: f64 = 1e-13;
+const NEWTON_MAX_ITERATIONS: u32 = 30;
+
+fn nonsingular(normal: DVec2, x: DVec2) -> Result<f64, SolveError> {
+    let nn = normal.length_squared();
+    if nn.is_finite() && nn > 1e-24 {
+        Ok(nn)
+    } else {
+        Err(SolveError::Singular { x: x.x, y: x.y })
+    }
+}
+
+/// λ of eq. 1.9 at a point whose geometry is `g`.
+#[inline]
+pub fn lambda(
+    g: &Geometry,
+    x: DVec2,
+    v: DVec2,
+    f: DVec2,
+    mass: f64,
+    alpha: f64,
+    beta: f64,
+) -> Result<f64, SolveError> {
+    let nn = nonsingular(g.normal, x)?;
+    let vhv = v.dot(g.hessian * v);
+    Ok((-mass * vhv - mass * alpha * g.c - mass * beta * g.normal.dot(v) - g.normal.dot(f)) / nn)
+}
+
+/// Solves eq. 1.9 at `state` and returns λ, `λN` and the acceleration.
+pub fn solve(
+    curve: &dyn ImplicitCurve,
+    state: BeadState,
+    force: &LinearForce,
+    mass: f64,
+    alpha: f64,
+    beta: f64,
+) -> Result<Solved, SolveError> {
+    let BeadState { position: x, velocity: v } = state;
+    let g = curve.geometry(x);
+    let f = force.at(x);
+    let lambda = lambda(&g, x, v, f, mass, alpha, beta)?;
+    let constraint_force = lambda * g.normal;
+    Ok(Solved {
+        lambda,
+        constraint_force,
+        acceleration: (f + constraint_force) / mass,
+    })
+}
+
+/// Advances one step from `state`, given `first`, the solve at `state`
+/// (what [`solve`] returns with the config's gains). Post-stabilization is
+/// applied when configured.
+pub fn integrate(
+    curve: &dyn ImplicitCurve,
+    state: BeadState,
+    force: &LinearForce,
+    first: &Solved,
+    cfg: &StepConfig,
+) -> Result<StepOutput, SolveError> {
+    let h = cfg.dt;
+    let (alpha, beta) = cfg.gains();
+    let BeadState { position: x, velocity: v } = state;
+    let mut out = match cfg.integrator {
+        Integrator::ExplicitEuler => StepOutput {
+            state: BeadState {
+                position: x + h * v,
+                velocity: v + h * first.acceleration,
+            },
+            lambda: first.lambda,
+            constraint_force: first.constraint_force,
+        },
+        Integrator::SemiImplicitEuler => {
+            let v1 = v + h * first.acceleration;
+            StepOutput {
+                state: BeadState {
+                    position: x + h * v1,
+                    velocity: v1,
+                },
+                lambda: first.lambda,
+                constraint_force: first.constraint_force,
+            }
+        }
+        Integrator::Rk4 => {
+            let accel = |s: BeadState| {
+                solve(curve, s, force, cfg.mass, alpha, beta).map(|solved| solved.acceleration)
+            };
+            let k1 = (v, first.acceleration);
+            let s2 = BeadState {
+                position: x + 0.5 * h * k1.0,
+                velocity: v + 0.5 * h * k1.1,
+            };
+            let k2 = (s2.velocity, accel(s2)?);
+            let s3 = BeadState {
+                position: x + 0.5 * h * k2.0,
+                velocity: v + 0.5 * h * k2.1,
+            };
+            let k3 = (s3.velocity, accel(s3)?);
+            let s4 = BeadState {
+                position: x + h * k3.0,
+                velocity: v + h * k3.1,
+            };
+            let k4 = (s4.velocity, accel(s4)?);
+            StepOutput {
+                state: BeadState {
+                    position: x + h / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0),
+                    velocity: v + h / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1),
+                },
+                lambda: first.lambda,
+                constraint_force: first.constraint_force,
+            }
+        }
+        Integrator::Rattle => rattle(curve, state, force, cfg.mass, h)?,
+    };
+    if cfg.stabilization == Stabilization::Projection && cfg.integrator != Integrator::Rattle {
+        out.state = project(curve, out.state)?;
+    }
+    if out.state.is_finite() {
+        Ok(out)
+    } else {
+        Err(SolveError::NonFinite)
+    }
+}
+
+/// [`solve`] then [`integrate`]: one whole step.
+pub fn step(
+    curve: &dyn ImplicitCurve,
+    state: BeadState,
+    force: &LinearForce,
+    cfg: &StepConfig,
+) -> Result<StepOutput, SolveError> {
+    let (alpha, beta) = cfg.gains();
+    let first = solve(curve, state, force, cfg.mass, alpha, beta)?;
+    integrate(curve, state, force, &first, cfg)
+}
+
+/// Newton's method on `s ↦ C(base + s dir)`, returning the root `s`.
+fn newton_along(curve: &dyn ImplicitCurve, base: DVec2, dir: DVec2) -> Result<f64, SolveError> {
+    let tol = NEWTON_TOLERANCE * curve.scale().max(f64::MIN_POSITIVE);
+    let mut s = 0.0;
+    let mut residual = f64::INFINITY;
+    for _ in 0..NEWTON_MAX_ITERATIONS {
+        let p = base + s * dir;
+        let g = curve.geometry(p);
+        residual = g.c.abs();
+        if residual <= tol {
+            return Ok(s);
+        }
+        let slope = g.normal.dot(dir);
+        if !(slope.is_finite() && slope.abs() > 1e-300) {
+            return Err(SolveError::Singular { x: p.x, y: p.y });
+        }
+        s -= g.c / slope;
+    }
+    Err(SolveError::NoConvergence {
+        iterations: NEWTON_MAX_ITERATIONS,
+        residual,
+    })
+}
+
+/// One RATTLE step (see the module docs).
+pub fn rattle(
+    curve: &dyn ImplicitCurve,
+    state: BeadState,
+    force: &LinearForce,
+    mass: f64,
+    h: f64,
+) -> Result<StepOutput, SolveError> {
+    let BeadState { position: x0, velocity: v0 } = state;
+    let n0 = curve.gradient(x0);
+    nonsingular(n0, x0)?;
+    let free = x0 + h * v0 + (h * h / (2.0 * mass)) * force.at(x0);
+    let s = newton_along(curve, free, n0)?;
+    let x1 = free + s * n0;
+    let lambda = 2.0 * mass * s / (h * h);
+    let v_half = (x1 - x0) / h;
+    let n1 = curve.gradient(x1);
+    let nn1 = nonsingular(n1, x1)?;
+    let w = v_half + (h / (2.0 * mass)) * force.at(x1);
+    let mu_scaled = -n1.dot(w) / nn1;
+    let v1 = w + mu_scaled * n1;
+    let mu = 2.0 * mass * mu_scaled / h;
+    Ok(StepOutput {
+        state: BeadState {
+            position: x1,
+            velocity: v1,
+        },
+        lambda: 0.5 * (lambda + mu),
+        constraint_force: 0.5 * (lambda * n0 + mu * n1),
+    })
+}
+
+/// Post-stabilization: moves the position onto `C = 0` by Newton steps along
+/// the local gradient, then removes the velocity's normal component.
+pub fn project(curve: &dyn ImplicitCurve, state: BeadState) -> Result<BeadState, SolveError> {
+    let tol = NEWTON_TOLERANCE * curve.scale().max(f64::MIN_POSITIVE);
+    let mut x = state.position;
+    let mut converged = false;
+    let mut residual = f64::INFINITY;
+    for _ in 0..NEWTON_MAX_ITERATIONS {
+        let g = curve.geometry(x);
+        residual = g.c.abs();
+        if residual <= tol {
+            converged = true;
+            break;
+        }
+        let nn = nonsingular(g.normal, x)?;
+        x -= (g.c / nn) * g.normal;
+    }
+    if !converged {
+        return Err(SolveError::NoConvergence {
+            iterations: NEWTON_MAX_ITERATIONS,
+            residual,
+        });
+    }
+    let n = curve.gradient(x);
+    let nn = nonsingular(n, x)?;
+    let v = state.velocity - (n.dot(state.velocity) / nn) * n;
+    Ok(BeadState {
+        position: x,
+        velocity: v,
+    })
+}
+
+/// `C` and `Ċ = N·ẋ` at a state.
+pub fn drift(curve: &dyn ImplicitCurve, state: BeadState) -> (f64, f64) {
+    let g = curve.geometry(state.position);
+    (g.c, g.normal.dot(state.velocity))
+}
+
+/// Kinetic and gravitational potential energy `(½ m |v|², -m g·x)`.
+pub fn energy(mass: f64, gravity: DVec2, state: BeadState) -> (f64, f64) {
+    (
+        0.5 * mass * state.velocity.length_squared(),
+        -mass * gravity.dot(state.position),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wire::{Circle, Ellipse, Placed, Pose, Sine};
+    use approx::assert_relative_eq;
+
+    const G: DVec2 = DVec2::new(0.0, -9.81);
+
+    fn cfg(integrator: Integrator, stabilization: Stabilization, dt: f64) -> StepConfig {
+        StepConfig {
+            dt,
+            mass: 1.0,
+            alpha: 100.0,
+            beta: 20.0,
+            integrator,
+            stabilization,
+        }
+    }
+
+    #[test]
+    fn lambda_on_circle_is_the_centripetal_and_gravity_balance() {
+        // At the bottom of a unit circle moving at speed u: λ = -(m u²/r + m|g|)
+        // (pointing inward, N points outward).
+        let circle = Circle { radius: 1.0 };
+        let u = 3.0;
+        let state = BeadState {
+            position: DVec2::new(0.0, -1.0),
+            velocity: DVec2::new(u, 0.0),
+        };
+        let s = solve(&circle, state, &LinearForce::constant(2.0 * G), 2.0, 0.0, 0.0).unwrap();
+        assert_relative_eq!(s.lambda, -(2.0 * u * u + 2.0 * 9.81), epsilon = 1e-12);
+        assert_relative_eq!(s.acceleration.y, u * u, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn baumgarte_lambda_makes_c_double_dot_follow_the_law() {
+        // Check C̈ = -αC - βĊ numerically on an ellipse, off the wire, placed and rotated.
+        let ellipse = Ellipse { a: 2.0, b: 1.0 };
+        let placed = Placed {
+            curve: &ellipse,
+            pose: Pose::new(DVec2::new(0.5, 0.2), 0.4),
+        };
+        let state = BeadState {
+            position: placed.pose.to_world(DVec2::new(1.2, 0.9)),
+            velocity: DVec2::new(0.3, -0.8),
+        };
+        let force = LinearForce::constant(DVec2::new(0.7, -9.81));
+        let (alpha, beta, m) = (50.0, 7.0, 1.5);
+        let s = solve(&placed, state, &force, m, alpha, beta).unwrap();
+        let g = placed.geometry(state.position);
+        let c_dot = g.normal.dot(state.velocity);
+        let c_ddot = state.velocity.dot(g.hessian * state.velocity) + g.normal.dot(s.acceleration);
+        assert_relative_eq!(c_ddot, -alpha * g.c - beta * c_dot, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn singular_point_is_an_error_not_a_nan() {
+        let circle = Circle { radius: 1.0 };
+        let state = BeadState::default();
+        for integrator in Integrator::ALL {
+            let err = step(
+                &circle,
+                state,
+                &LinearForce::constant(G),
+                &cfg(*integrator, Stabilization::Baumgarte, 0.01),
+            )
+            .unwrap_err();
+            assert_eq!(err, SolveError::Singular { x: 0.0, y: 0.0 });
+        }
+    }
+
+    #[test]
+    fn rattle_and_projection_hold_the_constraint_to_tolerance() {
+        let sine = Sine {
+            amplitude: 0.5,
+            wavelength: 3.0,
+        };
+        for (integrator, stabilization) in [
+            (Integrator::Rattle, Stabilization::None),
+            (Integrator::SemiImplicitEuler, Stabilization::Projection),
+            (Integrator::Rk4, Stabilization::Projection),
+        ] {
+            let mut state = BeadState {
+                position: DVec2::new(0.0, 0.0),
+                velocity: DVec2::new(2.0, 2.0 * 0.5 * std::f64::consts::TAU / 3.0),
+            };
+            let c = cfg(integrator, stabilization, 1.0 / 60.0);
+            for _ in 0..600 {
+                state = step(&sine, state, &LinearForce::constant(G), &c).unwrap().state;
+                let (drift, drift_rate) = drift(&sine, state);
+                assert!(drift.abs() <= NEWTON_TOLERANCE * 3.0, "{integrator:?}: C = {drift:e}");
+                assert!(drift_rate.abs() <= 1e-12, "{integrator:?}: Ċ = {drift_rate:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn linear_force_reproduces_the_drag_spring() {
+        let target = DVec2::new(2.0, 1.0);
+        let k = 30.0;
+        let at = DVec2::new(0.5, -0.5);
+        let f = LinearForce {
+            force: k * (target - at),
+            stiffness: k,
+            at,
+        };
+        let x = DVec2::new(-0.3, 0.8);
+        let expect = k * (target - x);
+        assert_relative_eq!(f.at(x).x, expect.x, epsilon = 1e-12);
+        assert_relative_eq!(f.at(x).y, expect.y, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn rk4_is_fourth_order_on_the_pendulum() {
+        // Halving dt divides the end-point error by about 16.
+        let circle = Circle { radius: 1.0 };
+        let start = BeadState {
+            position: DVec2::new(1.0, 0.0),
+            velocity: DVec2::ZERO,
+        };
+        let run = |dt: f64| {
+            let c = cfg(Integrator::Rk4, Stabilization::None, dt);
+            let mut s = start;
+            for _ in 0..(1.0 / dt).round() as usize {
+                s = step(&circle, s, &LinearForce::constant(G), &c).unwrap().state;
+            }
+            s.position
+        };
+        let reference = run(1.0 / 2560.0);
+        let e1 = (run(1.0 / 80.0) - reference).length();
+        let e2 = (run(1.0 / 160.0) - reference).length();
+        let order = (e1 / e2).log2();
+        assert!((3.7..4.3).contains(&order), "observed order {order}");
+    }
+}
