@@ -230,19 +230,12 @@ impl BeadDiagnostics {
 /// Why a bead stopped.
 #[derive(Clone, Debug, PartialEq)]
 pub enum DivergenceReason {
-    /// The step failed (a singular point, a Newton solve that did not
-    /// converge, a non-finite result).
+    /// The step failed: a singular point, a Newton solve that did not
+    /// converge, a non-finite result, or drift past the configured bound.
     Solve(SolveError),
     /// The state was already non-finite before the step (written from
     /// outside).
     NonFiniteState,
-    /// `|C|` passed the configured bound.
-    Drift {
-        /// The drift `C`.
-        c: f64,
-        /// The bound it passed, in world units.
-        bound: f64,
-    },
     /// The bead's wire entity has no [`Wire`] or its `Transform` is not
     /// finite.
     InvalidWire(String),
@@ -253,9 +246,6 @@ impl fmt::Display for DivergenceReason {
         match self {
             Self::Solve(e) => e.fmt(f),
             Self::NonFiniteState => f.write_str("its position or velocity is not finite"),
-            Self::Drift { c, bound } => {
-                write!(f, "it drifted {c:.3e} off its wire, past the bound {bound:.3e}")
-            }
             Self::InvalidWire(why) => write!(f, "its wire is invalid: {why}"),
         }
     }

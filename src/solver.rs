@@ -118,6 +118,15 @@ pub enum SolveError {
     /// The new state has a NaN or infinite component.
     #[error("the state became non-finite")]
     NonFinite,
+    /// The step left the bead farther off its wire than the bound: the
+    /// simulation has blown up.
+    #[error("the bead drifted {c:.3e} off its wire, past the bound {bound:.3e}")]
+    DriftExceeded {
+        /// The drift `C` after the step (before any projection).
+        c: f64,
+        /// The bound, in world units.
+        bound: f64,
+    },
 }
 
 /// The constants a step needs.
@@ -135,6 +144,9 @@ pub struct StepConfig {
     pub integrator: Integrator,
     /// The stabilization.
     pub stabilization: Stabilization,
+    /// The largest `|C|` a step may leave (in world units) before the run
+    /// is declared blown up; checked before any projection.
+    pub drift_bound: f64,
 }
 
 impl StepConfig {
@@ -171,10 +183,18 @@ pub struct StepOutput {
     pub constraint_force: DVec2,
 }
 
-/// Relative tolerance on `|C|` for the Newton solves (RATTLE, projection),
-/// in units of the wire's scale.
-pub const NEWTON_TOLERANCE: f64 = 1e-13;
-const NEWTON_MAX_ITERATIONS: u32 = 30;
+/// Tolerance on `|C|` for the Newton solves (RATTLE, projection), in units
+/// of the wire's scale: a few ulps, which Newton's quadratic convergence
+/// reaches in two or three iterations.
+pub const NEWTON_TOLERANCE: f64 = 4.0 * f64::EPSILON;
+/// Where rounding keeps `|C|` from reaching [`NEWTON_TOLERANCE`], a residual
+/// below this (in wire scales) after the last iteration is accepted.
+pub const NEWTON_ACCEPT: f64 = 1e-10;
+const NEWTON_MAX_ITERATIONS: u32 = 20;
+
+fn newton_done(residual: f64, scale: f64, last: bool) -> bool {
+    residual <= NEWTON_TOLERANCE * scale || (last && residual <= NEWTON_ACCEPT * scale)
+}
 
 fn nonsingular(normal: DVec2, x: DVec2) -> Result<f64, SolveError> {
     let nn = normal.length_squared();
@@ -286,14 +306,20 @@ pub fn integrate(
         }
         Integrator::Rattle => rattle(curve, state, force, cfg.mass, h)?,
     };
+    if !out.state.is_finite() {
+        return Err(SolveError::NonFinite);
+    }
+    let c = curve.value(out.state.position);
+    if !(c.abs() <= cfg.drift_bound) {
+        return Err(SolveError::DriftExceeded {
+            c,
+            bound: cfg.drift_bound,
+        });
+    }
     if cfg.stabilization == Stabilization::Projection && cfg.integrator != Integrator::Rattle {
         out.state = project(curve, out.state)?;
     }
-    if out.state.is_finite() {
-        Ok(out)
-    } else {
-        Err(SolveError::NonFinite)
-    }
+    Ok(out)
 }
 
 /// [`solve`] then [`integrate`]: one whole step.
@@ -310,15 +336,18 @@ pub fn step(
 
 /// Newton's method on `s ↦ C(base + s dir)`, returning the root `s`.
 fn newton_along(curve: &dyn ImplicitCurve, base: DVec2, dir: DVec2) -> Result<f64, SolveError> {
-    let tol = NEWTON_TOLERANCE * curve.scale().max(f64::MIN_POSITIVE);
+    let scale = curve.scale().max(f64::MIN_POSITIVE);
     let mut s = 0.0;
     let mut residual = f64::INFINITY;
-    for _ in 0..NEWTON_MAX_ITERATIONS {
+    for i in 0..=NEWTON_MAX_ITERATIONS {
         let p = base + s * dir;
         let g = curve.geometry(p);
         residual = g.c.abs();
-        if residual <= tol {
+        if newton_done(residual, scale, i == NEWTON_MAX_ITERATIONS) {
             return Ok(s);
+        }
+        if i == NEWTON_MAX_ITERATIONS {
+            break;
         }
         let slope = g.normal.dot(dir);
         if !(slope.is_finite() && slope.abs() > 1e-300) {
@@ -367,15 +396,18 @@ pub fn rattle(
 /// Post-stabilization: moves the position onto `C = 0` by Newton steps along
 /// the local gradient, then removes the velocity's normal component.
 pub fn project(curve: &dyn ImplicitCurve, state: BeadState) -> Result<BeadState, SolveError> {
-    let tol = NEWTON_TOLERANCE * curve.scale().max(f64::MIN_POSITIVE);
+    let scale = curve.scale().max(f64::MIN_POSITIVE);
     let mut x = state.position;
     let mut converged = false;
     let mut residual = f64::INFINITY;
-    for _ in 0..NEWTON_MAX_ITERATIONS {
+    for i in 0..=NEWTON_MAX_ITERATIONS {
         let g = curve.geometry(x);
         residual = g.c.abs();
-        if residual <= tol {
+        if newton_done(residual, scale, i == NEWTON_MAX_ITERATIONS) {
             converged = true;
+            break;
+        }
+        if i == NEWTON_MAX_ITERATIONS {
             break;
         }
         let nn = nonsingular(g.normal, x)?;
@@ -426,6 +458,7 @@ mod tests {
             beta: 20.0,
             integrator,
             stabilization,
+            drift_bound: 1.0,
         }
     }
 
@@ -500,7 +533,7 @@ mod tests {
             for _ in 0..600 {
                 state = step(&sine, state, &LinearForce::constant(G), &c).unwrap().state;
                 let (drift, drift_rate) = drift(&sine, state);
-                assert!(drift.abs() <= NEWTON_TOLERANCE * 3.0, "{integrator:?}: C = {drift:e}");
+                assert!(drift.abs() <= NEWTON_ACCEPT * 3.0, "{integrator:?}: C = {drift:e}");
                 assert!(drift_rate.abs() <= 1e-12, "{integrator:?}: Ċ = {drift_rate:e}");
             }
         }

@@ -134,7 +134,7 @@ pub fn solve_constraints(
     mut beads: Query<(Entity, &mut Bead, &OnWire, &BeadDiagnostics), Without<Diverged>>,
     mut divergences: Divergences,
 ) {
-    let (alpha, beta) = step_config(&params, 1.0).gains();
+    let (alpha, beta) = step_config(&params, 1.0, 1.0).gains();
     for (entity, mut bead, on_wire, diagnostics) in &mut beads {
         let result = placed_wire(&wires, on_wire).and_then(|placed| {
             if !bead.state().is_finite() {
@@ -165,7 +165,7 @@ pub fn integrate(
         let Ok(placed) = placed_wire(&wires, on_wire) else {
             continue; // reported by solve_constraints
         };
-        let cfg = step_config(&params, bead.mass());
+        let cfg = step_config(&params, bead.mass(), placed.scale());
         let force = force_of(&bead);
         let first = Solved {
             lambda: bead.lambda,
@@ -185,11 +185,6 @@ pub fn integrate(
                     time,
                     ..diagnose(&placed, &bead, params.gravity)
                 };
-                let bound = params.divergence_bound * placed.scale();
-                if diagnostics.c.abs() > bound {
-                    let c = diagnostics.c;
-                    divergences.report(entity, DivergenceReason::Drift { c, bound }, time);
-                }
             }
             Err(e) => divergences.report(entity, DivergenceReason::Solve(e), time),
         }
@@ -207,7 +202,7 @@ pub fn write_transforms(mut beads: Query<(&Bead, &mut Transform), Changed<Bead>>
     }
 }
 
-fn step_config(params: &SimParams, mass: f64) -> StepConfig {
+fn step_config(params: &SimParams, mass: f64, wire_scale: f64) -> StepConfig {
     StepConfig {
         dt: params.timestep,
         mass,
@@ -215,6 +210,7 @@ fn step_config(params: &SimParams, mass: f64) -> StepConfig {
         beta: params.beta,
         integrator: params.integrator,
         stabilization: params.stabilization,
+        drift_bound: params.divergence_bound * wire_scale,
     }
 }
 

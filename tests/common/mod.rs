@@ -1,0 +1,125 @@
+//! The headless test harness: `MinimalPlugins` + the plugin, stepped with
+//! `TimeUpdateStrategy::FixedTimesteps`, and a recorder of every bead's
+//! state after every step.
+#![allow(dead_code)]
+
+use std::time::Duration;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+use wirebead::prelude::*;
+use wirebead::reference;
+
+/// One recorded step of one bead.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    pub t: f64,
+    pub position: DVec2,
+    pub velocity: DVec2,
+    pub diagnostics: BeadDiagnostics,
+}
+
+/// Every bead's samples, in step order.
+#[derive(Resource, Default)]
+pub struct Recording(pub Vec<(Entity, Sample)>);
+
+impl Recording {
+    pub fn of(&self, bead: Entity) -> Vec<Sample> {
+        self.0.iter().filter(|(e, _)| *e == bead).map(|(_, s)| *s).collect()
+    }
+}
+
+fn record(beads: Query<(Entity, &Bead, &BeadDiagnostics)>, mut recording: ResMut<Recording>) {
+    for (entity, bead, diagnostics) in &beads {
+        recording.0.push((
+            entity,
+            Sample {
+                t: diagnostics.time,
+                position: bead.position,
+                velocity: bead.velocity,
+                diagnostics: *diagnostics,
+            },
+        ));
+    }
+}
+
+/// A headless app with the plugin, ready to step.
+pub fn app(params: SimParams) -> App {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, WireBeadPlugin::new(params).expect("valid params")))
+        .init_resource::<Recording>()
+        .insert_resource(TimeUpdateStrategy::FixedTimesteps(1))
+        .add_systems(FixedUpdate, record.after(WireBeadSystems::Writeback));
+    app.world_mut()
+        .resource_mut::<Time<Virtual>>()
+        .set_max_delta(Duration::from_secs(1_000_000));
+    // The first update only starts the clocks; it runs no fixed step.
+    app.update();
+    app
+}
+
+/// Runs exactly `n` fixed steps.
+pub fn run_steps(app: &mut App, n: u32) {
+    app.insert_resource(TimeUpdateStrategy::FixedTimesteps(n));
+    app.update();
+}
+
+/// Runs for `seconds` of simulated time (rounded to whole steps).
+pub fn run_for(app: &mut App, seconds: f64) {
+    let dt = app.world().resource::<SimParams>().timestep;
+    run_steps(app, (seconds / dt).round() as u32);
+}
+
+pub fn spawn_wire(app: &mut App, wire: Wire, transform: Transform) -> Entity {
+    app.world_mut().spawn((wire, transform)).id()
+}
+
+pub fn spawn_bead(app: &mut App, wire: Entity, params: BeadParams) -> Entity {
+    app.world_mut()
+        .spawn((Bead::new(params).expect("valid bead"), OnWire(wire)))
+        .id()
+}
+
+/// A vertical circle of radius `r` at the origin with a bead released from
+/// rest `theta0` radians from the bottom. Returns the bead.
+pub fn pendulum(app: &mut App, r: f64, theta0: f64) -> Entity {
+    let wire = spawn_wire(app, Wire::circle(r).unwrap(), Transform::default());
+    spawn_bead(
+        app,
+        wire,
+        BeadParams {
+            mass: 1.0,
+            initial_position: reference::point_on_circle(r, theta0),
+            initial_velocity: DVec2::ZERO,
+        },
+    )
+}
+
+pub fn bead(app: &App, bead: Entity) -> Bead {
+    app.world().get::<Bead>(bead).expect("bead").clone()
+}
+
+pub fn diagnostics(app: &App, bead: Entity) -> BeadDiagnostics {
+    *app.world().get::<BeadDiagnostics>(bead).expect("bead")
+}
+
+pub fn params(integrator: Integrator, stabilization: Stabilization, dt: f64) -> SimParams {
+    SimParams {
+        timestep: dt,
+        integrator,
+        stabilization,
+        ..default()
+    }
+}
+
+/// The largest `|C|` over the samples.
+pub fn max_drift(samples: &[Sample]) -> f64 {
+    samples.iter().map(|s| s.diagnostics.c.abs()).fold(0.0, f64::max)
+}
+
+/// The period from upward zero crossings of x.
+pub fn measured_period(samples: &[Sample]) -> f64 {
+    let xs: Vec<(f64, f64)> = samples.iter().map(|s| (s.t, s.position.x)).collect();
+    reference::period_from_crossings(&xs).expect("at least two crossings")
+}
