@@ -35,6 +35,7 @@
 //! | [`SimParams`], [`PendingParams`], [`PendingBead`] | applied and edited parameters; [`Restart`] applies the edits |
 //! | [`DragTarget`] | the user's drag: a spring `k (target - x)` while present |
 //! | [`BeadDiagnostics`], [`Diverged`], [`BeadDiverged`] | `C`, `Ċ`, λ and energy each step; divergence reports |
+//! | [`ScenePresetPlugin`], [`ScenePreset`] | scenes as RON assets (`*.scene.ron`), hot-reloaded |
 //! | [`solver`], [`wire`], [`reference`] | the pure math: eq. 1.9, the integrators, the shapes, the exact pendulum period |
 //!
 //! ## Feature flags
@@ -49,25 +50,28 @@
 pub mod components;
 pub mod params;
 pub mod plugin;
+pub mod preset;
 pub mod reference;
 pub mod solver;
 pub mod systems;
 pub mod wire;
 
 pub use components::{
-    Bead, BeadDiagnostics, DivergenceReason, Diverged, DragTarget, OnWire, Wire, WireBeads,
+    Bead, BeadDiagnostics, Diverged, DivergenceReason, DragTarget, OnWire, Wire, WireBeads,
 };
 pub use params::{
     BeadParams, Integrator, ParamError, PendingBead, PendingParams, SimParams, Stabilization,
 };
 pub use plugin::{BeadDiverged, Restart, WireBeadPlugin, WireBeadSystems};
+pub use preset::{ActivePreset, LoadPreset, ScenePreset, ScenePresetPlugin};
 pub use wire::{ImplicitCurve, WireShape};
 
 /// The types most apps need: `use wirebead::prelude::*;`.
 pub mod prelude {
     pub use crate::{
         Bead, BeadDiagnostics, BeadDiverged, BeadParams, Diverged, DragTarget, ImplicitCurve,
-        Integrator, OnWire, PendingBead, PendingParams, Restart, SimParams, Stabilization, Wire,
-        WireBeadPlugin, WireBeadSystems, WireShape,
+        Integrator, LoadPreset, OnWire, PendingBead, PendingParams, Restart, ScenePreset,
+        ScenePresetPlugin, SimParams, Stabilization, Wire, WireBeadPlugin, WireBeadSystems,
+        WireBeads, WireShape,
     };
 }

@@ -94,13 +94,16 @@ pub(crate) fn check_vector(name: &'static str, v: DVec2) -> Result<(), ParamErro
     if v.is_finite() {
         Ok(())
     } else {
-        Err(ParamError::VectorNotFinite { name, x: v.x, y: v.y })
+        Err(ParamError::VectorNotFinite {
+            name,
+            x: v.x,
+            y: v.y,
+        })
     }
 }
 
 /// How a bead's state is advanced over one fixed step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, Reflect)]
-#[serde(rename_all = "kebab-case")]
 pub enum Integrator {
     /// `x += v dt; v += a dt`: first order, gains energy, the least stable.
     ExplicitEuler,
@@ -120,7 +123,6 @@ pub enum Integrator {
 
 /// How drift off the wire is corrected.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, Reflect)]
-#[serde(rename_all = "kebab-case")]
 pub enum Stabilization {
     /// The seed's: choose λ so that `C̈ = -αC - βĊ`.
     #[default]
@@ -347,12 +349,22 @@ mod tests {
     fn errors_name_the_parameter_and_value() {
         let mut pending = PendingParams::default();
         let err = pending.update(|p| p.timestep = 0.0).unwrap_err();
-        assert_eq!(err.to_string(), "timestep must be positive and finite, got 0");
+        assert_eq!(
+            err.to_string(),
+            "timestep must be positive and finite, got 0"
+        );
         let err = pending.update(|p| p.alpha = -3.0).unwrap_err();
-        assert_eq!(err.to_string(), "alpha must be zero or more and finite, got -3");
+        assert_eq!(
+            err.to_string(),
+            "alpha must be zero or more and finite, got -3"
+        );
         let err = pending.update(|p| p.gravity.y = f64::NAN).unwrap_err();
         assert_eq!(err.to_string(), "gravity must be finite, got (0, NaN)");
-        assert_eq!(pending.get(), &SimParams::default(), "a refused edit changes nothing");
+        assert_eq!(
+            pending.get(),
+            &SimParams::default(),
+            "a refused edit changes nothing"
+        );
         let err = PendingBead::new(BeadParams {
             mass: -2.0,
             ..default()

@@ -84,6 +84,10 @@ mod tests {
                 (t, (2.0 * PI * t / 1.7).sin())
             })
             .collect();
-        assert_relative_eq!(period_from_crossings(&samples).unwrap(), 1.7, max_relative = 1e-4);
+        assert_relative_eq!(
+            period_from_crossings(&samples).unwrap(),
+            1.7,
+            max_relative = 1e-4
+        );
     }
 }

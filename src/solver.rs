@@ -108,7 +108,9 @@ pub enum SolveError {
         y: f64,
     },
     /// The RATTLE or projection Newton iteration did not reach tolerance.
-    #[error("the constraint solve did not converge: |C| = {residual:e} after {iterations} iterations")]
+    #[error(
+        "the constraint solve did not converge: |C| = {residual:e} after {iterations} iterations"
+    )]
     NoConvergence {
         /// Newton iterations taken.
         iterations: u32,
@@ -230,7 +232,10 @@ pub fn solve(
     alpha: f64,
     beta: f64,
 ) -> Result<Solved, SolveError> {
-    let BeadState { position: x, velocity: v } = state;
+    let BeadState {
+        position: x,
+        velocity: v,
+    } = state;
     let g = curve.geometry(x);
     let f = force.at(x);
     let lambda = lambda(&g, x, v, f, mass, alpha, beta)?;
@@ -254,7 +259,10 @@ pub fn integrate(
 ) -> Result<StepOutput, SolveError> {
     let h = cfg.dt;
     let (alpha, beta) = cfg.gains();
-    let BeadState { position: x, velocity: v } = state;
+    let BeadState {
+        position: x,
+        velocity: v,
+    } = state;
     let mut out = match cfg.integrator {
         Integrator::ExplicitEuler => StepOutput {
             state: BeadState {
@@ -310,7 +318,7 @@ pub fn integrate(
         return Err(SolveError::NonFinite);
     }
     let c = curve.value(out.state.position);
-    if !(c.abs() <= cfg.drift_bound) {
+    if c.is_nan() || c.abs() > cfg.drift_bound {
         return Err(SolveError::DriftExceeded {
             c,
             bound: cfg.drift_bound,
@@ -369,7 +377,10 @@ pub fn rattle(
     mass: f64,
     h: f64,
 ) -> Result<StepOutput, SolveError> {
-    let BeadState { position: x0, velocity: v0 } = state;
+    let BeadState {
+        position: x0,
+        velocity: v0,
+    } = state;
     let n0 = curve.gradient(x0);
     nonsingular(n0, x0)?;
     let free = x0 + h * v0 + (h * h / (2.0 * mass)) * force.at(x0);
@@ -472,7 +483,15 @@ mod tests {
             position: DVec2::new(0.0, -1.0),
             velocity: DVec2::new(u, 0.0),
         };
-        let s = solve(&circle, state, &LinearForce::constant(2.0 * G), 2.0, 0.0, 0.0).unwrap();
+        let s = solve(
+            &circle,
+            state,
+            &LinearForce::constant(2.0 * G),
+            2.0,
+            0.0,
+            0.0,
+        )
+        .unwrap();
         assert_relative_eq!(s.lambda, -(2.0 * u * u + 2.0 * 9.81), epsilon = 1e-12);
         assert_relative_eq!(s.acceleration.y, u * u, epsilon = 1e-12);
     }
@@ -531,10 +550,18 @@ mod tests {
             };
             let c = cfg(integrator, stabilization, 1.0 / 60.0);
             for _ in 0..600 {
-                state = step(&sine, state, &LinearForce::constant(G), &c).unwrap().state;
+                state = step(&sine, state, &LinearForce::constant(G), &c)
+                    .unwrap()
+                    .state;
                 let (drift, drift_rate) = drift(&sine, state);
-                assert!(drift.abs() <= NEWTON_ACCEPT * 3.0, "{integrator:?}: C = {drift:e}");
-                assert!(drift_rate.abs() <= 1e-12, "{integrator:?}: Ċ = {drift_rate:e}");
+                assert!(
+                    drift.abs() <= NEWTON_ACCEPT * 3.0,
+                    "{integrator:?}: C = {drift:e}"
+                );
+                assert!(
+                    drift_rate.abs() <= 1e-12,
+                    "{integrator:?}: Ċ = {drift_rate:e}"
+                );
             }
         }
     }
@@ -567,7 +594,9 @@ mod tests {
             let c = cfg(Integrator::Rk4, Stabilization::None, dt);
             let mut s = start;
             for _ in 0..(1.0 / dt).round() as usize {
-                s = step(&circle, s, &LinearForce::constant(G), &c).unwrap().state;
+                s = step(&circle, s, &LinearForce::constant(G), &c)
+                    .unwrap()
+                    .state;
             }
             s.position
         };

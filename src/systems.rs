@@ -5,7 +5,7 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use crate::components::{
-    Bead, BeadDiagnostics, DivergenceReason, Diverged, DragTarget, OnWire, Wire,
+    Bead, BeadDiagnostics, Diverged, DivergenceReason, DragTarget, OnWire, Wire,
 };
 use crate::params::{PendingBead, PendingParams, SimParams};
 use crate::plugin::{BeadDiverged, Restart};
@@ -20,8 +20,8 @@ pub fn placed_wire<'a>(wires: &'a Wires, on: &OnWire) -> Result<Placed<'a>, Dive
     let (wire, transform) = wires
         .get(on.0)
         .map_err(|_| DivergenceReason::InvalidWire(format!("entity {} has no Wire", on.0)))?;
-    let pose =
-        Pose::from_transform(transform).map_err(|e| DivergenceReason::InvalidWire(e.to_string()))?;
+    let pose = Pose::from_transform(transform)
+        .map_err(|e| DivergenceReason::InvalidWire(e.to_string()))?;
     Ok(Placed {
         curve: wire.shape().curve(),
         pose,
@@ -29,7 +29,11 @@ pub fn placed_wire<'a>(wires: &'a Wires, on: &OnWire) -> Result<Placed<'a>, Dive
 }
 
 /// The diagnostics of a bead's current state on `curve`.
-pub fn diagnose(curve: &dyn ImplicitCurve, bead: &Bead, gravity: bevy::math::DVec2) -> BeadDiagnostics {
+pub fn diagnose(
+    curve: &dyn ImplicitCurve,
+    bead: &Bead,
+    gravity: bevy::math::DVec2,
+) -> BeadDiagnostics {
     let (c, c_dot) = solver::drift(curve, bead.state());
     let (kinetic, potential) = solver::energy(bead.mass(), gravity, bead.state());
     BeadDiagnostics {
@@ -53,7 +57,9 @@ pub struct Divergences<'w, 's> {
 impl Divergences<'_, '_> {
     /// Reports that `bead` stopped at simulated time `time`.
     pub fn report(&mut self, bead: Entity, reason: DivergenceReason, time: f64) {
-        warn!("wirebead: bead {bead} diverged at t = {time:.4} s: {reason}; press Space (send Restart) to recover");
+        warn!(
+            "wirebead: bead {bead} diverged at t = {time:.4} s: {reason}; press Space (send Restart) to recover"
+        );
         self.commands.entity(bead).try_insert(Diverged {
             reason: reason.clone(),
             time,

@@ -150,7 +150,9 @@ impl ImplicitCurve for Ellipse {
         self.ell() * DVec2::new(p.x / (self.a * self.a), p.y / (self.b * self.b))
     }
     fn hessian(&self, _p: DVec2) -> DMat2 {
-        DMat2::from_diagonal(self.ell() * DVec2::new(1.0 / (self.a * self.a), 1.0 / (self.b * self.b)))
+        DMat2::from_diagonal(
+            self.ell() * DVec2::new(1.0 / (self.a * self.a), 1.0 / (self.b * self.b)),
+        )
     }
     fn scale(&self) -> f64 {
         self.ell()
@@ -456,7 +458,11 @@ mod tests {
                 curve: shape.as_ref(),
                 pose,
             };
-            for p in [DVec2::new(0.9, 0.4), DVec2::new(-0.6, 1.1), DVec2::new(1.5, -0.2)] {
+            for p in [
+                DVec2::new(0.9, 0.4),
+                DVec2::new(-0.6, 1.1),
+                DVec2::new(1.5, -0.2),
+            ] {
                 let g = placed.geometry(p);
                 let fd_grad = DVec2::new(
                     (placed.value(p + DVec2::X * h) - placed.value(p - DVec2::X * h)) / (2.0 * h),
@@ -464,8 +470,10 @@ mod tests {
                 );
                 assert_relative_eq!(g.normal.x, fd_grad.x, epsilon = 1e-7);
                 assert_relative_eq!(g.normal.y, fd_grad.y, epsilon = 1e-7);
-                let col_x = (placed.gradient(p + DVec2::X * h) - placed.gradient(p - DVec2::X * h)) / (2.0 * h);
-                let col_y = (placed.gradient(p + DVec2::Y * h) - placed.gradient(p - DVec2::Y * h)) / (2.0 * h);
+                let col_x = (placed.gradient(p + DVec2::X * h) - placed.gradient(p - DVec2::X * h))
+                    / (2.0 * h);
+                let col_y = (placed.gradient(p + DVec2::Y * h) - placed.gradient(p - DVec2::Y * h))
+                    / (2.0 * h);
                 for (a, b) in [(g.hessian.x_axis, col_x), (g.hessian.y_axis, col_y)] {
                     assert_relative_eq!(a.x, b.x, epsilon = 1e-6);
                     assert_relative_eq!(a.y, b.y, epsilon = 1e-6);
@@ -493,11 +501,31 @@ mod tests {
 
     #[test]
     fn shapes_refuse_bad_dimensions() {
-        let err = WireShape::Circle(Circle { radius: 0.0 }).validate().unwrap_err();
+        let err = WireShape::Circle(Circle { radius: 0.0 })
+            .validate()
+            .unwrap_err();
         assert_eq!(err.to_string(), "radius must be positive and finite, got 0");
-        assert!(WireShape::Ellipse(Ellipse { a: 1.0, b: f64::NAN }).validate().is_err());
-        assert!(WireShape::Parabola(Parabola { focal_length: 0.0 }).validate().is_err());
-        assert!(WireShape::Sine(Sine { amplitude: 1.0, wavelength: -1.0 }).validate().is_err());
+        assert!(
+            WireShape::Ellipse(Ellipse {
+                a: 1.0,
+                b: f64::NAN
+            })
+            .validate()
+            .is_err()
+        );
+        assert!(
+            WireShape::Parabola(Parabola { focal_length: 0.0 })
+                .validate()
+                .is_err()
+        );
+        assert!(
+            WireShape::Sine(Sine {
+                amplitude: 1.0,
+                wavelength: -1.0
+            })
+            .validate()
+            .is_err()
+        );
         assert!(WireShape::Line(Line).validate().is_ok());
     }
 }

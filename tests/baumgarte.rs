@@ -43,33 +43,57 @@ fn drift_grows_without_alpha() {
     // bead is a whole radius off and the run is declared blown up.
     let (app, bead, samples) = seed_run(0.0, 0.0, Integrator::SemiImplicitEuler, 1.0 / 60.0);
     let window = |from: f64, to: f64| {
-        let s: Vec<Sample> = samples.iter().filter(|s| s.t > from && s.t <= to).copied().collect();
+        let s: Vec<Sample> = samples
+            .iter()
+            .filter(|s| s.t > from && s.t <= to)
+            .copied()
+            .collect();
         max_drift(&s)
     };
-    let drifts = [window(0.0, 0.5), window(0.5, 1.0), window(1.0, 2.0), window(2.0, 4.0)];
+    let drifts = [
+        window(0.0, 0.5),
+        window(0.5, 1.0),
+        window(1.0, 2.0),
+        window(2.0, 4.0),
+    ];
     for pair in drifts.windows(2) {
-        assert!(pair[1] > 1.2 * pair[0], "max |C| over 0-0.5, 0.5-1, 1-2, 2-4 s: {drifts:?}");
+        assert!(
+            pair[1] > 1.2 * pair[0],
+            "max |C| over 0-0.5, 0.5-1, 1-2, 2-4 s: {drifts:?}"
+        );
     }
-    assert!(app.world().get::<Diverged>(bead).is_some(), "α = 0 ends a whole radius off the wire");
+    assert!(
+        app.world().get::<Diverged>(bead).is_some(),
+        "α = 0 ends a whole radius off the wire"
+    );
 }
 
 #[test]
 fn drift_shrinks_as_alpha_grows() {
     let drifts: Vec<f64> = [0.0, 10.0, 100.0, 1000.0]
         .iter()
-        .map(|&alpha| mean_drift(&seed_run(alpha, 10.0, Integrator::SemiImplicitEuler, 1.0 / 60.0).2))
+        .map(|&alpha| {
+            mean_drift(&seed_run(alpha, 10.0, Integrator::SemiImplicitEuler, 1.0 / 60.0).2)
+        })
         .collect();
     for pair in drifts.windows(2) {
-        assert!(pair[1] < 0.7 * pair[0], "mean |C| by α = 0, 10, 100, 1000: {drifts:?}");
+        assert!(
+            pair[1] < 0.7 * pair[0],
+            "mean |C| by α = 0, 10, 100, 1000: {drifts:?}"
+        );
     }
 }
 
 #[test]
 fn too_much_damping_brings_drift_back() {
     // α = 100: β = 20 is critical damping (β² = 4α).
-    let drift = |beta| mean_drift(&seed_run(100.0, beta, Integrator::SemiImplicitEuler, 1.0 / 60.0).2);
+    let drift =
+        |beta| mean_drift(&seed_run(100.0, beta, Integrator::SemiImplicitEuler, 1.0 / 60.0).2);
     let (matched, too_large) = (drift(20.0), drift(400.0));
-    assert!(too_large > 2.0 * matched, "mean |C|: β = 20 {matched:e}, β = 400 {too_large:e}");
+    assert!(
+        too_large > 2.0 * matched,
+        "mean |C|: β = 20 {matched:e}, β = 400 {too_large:e}"
+    );
 }
 
 #[test]
@@ -80,7 +104,11 @@ fn explicit_euler_blow_up_is_reported_not_a_nan() {
 
     // ...blows up at the seed's 0.05 s, and says so.
     let (mut app, bead, _) = seed_run(100.0, 20.0, Integrator::ExplicitEuler, 0.05);
-    let diverged = app.world().get::<Diverged>(bead).expect("the blow-up is reported").clone();
+    let diverged = app
+        .world()
+        .get::<Diverged>(bead)
+        .expect("the blow-up is reported")
+        .clone();
     assert!(diverged.time < 10.0);
     let messages: Vec<BeadDiverged> = app
         .world_mut()
@@ -89,7 +117,11 @@ fn explicit_euler_blow_up_is_reported_not_a_nan() {
         .collect();
     assert_eq!(messages.len(), 1);
     assert_eq!(messages[0].bead, bead);
-    assert!(messages[0].reason.to_string().contains("drifted"), "{}", messages[0].reason);
+    assert!(
+        messages[0].reason.to_string().contains("drifted"),
+        "{}",
+        messages[0].reason
+    );
     let state = bead_state(&app, bead);
     let transform = *app.world().get::<Transform>(bead).unwrap();
     assert!(state.is_finite() && transform.translation.is_finite());

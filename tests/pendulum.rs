@@ -22,7 +22,13 @@ struct Errors {
     energy_last: f64,
 }
 
-fn run_pendulum(integrator: Integrator, stabilization: Stabilization, dt: f64, theta0_deg: f64, periods: f64) -> Errors {
+fn run_pendulum(
+    integrator: Integrator,
+    stabilization: Stabilization,
+    dt: f64,
+    theta0_deg: f64,
+    periods: f64,
+) -> Errors {
     let r = 1.0;
     let theta0 = theta0_deg.to_radians();
     let exact = pendulum_period(r, G, theta0);
@@ -33,7 +39,10 @@ fn run_pendulum(integrator: Integrator, stabilization: Stabilization, dt: f64, t
     let e0 = diagnostics(&app, bead).energy();
     run_for(&mut app, periods * exact);
     if let Some(d) = app.world().get::<Diverged>(bead) {
-        panic!("{integrator} × {stabilization} at {theta0_deg}° diverged: {}", d.reason);
+        panic!(
+            "{integrator} × {stabilization} at {theta0_deg}° diverged: {}",
+            d.reason
+        );
     }
     let samples = app.world().resource::<Recording>().of(bead);
     let energy_error = |s: &[Sample]| {
@@ -56,12 +65,48 @@ fn run_pendulum(integrator: Integrator, stabilization: Stabilization, dt: f64, t
 /// method's small energy error moves the period most).
 const PERIOD_CASES: &[(Integrator, Stabilization, f64, f64, f64)] = &[
     // (integrator, stabilization, dt, tolerance up to 135°, tolerance at 160°)
-    (Integrator::ExplicitEuler, Stabilization::Baumgarte, 1e-4, 1.5e-2, 8e-2),
-    (Integrator::SemiImplicitEuler, Stabilization::Baumgarte, 1e-4, 3e-3, 1.5e-2),
-    (Integrator::SemiImplicitEuler, Stabilization::Projection, 1e-4, 8e-3, 4e-2),
-    (Integrator::Rk4, Stabilization::Baumgarte, 1.0 / 60.0, 1e-4, 1e-4),
-    (Integrator::Rk4, Stabilization::Projection, 1.0 / 60.0, 1e-4, 1e-4),
-    (Integrator::Rattle, Stabilization::None, 1.0 / 60.0, 1e-3, 1e-3),
+    (
+        Integrator::ExplicitEuler,
+        Stabilization::Baumgarte,
+        1e-4,
+        1.5e-2,
+        8e-2,
+    ),
+    (
+        Integrator::SemiImplicitEuler,
+        Stabilization::Baumgarte,
+        1e-4,
+        3e-3,
+        1.5e-2,
+    ),
+    (
+        Integrator::SemiImplicitEuler,
+        Stabilization::Projection,
+        1e-4,
+        8e-3,
+        4e-2,
+    ),
+    (
+        Integrator::Rk4,
+        Stabilization::Baumgarte,
+        1.0 / 60.0,
+        1e-4,
+        1e-4,
+    ),
+    (
+        Integrator::Rk4,
+        Stabilization::Projection,
+        1.0 / 60.0,
+        1e-4,
+        1e-4,
+    ),
+    (
+        Integrator::Rattle,
+        Stabilization::None,
+        1.0 / 60.0,
+        1e-3,
+        1e-3,
+    ),
 ];
 
 #[test]
@@ -83,12 +128,21 @@ fn period_matches_elliptic_integral() {
 fn period_error_shrinks_at_each_integrators_order() {
     // Halving dt divides the period error by about 2^order.
     for (integrator, stabilization, dt, order) in [
-        (Integrator::SemiImplicitEuler, Stabilization::Baumgarte, 1.0 / 480.0, 1.0),
+        (
+            Integrator::SemiImplicitEuler,
+            Stabilization::Baumgarte,
+            1.0 / 480.0,
+            1.0,
+        ),
         (Integrator::Rattle, Stabilization::None, 1.0 / 60.0, 2.0),
         (Integrator::Rk4, Stabilization::None, 1.0 / 60.0, 4.0),
     ] {
-        let coarse = run_pendulum(integrator, stabilization, dt, 90.0, 2.2).period.abs();
-        let fine = run_pendulum(integrator, stabilization, dt / 2.0, 90.0, 2.2).period.abs();
+        let coarse = run_pendulum(integrator, stabilization, dt, 90.0, 2.2)
+            .period
+            .abs();
+        let fine = run_pendulum(integrator, stabilization, dt / 2.0, 90.0, 2.2)
+            .period
+            .abs();
         let observed = (coarse / fine).log2();
         assert!(
             (observed - order).abs() <= 0.35,
@@ -99,7 +153,13 @@ fn period_error_shrinks_at_each_integrators_order() {
 
 #[test]
 fn rattle_holds_the_wire_and_bounds_energy_over_1000_periods() {
-    let e = run_pendulum(Integrator::Rattle, Stabilization::None, 1.0 / 60.0, 135.0, 1000.0);
+    let e = run_pendulum(
+        Integrator::Rattle,
+        Stabilization::None,
+        1.0 / 60.0,
+        135.0,
+        1000.0,
+    );
     assert!(e.drift <= 1e-14, "max |C|/r = {:e}", e.drift);
     assert!(e.energy <= 3e-3, "max energy error {:e} m|g|r", e.energy);
     // Bounded, not drifting: the last hundred periods are no worse than the first.
@@ -113,7 +173,13 @@ fn rattle_holds_the_wire_and_bounds_energy_over_1000_periods() {
 
 #[test]
 fn projection_holds_the_wire_over_1000_periods() {
-    let e = run_pendulum(Integrator::Rk4, Stabilization::Projection, 1.0 / 60.0, 135.0, 1000.0);
+    let e = run_pendulum(
+        Integrator::Rk4,
+        Stabilization::Projection,
+        1.0 / 60.0,
+        135.0,
+        1000.0,
+    );
     assert!(e.drift <= 1e-14, "max |C|/r = {:e}", e.drift);
     assert!(e.energy <= 5e-3, "max energy error {:e} m|g|r", e.energy);
 }

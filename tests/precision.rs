@@ -10,7 +10,11 @@ use common::*;
 use wirebead::prelude::*;
 
 /// The samples of 10 s, and when the bead diverged if it did.
-fn trajectory(scale: f64, integrator: Integrator, stabilization: Stabilization) -> (Vec<Sample>, Option<f64>) {
+fn trajectory(
+    scale: f64,
+    integrator: Integrator,
+    stabilization: Stabilization,
+) -> (Vec<Sample>, Option<f64>) {
     let mut app = app(SimParams {
         gravity: DVec2::new(0.0, -9.81 * scale),
         integrator,
@@ -39,7 +43,10 @@ fn unit_and_radius_ten_circles_give_the_same_trajectory() {
             let (unit, unit_diverged) = trajectory(1.0, integrator, stabilization);
             let (ten, ten_diverged) = trajectory(10.0, integrator, stabilization);
             // Explicit Euler blows up at this step: at the same step at both scales.
-            assert_eq!(unit_diverged, ten_diverged, "{integrator} × {stabilization}");
+            assert_eq!(
+                unit_diverged, ten_diverged,
+                "{integrator} × {stabilization}"
+            );
             assert!(unit.len() >= 60);
             let worst = unit
                 .iter()

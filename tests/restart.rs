@@ -54,7 +54,10 @@ fn edits_without_restart_change_nothing() {
     run_steps(&mut control, 90);
     run_steps(&mut edited, 90);
     assert_eq!(bead(&control, control_bead), bead(&edited, edited_bead));
-    assert_eq!(edited.world().resource::<SimParams>(), &SimParams::default());
+    assert_eq!(
+        edited.world().resource::<SimParams>(),
+        &SimParams::default()
+    );
     assert_eq!(
         edited.world().resource::<Time<Fixed>>().timestep(),
         Duration::from_secs_f64(1.0 / 60.0)

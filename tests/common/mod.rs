@@ -26,7 +26,11 @@ pub struct Recording(pub Vec<(Entity, Sample)>);
 
 impl Recording {
     pub fn of(&self, bead: Entity) -> Vec<Sample> {
-        self.0.iter().filter(|(e, _)| *e == bead).map(|(_, s)| *s).collect()
+        self.0
+            .iter()
+            .filter(|(e, _)| *e == bead)
+            .map(|(_, s)| *s)
+            .collect()
     }
 }
 
@@ -47,10 +51,13 @@ fn record(beads: Query<(Entity, &Bead, &BeadDiagnostics)>, mut recording: ResMut
 /// A headless app with the plugin, ready to step.
 pub fn app(params: SimParams) -> App {
     let mut app = App::new();
-    app.add_plugins((MinimalPlugins, WireBeadPlugin::new(params).expect("valid params")))
-        .init_resource::<Recording>()
-        .insert_resource(TimeUpdateStrategy::FixedTimesteps(1))
-        .add_systems(FixedUpdate, record.after(WireBeadSystems::Writeback));
+    app.add_plugins((
+        MinimalPlugins,
+        WireBeadPlugin::new(params).expect("valid params"),
+    ))
+    .init_resource::<Recording>()
+    .insert_resource(TimeUpdateStrategy::FixedTimesteps(1))
+    .add_systems(FixedUpdate, record.after(WireBeadSystems::Writeback));
     app.world_mut()
         .resource_mut::<Time<Virtual>>()
         .set_max_delta(Duration::from_secs(1_000_000));
@@ -115,7 +122,10 @@ pub fn params(integrator: Integrator, stabilization: Stabilization, dt: f64) -> 
 
 /// The largest `|C|` over the samples.
 pub fn max_drift(samples: &[Sample]) -> f64 {
-    samples.iter().map(|s| s.diagnostics.c.abs()).fold(0.0, f64::max)
+    samples
+        .iter()
+        .map(|s| s.diagnostics.c.abs())
+        .fold(0.0, f64::max)
 }
 
 /// The period from upward zero crossings of x.

@@ -1,0 +1,254 @@
+//! Several beads on several wires, moved and rotated; custom curves; the
+//! Transform writeback; determinism.
+
+mod common;
+
+use std::collections::hash_map::DefaultHasher;
+use std::hash::{Hash, Hasher};
+
+use bevy::math::{DMat2, DVec2};
+use bevy::prelude::*;
+use common::*;
+use wirebead::prelude::*;
+use wirebead::wire::{ImplicitCurve, Placed, Pose};
+
+/// A circle written as a game would write its own curve:
+/// `C = (|x|² - r²) / (2r)`.
+struct SquaredCircle(f64);
+
+impl ImplicitCurve for SquaredCircle {
+    fn value(&self, p: DVec2) -> f64 {
+        (p.length_squared() - self.0 * self.0) / (2.0 * self.0)
+    }
+    fn gradient(&self, p: DVec2) -> DVec2 {
+        p / self.0
+    }
+    fn hessian(&self, _p: DVec2) -> DMat2 {
+        DMat2::IDENTITY / self.0
+    }
+    fn scale(&self) -> f64 {
+        self.0
+    }
+}
+
+/// Wires of every shape, moved and rotated, with beads placed on them
+/// (in local coordinates, then mapped to the world).
+fn many_wires(app: &mut App) -> Vec<(Entity, Entity)> {
+    let wires = [
+        (
+            Wire::circle(1.0).unwrap(),
+            DVec2::new(0.0, 0.0),
+            0.0,
+            DVec2::new(0.6, -0.8),
+        ),
+        (
+            Wire::circle(2.0).unwrap(),
+            DVec2::new(5.0, 1.0),
+            0.5,
+            DVec2::new(2.0, 0.0),
+        ),
+        (
+            Wire::ellipse(2.0, 1.0).unwrap(),
+            DVec2::new(-4.0, 2.0),
+            0.3,
+            DVec2::new(2.0, 0.0),
+        ),
+        (
+            Wire::line(),
+            DVec2::new(0.0, 6.0),
+            -0.4,
+            DVec2::new(0.0, 0.0),
+        ),
+        (
+            Wire::parabola(0.5).unwrap(),
+            DVec2::new(3.0, -4.0),
+            0.2,
+            DVec2::new(1.0, 0.5),
+        ),
+        (
+            Wire::sine(0.4, 2.0).unwrap(),
+            DVec2::new(-6.0, -3.0),
+            -0.25,
+            DVec2::new(0.0, 0.0),
+        ),
+        (
+            Wire::custom(SquaredCircle(1.5)),
+            DVec2::new(8.0, -2.0),
+            1.0,
+            DVec2::new(0.0, -1.5),
+        ),
+    ];
+    wires
+        .into_iter()
+        .map(|(wire, origin, angle, local_start)| {
+            let pose = Pose::new(origin, angle);
+            let transform = Transform::from_xyz(origin.x as f32, origin.y as f32, 0.0)
+                .with_rotation(Quat::from_rotation_z(angle as f32));
+            let wire_entity = spawn_wire(app, wire, transform);
+            let bead = spawn_bead(
+                app,
+                wire_entity,
+                BeadParams {
+                    mass: 0.5,
+                    initial_position: pose.to_world(local_start),
+                    initial_velocity: DVec2::ZERO,
+                },
+            );
+            (wire_entity, bead)
+        })
+        .collect()
+}
+
+#[test]
+fn each_bead_stays_on_its_own_moved_and_rotated_wire() {
+    for (integrator, stabilization, tolerance) in [
+        (Integrator::Rattle, Stabilization::None, 1e-10),
+        (
+            Integrator::SemiImplicitEuler,
+            Stabilization::Projection,
+            1e-10,
+        ),
+        (Integrator::Rk4, Stabilization::Baumgarte, 1e-3),
+        (
+            Integrator::SemiImplicitEuler,
+            Stabilization::Baumgarte,
+            5e-2,
+        ),
+    ] {
+        let mut app = app(params(integrator, stabilization, 1.0 / 120.0));
+        let pairs = many_wires(&mut app);
+        run_for(&mut app, 3.0);
+        for (wire_entity, bead_entity) in pairs {
+            assert!(app.world().get::<Diverged>(bead_entity).is_none());
+            let wire = app.world().get::<Wire>(wire_entity).unwrap();
+            let transform = app.world().get::<Transform>(wire_entity).unwrap();
+            let placed = Placed {
+                curve: wire.shape().curve(),
+                pose: Pose::from_transform(transform).unwrap(),
+            };
+            let b = bead(&app, bead_entity);
+            let drift = placed.value(b.position).abs() / placed.scale();
+            assert!(
+                drift <= tolerance,
+                "{integrator} × {stabilization}: bead on the {} is {drift:e} scales off",
+                wire.shape().name()
+            );
+            // It moved: gravity pulled it along its wire.
+            assert!((b.position - b.params().initial_position).length() > 1e-3);
+            // Its Transform is its f64 position, rounded to f32.
+            let t = app
+                .world()
+                .get::<Transform>(bead_entity)
+                .unwrap()
+                .translation;
+            assert_eq!((t.x, t.y), (b.position.x as f32, b.position.y as f32));
+        }
+    }
+}
+
+#[test]
+fn beads_sharing_a_wire_are_its_beads() {
+    let mut app = app(SimParams::default());
+    let wire = spawn_wire(&mut app, Wire::circle(1.0).unwrap(), Transform::default());
+    let a = spawn_bead(
+        &mut app,
+        wire,
+        BeadParams {
+            initial_position: DVec2::new(1.0, 0.0),
+            ..default()
+        },
+    );
+    let b = spawn_bead(
+        &mut app,
+        wire,
+        BeadParams {
+            initial_position: DVec2::new(-1.0, 0.0),
+            ..default()
+        },
+    );
+    let beads: Vec<Entity> = app.world().get::<WireBeads>(wire).unwrap().iter().collect();
+    assert_eq!(beads, vec![a, b]);
+    run_for(&mut app, 1.0);
+    // Released symmetrically, they mirror each other.
+    let (pa, pb) = (bead(&app, a).position, bead(&app, b).position);
+    assert!((pa.x + pb.x).abs() < 1e-12 && (pa.y - pb.y).abs() < 1e-12);
+    // Despawning the wire takes its beads.
+    app.world_mut().entity_mut(wire).despawn();
+    assert!(app.world().get_entity(a).is_err() && app.world().get_entity(b).is_err());
+}
+
+fn state_hash(integrator: Integrator) -> u64 {
+    let mut app = app(params(integrator, Stabilization::Baumgarte, 1.0 / 60.0));
+    let pairs = many_wires(&mut app);
+    let dragged = pairs[0].1;
+    app.world_mut()
+        .entity_mut(dragged)
+        .insert(DragTarget::new(DVec2::new(1.5, 0.5)).unwrap());
+    run_steps(&mut app, 90);
+    app.world_mut().entity_mut(dragged).remove::<DragTarget>();
+    run_steps(&mut app, 90);
+    let mut hasher = DefaultHasher::new();
+    for (_, b) in pairs {
+        let bead = bead(&app, b);
+        for v in [bead.position, bead.velocity, bead.constraint_force] {
+            v.x.to_bits().hash(&mut hasher);
+            v.y.to_bits().hash(&mut hasher);
+        }
+    }
+    hasher.finish()
+}
+
+#[test]
+fn same_inputs_give_bit_identical_state() {
+    for &integrator in Integrator::ALL {
+        assert_eq!(
+            state_hash(integrator),
+            state_hash(integrator),
+            "{integrator}"
+        );
+    }
+    assert_ne!(state_hash(Integrator::Rk4), state_hash(Integrator::Rattle));
+}
+
+#[test]
+fn drag_pulls_the_bead_toward_the_target_and_release_stops_it() {
+    let mut app = app(SimParams {
+        gravity: DVec2::ZERO,
+        ..default()
+    });
+    let wire = spawn_wire(&mut app, Wire::circle(1.0).unwrap(), Transform::default());
+    let b = spawn_bead(
+        &mut app,
+        wire,
+        BeadParams {
+            initial_position: DVec2::new(0.0, -1.0),
+            ..default()
+        },
+    );
+    let target = DVec2::new(1.0, 0.0);
+    app.world_mut()
+        .entity_mut(b)
+        .insert(DragTarget::new(target).unwrap());
+    run_steps(&mut app, 1);
+    // The seed's force, k (target - x), accumulated at the step's start.
+    let k = app.world().resource::<SimParams>().drag_stiffness;
+    let bead_after = bead(&app, b);
+    assert_eq!(bead_after.force, k * (target - DVec2::new(0.0, -1.0)));
+    run_steps(&mut app, 60);
+    // With no friction it swings about the target; it comes close to it.
+    let start = (DVec2::new(0.0, -1.0) - target).length();
+    let closest = app
+        .world()
+        .resource::<Recording>()
+        .of(b)
+        .iter()
+        .map(|s| (s.position - target).length())
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        closest < 0.2 * start,
+        "closest approach {closest} from {start}"
+    );
+    app.world_mut().entity_mut(b).remove::<DragTarget>();
+    run_steps(&mut app, 1);
+    assert_eq!(bead(&app, b).force, DVec2::ZERO);
+}
