@@ -73,6 +73,28 @@ impl Wire {
     }
 }
 
+/// An edited shape for a wire, applied (and removed) by the next
+/// [`Restart`](crate::Restart). Built only from a valid shape.
+#[derive(Component, Clone, Debug)]
+pub struct PendingWire(Wire);
+
+impl PendingWire {
+    /// A pending edit, if `shape` is valid.
+    pub fn new(shape: WireShape) -> Result<Self, ParamError> {
+        Wire::new(shape).map(Self)
+    }
+
+    /// The edited shape.
+    pub fn shape(&self) -> &WireShape {
+        self.0.shape()
+    }
+
+    /// The wire it will become.
+    pub fn wire(&self) -> &Wire {
+        &self.0
+    }
+}
+
 /// Puts a bead on a wire. Several beads may share one wire; despawning the
 /// wire despawns its beads.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]

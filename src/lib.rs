@@ -33,6 +33,8 @@
 //! | [`WireBeadSystems`] | the step's chained sets: `Prepare → Forces → Solve → Integrate → Writeback` |
 //! | [`Wire`], [`Bead`], [`OnWire`] | a wire placed by its `Transform`; a bead on it |
 //! | [`SimParams`], [`PendingParams`], [`PendingBead`] | applied and edited parameters; [`Restart`] applies the edits |
+//! | `gui::WireBeadGuiPlugin` | the windowed scene (feature `gui`): picking drag, egui panel, plots |
+//! | [`KeyboardControlsPlugin`] | Space restarts, P pauses, N steps once: headless-testable |
 //! | [`DragTarget`] | the user's drag: a spring `k (target - x)` while present |
 //! | [`BeadDiagnostics`], [`Diverged`], [`BeadDiverged`] | `C`, `Ċ`, λ and energy each step; divergence reports |
 //! | [`ScenePresetPlugin`], [`ScenePreset`] | scenes as RON assets (`*.scene.ron`), hot-reloaded |
@@ -47,7 +49,12 @@
 //! With `default-features = false` the crate needs only Bevy's headless core.
 #![warn(missing_docs)]
 
+#[cfg(feature = "analysis")]
+pub mod analysis;
 pub mod components;
+pub mod controls;
+#[cfg(feature = "gui")]
+pub mod gui;
 pub mod params;
 pub mod plugin;
 pub mod preset;
@@ -59,6 +66,7 @@ pub mod wire;
 pub use components::{
     Bead, BeadDiagnostics, Diverged, DivergenceReason, DragTarget, OnWire, Wire, WireBeads,
 };
+pub use controls::KeyboardControlsPlugin;
 pub use params::{
     BeadParams, Integrator, ParamError, PendingBead, PendingParams, SimParams, Stabilization,
 };
@@ -70,8 +78,13 @@ pub use wire::{ImplicitCurve, WireShape};
 pub mod prelude {
     pub use crate::{
         Bead, BeadDiagnostics, BeadDiverged, BeadParams, Diverged, DragTarget, ImplicitCurve,
-        Integrator, LoadPreset, OnWire, PendingBead, PendingParams, Restart, ScenePreset,
-        ScenePresetPlugin, SimParams, Stabilization, Wire, WireBeadPlugin, WireBeadSystems,
-        WireBeads, WireShape,
+        Integrator, KeyboardControlsPlugin, LoadPreset, OnWire, PendingBead, PendingParams,
+        Restart, ScenePreset, ScenePresetPlugin, SimParams, Stabilization, Wire, WireBeadPlugin,
+        WireBeadSystems, WireBeads, WireShape,
     };
 }
+
+/// The README's code blocks, compiled and run as doc tests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

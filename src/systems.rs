@@ -5,7 +5,7 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use crate::components::{
-    Bead, BeadDiagnostics, Diverged, DivergenceReason, DragTarget, OnWire, Wire,
+    Bead, BeadDiagnostics, Diverged, DivergenceReason, DragTarget, OnWire, PendingWire, Wire,
 };
 use crate::params::{PendingBead, PendingParams, SimParams};
 use crate::plugin::{BeadDiverged, Restart};
@@ -73,13 +73,14 @@ pub fn apply_timestep(params: Res<SimParams>, mut time: ResMut<Time<Fixed>>) {
     time.set_timestep_seconds(params.timestep);
 }
 
-/// Handles [`Restart`]: applies the pending parameters and resets every bead.
+/// Handles [`Restart`]: applies the pending wire shapes and parameters and
+/// returns every bead to its initial state.
 pub fn apply_restart(
     mut restarts: MessageReader<Restart>,
     pending: Res<PendingParams>,
     mut params: ResMut<SimParams>,
     mut time: ResMut<Time<Fixed>>,
-    wires: Wires,
+    mut wires: Query<(Entity, &mut Wire, &Transform, Option<&PendingWire>)>,
     mut beads: Query<(
         Entity,
         &mut Bead,
@@ -92,6 +93,12 @@ pub fn apply_restart(
     if restarts.read().count() == 0 {
         return;
     }
+    for (entity, mut wire, _, edit) in &mut wires {
+        if let Some(edit) = edit {
+            *wire = edit.wire().clone();
+            commands.entity(entity).remove::<PendingWire>();
+        }
+    }
     *params = pending.get().clone();
     time.set_timestep_seconds(params.timestep);
     let overstep = time.overstep();
@@ -99,8 +106,15 @@ pub fn apply_restart(
     for (entity, mut bead, mut diagnostics, on_wire, edit) in &mut beads {
         let bead_params = edit.map_or(*bead.params(), |p| *p.get());
         bead.reset(bead_params);
-        *diagnostics = match on_wire.map(|on| placed_wire(&wires, on)) {
-            Some(Ok(placed)) => diagnose(&placed, &bead, params.gravity),
+        let wire = on_wire.and_then(|on| wires.get(on.0).ok());
+        *diagnostics = match wire.map(|(_, w, t, _)| (w, Pose::from_transform(t))) {
+            Some((wire, Ok(pose))) => {
+                let placed = Placed {
+                    curve: wire.shape().curve(),
+                    pose,
+                };
+                diagnose(&placed, &bead, params.gravity)
+            }
             _ => BeadDiagnostics::default(),
         };
         commands.entity(entity).remove::<(Diverged, PendingBead)>();

@@ -16,6 +16,7 @@ const SHIPPED: &[&str] = &[
     "ellipse.scene.ron",
     "sine_track.scene.ron",
     "multi_bead.scene.ron",
+    "resting.scene.ron",
 ];
 
 #[test]

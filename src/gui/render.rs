@@ -1,0 +1,363 @@
+//! Drawing the scene: a camera that frames the wires, wires as gizmo
+//! strokes, beads as meshes, fading trails, and force arrows. Simulation
+//! state is `f64`; it becomes `f32` here, at the edge.
+
+use std::collections::VecDeque;
+use std::f64::consts::TAU;
+
+use bevy::camera::ScalingMode;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use crate::components::{Bead, DragTarget, OnWire, Wire};
+use crate::plugin::{Restart, WireBeadSystems};
+use crate::wire::{Pose, WireShape};
+
+/// Colours and sizes of the scene.
+#[derive(Resource, Clone, Debug)]
+pub struct SceneStyle {
+    /// Background.
+    pub background: Color,
+    /// Wire strokes.
+    pub wire: Color,
+    /// Beads.
+    pub bead: Color,
+    /// A diverged bead.
+    pub diverged: Color,
+    /// Trails (faded toward the background with age).
+    pub trail: Color,
+    /// The constraint force arrow.
+    pub constraint_force: Color,
+    /// The drag spring.
+    pub drag: Color,
+    /// Bead radius as a fraction of the framed view's height.
+    pub bead_radius: f32,
+    /// Seconds of trail kept.
+    pub trail_seconds: f64,
+    /// Pixels of the window's right edge covered by the panel: the wires are
+    /// framed in the rest.
+    pub panel_width: f32,
+    /// Arrow length per newton, as a fraction of the framed view's height.
+    pub force_scale: f32,
+}
+
+impl Default for SceneStyle {
+    fn default() -> Self {
+        Self {
+            background: Color::srgb(0.07, 0.08, 0.10),
+            wire: Color::srgb(0.35, 0.80, 1.0),
+            bead: Color::srgb(1.0, 0.55, 0.10),
+            diverged: Color::srgb(0.9, 0.1, 0.1),
+            trail: Color::srgb(1.0, 0.85, 0.3),
+            constraint_force: Color::srgb(0.4, 1.0, 0.4),
+            drag: Color::srgb(1.0, 0.3, 0.8),
+            bead_radius: 0.025,
+            trail_seconds: 2.0,
+            panel_width: 340.0,
+            force_scale: 0.012,
+        }
+    }
+}
+
+/// The camera the scene is framed in.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct SceneCamera;
+
+/// Marks a bead's visuals as added.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct BeadVisual;
+
+/// A bead's recent positions, newest last.
+#[derive(Component, Clone, Debug, Default)]
+pub struct Trail(pub VecDeque<Vec2>);
+
+/// The world rectangle the camera frames (center, size), updated each frame.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct FramedView {
+    /// Center of the framed rectangle.
+    pub center: Vec2,
+    /// Its size in world units.
+    pub size: Vec2,
+}
+
+/// Draws the scene.
+#[derive(Default)]
+pub struct SceneRenderPlugin;
+
+impl Plugin for SceneRenderPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<SceneStyle>()
+            .init_resource::<FramedView>()
+            .add_systems(Startup, (spawn_camera, style_gizmos))
+            .add_systems(FixedUpdate, record_trails.after(WireBeadSystems::Writeback))
+            .add_systems(
+                Update,
+                (
+                    add_bead_visuals,
+                    clear_trails_on_restart,
+                    frame_camera,
+                    size_and_colour_beads,
+                    draw_wires,
+                    draw_trails,
+                    draw_forces,
+                )
+                    .chain(),
+            );
+    }
+}
+
+fn spawn_camera(mut commands: Commands, style: Res<SceneStyle>) {
+    commands.insert_resource(ClearColor(style.background));
+    commands.spawn((
+        Camera2d,
+        SceneCamera,
+        Projection::Orthographic(OrthographicProjection {
+            scaling_mode: ScalingMode::WindowSize,
+            ..OrthographicProjection::default_2d()
+        }),
+    ));
+}
+
+fn style_gizmos(mut store: ResMut<GizmoConfigStore>) {
+    let (config, _) = store.config_mut::<DefaultGizmoConfigGroup>();
+    config.line.width = 3.0;
+}
+
+/// Gives new beads a mesh, a material and a trail.
+pub fn add_bead_visuals(
+    beads: Query<Entity, (With<Bead>, Without<BeadVisual>)>,
+    style: Res<SceneStyle>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<ColorMaterial>>,
+    mut commands: Commands,
+) {
+    for entity in &beads {
+        commands.entity(entity).insert((
+            Mesh2d(meshes.add(Circle::new(1.0))),
+            MeshMaterial2d(materials.add(ColorMaterial::from_color(style.bead))),
+            Trail::default(),
+            BeadVisual,
+        ));
+    }
+}
+
+/// Appends each bead's position to its trail and drops what is too old.
+pub fn record_trails(
+    params: Res<crate::SimParams>,
+    style: Res<SceneStyle>,
+    mut beads: Query<(&Bead, &mut Trail)>,
+) {
+    let keep = (style.trail_seconds / params.timestep).ceil() as usize;
+    for (bead, mut trail) in &mut beads {
+        trail.0.push_back(bead.position.as_vec2());
+        while trail.0.len() > keep.max(2) {
+            trail.0.pop_front();
+        }
+    }
+}
+
+fn clear_trails_on_restart(mut restarts: MessageReader<Restart>, mut trails: Query<&mut Trail>) {
+    if restarts.read().count() > 0 {
+        for mut trail in &mut trails {
+            trail.0.clear();
+        }
+    }
+}
+
+/// The world rectangle `(min, max)` that shows a wire whole (or a stretch of
+/// it, for unbounded shapes), in world coordinates.
+pub fn wire_bounds(shape: &WireShape, pose: &Pose) -> (DVec2, DVec2) {
+    let points = wire_points(shape, pose, None);
+    points.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    )
+}
+
+/// Points along a wire in world coordinates. Closed shapes are sampled whole;
+/// open ones over `half_span` on each side of their origin (default: a few
+/// wire scales).
+pub fn wire_points(shape: &WireShape, pose: &Pose, half_span: Option<f64>) -> Vec<DVec2> {
+    let n = 256;
+    let local: Vec<DVec2> = match shape {
+        WireShape::Circle(c) => (0..=n)
+            .map(|i| DVec2::from_angle(TAU * i as f64 / n as f64) * c.radius)
+            .collect(),
+        WireShape::Ellipse(e) => (0..=n)
+            .map(|i| {
+                let a = TAU * i as f64 / n as f64;
+                DVec2::new(e.a * a.cos(), e.b * a.sin())
+            })
+            .collect(),
+        open => {
+            let scale = open.curve().scale();
+            let span = half_span.unwrap_or(match open {
+                WireShape::Sine(s) => 1.5 * s.wavelength,
+                WireShape::Parabola(p) => 3.0 * p.focal_length.abs(),
+                _ => 2.0 * scale,
+            });
+            (0..=n)
+                .map(|i| {
+                    let x = -span + 2.0 * span * i as f64 / n as f64;
+                    match open {
+                        WireShape::Sine(s) => {
+                            DVec2::new(x, s.amplitude * (TAU * x / s.wavelength).sin())
+                        }
+                        WireShape::Parabola(p) => DVec2::new(x, x * x / (4.0 * p.focal_length)),
+                        _ => DVec2::new(x, 0.0),
+                    }
+                })
+                .collect()
+        }
+    };
+    local.into_iter().map(|p| pose.to_world(p)).collect()
+}
+
+fn wire_pose(transform: &Transform) -> Pose {
+    Pose::from_transform(transform).unwrap_or_default()
+}
+
+/// Frames every wire (and every bead's start) in the part of the window
+/// left of the panel, whatever their size.
+pub fn frame_camera(
+    wires: Query<(&Wire, &Transform)>,
+    beads: Query<&Bead>,
+    windows: Query<&Window>,
+    style: Res<SceneStyle>,
+    mut view: ResMut<FramedView>,
+    mut cameras: Query<(&mut Transform, &mut Projection), (With<SceneCamera>, Without<Wire>)>,
+) {
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for (wire, transform) in &wires {
+        let (a, b) = wire_bounds(wire.shape(), &wire_pose(transform));
+        lo = lo.min(a);
+        hi = hi.max(b);
+    }
+    for bead in &beads {
+        lo = lo.min(bead.params().initial_position);
+        hi = hi.max(bead.params().initial_position);
+    }
+    if !(lo.is_finite() && hi.is_finite()) {
+        return;
+    }
+    let center = ((lo + hi) * 0.5).as_vec2();
+    let size = ((hi - lo).as_vec2() * 1.25).max(Vec2::splat(0.5));
+    let Some(window) = windows.iter().next() else {
+        return;
+    };
+    let free = Vec2::new(
+        (window.width() - style.panel_width).max(100.0),
+        window.height().max(100.0),
+    );
+    let world_per_px = (size.x / free.x).max(size.y / free.y);
+    *view = FramedView {
+        center,
+        size: free * world_per_px,
+    };
+    for (mut transform, mut projection) in &mut cameras {
+        transform.translation.x = center.x + 0.5 * style.panel_width * world_per_px;
+        transform.translation.y = center.y;
+        if let Projection::Orthographic(ortho) = projection.as_mut() {
+            ortho.scaling_mode = ScalingMode::WindowSize;
+            ortho.scale = world_per_px;
+        }
+    }
+}
+
+fn size_and_colour_beads(
+    view: Res<FramedView>,
+    style: Res<SceneStyle>,
+    mut beads: Query<
+        (
+            &mut Transform,
+            &MeshMaterial2d<ColorMaterial>,
+            Has<crate::Diverged>,
+        ),
+        With<Bead>,
+    >,
+    mut materials: ResMut<Assets<ColorMaterial>>,
+) {
+    let radius = style.bead_radius * view.size.y;
+    for (mut transform, material, diverged) in &mut beads {
+        transform.scale = Vec3::splat(radius);
+        transform.translation.z = 1.0;
+        if let Some(mut m) = materials.get_mut(&material.0) {
+            let colour = if diverged { style.diverged } else { style.bead };
+            if m.color != colour {
+                m.color = colour;
+            }
+        }
+    }
+}
+
+/// Draws every wire as a gizmo stroke.
+pub fn draw_wires(
+    wires: Query<(&Wire, &Transform)>,
+    view: Res<FramedView>,
+    style: Res<SceneStyle>,
+    mut gizmos: Gizmos,
+) {
+    for (wire, transform) in &wires {
+        let pose = wire_pose(transform);
+        match wire.shape() {
+            WireShape::Custom(_) => {}
+            shape => {
+                // Open wires run past the edges of the view.
+                let span =
+                    (view.size.length() as f64) + (pose.origin - view.center.as_dvec2()).length();
+                let points = wire_points(shape, &pose, Some(span));
+                gizmos.linestrip_2d(points.iter().map(|p| p.as_vec2()), style.wire);
+            }
+        }
+    }
+}
+
+fn draw_trails(beads: Query<&Trail>, style: Res<SceneStyle>, mut gizmos: Gizmos) {
+    for trail in &beads {
+        let n = trail.0.len().max(1) as f32;
+        gizmos.linestrip_gradient_2d(
+            trail
+                .0
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (*p, style.trail.with_alpha((i as f32 + 1.0) / n))),
+        );
+    }
+}
+
+fn draw_forces(
+    beads: Query<(&Bead, Option<&DragTarget>), With<OnWire>>,
+    view: Res<FramedView>,
+    style: Res<SceneStyle>,
+    mut gizmos: Gizmos,
+) {
+    let per_newton = style.force_scale * view.size.y;
+    for (bead, drag) in &beads {
+        let at = bead.position.as_vec2();
+        let force = bead.constraint_force.as_vec2() * per_newton;
+        if force.length() > 1e-4 * view.size.y {
+            gizmos.arrow_2d(at, at + force, style.constraint_force);
+        }
+        if let Some(target) = drag {
+            gizmos.line_2d(at, target.get().as_vec2(), style.drag);
+            gizmos.circle_2d(
+                Isometry2d::from_translation(target.get().as_vec2()),
+                0.5 * style.bead_radius * view.size.y,
+                style.drag,
+            );
+        }
+    }
+}
+
+/// The world position under a screen position, through the scene camera.
+pub fn screen_to_world(
+    camera: &Camera,
+    camera_transform: &GlobalTransform,
+    screen: Vec2,
+) -> Option<DVec2> {
+    camera
+        .viewport_to_world_2d(camera_transform, screen)
+        .ok()
+        .map(|p| p.as_dvec2())
+}
