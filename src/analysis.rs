@@ -8,7 +8,6 @@ use std::path::{Path, PathBuf};
 use std::str::FromStr;
 use std::time::{Duration, Instant};
 
-use bevy::ecs::schedule::ExecutorKind;
 use bevy::math::DVec2;
 use bevy::prelude::{
     App, FixedUpdate, IntoScheduleConfigs, MinimalPlugins, Query, ResMut, Resource, Time, Virtual,
@@ -166,10 +165,7 @@ pub fn simulate(config: &RunConfig) -> Result<RunOutput, ParamError> {
     app.world_mut()
         .resource_mut::<Time<Virtual>>()
         .set_max_delta(Duration::from_secs(u64::MAX / 4));
-    // One bead: the thread pool would cost more than the step itself.
-    app.edit_schedule(FixedUpdate, |schedule| {
-        schedule.set_executor_kind(ExecutorKind::SingleThreaded);
-    });
+    crate::plugin::use_single_threaded_executors(&mut app);
     let wire = app.world_mut().spawn(wire).id();
     let bead = app.world_mut().spawn((bead, OnWire(wire))).id();
     app.update();

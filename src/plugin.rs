@@ -103,3 +103,14 @@ impl Plugin for WireBeadPlugin {
             );
     }
 }
+
+/// Gives every schedule of `app` a single-threaded executor. For headless
+/// runs of a few beads (tests, the analysis tool), where waking the thread
+/// pool for each tiny system costs more than the step itself. Call it after
+/// adding the plugins.
+pub fn use_single_threaded_executors(app: &mut App) {
+    let mut schedules = app.world_mut().resource_mut::<Schedules>();
+    for (_, schedule) in schedules.iter_mut() {
+        schedule.set_executor(bevy::ecs::schedule::SingleThreadedExecutor::new());
+    }
+}

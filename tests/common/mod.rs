@@ -5,7 +5,6 @@
 
 use std::time::Duration;
 
-use bevy::ecs::schedule::ExecutorKind;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
@@ -62,11 +61,7 @@ pub fn app(params: SimParams) -> App {
     app.world_mut()
         .resource_mut::<Time<Virtual>>()
         .set_max_delta(Duration::from_secs(1_000_000));
-    // The step's systems are tiny: a single-threaded executor runs them
-    // without the thread pool's per-system overhead.
-    app.edit_schedule(FixedUpdate, |schedule| {
-        schedule.set_executor_kind(ExecutorKind::SingleThreaded);
-    });
+    wirebead::plugin::use_single_threaded_executors(&mut app);
     // The first update only starts the clocks; it runs no fixed step.
     app.update();
     app
