@@ -43,11 +43,11 @@ pub struct WireReport {
 pub struct DragReport {
     /// The bead's position when the drag began.
     pub bead_start: [f64; 2],
-    /// The last drag target.
+    /// The last drag target (where the cursor was released).
     pub target: [f64; 2],
-    /// The bead's distance to the target when the drag began.
+    /// The distance from the bead's start to that target.
     pub start_distance: f64,
-    /// Its closest approach to the target during the drag.
+    /// The bead's closest approach to that target while dragged.
     pub closest_distance: f64,
 }
 
@@ -93,7 +93,9 @@ struct AutomationState {
     timed_frames: u32,
     timed_seconds: f64,
     ready_written: bool,
-    drag: Option<DragReport>,
+    /// The bead's positions while dragged, and the last drag target.
+    drag_path: Vec<DVec2>,
+    drag_target: Option<DVec2>,
     failures: Vec<String>,
 }
 
@@ -135,20 +137,24 @@ fn automation(
     // Follow a drag.
     for (bead, target, _, _) in &beads {
         if let Some(target) = target {
-            let t = target.get();
-            let d = (bead.position - t).length();
-            let drag = state.drag.get_or_insert(DragReport {
-                bead_start: bead.position.to_array(),
-                target: t.to_array(),
-                start_distance: d,
-                closest_distance: d,
-            });
-            drag.target = t.to_array();
-            drag.closest_distance = drag.closest_distance.min(d);
+            state.drag_path.push(bead.position);
+            state.drag_target = Some(target.get());
         }
     }
-
-    let drag = state.drag.clone();
+    // Measured against where the cursor ended up.
+    let drag = state
+        .drag_target
+        .zip(state.drag_path.first())
+        .map(|(target, start)| DragReport {
+            bead_start: start.to_array(),
+            target: target.to_array(),
+            start_distance: (*start - target).length(),
+            closest_distance: state
+                .drag_path
+                .iter()
+                .map(|p| (*p - target).length())
+                .fold(f64::INFINITY, f64::min),
+        });
     let mean_frame_ms = 1e3 * state.timed_seconds / f64::from(state.timed_frames.max(1));
     let report = || -> FrameReport {
         let window = windows.iter().next();

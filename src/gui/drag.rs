@@ -2,6 +2,10 @@
 //! cursor, which follows the cursor until release. The simulation turns it
 //! into the seed's spring force `k (cursor - bead)`. Egui windows block
 //! picking, so a drag over the panel never grabs a bead.
+//!
+//! A drag grabs the bead the picking ray hit or, failing that, the bead
+//! whose drawn disc the press landed in (a forgiving grab for a small bead,
+//! and robust when the window's hover state was reset by the press).
 
 use bevy::prelude::*;
 
@@ -12,6 +16,10 @@ use crate::gui::render::{SceneCamera, screen_to_world};
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SelectedBead(pub Option<Entity>);
 
+/// The bead being dragged, if any.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Grabbed(pub Option<Entity>);
+
 /// Drag beads with the mouse through Bevy's picking.
 #[derive(Default)]
 pub struct BeadDragPlugin;
@@ -19,15 +27,19 @@ pub struct BeadDragPlugin;
 impl Plugin for BeadDragPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<SelectedBead>()
+            .init_resource::<Grabbed>()
             .add_observer(start_drag)
             .add_observer(follow_drag)
             .add_observer(end_drag);
     }
 }
 
+type SceneCameras<'w, 's> =
+    Query<'w, 's, (&'static Camera, &'static GlobalTransform), With<SceneCamera>>;
+
 fn cursor_world(
     location: &bevy::picking::pointer::Location,
-    cameras: &Query<(&Camera, &GlobalTransform), With<SceneCamera>>,
+    cameras: &SceneCameras,
 ) -> Option<DragTarget> {
     let (camera, transform) = cameras.iter().next()?;
     let world = screen_to_world(camera, transform, location.position)?;
@@ -37,28 +49,52 @@ fn cursor_world(
 /// Grabs a bead: selects it and sets its drag target at the cursor.
 pub fn start_drag(
     event: On<Pointer<DragStart>>,
-    beads: Query<(), With<Bead>>,
-    cameras: Query<(&Camera, &GlobalTransform), With<SceneCamera>>,
+    beads: Query<(Entity, &Bead, &Transform)>,
+    cameras: SceneCameras,
+    mut grabbed: ResMut<Grabbed>,
     mut selected: ResMut<SelectedBead>,
     mut commands: Commands,
 ) {
-    if event.event.button != PointerButton::Primary || !beads.contains(event.entity) {
+    if event.event.button != PointerButton::Primary || grabbed.0.is_some() {
         return;
     }
-    selected.0 = Some(event.entity);
-    if let Some(target) = cursor_world(&event.pointer_location, &cameras) {
-        commands.entity(event.entity).insert(target);
-    }
+    let Some(target) = cursor_world(&event.pointer_location, &cameras) else {
+        return;
+    };
+    let bead = if beads.contains(event.entity) {
+        Some(event.entity)
+    } else {
+        // The press missed every bead mesh: take the nearest bead whose
+        // drawn disc (scale = radius) is under the cursor, with some slack.
+        beads
+            .iter()
+            .map(|(e, b, t)| {
+                (
+                    e,
+                    (b.position - target.get()).length() / f64::from(t.scale.x.max(1e-6)),
+                )
+            })
+            .filter(|(_, d)| *d <= 1.5)
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(e, _)| e)
+    };
+    let Some(bead) = bead else { return };
+    debug!("wirebead: grabbed bead {bead}");
+    grabbed.0 = Some(bead);
+    selected.0 = Some(bead);
+    commands.entity(bead).insert(target);
 }
 
 /// Moves the drag target with the cursor.
 pub fn follow_drag(
     event: On<Pointer<Drag>>,
-    cameras: Query<(&Camera, &GlobalTransform), With<SceneCamera>>,
+    cameras: SceneCameras,
+    grabbed: Res<Grabbed>,
     mut targets: Query<&mut DragTarget>,
 ) {
+    let Some(bead) = grabbed.0 else { return };
     if let (Ok(mut target), Some(next)) = (
-        targets.get_mut(event.entity),
+        targets.get_mut(bead),
         cursor_world(&event.pointer_location, &cameras),
     ) {
         *target = next;
@@ -66,8 +102,14 @@ pub fn follow_drag(
 }
 
 /// Releases the bead: the spring force ends.
-pub fn end_drag(event: On<Pointer<DragEnd>>, mut commands: Commands) {
-    if let Ok(mut entity) = commands.get_entity(event.entity) {
+pub fn end_drag(
+    _event: On<Pointer<DragEnd>>,
+    mut grabbed: ResMut<Grabbed>,
+    mut commands: Commands,
+) {
+    if let Some(bead) = grabbed.0.take()
+        && let Ok(mut entity) = commands.get_entity(bead)
+    {
         entity.remove::<DragTarget>();
     }
 }

@@ -249,9 +249,10 @@ pub fn panel(
             ui.colored_label(egui::Color32::LIGHT_GRAY, keys.help());
         });
 
+    let height = (ctx.content_rect().height() - 40.0).max(200.0);
     egui::Window::new("wirebead")
         .anchor(egui::Align2::RIGHT_TOP, [-6.0, 6.0])
-        .default_width(style.panel_width - 30.0)
+        .fixed_size([style.panel_width - 30.0, height])
         .resizable(false)
         .collapsible(true)
         .vscroll(true)

@@ -37,7 +37,8 @@ pub struct SceneStyle {
     /// Pixels of the window's right edge covered by the panel: the wires are
     /// framed in the rest.
     pub panel_width: f32,
-    /// Arrow length per newton, as a fraction of the framed view's height.
+    /// Arrow length for a force equal to the bead's weight, as a fraction of
+    /// the framed view's height.
     pub force_scale: f32,
 }
 
@@ -54,7 +55,7 @@ impl Default for SceneStyle {
             bead_radius: 0.025,
             trail_seconds: 2.0,
             panel_width: 340.0,
-            force_scale: 0.012,
+            force_scale: 0.06,
         }
     }
 }
@@ -328,12 +329,15 @@ fn draw_trails(beads: Query<&Trail>, style: Res<SceneStyle>, mut gizmos: Gizmos)
 
 fn draw_forces(
     beads: Query<(&Bead, Option<&DragTarget>), With<OnWire>>,
+    params: Res<crate::SimParams>,
     view: Res<FramedView>,
     style: Res<SceneStyle>,
     mut gizmos: Gizmos,
 ) {
-    let per_newton = style.force_scale * view.size.y;
+    let g = params.gravity.length().max(1e-3) as f32;
     for (bead, drag) in &beads {
+        // Forces are drawn in units of the bead's weight.
+        let per_newton = style.force_scale * view.size.y / (bead.mass() as f32 * g);
         let at = bead.position.as_vec2();
         let force = bead.constraint_force.as_vec2() * per_newton;
         if force.length() > 1e-4 * view.size.y {
