@@ -495,7 +495,7 @@ pub fn seed_studies(duration: f64) -> Vec<Study> {
         Study {
             name: "beta".into(),
             title: "Figure 1.2: damping constant β (α = 100)".into(),
-            runs: [(2.0, "small"), (20.0, "matched"), (400.0, "too large")]
+            runs: [(2.0, "small"), (20.0, "matched"), (100.0, "too large")]
                 .map(|(b, what)| {
                     with(format!("β = {b} ({what})"), format!("beta_{b}"), &|p| {
                         p.alpha = 100.0;
