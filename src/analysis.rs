@@ -15,6 +15,7 @@ use bevy::prelude::{
 };
 use bevy::time::TimeUpdateStrategy;
 use indicatif::{ProgressBar, ProgressStyle};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use crate::components::{Bead, BeadDiagnostics, Diverged, OnWire, Wire};
@@ -251,9 +252,9 @@ fn register_font() {
     });
 }
 
-/// Line colours for up to eight series.
+/// Line colours for up to twelve series.
 fn palette(i: usize) -> RGBColor {
-    const COLOURS: [RGBColor; 8] = [
+    const COLOURS: [RGBColor; 12] = [
         RGBColor(31, 119, 180),
         RGBColor(214, 39, 40),
         RGBColor(44, 160, 44),
@@ -262,6 +263,10 @@ fn palette(i: usize) -> RGBColor {
         RGBColor(140, 86, 75),
         RGBColor(227, 119, 194),
         RGBColor(23, 190, 207),
+        RGBColor(188, 189, 34),
+        RGBColor(127, 127, 127),
+        RGBColor(0, 0, 128),
+        RGBColor(0, 0, 0),
     ];
     COLOURS[i % COLOURS.len()]
 }
@@ -344,6 +349,31 @@ pub fn plot_trajectories(
     Ok(())
 }
 
+/// Draws one line per run (y mapped by `map_y`, points it drops skipped)
+/// with a legend.
+fn draw_runs<'a, Y: Ranged<ValueType = f64>>(
+    chart: &mut ChartContext<'a, BitMapBackend<'a>, Cartesian2d<RangedCoordf64, Y>>,
+    runs: &[(String, Vec<(f64, f64)>)],
+    map_y: impl Fn(f64) -> Option<f64>,
+) -> AnalysisResult<()> {
+    for (i, (label, series)) in runs.iter().enumerate() {
+        let colour = palette(i);
+        let points = series.iter().filter_map(|&(t, y)| map_y(y).map(|y| (t, y)));
+        chart
+            .draw_series(LineSeries::new(points, colour.stroke_width(2)))?
+            .label(label.as_str())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
+}
+
 /// Plots one quantity of each run against time.
 pub fn plot_series(
     path: &Path,
@@ -376,27 +406,9 @@ pub fn plot_series(
             .configure_mesh()
             .x_desc("t (s)")
             .y_desc(y_label)
+            .y_label_formatter(&|v| format!("{v:.0e}"))
             .draw()?;
-        for (i, (label, series)) in runs.iter().enumerate() {
-            let colour = palette(i);
-            chart
-                .draw_series(LineSeries::new(
-                    series
-                        .iter()
-                        .filter(|(_, y)| y.abs() > 0.0)
-                        .map(|(t, y)| (*t, y.abs())),
-                    colour.stroke_width(2),
-                ))?
-                .label(label.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()?;
+        draw_runs(&mut chart, runs, |y| (y.abs() > 0.0).then_some(y.abs()))?;
     } else {
         let lo = finite().map(|(_, y)| *y).fold(f64::INFINITY, f64::min);
         let hi = finite().map(|(_, y)| *y).fold(f64::NEG_INFINITY, f64::max);
@@ -407,23 +419,7 @@ pub fn plot_series(
             .x_desc("t (s)")
             .y_desc(y_label)
             .draw()?;
-        for (i, (label, series)) in runs.iter().enumerate() {
-            let colour = palette(i);
-            chart
-                .draw_series(LineSeries::new(
-                    series.iter().copied(),
-                    colour.stroke_width(2),
-                ))?
-                .label(label.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()?;
+        draw_runs(&mut chart, runs, Some)?;
     }
     root.present()?;
     Ok(())
@@ -793,6 +789,8 @@ pub fn plot_convergence(path: &Path, table: &[Comparison]) -> AnalysisResult<()>
         .configure_mesh()
         .x_desc("dt (s)")
         .y_desc("|period error| (relative)")
+        .x_label_formatter(&|v| format!("{v:.3}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()?;
     let mut i = 0;
     for &integrator in Integrator::ALL {

@@ -10,16 +10,7 @@ use wirebead::prelude::*;
 
 fn scene() -> (App, Entity) {
     let mut app = app(SimParams::default());
-    let wire = spawn_wire(&mut app, Wire::circle(1.0).unwrap(), Transform::default());
-    let bead = spawn_bead(
-        &mut app,
-        wire,
-        BeadParams {
-            mass: 1.0,
-            initial_position: DVec2::new(0.8, -0.6),
-            initial_velocity: DVec2::new(0.5, 0.0),
-        },
-    );
+    let bead = circle_bead(&mut app, 1.0, DVec2::new(0.8, -0.6), DVec2::new(0.5, 0.0));
     run_steps(&mut app, 20);
     (app, bead)
 }

@@ -18,16 +18,7 @@ fn seed_run(alpha: f64, beta: f64, integrator: Integrator, dt: f64) -> (App, Ent
         integrator,
         ..default()
     });
-    let wire = spawn_wire(&mut app, Wire::circle(1.0).unwrap(), Transform::default());
-    let bead = spawn_bead(
-        &mut app,
-        wire,
-        BeadParams {
-            mass: 1.0,
-            initial_position: DVec2::new(0.0, -1.0),
-            initial_velocity: DVec2::new(4.0, 0.0),
-        },
-    );
+    let bead = circle_bead(&mut app, 1.0, DVec2::new(0.0, -1.0), DVec2::new(4.0, 0.0));
     run_for(&mut app, 10.0);
     let samples = app.world().resource::<Recording>().of(bead);
     (app, bead, samples)

@@ -11,16 +11,7 @@ use wirebead::prelude::*;
 
 fn scene() -> (App, Entity) {
     let mut app = app(SimParams::default());
-    let wire = spawn_wire(&mut app, Wire::circle(1.0).unwrap(), Transform::default());
-    let bead = spawn_bead(
-        &mut app,
-        wire,
-        BeadParams {
-            mass: 1.0,
-            initial_position: DVec2::new(1.0, 0.0),
-            initial_velocity: DVec2::ZERO,
-        },
-    );
+    let bead = circle_bead(&mut app, 1.0, DVec2::new(1.0, 0.0), DVec2::ZERO);
     (app, bead)
 }
 

@@ -89,19 +89,25 @@ pub fn spawn_bead(app: &mut App, wire: Entity, params: BeadParams) -> Entity {
         .id()
 }
 
-/// A vertical circle of radius `r` at the origin with a bead released from
-/// rest `theta0` radians from the bottom. Returns the bead.
-pub fn pendulum(app: &mut App, r: f64, theta0: f64) -> Entity {
+/// A circle of radius `r` at the origin with one bead of mass 1 starting at
+/// `x0` with velocity `v0`. Returns the bead.
+pub fn circle_bead(app: &mut App, r: f64, x0: DVec2, v0: DVec2) -> Entity {
     let wire = spawn_wire(app, Wire::circle(r).unwrap(), Transform::default());
     spawn_bead(
         app,
         wire,
         BeadParams {
             mass: 1.0,
-            initial_position: reference::point_on_circle(r, theta0),
-            initial_velocity: DVec2::ZERO,
+            initial_position: x0,
+            initial_velocity: v0,
         },
     )
+}
+
+/// A vertical circle of radius `r` at the origin with a bead released from
+/// rest `theta0` radians from the bottom. Returns the bead.
+pub fn pendulum(app: &mut App, r: f64, theta0: f64) -> Entity {
+    circle_bead(app, r, reference::point_on_circle(r, theta0), DVec2::ZERO)
 }
 
 pub fn bead(app: &App, bead: Entity) -> Bead {
