@@ -9,7 +9,7 @@ use bevy::prelude::*;
 
 use crate::params::{BeadParams, ParamError};
 use crate::solver::{BeadState, SolveError};
-use crate::wire::{Circle, Ellipse, ImplicitCurve, Line, Parabola, Sine, WireShape};
+use crate::wire::{Circle, Ellipse, ImplicitCurve, Line, Parabola, Pose, Sine, WireShape};
 
 /// A wire: a shape placed in the plane by the entity's `Transform`
 /// (translation x, y and rotation about z; the wire should be a top-level
@@ -18,7 +18,7 @@ use crate::wire::{Circle, Ellipse, ImplicitCurve, Line, Parabola, Sine, WireShap
 /// Built only through validating constructors, so a wire in the world always
 /// has valid dimensions.
 #[derive(Component, Clone, Debug)]
-#[require(Transform)]
+#[require(Transform, WirePose)]
 pub struct Wire {
     shape: WireShape,
 }
@@ -70,6 +70,33 @@ impl Wire {
     /// The shape.
     pub fn shape(&self) -> &WireShape {
         &self.shape
+    }
+}
+
+/// Where a wire sits for the current step: its `Transform` read once, in
+/// [`WireBeadSystems::Prepare`](crate::WireBeadSystems::Prepare), so the
+/// beads on it do not each convert it. Kept by the plugin.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct WirePose(Option<Pose>);
+
+impl Default for WirePose {
+    fn default() -> Self {
+        Self(Some(Pose::IDENTITY))
+    }
+}
+
+impl WirePose {
+    /// The pose of `transform`, or none if it is not finite.
+    pub fn from_transform(transform: &Transform) -> Self {
+        Self(Pose::from_transform(transform).ok())
+    }
+
+    /// The pose, or the error that the wire's transform is not finite.
+    pub fn get(&self) -> Result<Pose, ParamError> {
+        self.0.ok_or(ParamError::NotFinite {
+            name: "wire transform",
+            value: f64::NAN,
+        })
     }
 }
 

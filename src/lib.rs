@@ -65,12 +65,13 @@ pub mod wire;
 
 pub use components::{
     Bead, BeadDiagnostics, Diverged, DivergenceReason, DragTarget, OnWire, Wire, WireBeads,
+    WirePose,
 };
 pub use controls::KeyboardControlsPlugin;
 pub use params::{
     BeadParams, Integrator, ParamError, PendingBead, PendingParams, SimParams, Stabilization,
 };
-pub use plugin::{BeadDiverged, Restart, WireBeadPlugin, WireBeadSystems};
+pub use plugin::{BeadDiverged, ParallelStep, Restart, WireBeadPlugin, WireBeadSystems};
 pub use preset::{ActivePreset, LoadPreset, ScenePreset, ScenePresetPlugin};
 pub use wire::{ImplicitCurve, WireShape};
 
@@ -78,9 +79,9 @@ pub use wire::{ImplicitCurve, WireShape};
 pub mod prelude {
     pub use crate::{
         Bead, BeadDiagnostics, BeadDiverged, BeadParams, Diverged, DragTarget, ImplicitCurve,
-        Integrator, KeyboardControlsPlugin, LoadPreset, OnWire, PendingBead, PendingParams,
-        Restart, ScenePreset, ScenePresetPlugin, SimParams, Stabilization, Wire, WireBeadPlugin,
-        WireBeadSystems, WireBeads, WireShape,
+        Integrator, KeyboardControlsPlugin, LoadPreset, OnWire, ParallelStep, PendingBead,
+        PendingParams, Restart, ScenePreset, ScenePresetPlugin, SimParams, Stabilization, Wire,
+        WireBeadPlugin, WireBeadSystems, WireBeads, WireShape,
     };
 }
 

@@ -14,9 +14,10 @@ use crate::systems;
 /// calling [`Bead::add_force`] or [`Bead::add_spring`].
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum WireBeadSystems {
-    /// Clears each bead's force accumulator.
+    /// Places each wire for the step and starts each bead's force
+    /// accumulator at its weight `m g` (gravity).
     Prepare,
-    /// Accumulates external forces: gravity, the drag spring, the game's own.
+    /// Accumulates the other external forces: the drag spring, the game's own.
     Forces,
     /// Solves eq. 1.9 for each bead's constraint force.
     Solve,
@@ -33,6 +34,51 @@ pub enum WireBeadSystems {
 /// that sends it already steps with the new parameters.
 #[derive(Message, Clone, Copy, Debug, Default)]
 pub struct Restart;
+
+/// When the step's per-bead systems run in parallel: a system whose query
+/// has at least `threshold` beads splits them over the compute task pool
+/// (with the `parallel` feature, which enables Bevy's `multi_threaded`);
+/// below it, it loops in its own thread, where waking the pool would cost
+/// more than the work. [`ParallelStep::OFF`] keeps every loop sequential.
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Eq, Reflect)]
+#[reflect(Resource)]
+pub struct ParallelStep {
+    /// The fewest beads a system splits over threads.
+    pub threshold: usize,
+}
+
+impl ParallelStep {
+    /// Never parallel.
+    pub const OFF: Self = Self {
+        threshold: usize::MAX,
+    };
+}
+
+impl Default for ParallelStep {
+    /// Parallel from 4,096 beads up.
+    fn default() -> Self {
+        Self { threshold: 4096 }
+    }
+}
+
+/// Task pool options whose compute pool has a thread for every core.
+///
+/// Bevy's default gives the compute pool the cores left after one IO and one
+/// async-compute thread: one thread on a two-core machine, where
+/// [`ParallelStep`] then has nothing to split over. The IO and async pools
+/// mostly sleep, so sharing the cores with them costs little:
+///
+/// ```
+/// use bevy::prelude::*;
+/// App::new().add_plugins(MinimalPlugins.set(TaskPoolPlugin {
+///     task_pool_options: wirebead::plugin::compute_on_all_cores(),
+/// }));
+/// ```
+pub fn compute_on_all_cores() -> TaskPoolOptions {
+    let mut options = TaskPoolOptions::default();
+    options.compute.min_threads = bevy::tasks::available_parallelism();
+    options
+}
 
 /// Sent when a bead diverges: which bead and why.
 #[derive(Message, Clone, Debug)]
@@ -70,6 +116,7 @@ impl Plugin for WireBeadPlugin {
             app.insert_resource(SimParams::default());
         }
         app.insert_resource(pending)
+            .init_resource::<ParallelStep>()
             .add_message::<Restart>()
             .add_message::<BeadDiverged>()
             .register_type::<Bead>()
@@ -77,6 +124,7 @@ impl Plugin for WireBeadPlugin {
             .register_type::<DragTarget>()
             .register_type::<PendingBead>()
             .register_type::<SimParams>()
+            .register_type::<ParallelStep>()
             .register_type::<PendingParams>()
             .configure_sets(
                 FixedUpdate,
@@ -94,8 +142,8 @@ impl Plugin for WireBeadPlugin {
             .add_systems(
                 FixedUpdate,
                 (
-                    systems::clear_forces.in_set(WireBeadSystems::Prepare),
-                    (systems::apply_gravity, systems::apply_drag).in_set(WireBeadSystems::Forces),
+                    (systems::place_wires, systems::start_forces).in_set(WireBeadSystems::Prepare),
+                    systems::apply_drag.in_set(WireBeadSystems::Forces),
                     systems::solve_constraints.in_set(WireBeadSystems::Solve),
                     systems::integrate.in_set(WireBeadSystems::Integrate),
                     systems::write_transforms.in_set(WireBeadSystems::Writeback),

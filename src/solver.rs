@@ -183,6 +183,10 @@ pub struct StepOutput {
     pub lambda: f64,
     /// The constraint force the step applied.
     pub constraint_force: DVec2,
+    /// `C` at the new state.
+    pub c: f64,
+    /// `Ċ` at the new state.
+    pub c_dot: f64,
 }
 
 /// Tolerance on `|C|` for the Newton solves (RATTLE, projection), in units
@@ -224,8 +228,8 @@ pub fn lambda(
 }
 
 /// Solves eq. 1.9 at `state` and returns λ, `λN` and the acceleration.
-pub fn solve(
-    curve: &dyn ImplicitCurve,
+pub fn solve<C: ImplicitCurve + ?Sized>(
+    curve: &C,
     state: BeadState,
     force: &LinearForce,
     mass: f64,
@@ -250,8 +254,8 @@ pub fn solve(
 /// Advances one step from `state`, given `first`, the solve at `state`
 /// (what [`solve`] returns with the config's gains). Post-stabilization is
 /// applied when configured.
-pub fn integrate(
-    curve: &dyn ImplicitCurve,
+pub fn integrate<C: ImplicitCurve + ?Sized>(
+    curve: &C,
     state: BeadState,
     force: &LinearForce,
     first: &Solved,
@@ -271,6 +275,8 @@ pub fn integrate(
             },
             lambda: first.lambda,
             constraint_force: first.constraint_force,
+            c: 0.0,
+            c_dot: 0.0,
         },
         Integrator::SemiImplicitEuler => {
             let v1 = v + h * first.acceleration;
@@ -281,6 +287,8 @@ pub fn integrate(
                 },
                 lambda: first.lambda,
                 constraint_force: first.constraint_force,
+                c: 0.0,
+                c_dot: 0.0,
             }
         }
         Integrator::Rk4 => {
@@ -310,6 +318,8 @@ pub fn integrate(
                 },
                 lambda: first.lambda,
                 constraint_force: first.constraint_force,
+                c: 0.0,
+                c_dot: 0.0,
             }
         }
         Integrator::Rattle => rattle(curve, state, force, cfg.mass, h)?,
@@ -317,22 +327,25 @@ pub fn integrate(
     if !out.state.is_finite() {
         return Err(SolveError::NonFinite);
     }
-    let c = curve.value(out.state.position);
-    if c.is_nan() || c.abs() > cfg.drift_bound {
+    let g = curve.geometry(out.state.position);
+    if g.c.is_nan() || g.c.abs() > cfg.drift_bound {
         return Err(SolveError::DriftExceeded {
-            c,
+            c: g.c,
             bound: cfg.drift_bound,
         });
     }
     if cfg.stabilization == Stabilization::Projection && cfg.integrator != Integrator::Rattle {
         out.state = project(curve, out.state)?;
+        (out.c, out.c_dot) = drift(curve, out.state);
+    } else {
+        (out.c, out.c_dot) = (g.c, g.normal.dot(out.state.velocity));
     }
     Ok(out)
 }
 
 /// [`solve`] then [`integrate`]: one whole step.
-pub fn step(
-    curve: &dyn ImplicitCurve,
+pub fn step<C: ImplicitCurve + ?Sized>(
+    curve: &C,
     state: BeadState,
     force: &LinearForce,
     cfg: &StepConfig,
@@ -343,7 +356,11 @@ pub fn step(
 }
 
 /// Newton's method on `s ↦ C(base + s dir)`, returning the root `s`.
-fn newton_along(curve: &dyn ImplicitCurve, base: DVec2, dir: DVec2) -> Result<f64, SolveError> {
+fn newton_along<C: ImplicitCurve + ?Sized>(
+    curve: &C,
+    base: DVec2,
+    dir: DVec2,
+) -> Result<f64, SolveError> {
     let scale = curve.scale().max(f64::MIN_POSITIVE);
     let mut s = 0.0;
     let mut residual = f64::INFINITY;
@@ -370,8 +387,8 @@ fn newton_along(curve: &dyn ImplicitCurve, base: DVec2, dir: DVec2) -> Result<f6
 }
 
 /// One RATTLE step (see the module docs).
-pub fn rattle(
-    curve: &dyn ImplicitCurve,
+pub fn rattle<C: ImplicitCurve + ?Sized>(
+    curve: &C,
     state: BeadState,
     force: &LinearForce,
     mass: f64,
@@ -401,12 +418,17 @@ pub fn rattle(
         },
         lambda: 0.5 * (lambda + mu),
         constraint_force: 0.5 * (lambda * n0 + mu * n1),
+        c: curve.value(x1),
+        c_dot: n1.dot(v1),
     })
 }
 
 /// Post-stabilization: moves the position onto `C = 0` by Newton steps along
 /// the local gradient, then removes the velocity's normal component.
-pub fn project(curve: &dyn ImplicitCurve, state: BeadState) -> Result<BeadState, SolveError> {
+pub fn project<C: ImplicitCurve + ?Sized>(
+    curve: &C,
+    state: BeadState,
+) -> Result<BeadState, SolveError> {
     let scale = curve.scale().max(f64::MIN_POSITIVE);
     let mut x = state.position;
     let mut converged = false;
@@ -440,7 +462,7 @@ pub fn project(curve: &dyn ImplicitCurve, state: BeadState) -> Result<BeadState,
 }
 
 /// `C` and `Ċ = N·ẋ` at a state.
-pub fn drift(curve: &dyn ImplicitCurve, state: BeadState) -> (f64, f64) {
+pub fn drift<C: ImplicitCurve + ?Sized>(curve: &C, state: BeadState) -> (f64, f64) {
     let g = curve.geometry(state.position);
     (g.c, g.normal.dot(state.velocity))
 }

@@ -101,6 +101,7 @@ impl ImplicitCurve for Circle {
     fn scale(&self) -> f64 {
         self.radius
     }
+    #[inline]
     fn geometry(&self, p: DVec2) -> Geometry {
         let len = p.length();
         if len == 0.0 {
@@ -111,12 +112,13 @@ impl ImplicitCurve for Circle {
                 hessian: DMat2::ZERO,
             };
         }
-        let n = p / len;
+        let inv = 1.0 / len;
+        let n = p * inv;
         // H = (I - n nᵀ) / |x|
         let hessian = DMat2::from_cols(
-            DVec2::new(1.0 - n.x * n.x, -n.x * n.y),
-            DVec2::new(-n.x * n.y, 1.0 - n.y * n.y),
-        ) * (1.0 / len);
+            DVec2::new(1.0 - n.x * n.x, -n.x * n.y) * inv,
+            DVec2::new(-n.x * n.y, 1.0 - n.y * n.y) * inv,
+        );
         Geometry {
             c: len - self.radius,
             normal: n,
@@ -398,16 +400,30 @@ impl Pose {
 }
 
 /// A curve placed in the world by a [`Pose`]: itself an [`ImplicitCurve`] in
-/// world coordinates.
-#[derive(Clone, Copy)]
-pub struct Placed<'a> {
+/// world coordinates. `C` is the curve's type: `dyn ImplicitCurve` by
+/// default, or a concrete shape so the step's loops inline it.
+pub struct Placed<'a, C: ImplicitCurve + ?Sized = dyn ImplicitCurve + 'a> {
     /// The curve in its local frame.
-    pub curve: &'a dyn ImplicitCurve,
+    pub curve: &'a C,
     /// Where it sits.
     pub pose: Pose,
 }
 
-impl ImplicitCurve for Placed<'_> {
+impl<C: ImplicitCurve + ?Sized> Clone for Placed<'_, C> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<C: ImplicitCurve + ?Sized> Copy for Placed<'_, C> {}
+
+impl<C: ImplicitCurve + ?Sized> Placed<'_, C> {
+    fn unrotated(&self) -> bool {
+        self.pose.rotation == DVec2::X
+    }
+}
+
+impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Placed<'_, C> {
     fn value(&self, p: DVec2) -> f64 {
         self.curve.value(self.pose.to_local(p))
     }
@@ -421,7 +437,12 @@ impl ImplicitCurve for Placed<'_> {
     fn scale(&self) -> f64 {
         self.curve.scale()
     }
+    #[inline]
     fn geometry(&self, p: DVec2) -> Geometry {
+        if self.unrotated() {
+            // The common case needs no rotation, only the translation.
+            return self.curve.geometry(p - self.pose.origin);
+        }
         let local = self.curve.geometry(self.pose.to_local(p));
         let r = self.pose.matrix();
         Geometry {

@@ -1,0 +1,209 @@
+//! Many beads for the benchmarks, the memory measurement and the profile:
+//! pendulums on circles of radius 1, through the plugin or as plain structs.
+
+#![allow(dead_code)]
+
+use bevy::app::TaskPoolPlugin;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use wirebead::prelude::*;
+use wirebead::solver::{self, BeadState, LinearForce, StepConfig};
+use wirebead::wire::{Circle, Placed, Pose};
+
+/// How the beads are put on wires.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// Each bead on a circle of its own, the circles on a grid.
+    OwnWires,
+    /// Every bead on one circle.
+    SharedWire,
+}
+
+impl Layout {
+    /// A short name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::OwnWires => "own-wires",
+            Self::SharedWire => "shared-wire",
+        }
+    }
+}
+
+/// How the plugin runs its loops.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Threads {
+    /// One thread: single-threaded executor, [`ParallelStep::OFF`].
+    Single,
+    /// Bevy's default executor and [`ParallelStep::default`].
+    Parallel,
+}
+
+/// The starting angle from the bottom of bead `i`: spread over ±120° so the
+/// beads are at different phases.
+pub fn start_angle(i: usize) -> f64 {
+    let spread = (i % 241) as f64 / 240.0;
+    (spread * 2.0 - 1.0) * 120f64.to_radians()
+}
+
+/// Where bead `i`'s circle sits.
+pub fn grid_origin(i: usize) -> DVec2 {
+    DVec2::new(3.0 * (i % 1024) as f64, 3.0 * (i / 1024) as f64)
+}
+
+fn on_circle(origin: DVec2, angle: f64) -> DVec2 {
+    origin + DVec2::new(angle.sin(), -angle.cos())
+}
+
+/// An app with the plugin and `n` beads at rest, ready for
+/// `world_mut().run_schedule(FixedUpdate)` (one step per call).
+pub fn plugin_app(n: usize, layout: Layout, threads: Threads) -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        TaskPoolPlugin {
+            task_pool_options: wirebead::plugin::compute_on_all_cores(),
+        },
+        WireBeadPlugin::default(),
+    ));
+    if threads == Threads::Single {
+        app.insert_resource(ParallelStep::OFF);
+        wirebead::plugin::use_single_threaded_executors(&mut app);
+    }
+    let world = app.world_mut();
+    match layout {
+        Layout::SharedWire => {
+            let wire = world.spawn(Wire::circle(1.0).expect("radius 1")).id();
+            world.spawn_batch((0..n).map(move |i| {
+                let bead = Bead::at_rest(1.0, on_circle(DVec2::ZERO, start_angle(i)));
+                (bead.expect("valid bead"), OnWire(wire))
+            }));
+        }
+        Layout::OwnWires => {
+            let wires: Vec<Entity> = world
+                .spawn_batch((0..n).map(|i| {
+                    let o = grid_origin(i);
+                    (
+                        Wire::circle(1.0).expect("radius 1"),
+                        Transform::from_xyz(o.x as f32, o.y as f32, 0.0),
+                    )
+                }))
+                .collect();
+            world.spawn_batch(wires.into_iter().enumerate().map(|(i, wire)| {
+                let bead = Bead::at_rest(1.0, on_circle(grid_origin(i), start_angle(i)));
+                (bead.expect("valid bead"), OnWire(wire))
+            }));
+        }
+    }
+    app.finish();
+    app.cleanup();
+    app
+}
+
+/// One bead as a plain struct: the same state and diagnostics the plugin
+/// keeps.
+#[derive(Clone, Copy, Debug)]
+pub struct RawBead {
+    /// Position and velocity.
+    pub state: BeadState,
+    /// Mass.
+    pub mass: f64,
+    /// λ and `λN` of the last step.
+    pub lambda: f64,
+    /// `λN`.
+    pub constraint_force: DVec2,
+    /// `C`, `Ċ`, kinetic and potential energy.
+    pub diagnostics: [f64; 4],
+    /// The rendered position.
+    pub rendered: [f32; 2],
+    /// Index of its wire's pose.
+    pub wire: u32,
+}
+
+/// The floor: the plugin's step as one fused loop over a `Vec`.
+pub struct RawLoop {
+    /// The beads.
+    pub beads: Vec<RawBead>,
+    /// Each wire's pose.
+    pub poses: Vec<Pose>,
+    /// The shared shape.
+    pub circle: Circle,
+    /// The step's constants.
+    pub cfg: StepConfig,
+    /// Gravity.
+    pub gravity: DVec2,
+}
+
+impl RawLoop {
+    /// `n` beads laid out as [`plugin_app`] lays them out.
+    pub fn new(n: usize, layout: Layout) -> Self {
+        let params = SimParams::default();
+        let poses: Vec<Pose> = match layout {
+            Layout::SharedWire => vec![Pose::IDENTITY],
+            Layout::OwnWires => (0..n).map(|i| Pose::new(grid_origin(i), 0.0)).collect(),
+        };
+        let beads = (0..n)
+            .map(|i| {
+                let wire = if layout == Layout::SharedWire { 0 } else { i };
+                (wire, poses[wire].origin, i)
+            })
+            .map(|(wire, origin, i)| RawBead {
+                state: BeadState {
+                    position: on_circle(origin, start_angle(i)),
+                    velocity: DVec2::ZERO,
+                },
+                mass: 1.0,
+                lambda: 0.0,
+                constraint_force: DVec2::ZERO,
+                diagnostics: [0.0; 4],
+                rendered: [0.0; 2],
+                wire: wire as u32,
+            })
+            .collect();
+        Self {
+            beads,
+            poses,
+            circle: Circle { radius: 1.0 },
+            cfg: StepConfig {
+                dt: params.timestep,
+                mass: 1.0,
+                alpha: params.alpha,
+                beta: params.beta,
+                integrator: params.integrator,
+                stabilization: params.stabilization,
+                drift_bound: params.divergence_bound,
+            },
+            gravity: params.gravity,
+        }
+    }
+
+    /// One step of every bead; returns how many failed.
+    pub fn step(&mut self) -> usize {
+        let (alpha, beta) = self.cfg.gains();
+        let mut failed = 0;
+        for bead in &mut self.beads {
+            let placed = Placed {
+                curve: &self.circle,
+                pose: self.poses[bead.wire as usize],
+            };
+            let force = LinearForce::constant(bead.mass * self.gravity);
+            let cfg = StepConfig {
+                mass: bead.mass,
+                ..self.cfg
+            };
+            let stepped = solver::solve(&placed, bead.state, &force, bead.mass, alpha, beta)
+                .and_then(|first| solver::integrate(&placed, bead.state, &force, &first, &cfg));
+            match stepped {
+                Ok(out) => {
+                    bead.state = out.state;
+                    bead.lambda = out.lambda;
+                    bead.constraint_force = out.constraint_force;
+                    let (c, c_dot) = (out.c, out.c_dot);
+                    let (kinetic, potential) = solver::energy(bead.mass, self.gravity, out.state);
+                    bead.diagnostics = [c, c_dot, kinetic, potential];
+                    bead.rendered = [out.state.position.x as f32, out.state.position.y as f32];
+                }
+                Err(_) => failed += 1,
+            }
+        }
+        failed
+    }
+}
