@@ -18,6 +18,7 @@ use clap::{Parser, ValueEnum};
 #[path = "../benches/support/mod.rs"]
 mod support;
 use support::{Layout, Threads, plugin_app};
+use wirebead::prelude::*;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum LayoutArg {
@@ -136,6 +137,14 @@ fn main() -> ExitCode {
         args.steps,
         seconds * 1e9 / bead_steps,
         bead_steps / seconds
+    );
+    println!(
+        "component_bytes: Bead={} BeadDiagnostics={} OnWire={} Transform={} GlobalTransform={}",
+        size_of::<Bead>(),
+        size_of::<BeadDiagnostics>(),
+        size_of::<OnWire>(),
+        size_of::<Transform>(),
+        size_of::<GlobalTransform>()
     );
     match peak_rss() {
         Some(bytes) => println!("peak_rss_bytes={bytes}"),

@@ -228,6 +228,7 @@ pub fn lambda(
 }
 
 /// Solves eq. 1.9 at `state` and returns λ, `λN` and the acceleration.
+#[inline]
 pub fn solve<C: ImplicitCurve + ?Sized>(
     curve: &C,
     state: BeadState,
@@ -254,6 +255,7 @@ pub fn solve<C: ImplicitCurve + ?Sized>(
 /// Advances one step from `state`, given `first`, the solve at `state`
 /// (what [`solve`] returns with the config's gains). Post-stabilization is
 /// applied when configured.
+#[inline]
 pub fn integrate<C: ImplicitCurve + ?Sized>(
     curve: &C,
     state: BeadState,

@@ -437,12 +437,20 @@ impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Placed<'_, C> {
     fn scale(&self) -> f64 {
         self.curve.scale()
     }
-    #[inline]
+    #[inline(always)]
     fn geometry(&self, p: DVec2) -> Geometry {
         if self.unrotated() {
             // The common case needs no rotation, only the translation.
-            return self.curve.geometry(p - self.pose.origin);
+            self.curve.geometry(p - self.pose.origin)
+        } else {
+            self.rotated_geometry(p)
         }
+    }
+}
+
+impl<C: ImplicitCurve + ?Sized> Placed<'_, C> {
+    #[inline(never)]
+    fn rotated_geometry(&self, p: DVec2) -> Geometry {
         let local = self.curve.geometry(self.pose.to_local(p));
         let r = self.pose.matrix();
         Geometry {
