@@ -38,7 +38,7 @@
 //! | [`DragTarget`] | the user's drag: a spring `k (target - x)` while present |
 //! | [`BeadDiagnostics`], [`Diverged`], [`BeadDiverged`] | `C`, `Ċ`, λ and energy each step; divergence reports |
 //! | [`ScenePresetPlugin`], [`ScenePreset`] | scenes as RON assets (`*.scene.ron`), hot-reloaded |
-//! | [`solver`], [`wire`], [`reference`] | the pure math: eq. 1.9, the integrators, the shapes, the exact pendulum period |
+//! | [`solver`], [`wire`], [`reference`](mod@reference) | the pure math: eq. 1.9, the integrators, the shapes, the exact pendulum period |
 //!
 //! ## Feature flags
 //!

@@ -4,7 +4,7 @@
 //!
 //! | plugin | what it adds |
 //! |---|---|
-//! | [`WireBeadGuiPlugin`] | everything below plus [`ScenePresetPlugin`](crate::ScenePresetPlugin) and [`KeyboardControlsPlugin`](crate::KeyboardControlsPlugin) |
+//! | [`WireBeadGuiPlugin`] | everything below plus [`crate::ScenePresetPlugin`] and [`crate::KeyboardControlsPlugin`] |
 //! | [`SceneRenderPlugin`] | camera framing, wire gizmos, bead meshes, trails, force arrows |
 //! | [`BeadDragPlugin`] | mesh picking: drag a bead with the mouse (the seed's spring) |
 //! | [`PanelPlugin`] | the egui panel and plots |
