@@ -50,6 +50,7 @@ fn cursor_world(
 pub fn start_drag(
     event: On<Pointer<DragStart>>,
     beads: Query<(Entity, &Bead, &Transform)>,
+    windows: Query<(), With<Window>>,
     cameras: SceneCameras,
     mut grabbed: ResMut<Grabbed>,
     mut selected: ResMut<SelectedBead>,
@@ -63,6 +64,10 @@ pub fn start_drag(
     };
     let bead = if beads.contains(event.entity) {
         Some(event.entity)
+    } else if !windows.contains(event.entity) {
+        // The press landed on something else that takes the pointer, such
+        // as an egui window: never grab a bead through it.
+        None
     } else {
         // The press missed every bead mesh: take the nearest bead whose
         // drawn disc (scale = radius) is under the cursor, with some slack.
