@@ -1,7 +1,7 @@
 //! Checks of the example in a real window. `.ci/run` runs the example under
 //! Xvfb with Mesa's software Vulkan, saves a screenshot and its report, and
-//! drives a real mouse drag with xdotool; these tests then check the
-//! pixels and the drag. They need those files, so they are ignored by a
+//! drives a real mouse drag with xdotool and edits the running preset's
+//! file; these tests then check the pixels, the drag and the reload. They need those files, so they are ignored by a
 //! plain `cargo test`; `.ci/run` runs them with `--ignored` and
 //! `WIREBEAD_WINDOW_DIR` set.
 #![cfg(feature = "gui")]
@@ -126,4 +126,23 @@ fn a_real_mouse_drag_pulls_the_bead_toward_the_cursor() {
         drag.closest_distance,
         drag.start_distance
     );
+}
+
+#[test]
+#[ignore = "needs the hot-reload run .ci/run makes under Xvfb"]
+fn editing_the_running_preset_reloads_it() {
+    let ready = report("reload_ready.ron");
+    let end = report("reload.ron");
+    assert_eq!(ready.preset.as_deref(), Some("Bead at rest"));
+    assert_eq!(end.preset.as_deref(), Some("Bead at rest, edited"));
+    assert_eq!(end.preset_error, None);
+    // The edited preset hangs the bead at rest at the bottom of a circle of
+    // radius 2 instead of 1.
+    let [x, y] = end.beads[0].world;
+    assert!(
+        x.abs() < 1e-9 && (y + 2.0).abs() < 1e-9,
+        "bead at ({x}, {y})"
+    );
+    let [_, y0] = ready.beads[0].world;
+    assert!((y0 + 1.0).abs() < 1e-9, "bead started at y = {y0}");
 }
