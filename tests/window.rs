@@ -1,9 +1,9 @@
 //! Checks of the example in a real window. `.ci/run` runs the example under
-//! Xvfb with Mesa's software Vulkan, saves a screenshot and its report, and
+//! Xvfb with Mesa's software Vulkan, saves a screenshot and its report,
 //! drives a real mouse drag with xdotool and edits the running preset's
-//! file; these tests then check the pixels, the drag and the reload. They need those files, so they are ignored by a
-//! plain `cargo test`; `.ci/run` runs them with `--ignored` and
-//! `WIREBEAD_WINDOW_DIR` set.
+//! file; these tests then check the pixels, the drag and the reload. They
+//! need those files, so they are ignored by a plain `cargo test`; `.ci/run`
+//! runs them with `--ignored` and `WIREBEAD_WINDOW_DIR` set.
 #![cfg(feature = "gui")]
 
 use std::path::PathBuf;
