@@ -253,10 +253,12 @@ fn automation(
         let failure = format!("scene file error: {error}");
         state.failures.push(failure);
     }
-    if active.running.is_none() {
-        state
-            .failures
-            .push("no scene preset was running".to_owned());
+    if active.running.is_none() && !active.path.is_empty() {
+        let failure = format!("the scene preset {} never ran", active.path);
+        state.failures.push(failure);
+    }
+    if report().beads.is_empty() {
+        state.failures.push("there was no bead in the scene".to_owned());
     }
     if let Some(path) = state.config.report.clone()
         && let Err(e) = write_report(&path, &report())

@@ -11,7 +11,7 @@ use bevy::prelude::*;
 
 use crate::components::{Bead, DragTarget, OnWire, Wire};
 use crate::plugin::{Restart, WireBeadSystems};
-use crate::wire::{Pose, WireShape};
+use crate::wire::{ImplicitCurve, Placed, Pose, WireShape};
 
 /// Colours and sizes of the scene.
 #[derive(Resource, Clone, Debug)]
@@ -302,7 +302,18 @@ pub fn draw_wires(
     for (wire, transform) in &wires {
         let pose = wire_pose(transform);
         match wire.shape() {
-            WireShape::Custom(_) => {}
+            WireShape::Custom(curve) => {
+                // A game's own curve: traced where it crosses the view.
+                let center = view.center.as_dvec2();
+                let half = view.size.as_dvec2();
+                let placed = Placed {
+                    curve: curve.as_ref(),
+                    pose,
+                };
+                for (a, b) in implicit_segments(&placed, center - half, center + half, [192, 128]) {
+                    gizmos.line_2d(a.as_vec2(), b.as_vec2(), style.wire);
+                }
+            }
             shape => {
                 // Open wires run past the edges of the view.
                 let span =
@@ -312,6 +323,45 @@ pub fn draw_wires(
             }
         }
     }
+}
+
+/// The zero set of `curve` inside the rectangle `lo..hi`, as line segments:
+/// marching squares on a grid of `cells` (x, y), the crossings on each cell
+/// edge placed by linear interpolation of `C`. Draws any [`ImplicitCurve`]
+/// without knowing its shape.
+pub fn implicit_segments(
+    curve: &dyn ImplicitCurve,
+    lo: DVec2,
+    hi: DVec2,
+    cells: [usize; 2],
+) -> Vec<(DVec2, DVec2)> {
+    let [nx, ny] = cells.map(|n| n.max(1));
+    let step = (hi - lo) / DVec2::new(nx as f64, ny as f64);
+    let node = |i: usize, j: usize| lo + step * DVec2::new(i as f64, j as f64);
+    let values: Vec<f64> = (0..=ny)
+        .flat_map(|j| (0..=nx).map(move |i| (i, j)))
+        .map(|(i, j)| curve.value(node(i, j)))
+        .collect();
+    let value = |i: usize, j: usize| values[j * (nx + 1) + i];
+    let crossing = |(pa, va): (DVec2, f64), (pb, vb): (DVec2, f64)| {
+        let differ = (va < 0.0) != (vb < 0.0);
+        (differ && va.is_finite() && vb.is_finite()).then(|| pa + (pb - pa) * (va / (va - vb)))
+    };
+    let mut segments = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
+                .map(|(a, b)| (node(a, b), value(a, b)));
+            let points: Vec<DVec2> = (0..4)
+                .filter_map(|k| crossing(corners[k], corners[(k + 1) % 4]))
+                .collect();
+            // Two crossings make one segment; a saddle's four make two.
+            for pair in points.chunks_exact(2) {
+                segments.push((pair[0], pair[1]));
+            }
+        }
+    }
+    segments
 }
 
 fn draw_trails(beads: Query<&Trail>, style: Res<SceneStyle>, mut gizmos: Gizmos) {
@@ -364,4 +414,43 @@ pub fn screen_to_world(
         .viewport_to_world_2d(camera_transform, screen)
         .ok()
         .map(|p| p.as_dvec2())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wire::Circle;
+
+    /// Marching squares on a moved circle: every segment end lies on the
+    /// circle to within the interpolation error, and the segments add up to
+    /// its circumference.
+    #[test]
+    fn implicit_segments_trace_a_circle() {
+        let circle = Circle { radius: 1.5 };
+        let pose = Pose::new(DVec2::new(2.0, -1.0), 0.3);
+        let placed = Placed {
+            curve: &circle,
+            pose,
+        };
+        let segments = implicit_segments(
+            &placed,
+            DVec2::new(-1.0, -4.0),
+            DVec2::new(5.0, 2.0),
+            [120, 120],
+        );
+        assert!(segments.len() > 100, "{} segments", segments.len());
+        let cell = 6.0 / 120.0;
+        for (a, b) in &segments {
+            for p in [a, b] {
+                let off = ((*p - pose.origin).length() - 1.5).abs();
+                assert!(off < 0.05 * cell, "a point {off:.2e} off the circle");
+            }
+        }
+        let length: f64 = segments.iter().map(|(a, b)| (*b - *a).length()).sum();
+        let circumference = TAU * 1.5;
+        assert!(
+            (length - circumference).abs() < 1e-3 * circumference,
+            "traced length {length} against {circumference}"
+        );
+    }
 }
