@@ -258,7 +258,9 @@ fn automation(
         state.failures.push(failure);
     }
     if report().beads.is_empty() {
-        state.failures.push("there was no bead in the scene".to_owned());
+        state
+            .failures
+            .push("there was no bead in the scene".to_owned());
     }
     if let Some(path) = state.config.report.clone()
         && let Err(e) = write_report(&path, &report())
