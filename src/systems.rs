@@ -18,20 +18,6 @@ use crate::wire::{ImplicitCurve, Placed, Pose, WireShape};
 /// Read access to every wire and its placement for this step.
 pub type Wires<'w, 's> = Query<'w, 's, (&'static Wire, &'static WirePose)>;
 
-/// The wire a bead is on, placed in the world.
-pub fn placed_wire<'a>(wires: &'a Wires, on: &OnWire) -> Result<Placed<'a>, DivergenceReason> {
-    let (wire, pose) = wires
-        .get(on.0)
-        .map_err(|_| DivergenceReason::InvalidWire(format!("entity {} has no Wire", on.0)))?;
-    let pose = pose
-        .get()
-        .map_err(|e| DivergenceReason::InvalidWire(e.to_string()))?;
-    Ok(Placed {
-        curve: wire.shape().curve(),
-        pose,
-    })
-}
-
 /// Runs `f` on every item of `query`: on the compute task pool when the
 /// query has at least `parallel.threshold` items, in this thread otherwise.
 macro_rules! for_each_bead {
@@ -209,7 +195,7 @@ macro_rules! with_curve {
 }
 
 /// The wire a bead is on and its pose for this step.
-fn wire_of<'a>(wires: &'a Wires, on: &OnWire) -> Result<(&'a Wire, Pose), DivergenceReason> {
+pub fn wire_of<'a>(wires: &'a Wires, on: &OnWire) -> Result<(&'a Wire, Pose), DivergenceReason> {
     let (wire, pose) = wires
         .get(on.0)
         .map_err(|_| DivergenceReason::InvalidWire(format!("entity {} has no Wire", on.0)))?;
