@@ -142,7 +142,7 @@ impl Plugin for WireBeadPlugin {
             .add_systems(
                 FixedUpdate,
                 (
-                    (systems::place_wires, systems::start_forces).in_set(WireBeadSystems::Prepare),
+                    systems::prepare_step.in_set(WireBeadSystems::Prepare),
                     systems::apply_drag.in_set(WireBeadSystems::Forces),
                     systems::solve_constraints.in_set(WireBeadSystems::Solve),
                     systems::integrate.in_set(WireBeadSystems::Integrate),

@@ -144,21 +144,19 @@ pub fn apply_restart(
     }
 }
 
-/// Places every wire for this step: reads each changed wire `Transform`
-/// once, so the beads do not.
-pub fn place_wires(mut wires: Query<(&Transform, &mut WirePose), Changed<Transform>>) {
+/// Prepares the step: places every wire (reads each changed wire
+/// `Transform` once, so the beads do not) and starts each bead's force
+/// accumulator at its weight `m g` (gravity), with no stiffness. One system,
+/// so a multi-threaded executor wakes a thread once for both.
+pub fn prepare_step(
+    params: Res<SimParams>,
+    parallel: Res<ParallelStep>,
+    mut wires: Query<(&Transform, &mut WirePose), Changed<Transform>>,
+    mut beads: Query<&mut Bead, Without<Diverged>>,
+) {
     for (transform, mut pose) in &mut wires {
         *pose = WirePose::from_transform(transform);
     }
-}
-
-/// Starts each bead's force accumulator at its weight `m g` (gravity), with
-/// no stiffness.
-pub fn start_forces(
-    params: Res<SimParams>,
-    parallel: Res<ParallelStep>,
-    mut beads: Query<&mut Bead, Without<Diverged>>,
-) {
     let gravity = params.gravity;
     for_each_bead!(beads, parallel, |mut bead: Mut<Bead>| {
         bead.force = bead.mass() * gravity;
