@@ -417,12 +417,6 @@ impl<C: ImplicitCurve + ?Sized> Clone for Placed<'_, C> {
 
 impl<C: ImplicitCurve + ?Sized> Copy for Placed<'_, C> {}
 
-impl<C: ImplicitCurve + ?Sized> Placed<'_, C> {
-    fn unrotated(&self) -> bool {
-        self.pose.rotation == DVec2::X
-    }
-}
-
 impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Placed<'_, C> {
     fn value(&self, p: DVec2) -> f64 {
         self.curve.value(self.pose.to_local(p))
@@ -449,6 +443,10 @@ impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Placed<'_, C> {
 }
 
 impl<C: ImplicitCurve + ?Sized> Placed<'_, C> {
+    fn unrotated(&self) -> bool {
+        self.pose.rotation == DVec2::X
+    }
+
     #[inline(never)]
     fn rotated_geometry(&self, p: DVec2) -> Geometry {
         let local = self.curve.geometry(self.pose.to_local(p));
