@@ -13,24 +13,12 @@ use std::process::{Command, ExitCode};
 use std::time::Instant;
 
 use bevy::prelude::*;
-use clap::{Parser, ValueEnum};
+use clap::Parser;
 
 #[path = "../benches/support/mod.rs"]
 mod support;
 use support::{Layout, Threads, plugin_app};
 use wirebead::prelude::*;
-
-#[derive(Clone, Copy, Debug, ValueEnum)]
-enum LayoutArg {
-    OwnWires,
-    SharedWire,
-}
-
-#[derive(Clone, Copy, Debug, ValueEnum)]
-enum ThreadsArg {
-    Single,
-    Parallel,
-}
 
 #[derive(Parser, Debug)]
 #[command(about = "Step N beads through the plugin and report time and memory")]
@@ -42,11 +30,11 @@ struct Args {
     #[arg(long, default_value_t = 20)]
     steps: usize,
     /// Each bead on its own circle, or all on one.
-    #[arg(long, value_enum, default_value_t = LayoutArg::SharedWire)]
-    layout: LayoutArg,
+    #[arg(long, value_enum, default_value_t = Layout::SharedWire)]
+    layout: Layout,
     /// Single-threaded or parallel loops.
-    #[arg(long, value_enum, default_value_t = ThreadsArg::Parallel)]
-    threads: ThreadsArg,
+    #[arg(long, value_enum, default_value_t = Threads::Parallel)]
+    threads: Threads,
     /// Measure bytes per bead: run with 0 and with N beads and compare peak RSS.
     #[arg(long)]
     memory: bool,
@@ -69,8 +57,8 @@ fn child_peak(args: &Args, beads: usize) -> Result<u64, String> {
             "--steps",
             &args.steps.to_string(),
         ])
-        .args(["--layout", layout_name(args.layout)])
-        .args(["--threads", threads_name(args.threads)])
+        .args(["--layout", args.layout.name()])
+        .args(["--threads", args.threads.name()])
         .output()
         .map_err(|e| e.to_string())?;
     let text = String::from_utf8_lossy(&out.stdout);
@@ -83,20 +71,6 @@ fn child_peak(args: &Args, beads: usize) -> Result<u64, String> {
         .ok_or_else(|| format!("no peak_rss_bytes in the output of the run with {beads} beads"))
 }
 
-fn layout_name(layout: LayoutArg) -> &'static str {
-    match layout {
-        LayoutArg::OwnWires => "own-wires",
-        LayoutArg::SharedWire => "shared-wire",
-    }
-}
-
-fn threads_name(threads: ThreadsArg) -> &'static str {
-    match threads {
-        ThreadsArg::Single => "single",
-        ThreadsArg::Parallel => "parallel",
-    }
-}
-
 fn main() -> ExitCode {
     let args = Args::parse();
     if args.memory {
@@ -105,7 +79,7 @@ fn main() -> ExitCode {
                 let per_bead = (full.saturating_sub(empty)) as f64 / args.beads.max(1) as f64;
                 println!(
                     "layout={} beads={} empty_app_peak_rss={empty} peak_rss={full} bytes_per_bead={per_bead:.1}",
-                    layout_name(args.layout),
+                    args.layout.name(),
                     args.beads
                 );
                 ExitCode::SUCCESS
@@ -116,15 +90,7 @@ fn main() -> ExitCode {
             }
         };
     }
-    let layout = match args.layout {
-        LayoutArg::OwnWires => Layout::OwnWires,
-        LayoutArg::SharedWire => Layout::SharedWire,
-    };
-    let threads = match args.threads {
-        ThreadsArg::Single => Threads::Single,
-        ThreadsArg::Parallel => Threads::Parallel,
-    };
-    let mut app = plugin_app(args.beads, layout, threads);
+    let mut app = plugin_app(args.beads, args.layout, args.threads);
     let start = Instant::now();
     for _ in 0..args.steps {
         app.world_mut().run_schedule(FixedUpdate);

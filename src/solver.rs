@@ -357,12 +357,13 @@ pub fn step<C: ImplicitCurve + ?Sized>(
     integrate(curve, state, force, &first, cfg)
 }
 
-/// Newton's method on `s ↦ C(base + s dir)`, returning the root `s`.
+/// Newton's method on `s ↦ C(base + s dir)`, returning the root `s` and the
+/// residual `C` there.
 fn newton_along<C: ImplicitCurve + ?Sized>(
     curve: &C,
     base: DVec2,
     dir: DVec2,
-) -> Result<f64, SolveError> {
+) -> Result<(f64, f64), SolveError> {
     let scale = curve.scale().max(f64::MIN_POSITIVE);
     let mut s = 0.0;
     let mut residual = f64::INFINITY;
@@ -371,7 +372,7 @@ fn newton_along<C: ImplicitCurve + ?Sized>(
         let g = curve.geometry(p);
         residual = g.c.abs();
         if newton_done(residual, scale, i == NEWTON_MAX_ITERATIONS) {
-            return Ok(s);
+            return Ok((s, g.c));
         }
         if i == NEWTON_MAX_ITERATIONS {
             break;
@@ -403,7 +404,7 @@ pub fn rattle<C: ImplicitCurve + ?Sized>(
     let n0 = curve.gradient(x0);
     nonsingular(n0, x0)?;
     let free = x0 + h * v0 + (h * h / (2.0 * mass)) * force.at(x0);
-    let s = newton_along(curve, free, n0)?;
+    let (s, c1) = newton_along(curve, free, n0)?;
     let x1 = free + s * n0;
     let lambda = 2.0 * mass * s / (h * h);
     let v_half = (x1 - x0) / h;
@@ -420,7 +421,7 @@ pub fn rattle<C: ImplicitCurve + ?Sized>(
         },
         lambda: 0.5 * (lambda + mu),
         constraint_force: 0.5 * (lambda * n0 + mu * n1),
-        c: curve.value(x1),
+        c: c1,
         c_dot: n1.dot(v1),
     })
 }

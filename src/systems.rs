@@ -20,10 +20,12 @@ pub type Wires<'w, 's> = Query<'w, 's, (&'static Wire, &'static WirePose)>;
 
 /// Runs `f` on every item of `query`: on the compute task pool when the
 /// query has at least `parallel.threshold` items, in this thread otherwise.
+/// The count is the iterator's upper bound: exact under archetype filters
+/// (`Without`), the matched tables' rows under `Changed`.
 macro_rules! for_each_bead {
     ($query:expr, $parallel:expr, $f:expr) => {{
         let f = $f;
-        if $query.iter().len() >= $parallel.threshold {
+        if $query.iter().size_hint().1.unwrap_or(usize::MAX) >= $parallel.threshold {
             $query.par_iter_mut().for_each(f);
         } else {
             $query.iter_mut().for_each(f);
@@ -328,18 +330,15 @@ pub fn write_transforms(
     parallel: Res<ParallelStep>,
     mut beads: Query<(&Bead, &mut Transform), Changed<Bead>>,
 ) {
-    let write = |(bead, mut transform): (&Bead, Mut<Transform>)| {
+    for_each_bead!(beads, parallel, |(bead, mut transform): (
+        &Bead,
+        Mut<Transform>
+    )| {
         if bead.position.is_finite() {
             transform.translation.x = bead.position.x as f32;
             transform.translation.y = bead.position.y as f32;
         }
-    };
-    // `Changed` is not an archetype filter, so the count is the beads' tables'.
-    if beads.as_readonly().iter().size_hint().1.unwrap_or(0) >= parallel.threshold {
-        beads.par_iter_mut().for_each(write);
-    } else {
-        beads.iter_mut().for_each(write);
-    }
+    });
 }
 
 fn step_config(params: &SimParams, mass: f64, wire_scale: f64) -> StepConfig {

@@ -11,7 +11,7 @@ use wirebead::solver::{self, BeadState, LinearForce, StepConfig};
 use wirebead::wire::{Circle, Placed, Pose};
 
 /// How the beads are put on wires.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Layout {
     /// Each bead on a circle of its own, the circles on a grid.
     OwnWires,
@@ -30,12 +30,22 @@ impl Layout {
 }
 
 /// How the plugin runs its loops.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Threads {
     /// One thread: single-threaded executor, [`ParallelStep::OFF`].
     Single,
     /// Bevy's default executor and [`ParallelStep::default`].
     Parallel,
+}
+
+impl Threads {
+    /// A short name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Single => "single",
+            Self::Parallel => "parallel",
+        }
+    }
 }
 
 /// The starting angle from the bottom of bead `i`: spread over ±120° so the

@@ -257,13 +257,14 @@ fn automation(
         let failure = format!("the scene preset {} never ran", active.path);
         state.failures.push(failure);
     }
-    if report().beads.is_empty() {
+    let last = report();
+    if last.beads.is_empty() {
         state
             .failures
             .push("there was no bead in the scene".to_owned());
     }
     if let Some(path) = state.config.report.clone()
-        && let Err(e) = write_report(&path, &report())
+        && let Err(e) = write_report(&path, &last)
     {
         state.failures.push(e);
     }
