@@ -3,6 +3,7 @@
 //!
 //! ```text
 //! cargo run --release --example many_beads -- --beads 1000000 --steps 20
+//! cargo run --release --example many_beads -- --memory --kind lean
 //! ```
 //!
 //! Prints the time per bead-step and the process's peak resident memory;
@@ -17,7 +18,7 @@ use clap::Parser;
 
 #[path = "../benches/support/mod.rs"]
 mod support;
-use support::{Layout, Threads, plugin_app};
+use support::{Kind, Layout, Threads, plugin_app};
 use wirebead::prelude::*;
 
 #[derive(Parser, Debug)]
@@ -35,6 +36,9 @@ struct Args {
     /// Single-threaded or parallel loops.
     #[arg(long, value_enum, default_value_t = Threads::Parallel)]
     threads: Threads,
+    /// Full beads (with Transform and diagnostics) or lean ones.
+    #[arg(long, value_enum, default_value_t = Kind::Full)]
+    kind: Kind,
     /// Measure bytes per bead: run with 0 and with N beads and compare peak RSS.
     #[arg(long)]
     memory: bool,
@@ -59,6 +63,7 @@ fn child_peak(args: &Args, beads: usize) -> Result<u64, String> {
         ])
         .args(["--layout", args.layout.name()])
         .args(["--threads", args.threads.name()])
+        .args(["--kind", args.kind.name()])
         .output()
         .map_err(|e| e.to_string())?;
     let text = String::from_utf8_lossy(&out.stdout);
@@ -78,8 +83,9 @@ fn main() -> ExitCode {
             (Ok(empty), Ok(full)) => {
                 let per_bead = (full.saturating_sub(empty)) as f64 / args.beads.max(1) as f64;
                 println!(
-                    "layout={} beads={} empty_app_peak_rss={empty} peak_rss={full} bytes_per_bead={per_bead:.1}",
+                    "layout={} kind={} beads={} empty_app_peak_rss={empty} peak_rss={full} bytes_per_bead={per_bead:.1}",
                     args.layout.name(),
+                    args.kind.name(),
                     args.beads
                 );
                 ExitCode::SUCCESS
@@ -90,7 +96,7 @@ fn main() -> ExitCode {
             }
         };
     }
-    let mut app = plugin_app(args.beads, args.layout, args.threads);
+    let mut app = plugin_app(args.beads, args.layout, args.threads, args.kind);
     let start = Instant::now();
     for _ in 0..args.steps {
         app.world_mut().run_schedule(FixedUpdate);

@@ -134,29 +134,35 @@ pub struct OnWire(pub Entity);
 pub struct WireBeads(Vec<Entity>);
 
 /// A bead: its applied parameters, its `f64` state, the external force
-/// accumulated for the current step and the last constraint force.
+/// accumulated for the next step and the last constraint multiplier.
 ///
 /// The position and velocity may be written directly (a game teleporting a
 /// bead); the step checks them and marks the bead [`Diverged`] rather than
 /// propagate a non-finite value.
+///
+/// With [`WireBeadPlugin`](crate::WireBeadPlugin)'s defaults a bead also gets
+/// a `Transform` (the plugin writes its position there) and
+/// [`BeadDiagnostics`]; [`WireBeadPlugin::lean`](crate::WireBeadPlugin::lean)
+/// leaves both out for crowds of beads nobody looks at one by one.
 #[derive(Component, Clone, Debug, PartialEq, Reflect)]
 #[reflect(Component)]
-#[require(Transform, BeadDiagnostics)]
 pub struct Bead {
     params: BeadParams,
     /// Position in world coordinates.
     pub position: DVec2,
     /// Velocity.
     pub velocity: DVec2,
-    /// The external force accumulated at `position` for this step.
+    /// The external force accumulated for the next step, gravity not
+    /// included (the step adds `m g` itself). The step consumes it: it is
+    /// zero again after every step.
     pub force: DVec2,
     /// The stiffness of that force (the sum of the spring constants in it):
     /// multi-stage integrators evaluate `force - force_stiffness (x - position)`.
+    /// Consumed with `force`.
     pub force_stiffness: f64,
-    /// λ of the last constraint solve.
+    /// λ of the last step (for RATTLE the mean of its position and velocity
+    /// multipliers).
     pub lambda: f64,
-    /// `λN` of the last step.
-    pub constraint_force: DVec2,
 }
 
 impl Bead {
@@ -164,15 +170,18 @@ impl Bead {
     /// parameters are valid.
     pub fn new(params: BeadParams) -> Result<Self, ParamError> {
         params.validate()?;
-        Ok(Self {
+        Ok(Self::initial(params))
+    }
+
+    fn initial(params: BeadParams) -> Self {
+        Self {
             params,
             position: params.initial_position,
             velocity: params.initial_velocity,
             force: DVec2::ZERO,
             force_stiffness: 0.0,
             lambda: 0.0,
-            constraint_force: DVec2::ZERO,
-        })
+        }
     }
 
     /// A bead of the given mass at rest at `position`.
@@ -202,13 +211,13 @@ impl Bead {
         }
     }
 
-    /// Adds a constant force for this step (call it from a system in
+    /// Adds a constant force for the next step (call it from a system in
     /// [`WireBeadSystems::Forces`](crate::WireBeadSystems::Forces)).
     pub fn add_force(&mut self, force: DVec2) {
         self.force += force;
     }
 
-    /// Adds a spring `k (anchor - x)` for this step.
+    /// Adds a spring `k (anchor - x)` for the next step.
     pub fn add_spring(&mut self, k: f64, anchor: DVec2) {
         self.force += k * (anchor - self.position);
         self.force_stiffness += k;
@@ -216,15 +225,7 @@ impl Bead {
 
     /// Applies `params` and returns the bead to its initial state.
     pub(crate) fn reset(&mut self, params: BeadParams) {
-        *self = Self {
-            params,
-            position: params.initial_position,
-            velocity: params.initial_velocity,
-            force: DVec2::ZERO,
-            force_stiffness: 0.0,
-            lambda: 0.0,
-            constraint_force: DVec2::ZERO,
-        };
+        *self = Self::initial(params);
     }
 }
 
@@ -249,7 +250,8 @@ impl DragTarget {
     }
 }
 
-/// Per-bead diagnostics, updated after every step.
+/// Per-bead diagnostics, updated after every step (on beads that have
+/// them: see [`WireBeadPlugin::lean`](crate::WireBeadPlugin::lean)).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
 #[reflect(Component)]
 pub struct BeadDiagnostics {
@@ -259,6 +261,9 @@ pub struct BeadDiagnostics {
     pub c_dot: f64,
     /// The constraint multiplier λ.
     pub lambda: f64,
+    /// The constraint force `λN` of the last step (for RATTLE the mean of
+    /// its two multipliers' forces).
+    pub constraint_force: DVec2,
     /// `½ m |v|²`.
     pub kinetic: f64,
     /// `-m g·x`.
@@ -305,6 +310,7 @@ impl fmt::Display for DivergenceReason {
 pub struct Diverged {
     /// Why.
     pub reason: DivergenceReason,
-    /// The simulated time at which it happened.
+    /// The simulated time ([`SimClock`](crate::SimClock)) at the end of the
+    /// step that found it.
     pub time: f64,
 }

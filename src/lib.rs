@@ -30,7 +30,7 @@
 //! | item | what it is |
 //! |---|---|
 //! | [`WireBeadPlugin`] | the simulation: components, parameters, the step in `FixedUpdate` |
-//! | [`WireBeadSystems`] | the step's chained sets: `Prepare → Forces → Solve → Integrate → Writeback` |
+//! | [`WireBeadSystems`] | the step's chained sets: `Prepare → Forces → Step → Writeback` |
 //! | [`Wire`], [`Bead`], [`OnWire`] | a wire placed by its `Transform`; a bead on it |
 //! | [`SimParams`], [`PendingParams`], [`PendingBead`] | applied and edited parameters; [`Restart`] applies the edits |
 //! | `gui::WireBeadGuiPlugin` | the windowed scene (feature `gui`): picking drag, egui panel, plots |
@@ -71,7 +71,7 @@ pub use controls::KeyboardControlsPlugin;
 pub use params::{
     BeadParams, Integrator, ParamError, PendingBead, PendingParams, SimParams, Stabilization,
 };
-pub use plugin::{BeadDiverged, ParallelStep, Restart, WireBeadPlugin, WireBeadSystems};
+pub use plugin::{BeadDiverged, ParallelStep, Restart, SimClock, WireBeadPlugin, WireBeadSystems};
 pub use preset::{ActivePreset, LoadPreset, ScenePreset, ScenePresetPlugin};
 pub use wire::{ImplicitCurve, WireShape};
 
@@ -80,8 +80,8 @@ pub mod prelude {
     pub use crate::{
         Bead, BeadDiagnostics, BeadDiverged, BeadParams, Diverged, DragTarget, ImplicitCurve,
         Integrator, KeyboardControlsPlugin, LoadPreset, OnWire, ParallelStep, PendingBead,
-        PendingParams, Restart, ScenePreset, ScenePresetPlugin, SimParams, Stabilization, Wire,
-        WireBeadPlugin, WireBeadSystems, WireBeads, WireShape,
+        PendingParams, Restart, ScenePreset, ScenePresetPlugin, SimClock, SimParams, Stabilization,
+        Wire, WireBeadPlugin, WireBeadSystems, WireBeads, WireShape,
     };
 }
 

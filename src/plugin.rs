@@ -14,18 +14,34 @@ use crate::systems;
 /// calling [`Bead::add_force`] or [`Bead::add_spring`].
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum WireBeadSystems {
-    /// Places each wire for the step and starts each bead's force
-    /// accumulator at its weight `m g` (gravity).
+    /// Places each wire for the step (reads its `Transform` once) and
+    /// advances the [`SimClock`].
     Prepare,
-    /// Accumulates the other external forces: the drag spring, the game's own.
+    /// Accumulates the external forces other than gravity: the drag spring,
+    /// the game's own.
     Forces,
-    /// Solves eq. 1.9 for each bead's constraint force.
-    Solve,
-    /// Advances each bead, applies post-stabilization, checks for divergence
-    /// and updates diagnostics.
-    Integrate,
+    /// Solves eq. 1.9 for each bead's constraint force under gravity plus
+    /// the accumulated forces, integrates, applies post-stabilization,
+    /// checks for divergence and updates diagnostics. One pass over the
+    /// beads: the solve and the integrators are separate pure functions in
+    /// [`solver`](crate::solver), but a second pass would read every bead
+    /// from memory again (RK4 and RATTLE solve at each of their stages
+    /// anyway).
+    Step,
     /// Writes each bead's `f64` position into its `Transform`.
     Writeback,
+}
+
+/// Simulated time since the last [`Restart`]: steps taken and seconds.
+/// Advanced in [`WireBeadSystems::Prepare`], so during a step it already
+/// reads the time the step reaches.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Reflect)]
+#[reflect(Resource)]
+pub struct SimClock {
+    /// Steps since the last restart.
+    pub steps: u64,
+    /// Seconds since the last restart.
+    pub time: f64,
 }
 
 /// Restarts the run: applies [`PendingParams`] and every [`PendingBead`],
@@ -91,21 +107,56 @@ pub struct BeadDiverged {
 
 /// Beads on wires: the simulation, headless. Add it to any app that has
 /// `Time` (`MinimalPlugins` or `DefaultPlugins`).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct WireBeadPlugin {
     params: SimParams,
+    extras: bool,
+}
+
+impl Default for WireBeadPlugin {
+    fn default() -> Self {
+        Self {
+            params: SimParams::default(),
+            extras: true,
+        }
+    }
 }
 
 impl WireBeadPlugin {
     /// The plugin with the given initial parameters, if they are valid.
     pub fn new(params: SimParams) -> Result<Self, ParamError> {
         params.validate()?;
-        Ok(Self { params })
+        Ok(Self {
+            params,
+            ..Self::default()
+        })
+    }
+
+    /// Lean beads: a [`Bead`] no longer brings a `Transform` (with its
+    /// `GlobalTransform`) and [`BeadDiagnostics`] along. For crowds of
+    /// beads: a lean bead takes about a third of the memory and steps
+    /// faster. A bead given either component explicitly still has it kept
+    /// up to date, so a game can render or watch a few of many.
+    pub fn lean(self) -> Self {
+        Self {
+            extras: false,
+            ..self
+        }
     }
 }
 
 impl Plugin for WireBeadPlugin {
     fn build(&self, app: &mut App) {
+        if self.extras {
+            for registered in [
+                app.try_register_required_components::<Bead, Transform>(),
+                app.try_register_required_components::<Bead, BeadDiagnostics>(),
+            ] {
+                if let Err(err) = registered {
+                    warn!("wirebead: could not give beads their Transform and diagnostics: {err}");
+                }
+            }
+        }
         if !app.world().contains_resource::<SimParams>() {
             app.insert_resource(self.params.clone());
         }
@@ -117,6 +168,7 @@ impl Plugin for WireBeadPlugin {
         }
         app.insert_resource(pending)
             .init_resource::<ParallelStep>()
+            .init_resource::<SimClock>()
             .add_message::<Restart>()
             .add_message::<BeadDiverged>()
             .register_type::<Bead>()
@@ -125,14 +177,14 @@ impl Plugin for WireBeadPlugin {
             .register_type::<PendingBead>()
             .register_type::<SimParams>()
             .register_type::<ParallelStep>()
+            .register_type::<SimClock>()
             .register_type::<PendingParams>()
             .configure_sets(
                 FixedUpdate,
                 (
                     WireBeadSystems::Prepare,
                     WireBeadSystems::Forces,
-                    WireBeadSystems::Solve,
-                    WireBeadSystems::Integrate,
+                    WireBeadSystems::Step,
                     WireBeadSystems::Writeback,
                 )
                     .chain(),
@@ -144,8 +196,7 @@ impl Plugin for WireBeadPlugin {
                 (
                     systems::prepare_step.in_set(WireBeadSystems::Prepare),
                     systems::apply_drag.in_set(WireBeadSystems::Forces),
-                    systems::solve_constraints.in_set(WireBeadSystems::Solve),
-                    systems::integrate.in_set(WireBeadSystems::Integrate),
+                    systems::step_beads.in_set(WireBeadSystems::Step),
                     systems::write_transforms.in_set(WireBeadSystems::Writeback),
                 ),
             );

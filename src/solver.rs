@@ -212,7 +212,7 @@ fn nonsingular(normal: DVec2, x: DVec2) -> Result<f64, SolveError> {
 }
 
 /// λ of eq. 1.9 at a point whose geometry is `g`.
-#[inline]
+#[inline(always)]
 pub fn lambda(
     g: &Geometry,
     x: DVec2,
@@ -228,7 +228,7 @@ pub fn lambda(
 }
 
 /// Solves eq. 1.9 at `state` and returns λ, `λN` and the acceleration.
-#[inline]
+#[inline(always)]
 pub fn solve<C: ImplicitCurve + ?Sized>(
     curve: &C,
     state: BeadState,
@@ -248,14 +248,15 @@ pub fn solve<C: ImplicitCurve + ?Sized>(
     Ok(Solved {
         lambda,
         constraint_force,
-        acceleration: (f + constraint_force) / mass,
+        // The reciprocal does not wait for λ; a division here would.
+        acceleration: (f + constraint_force) * mass.recip(),
     })
 }
 
 /// Advances one step from `state`, given `first`, the solve at `state`
 /// (what [`solve`] returns with the config's gains). Post-stabilization is
 /// applied when configured.
-#[inline]
+#[inline(always)]
 pub fn integrate<C: ImplicitCurve + ?Sized>(
     curve: &C,
     state: BeadState,
@@ -346,6 +347,7 @@ pub fn integrate<C: ImplicitCurve + ?Sized>(
 }
 
 /// [`solve`] then [`integrate`]: one whole step.
+#[inline(always)]
 pub fn step<C: ImplicitCurve + ?Sized>(
     curve: &C,
     state: BeadState,
@@ -355,6 +357,155 @@ pub fn step<C: ImplicitCurve + ?Sized>(
     let (alpha, beta) = cfg.gains();
     let first = solve(curve, state, force, cfg.mass, alpha, beta)?;
     integrate(curve, state, force, &first, cfg)
+}
+
+/// How many beads [`euler_on_circles`] steps at once.
+pub const LANES: usize = 8;
+
+/// [`LANES`] beads on circles, as arrays of their scalars (one entry per
+/// bead), the layout the batched step vectorizes over.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CircleLanes {
+    /// Position x.
+    pub x: [f64; LANES],
+    /// Position y.
+    pub y: [f64; LANES],
+    /// Velocity x.
+    pub vx: [f64; LANES],
+    /// Velocity y.
+    pub vy: [f64; LANES],
+    /// External force x at the position.
+    pub fx: [f64; LANES],
+    /// External force y at the position.
+    pub fy: [f64; LANES],
+    /// Mass.
+    pub mass: [f64; LANES],
+    /// The circle's centre, x.
+    pub ox: [f64; LANES],
+    /// The circle's centre, y.
+    pub oy: [f64; LANES],
+    /// The circle's radius.
+    pub radius: [f64; LANES],
+}
+
+impl CircleLanes {
+    /// Puts bead `lane`'s state, force, mass and circle in place.
+    #[inline(always)]
+    pub fn set(
+        &mut self,
+        lane: usize,
+        state: BeadState,
+        force: DVec2,
+        mass: f64,
+        centre: DVec2,
+        radius: f64,
+    ) {
+        (self.x[lane], self.y[lane]) = (state.position.x, state.position.y);
+        (self.vx[lane], self.vy[lane]) = (state.velocity.x, state.velocity.y);
+        (self.fx[lane], self.fy[lane]) = (force.x, force.y);
+        self.mass[lane] = mass;
+        (self.ox[lane], self.oy[lane]) = (centre.x, centre.y);
+        self.radius[lane] = radius;
+    }
+}
+
+/// Runs `$body` once per lane, as a loop the compiler turns into vector
+/// instructions.
+macro_rules! lanes {
+    ($i:ident => $body:expr) => {
+        for $i in 0..LANES {
+            $body;
+        }
+    };
+}
+
+/// The explicit or semi-implicit Euler step of eq. 1.9 (with the config's
+/// gains: Baumgarte or none) for [`LANES`] beads on unrotated
+/// [`Circle`](crate::wire::Circle)s at once.
+///
+/// It performs the operations of [`step`] on a
+/// [`Placed`](crate::wire::Placed) circle in the same order, lane by lane,
+/// so each lane's result is bit for bit what [`step`] returns; what differs
+/// is that the square roots and divisions of four beads run side by side
+/// instead of one after another. A lane the batch cannot finish (a
+/// non-finite state, the circle's centre, a step past the drift bound)
+/// comes back `None`: take that bead through [`step`], which reports why.
+/// `cfg.mass` is unused (each lane has its own); the force must be constant
+/// over the step (true of any [`LinearForce`] for one-stage integrators).
+#[inline(always)]
+pub fn euler_on_circles(
+    b: &CircleLanes,
+    cfg: &StepConfig,
+    bound_per_radius: f64,
+) -> [Option<StepOutput>; LANES] {
+    let h = cfg.dt;
+    let (alpha, beta) = cfg.gains();
+    let semi_implicit = cfg.integrator == Integrator::SemiImplicitEuler;
+    let z = [0.0; LANES];
+    let (mut len, mut inv, mut nx, mut ny, mut lambda) = (z, z, z, z, z);
+    let (mut ax, mut ay, mut x1, mut y1, mut vx1, mut vy1) = (z, z, z, z, z, z);
+    let (mut len1, mut c1, mut cdot1, mut nn) = (z, z, z, z);
+    // Circle::geometry at x0, after Placed's translation.
+    lanes!(i => {
+        let (px, py) = (b.x[i] - b.ox[i], b.y[i] - b.oy[i]);
+        len[i] = (px * px + py * py).sqrt();
+        inv[i] = 1.0 / len[i];
+        (nx[i], ny[i]) = (px * inv[i], py * inv[i]);
+    });
+    // λ of eq. 1.9, with H = (I - n nᵀ)/|x| as Circle::geometry builds it.
+    lanes!(i => {
+        let (h00, h10) = ((1.0 - nx[i] * nx[i]) * inv[i], (-nx[i] * ny[i]) * inv[i]);
+        let (h01, h11) = ((-nx[i] * ny[i]) * inv[i], (1.0 - ny[i] * ny[i]) * inv[i]);
+        let (vx, vy) = (b.vx[i], b.vy[i]);
+        let (hvx, hvy) = (h00 * vx + h01 * vy, h10 * vx + h11 * vy);
+        let vhv = vx * hvx + vy * hvy;
+        let c = len[i] - b.radius[i];
+        let m = b.mass[i];
+        nn[i] = nx[i] * nx[i] + ny[i] * ny[i];
+        let ndv = nx[i] * vx + ny[i] * vy;
+        let ndf = nx[i] * b.fx[i] + ny[i] * b.fy[i];
+        lambda[i] = (-m * vhv - m * alpha * c - m * beta * ndv - ndf) / nn[i];
+    });
+    // The acceleration and the Euler update.
+    lanes!(i => {
+        let inv_m = b.mass[i].recip();
+        ax[i] = (b.fx[i] + lambda[i] * nx[i]) * inv_m;
+        ay[i] = (b.fy[i] + lambda[i] * ny[i]) * inv_m;
+        (vx1[i], vy1[i]) = (b.vx[i] + h * ax[i], b.vy[i] + h * ay[i]);
+        let (ux, uy) = if semi_implicit { (vx1[i], vy1[i]) } else { (b.vx[i], b.vy[i]) };
+        (x1[i], y1[i]) = (b.x[i] + h * ux, b.y[i] + h * uy);
+    });
+    // C and Ċ at the new state.
+    lanes!(i => {
+        let (px, py) = (x1[i] - b.ox[i], y1[i] - b.oy[i]);
+        len1[i] = (px * px + py * py).sqrt();
+        let k = 1.0 / len1[i];
+        c1[i] = len1[i] - b.radius[i];
+        cdot1[i] = (px * k) * vx1[i] + (py * k) * vy1[i];
+    });
+    // Which lanes finished as `step` would: `&`, not `&&`, so the checks
+    // vectorize too.
+    let mut fine = [false; LANES];
+    lanes!(i => {
+        let finite = |v: f64| v.is_finite();
+        let states = finite(b.x[i]) & finite(b.y[i]) & finite(b.vx[i]) & finite(b.vy[i]);
+        let ends = finite(x1[i]) & finite(y1[i]) & finite(vx1[i]) & finite(vy1[i]);
+        let regular = (len[i] != 0.0) & finite(nn[i]) & (nn[i] > 1e-24) & (len1[i] != 0.0);
+        let bounded = c1[i].abs() <= bound_per_radius * b.radius[i];
+        fine[i] = states & ends & regular & bounded;
+    });
+    std::array::from_fn(|i| {
+        fine[i].then(|| StepOutput {
+            state: BeadState {
+                position: DVec2::new(x1[i], y1[i]),
+                velocity: DVec2::new(vx1[i], vy1[i]),
+            },
+            lambda: lambda[i],
+            constraint_force: DVec2::new(lambda[i] * nx[i], lambda[i] * ny[i]),
+            c: c1[i],
+            c_dot: cdot1[i],
+        })
+    })
 }
 
 /// Newton's method on `s ↦ C(base + s dir)`, returning the root `s` and the
@@ -496,6 +647,97 @@ mod tests {
             stabilization,
             drift_bound: 1.0,
         }
+    }
+
+    #[test]
+    fn batched_euler_on_circles_is_bit_identical_to_step() {
+        // Beads in all directions, at all speeds, on circles of different
+        // sizes and centres, with a spring's stiffness on some.
+        let bound = 0.5;
+        for integrator in [Integrator::ExplicitEuler, Integrator::SemiImplicitEuler] {
+            for stabilization in [Stabilization::Baumgarte, Stabilization::None] {
+                let mut batch_cfg = cfg(integrator, stabilization, 1.0 / 60.0);
+                batch_cfg.mass = f64::NAN; // each lane has its own
+                for k in 0..50 {
+                    let mut lanes = CircleLanes::default();
+                    let mut inputs = Vec::new();
+                    for lane in 0..LANES {
+                        let j = (k * LANES + lane) as f64;
+                        let radius = 0.5 + (j * 0.37) % 3.0;
+                        let centre = DVec2::new((j * 1.3) % 5.0 - 2.5, (j * 0.7) % 4.0 - 2.0);
+                        let angle = j * 0.91;
+                        let off = 1.0 + 0.02 * ((j * 0.13).sin());
+                        let state = BeadState {
+                            position: centre + radius * off * DVec2::from_angle(angle),
+                            velocity: DVec2::new((j * 0.29).sin(), (j * 0.41).cos()) * 4.0,
+                        };
+                        let mass = 0.3 + (j * 0.17) % 2.0;
+                        let force = LinearForce {
+                            force: mass * G + DVec2::new(j % 3.0, -(j % 2.0)),
+                            stiffness: j % 4.0,
+                            at: state.position,
+                        };
+                        lanes.set(lane, state, force.at(state.position), mass, centre, radius);
+                        inputs.push((state, force, mass, centre, radius));
+                    }
+                    let outs = euler_on_circles(&lanes, &batch_cfg, bound);
+                    for (out, (state, force, mass, centre, radius)) in outs.iter().zip(inputs) {
+                        let placed = Placed {
+                            curve: &Circle { radius },
+                            pose: Pose::new(centre, 0.0),
+                        };
+                        let cfg = StepConfig {
+                            mass,
+                            drift_bound: bound * radius,
+                            ..batch_cfg
+                        };
+                        let expected = step(&placed, state, &force, &cfg).unwrap();
+                        let out = out.expect("an ordinary lane");
+                        let bits = |o: &StepOutput| {
+                            [o.state.position, o.state.velocity, o.constraint_force]
+                                .map(|v| v.to_array().map(f64::to_bits))
+                        };
+                        assert_eq!(
+                            bits(&out),
+                            bits(&expected),
+                            "{integrator} {stabilization} lane {k}"
+                        );
+                        for (a, b) in [
+                            (out.lambda, expected.lambda),
+                            (out.c, expected.c),
+                            (out.c_dot, expected.c_dot),
+                        ] {
+                            assert_eq!(a.to_bits(), b.to_bits());
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn batched_euler_hands_back_the_lanes_it_cannot_finish() {
+        let centre = DVec2::new(1.0, 2.0);
+        let mut lanes = CircleLanes::default();
+        let at = |angle: f64| centre + DVec2::from_angle(angle);
+        let states = [
+            (at(0.3), DVec2::new(1.0, 0.0)),      // ordinary
+            (centre, DVec2::ZERO),                // the singular centre
+            (at(1.0), DVec2::new(f64::NAN, 0.0)), // not finite
+            (at(2.0), DVec2::new(1e6, 0.0)),      // flung past the bound
+        ];
+        for (lane, (position, velocity)) in states.into_iter().enumerate() {
+            let state = BeadState { position, velocity };
+            lanes.set(lane, state, G, 1.0, centre, 1.0);
+        }
+        let cfg = cfg(
+            Integrator::SemiImplicitEuler,
+            Stabilization::Baumgarte,
+            0.01,
+        );
+        let outs = euler_on_circles(&lanes, &cfg, 1.0);
+        assert!(outs[0].is_some());
+        assert!(outs[1..].iter().all(Option::is_none), "{outs:?}");
     }
 
     #[test]

@@ -3,16 +3,19 @@
 
 use std::sync::{Mutex, PoisonError};
 
+use bevy::ecs::change_detection::ContiguousMut;
 use bevy::ecs::system::SystemParam;
+use bevy::math::DVec2;
 use bevy::prelude::*;
+use bevy::tasks::ComputeTaskPool;
 
 use crate::components::{
     Bead, BeadDiagnostics, Diverged, DivergenceReason, DragTarget, OnWire, PendingWire, Wire,
     WirePose,
 };
-use crate::params::{PendingBead, PendingParams, SimParams};
-use crate::plugin::{BeadDiverged, ParallelStep, Restart};
-use crate::solver::{self, LinearForce, SolveError, Solved, StepConfig};
+use crate::params::{Integrator, PendingBead, PendingParams, SimParams, Stabilization};
+use crate::plugin::{BeadDiverged, ParallelStep, Restart, SimClock};
+use crate::solver::{self, LinearForce, StepConfig};
 use crate::wire::{ImplicitCurve, Placed, Pose, WireShape};
 
 /// Read access to every wire and its placement for this step.
@@ -105,11 +108,12 @@ pub fn apply_restart(
     pending: Res<PendingParams>,
     mut params: ResMut<SimParams>,
     mut time: ResMut<Time<Fixed>>,
+    mut clock: ResMut<SimClock>,
     mut wires: Query<(Entity, &mut Wire, &Transform, Option<&PendingWire>)>,
     mut beads: Query<(
         Entity,
         &mut Bead,
-        &mut BeadDiagnostics,
+        Option<&mut BeadDiagnostics>,
         Option<&OnWire>,
         Option<&PendingBead>,
     )>,
@@ -128,9 +132,14 @@ pub fn apply_restart(
     time.set_timestep_seconds(params.timestep);
     let overstep = time.overstep();
     time.discard_overstep(overstep);
-    for (entity, mut bead, mut diagnostics, on_wire, edit) in &mut beads {
+    *clock = SimClock::default();
+    for (entity, mut bead, diagnostics, on_wire, edit) in &mut beads {
         let bead_params = edit.map_or(*bead.params(), |p| *p.get());
         bead.reset(bead_params);
+        commands.entity(entity).remove::<(Diverged, PendingBead)>();
+        let Some(mut diagnostics) = diagnostics else {
+            continue;
+        };
         let wire = on_wire.and_then(|on| wires.get(on.0).ok());
         *diagnostics = match wire.map(|(_, w, t, _)| (w, Pose::from_transform(t))) {
             Some((wire, Ok(pose))) => {
@@ -142,28 +151,21 @@ pub fn apply_restart(
             }
             _ => BeadDiagnostics::default(),
         };
-        commands.entity(entity).remove::<(Diverged, PendingBead)>();
     }
 }
 
 /// Prepares the step: places every wire (reads each changed wire
-/// `Transform` once, so the beads do not) and starts each bead's force
-/// accumulator at its weight `m g` (gravity), with no stiffness. One system,
-/// so a multi-threaded executor wakes a thread once for both.
+/// `Transform` once, so the beads do not) and advances the [`SimClock`].
 pub fn prepare_step(
     params: Res<SimParams>,
-    parallel: Res<ParallelStep>,
+    mut clock: ResMut<SimClock>,
     mut wires: Query<(&Transform, &mut WirePose), Changed<Transform>>,
-    mut beads: Query<&mut Bead, Without<Diverged>>,
 ) {
     for (transform, mut pose) in &mut wires {
         *pose = WirePose::from_transform(transform);
     }
-    let gravity = params.gravity;
-    for_each_bead!(beads, parallel, |mut bead: Mut<Bead>| {
-        bead.force = bead.mass() * gravity;
-        bead.force_stiffness = 0.0;
-    });
+    clock.steps += 1;
+    clock.time += params.timestep;
 }
 
 /// Adds the seed's drag spring `k (target - x)` to dragged beads.
@@ -205,122 +207,271 @@ pub fn wire_of<'a>(wires: &'a Wires, on: &OnWire) -> Result<(&'a Wire, Pose), Di
     Ok((wire, pose))
 }
 
-/// Eq. 1.9 for one bead: stores λ and `λN`.
-fn solve_bead<C: ImplicitCurve + ?Sized>(
-    placed: &Placed<C>,
-    bead: &mut Bead,
-    alpha: f64,
-    beta: f64,
-) -> Result<(), DivergenceReason> {
-    if !bead.state().is_finite() {
-        return Err(DivergenceReason::NonFiniteState);
+/// The wire a bead's last neighbour was on and its pose, kept per thread:
+/// beads sharing a wire are stored together, so most of them skip the
+/// lookup. (A copy, not a borrow: the compute pool's tasks outlive borrows.)
+type WireCache = Option<(Entity, Result<(WireShape, Pose), DivergenceReason>)>;
+
+fn cached_wire<'c>(
+    cache: &'c mut WireCache,
+    wires: &Wires,
+    on: &OnWire,
+) -> &'c Result<(WireShape, Pose), DivergenceReason> {
+    match cache {
+        Some((entity, _)) if *entity == on.0 => {}
+        _ => {
+            let found = wire_of(wires, on).map(|(wire, pose)| (wire.shape().clone(), pose));
+            *cache = Some((on.0, found));
+        }
     }
-    let force = force_of(bead);
-    let solved = solver::solve(placed, bead.state(), &force, bead.mass(), alpha, beta)
-        .map_err(DivergenceReason::Solve)?;
-    bead.lambda = solved.lambda;
-    bead.constraint_force = solved.constraint_force;
-    Ok(())
+    &cache.as_ref().expect("filled above").1
 }
 
-/// One step of one bead and its new diagnostics.
-fn integrate_bead<C: ImplicitCurve + ?Sized>(
-    placed: &Placed<C>,
-    bead: &mut Bead,
-    diagnostics: &mut BeadDiagnostics,
-    params: &SimParams,
-) -> Result<(), SolveError> {
-    let cfg = step_config(params, bead.mass(), placed.scale());
-    let force = force_of(bead);
-    let first = Solved {
-        lambda: bead.lambda,
-        constraint_force: bead.constraint_force,
-        acceleration: (bead.force + bead.constraint_force) / bead.mass(),
-    };
-    let out = solver::integrate(placed, bead.state(), &force, &first, &cfg)?;
-    bead.position = out.state.position;
-    bead.velocity = out.state.velocity;
-    bead.lambda = out.lambda;
-    bead.constraint_force = out.constraint_force;
-    let (kinetic, potential) = solver::energy(bead.mass(), params.gravity, out.state);
-    *diagnostics = BeadDiagnostics {
-        c: out.c,
-        c_dot: out.c_dot,
-        lambda: out.lambda,
-        kinetic,
-        potential,
-        steps: diagnostics.steps + 1,
-        time: diagnostics.time + params.timestep,
-    };
-    Ok(())
+/// What stepping a run of beads needs, shared by the threads.
+struct StepContext<'a, 'w, 's> {
+    params: &'a SimParams,
+    wires: &'a Wires<'w, 's>,
+    found: &'a Found,
+    time: f64,
+    /// The step's config when it is one [`solver::euler_on_circles`] takes.
+    batch: Option<StepConfig>,
 }
 
-/// Solves eq. 1.9 for each bead and stores λ and `λN`.
-pub fn solve_constraints(
-    params: Res<SimParams>,
-    parallel: Res<ParallelStep>,
-    wires: Wires,
-    mut beads: Query<(Entity, &mut Bead, &OnWire, &BeadDiagnostics), Without<Diverged>>,
-    mut found: Local<Found>,
-    mut divergences: Divergences,
-) {
-    let (alpha, beta) = step_config(&params, 1.0, 1.0).gains();
-    let (wires, found_ref) = (&wires, &*found);
-    for_each_bead!(beads, parallel, |(
-        entity,
-        mut bead,
-        on_wire,
-        diagnostics,
-    ): (
-        Entity,
-        Mut<Bead>,
-        &OnWire,
-        &BeadDiagnostics
-    )| {
-        let result = wire_of(wires, on_wire).and_then(|(wire, pose)| {
-            with_curve!(wire.shape(), curve => {
-                solve_bead(&Placed { curve, pose }, &mut bead, alpha, beta)
-            })
-        });
-        if let Err(reason) = result {
-            found_ref.push(entity, reason, diagnostics.time);
+impl StepContext<'_, '_, '_> {
+    /// Steps a run of beads stored side by side (`diagnostics`, when
+    /// present, lines up with `beads`). Beads on unrotated circles go
+    /// through the batched step, [`solver::LANES`] at a time, when the
+    /// config allows; the others, and the lanes it hands back, one by one.
+    fn step_run(
+        &self,
+        entities: &[Entity],
+        beads: &mut [Bead],
+        on_wires: &[OnWire],
+        mut diagnostics: Option<&mut [BeadDiagnostics]>,
+    ) {
+        let mut cache = WireCache::None;
+        let mut lanes = solver::CircleLanes::default();
+        let mut waiting = [0; solver::LANES];
+        let mut queued = 0;
+        for i in 0..beads.len() {
+            let wire = cached_wire(&mut cache, self.wires, &on_wires[i]);
+            if let (Some(cfg), Ok((WireShape::Circle(circle), pose))) = (&self.batch, wire)
+                && pose.rotation == DVec2::X
+            {
+                let bead = &beads[i];
+                let mass = bead.mass();
+                let force = self.force_on(bead).at(bead.position);
+                lanes.set(
+                    queued,
+                    bead.state(),
+                    force,
+                    mass,
+                    pose.origin,
+                    circle.radius,
+                );
+                waiting[queued] = i;
+                queued += 1;
+                if queued == solver::LANES {
+                    let bound = self.params.divergence_bound;
+                    let outs = solver::euler_on_circles(&lanes, cfg, bound);
+                    for (&j, out) in waiting.iter().zip(outs) {
+                        let diagnostics = diagnostics.as_deref_mut().map(|d| &mut d[j]);
+                        match out {
+                            Some(out) => self.finish(&mut beads[j], diagnostics, out),
+                            None => self.step_one(
+                                entities[j],
+                                &mut beads[j],
+                                diagnostics,
+                                &mut cache,
+                                &on_wires[j],
+                            ),
+                        }
+                    }
+                    queued = 0;
+                }
+                continue;
+            }
+            let diagnostics = diagnostics.as_deref_mut().map(|d| &mut d[i]);
+            self.step_one(
+                entities[i],
+                &mut beads[i],
+                diagnostics,
+                &mut cache,
+                &on_wires[i],
+            );
         }
-    });
-    found.report(&mut divergences);
-}
+        for &j in &waiting[..queued] {
+            let diagnostics = diagnostics.as_deref_mut().map(|d| &mut d[j]);
+            self.step_one(
+                entities[j],
+                &mut beads[j],
+                diagnostics,
+                &mut cache,
+                &on_wires[j],
+            );
+        }
+    }
 
-/// Advances each bead one step, checks it, and updates its diagnostics.
-pub fn integrate(
-    params: Res<SimParams>,
-    parallel: Res<ParallelStep>,
-    wires: Wires,
-    mut beads: Query<(Entity, &mut Bead, &OnWire, &mut BeadDiagnostics), Without<Diverged>>,
-    mut found: Local<Found>,
-    mut divergences: Divergences,
-) {
-    let (params, wires, found_ref) = (&*params, &wires, &*found);
-    for_each_bead!(beads, parallel, |(
-        entity,
-        mut bead,
-        on_wire,
-        mut diagnostics,
-    ): (
-        Entity,
-        Mut<Bead>,
-        &OnWire,
-        Mut<BeadDiagnostics>
-    )| {
-        let Ok((wire, pose)) = wire_of(wires, on_wire) else {
-            return; // reported by solve_constraints
+    /// Gravity plus the accumulated force, linearized at the bead.
+    fn force_on(&self, bead: &Bead) -> LinearForce {
+        LinearForce {
+            force: bead.force + bead.mass() * self.params.gravity,
+            stiffness: bead.force_stiffness,
+            at: bead.position,
+        }
+    }
+
+    /// One bead through [`solver::step`]; a failure is recorded.
+    fn step_one(
+        &self,
+        entity: Entity,
+        bead: &mut Bead,
+        diagnostics: Option<&mut BeadDiagnostics>,
+        cache: &mut WireCache,
+        on_wire: &OnWire,
+    ) {
+        let result = match cached_wire(cache, self.wires, on_wire) {
+            Err(reason) => Err(reason.clone()),
+            Ok((shape, pose)) => with_curve!(shape, curve => {
+                self.step_bead(&Placed { curve, pose: *pose }, bead)
+            }),
         };
-        let result = with_curve!(wire.shape(), curve => {
-            integrate_bead(&Placed { curve, pose }, &mut bead, &mut diagnostics, params)
-        });
-        if let Err(e) = result {
-            let time = diagnostics.time + params.timestep;
-            found_ref.push(entity, DivergenceReason::Solve(e), time);
+        match result {
+            Ok(out) => self.finish(bead, diagnostics, out),
+            Err(reason) => self.found.push(entity, reason, self.time),
         }
-    });
+    }
+
+    /// Eq. 1.9 and the integrator for one bead.
+    fn step_bead<C: ImplicitCurve + ?Sized>(
+        &self,
+        placed: &Placed<C>,
+        bead: &Bead,
+    ) -> Result<solver::StepOutput, DivergenceReason> {
+        let state = bead.state();
+        if !state.is_finite() {
+            return Err(DivergenceReason::NonFiniteState);
+        }
+        let cfg = step_config(self.params, bead.mass(), placed.scale());
+        solver::step(placed, state, &self.force_on(bead), &cfg).map_err(DivergenceReason::Solve)
+    }
+
+    /// Stores a step's result: the new state, λ, the consumed force, the
+    /// diagnostics.
+    #[inline(always)]
+    fn finish(
+        &self,
+        bead: &mut Bead,
+        diagnostics: Option<&mut BeadDiagnostics>,
+        out: solver::StepOutput,
+    ) {
+        bead.position = out.state.position;
+        bead.velocity = out.state.velocity;
+        bead.lambda = out.lambda;
+        bead.force = DVec2::ZERO;
+        bead.force_stiffness = 0.0;
+        if let Some(diagnostics) = diagnostics {
+            let (kinetic, potential) = solver::energy(bead.mass(), self.params.gravity, out.state);
+            *diagnostics = BeadDiagnostics {
+                c: out.c,
+                c_dot: out.c_dot,
+                lambda: out.lambda,
+                constraint_force: out.constraint_force,
+                kinetic,
+                potential,
+                steps: diagnostics.steps + 1,
+                time: diagnostics.time + self.params.timestep,
+            };
+        }
+    }
+}
+
+/// A run of beads stored side by side, with their entities, wires and
+/// (when they have them) diagnostics.
+type Run<'w> = (
+    &'w [Entity],
+    &'w mut [Bead],
+    &'w [OnWire],
+    Option<&'w mut [BeadDiagnostics]>,
+);
+
+/// Cuts one table's beads into runs of about a quarter of each thread's
+/// share, so a slow thread does not hold the others up. Marks the beads
+/// and diagnostics changed.
+fn split_table<'w>(
+    (entities, beads, on_wires, diagnostics): (
+        &'w [Entity],
+        ContiguousMut<'w, Bead>,
+        &'w [OnWire],
+        Option<ContiguousMut<'w, BeadDiagnostics>>,
+    ),
+    threads: usize,
+) -> Vec<Run<'w>> {
+    let n = entities.len().div_ceil(4 * threads).max(1);
+    let beads = ContiguousMut::split(beads).0;
+    let diagnostics = diagnostics.map(|d| ContiguousMut::split(d).0);
+    let diagnostic_runs = diagnostics
+        .into_iter()
+        .flat_map(|d| d.chunks_mut(n).map(Some))
+        .chain(std::iter::repeat_with(|| None));
+    entities
+        .chunks(n)
+        .zip(beads.chunks_mut(n))
+        .zip(on_wires.chunks(n))
+        .zip(diagnostic_runs)
+        .map(|(((e, b), o), d)| (e, b, o, d))
+        .collect()
+}
+
+/// Steps every bead that has not diverged: solve, integrate, check, update
+/// diagnostics (see [`WireBeadSystems::Step`](crate::WireBeadSystems::Step)).
+/// Walks the beads table by table as slices, split over the compute task
+/// pool from [`ParallelStep::threshold`] beads up.
+pub fn step_beads(
+    params: Res<SimParams>,
+    clock: Res<SimClock>,
+    parallel: Res<ParallelStep>,
+    wires: Wires,
+    mut beads: Query<(Entity, &mut Bead, &OnWire, Option<&mut BeadDiagnostics>), Without<Diverged>>,
+    mut found: Local<Found>,
+    mut divergences: Divergences,
+) {
+    let batch = step_config(&params, 1.0, 1.0);
+    let eulerian = matches!(
+        batch.integrator,
+        Integrator::ExplicitEuler | Integrator::SemiImplicitEuler
+    ) && batch.stabilization != Stabilization::Projection;
+    let ctx = StepContext {
+        params: &params,
+        wires: &wires,
+        found: &found,
+        time: clock.time,
+        batch: eulerian.then_some(batch),
+    };
+    let count = beads.iter().size_hint().1.unwrap_or(usize::MAX);
+    let pool = ComputeTaskPool::try_get().filter(|_| count >= parallel.threshold);
+    let threads = pool.map_or(1, |pool| pool.thread_num().max(1));
+    let Ok(tables) = beads.contiguous_iter_mut() else {
+        error!("wirebead: the bead query is not table-dense; no bead was stepped");
+        return;
+    };
+    let split = |table| split_table(table, threads);
+    match pool {
+        Some(pool) if threads > 1 => {
+            pool.scope(|scope| {
+                for (entities, beads, on_wires, diagnostics) in tables.flat_map(split) {
+                    let ctx = &ctx;
+                    scope
+                        .spawn(async move { ctx.step_run(entities, beads, on_wires, diagnostics) });
+                }
+            });
+        }
+        _ => {
+            for (entities, beads, on_wires, diagnostics) in tables.flat_map(split) {
+                ctx.step_run(entities, beads, on_wires, diagnostics);
+            }
+        }
+    };
     found.report(&mut divergences);
 }
 
@@ -350,13 +501,5 @@ fn step_config(params: &SimParams, mass: f64, wire_scale: f64) -> StepConfig {
         integrator: params.integrator,
         stabilization: params.stabilization,
         drift_bound: params.divergence_bound * wire_scale,
-    }
-}
-
-fn force_of(bead: &Bead) -> LinearForce {
-    LinearForce {
-        force: bead.force,
-        stiffness: bead.force_stiffness,
-        at: bead.position,
     }
 }

@@ -1,5 +1,5 @@
 //! The parallel step gives bit-for-bit the sequential step's result, and
-//! reports the same divergences.
+//! reports the same divergences; so do lean beads.
 
 use std::time::Duration;
 
@@ -13,13 +13,13 @@ const BEADS_PER_WIRE: usize = 1500;
 /// Four wires of different shapes, moved and rotated, 1,500 beads on each
 /// spread along it with different speeds, plus beads at the circle's centre
 /// (a singular point). Returns the app and the beads in spawn order.
-fn scene(parallel: ParallelStep) -> (App, Vec<Entity>) {
+fn scene(parallel: ParallelStep, plugin: WireBeadPlugin) -> (App, Vec<Entity>) {
     let mut app = App::new();
     app.add_plugins((
         MinimalPlugins.set(TaskPoolPlugin {
             task_pool_options: wirebead::plugin::compute_on_all_cores(),
         }),
-        WireBeadPlugin::default(),
+        plugin,
     ))
     .insert_resource(parallel)
     .insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
@@ -94,48 +94,93 @@ fn scene(parallel: ParallelStep) -> (App, Vec<Entity>) {
     (app, beads)
 }
 
-#[test]
-fn parallel_step_matches_sequential_bit_for_bit() {
-    let (mut sequential, seq_beads) = scene(ParallelStep::OFF);
-    let (mut parallel, par_beads) = scene(ParallelStep { threshold: 0 });
-    for app in [&mut sequential, &mut parallel] {
-        app.insert_resource(TimeUpdateStrategy::FixedTimesteps(300));
+const STEPS: u32 = 300;
+
+fn run(apps: [&mut App; 2]) {
+    for app in apps {
+        app.insert_resource(TimeUpdateStrategy::FixedTimesteps(STEPS));
         app.update();
     }
+}
+
+/// Asserts that every bead of `b` has bit for bit the state of its twin in
+/// `a`, and the same divergence; returns how many diverged.
+fn assert_same_beads(a: (&App, &[Entity]), b: (&App, &[Entity])) -> usize {
     let mut diverged = 0;
     let mut moved = 0;
-    for (&s, &p) in seq_beads.iter().zip(&par_beads) {
-        let (a, b) = (
-            sequential.world().get::<Bead>(s).unwrap(),
-            parallel.world().get::<Bead>(p).unwrap(),
+    for (&ea, &eb) in a.1.iter().zip(b.1) {
+        let (ba, bb) = (
+            a.0.world().get::<Bead>(ea).unwrap(),
+            b.0.world().get::<Bead>(eb).unwrap(),
         );
-        assert_eq!(
-            a.position.to_array().map(f64::to_bits),
-            b.position.to_array().map(f64::to_bits)
-        );
-        assert_eq!(
-            a.velocity.to_array().map(f64::to_bits),
-            b.velocity.to_array().map(f64::to_bits)
-        );
-        let (da, db) = (
-            sequential.world().get::<BeadDiagnostics>(s).unwrap(),
-            parallel.world().get::<BeadDiagnostics>(p).unwrap(),
-        );
-        assert_eq!(da, db);
+        for (va, vb) in [(ba.position, bb.position), (ba.velocity, bb.velocity)] {
+            assert_eq!(
+                va.to_array().map(f64::to_bits),
+                vb.to_array().map(f64::to_bits)
+            );
+        }
+        assert_eq!(ba.lambda.to_bits(), bb.lambda.to_bits());
         let (ra, rb) = (
-            sequential.world().get::<Diverged>(s),
-            parallel.world().get::<Diverged>(p),
+            a.0.world().get::<Diverged>(ea),
+            b.0.world().get::<Diverged>(eb),
         );
         assert_eq!(ra, rb, "the same beads diverge for the same reason");
         diverged += usize::from(ra.is_some());
-        moved += usize::from(a.position != a.params().initial_position);
+        moved += usize::from(ba.position != ba.params().initial_position);
     }
-    assert_eq!(diverged, 3, "the three beads at the circle's centre");
     assert!(moved > 4 * BEADS_PER_WIRE - 10, "{moved} beads moved");
-    let steps = sequential
-        .world()
-        .get::<BeadDiagnostics>(seq_beads[0])
-        .unwrap()
-        .steps;
-    assert_eq!(steps, 300);
+    diverged
+}
+
+#[test]
+fn parallel_step_matches_sequential_bit_for_bit() {
+    let (mut sequential, seq_beads) = scene(ParallelStep::OFF, WireBeadPlugin::default());
+    let (mut parallel, par_beads) = scene(ParallelStep { threshold: 0 }, WireBeadPlugin::default());
+    run([&mut sequential, &mut parallel]);
+    let diverged = assert_same_beads((&sequential, &seq_beads), (&parallel, &par_beads));
+    assert_eq!(diverged, 3, "the three beads at the circle's centre");
+    for (&s, &p) in seq_beads.iter().zip(&par_beads) {
+        assert_eq!(
+            sequential.world().get::<BeadDiagnostics>(s).unwrap(),
+            parallel.world().get::<BeadDiagnostics>(p).unwrap()
+        );
+    }
+    let diagnostics = sequential.world().get::<BeadDiagnostics>(seq_beads[0]);
+    assert_eq!(diagnostics.unwrap().steps, u64::from(STEPS));
+}
+
+#[test]
+fn lean_beads_step_like_full_ones_without_their_extras() {
+    let (mut full, full_beads) = scene(ParallelStep::OFF, WireBeadPlugin::default());
+    let (mut lean, lean_beads) = scene(
+        ParallelStep { threshold: 0 },
+        WireBeadPlugin::default().lean(),
+    );
+    // A lean bead given a Transform has it written.
+    let watched = lean_beads[0];
+    lean.world_mut()
+        .entity_mut(watched)
+        .insert(Transform::default());
+    run([&mut full, &mut lean]);
+    assert_eq!(
+        assert_same_beads((&full, &full_beads), (&lean, &lean_beads)),
+        3
+    );
+    for &bead in &lean_beads[1..] {
+        let entity = lean.world().entity(bead);
+        assert!(!entity.contains::<Transform>() && !entity.contains::<GlobalTransform>());
+        assert!(!entity.contains::<BeadDiagnostics>());
+    }
+    let position = lean.world().get::<Bead>(watched).unwrap().position;
+    let written = lean.world().get::<Transform>(watched).unwrap().translation;
+    assert_eq!(
+        (written.x, written.y),
+        (position.x as f32, position.y as f32)
+    );
+    // Divergences are timed by the clock: the centre beads fail in step 1.
+    let dt = lean.world().resource::<SimParams>().timestep;
+    let clock = *lean.world().resource::<SimClock>();
+    assert_eq!(clock.steps, u64::from(STEPS));
+    let first = lean.world().get::<Diverged>(lean_beads[BEADS_PER_WIRE]);
+    assert_eq!(first.map(|d| d.time), Some(dt));
 }

@@ -48,6 +48,25 @@ impl Threads {
     }
 }
 
+/// What a bead carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Kind {
+    /// The default bead: `Transform` and `BeadDiagnostics` included.
+    Full,
+    /// [`WireBeadPlugin::lean`]: the bead's state and its wire only.
+    Lean,
+}
+
+impl Kind {
+    /// A short name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Full => "full",
+            Self::Lean => "lean",
+        }
+    }
+}
+
 /// The starting angle from the bottom of bead `i`: spread over ±120° so the
 /// beads are at different phases.
 pub fn start_angle(i: usize) -> f64 {
@@ -66,13 +85,17 @@ fn on_circle(origin: DVec2, angle: f64) -> DVec2 {
 
 /// An app with the plugin and `n` beads at rest, ready for
 /// `world_mut().run_schedule(FixedUpdate)` (one step per call).
-pub fn plugin_app(n: usize, layout: Layout, threads: Threads) -> App {
+pub fn plugin_app(n: usize, layout: Layout, threads: Threads, kind: Kind) -> App {
     let mut app = App::new();
+    let plugin = match kind {
+        Kind::Full => WireBeadPlugin::default(),
+        Kind::Lean => WireBeadPlugin::default().lean(),
+    };
     app.add_plugins((
         TaskPoolPlugin {
             task_pool_options: wirebead::plugin::compute_on_all_cores(),
         },
-        WireBeadPlugin::default(),
+        plugin,
     ));
     if threads == Threads::Single {
         app.insert_resource(ParallelStep::OFF);
@@ -108,30 +131,36 @@ pub fn plugin_app(n: usize, layout: Layout, threads: Threads) -> App {
     app
 }
 
-/// One bead as a plain struct: the same state and diagnostics the plugin
-/// keeps.
+/// One lean bead as a plain struct: the state the plugin keeps.
 #[derive(Clone, Copy, Debug)]
 pub struct RawBead {
     /// Position and velocity.
     pub state: BeadState,
     /// Mass.
     pub mass: f64,
-    /// λ and `λN` of the last step.
+    /// λ of the last step.
     pub lambda: f64,
+    /// Index of its wire's pose.
+    pub wire: u32,
+}
+
+/// What a full bead adds: diagnostics and the rendered position.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RawExtras {
     /// `λN`.
     pub constraint_force: DVec2,
     /// `C`, `Ċ`, kinetic and potential energy.
     pub diagnostics: [f64; 4],
     /// The rendered position.
     pub rendered: [f32; 2],
-    /// Index of its wire's pose.
-    pub wire: u32,
 }
 
 /// The floor: the plugin's step as one fused loop over a `Vec`.
 pub struct RawLoop {
     /// The beads.
     pub beads: Vec<RawBead>,
+    /// Their extras, for [`Kind::Full`]; empty for [`Kind::Lean`].
+    pub extras: Vec<RawExtras>,
     /// Each wire's pose.
     pub poses: Vec<Pose>,
     /// The shared shape.
@@ -140,11 +169,13 @@ pub struct RawLoop {
     pub cfg: StepConfig,
     /// Gravity.
     pub gravity: DVec2,
+    /// The divergence bound, in radii.
+    pub bound_per_radius: f64,
 }
 
 impl RawLoop {
     /// `n` beads laid out as [`plugin_app`] lays them out.
-    pub fn new(n: usize, layout: Layout) -> Self {
+    pub fn new(n: usize, layout: Layout, kind: Kind) -> Self {
         let params = SimParams::default();
         let poses: Vec<Pose> = match layout {
             Layout::SharedWire => vec![Pose::IDENTITY],
@@ -162,14 +193,16 @@ impl RawLoop {
                 },
                 mass: 1.0,
                 lambda: 0.0,
-                constraint_force: DVec2::ZERO,
-                diagnostics: [0.0; 4],
-                rendered: [0.0; 2],
                 wire: wire as u32,
             })
             .collect();
+        let extras = match kind {
+            Kind::Full => vec![RawExtras::default(); n],
+            Kind::Lean => Vec::new(),
+        };
         Self {
             beads,
+            extras,
             poses,
             circle: Circle { radius: 1.0 },
             cfg: StepConfig {
@@ -182,38 +215,108 @@ impl RawLoop {
                 drift_bound: params.divergence_bound,
             },
             gravity: params.gravity,
+            bound_per_radius: params.divergence_bound,
         }
     }
 
     /// One step of every bead; returns how many failed.
     pub fn step(&mut self) -> usize {
-        let (alpha, beta) = self.cfg.gains();
+        if self.extras.is_empty() {
+            self.step_lean()
+        } else {
+            self.step_full()
+        }
+    }
+
+    /// Steps `beads` (at most [`solver::LANES`]) as the plugin does: the
+    /// batched circle step, with lanes it hands back through `step`.
+    #[inline(always)]
+    fn step_lanes(
+        &self,
+        beads: &[RawBead],
+    ) -> [Result<solver::StepOutput, solver::SolveError>; solver::LANES] {
+        let mut lanes = solver::CircleLanes::default();
+        for (lane, bead) in beads.iter().enumerate() {
+            let force = bead.mass * self.gravity;
+            let pose = self.poses[bead.wire as usize];
+            lanes.set(
+                lane,
+                bead.state,
+                force,
+                bead.mass,
+                pose.origin,
+                self.circle.radius,
+            );
+        }
+        let outs = solver::euler_on_circles(&lanes, &self.cfg, self.bound_per_radius);
+        std::array::from_fn(|lane| match (beads.get(lane), outs[lane]) {
+            (Some(_), Some(out)) if beads.len() == solver::LANES => Ok(out),
+            (Some(bead), _) => self.step_one(bead),
+            (None, _) => Err(solver::SolveError::NonFinite),
+        })
+    }
+
+    fn step_one(&self, bead: &RawBead) -> Result<solver::StepOutput, solver::SolveError> {
+        let placed = Placed {
+            curve: &self.circle,
+            pose: self.poses[bead.wire as usize],
+        };
+        let force = LinearForce::constant(bead.mass * self.gravity);
+        let cfg = StepConfig {
+            mass: bead.mass,
+            ..self.cfg
+        };
+        solver::step(&placed, bead.state, &force, &cfg)
+    }
+
+    fn step_lean(&mut self) -> usize {
         let mut failed = 0;
-        for bead in &mut self.beads {
-            let placed = Placed {
-                curve: &self.circle,
-                pose: self.poses[bead.wire as usize],
-            };
-            let force = LinearForce::constant(bead.mass * self.gravity);
-            let cfg = StepConfig {
-                mass: bead.mass,
-                ..self.cfg
-            };
-            let stepped = solver::solve(&placed, bead.state, &force, bead.mass, alpha, beta)
-                .and_then(|first| solver::integrate(&placed, bead.state, &force, &first, &cfg));
-            match stepped {
-                Ok(out) => {
-                    bead.state = out.state;
-                    bead.lambda = out.lambda;
-                    bead.constraint_force = out.constraint_force;
-                    let (c, c_dot) = (out.c, out.c_dot);
-                    let (kinetic, potential) = solver::energy(bead.mass, self.gravity, out.state);
-                    bead.diagnostics = [c, c_dot, kinetic, potential];
-                    bead.rendered = [out.state.position.x as f32, out.state.position.y as f32];
+        let mut beads = std::mem::take(&mut self.beads);
+        for chunk in beads.chunks_mut(solver::LANES) {
+            let outs = self.step_lanes(chunk);
+            for (bead, out) in chunk.iter_mut().zip(outs) {
+                match out {
+                    Ok(out) => {
+                        bead.state = out.state;
+                        bead.lambda = out.lambda;
+                    }
+                    Err(_) => failed += 1,
                 }
-                Err(_) => failed += 1,
             }
         }
+        self.beads = beads;
+        failed
+    }
+
+    fn step_full(&mut self) -> usize {
+        let mut failed = 0;
+        let (mut beads, mut extras) = (
+            std::mem::take(&mut self.beads),
+            std::mem::take(&mut self.extras),
+        );
+        let chunks = beads
+            .chunks_mut(solver::LANES)
+            .zip(extras.chunks_mut(solver::LANES));
+        for (chunk, extra) in chunks {
+            let outs = self.step_lanes(chunk);
+            for ((bead, extra), out) in chunk.iter_mut().zip(extra).zip(outs) {
+                match out {
+                    Ok(out) => {
+                        bead.state = out.state;
+                        bead.lambda = out.lambda;
+                        let (kinetic, potential) =
+                            solver::energy(bead.mass, self.gravity, out.state);
+                        *extra = RawExtras {
+                            constraint_force: out.constraint_force,
+                            diagnostics: [out.c, out.c_dot, kinetic, potential],
+                            rendered: [out.state.position.x as f32, out.state.position.y as f32],
+                        };
+                    }
+                    Err(_) => failed += 1,
+                }
+            }
+        }
+        (self.beads, self.extras) = (beads, extras);
         failed
     }
 }

@@ -9,7 +9,7 @@ use bevy::camera::ScalingMode;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::components::{Bead, DragTarget, OnWire, Wire};
+use crate::components::{Bead, BeadDiagnostics, DragTarget, OnWire, Wire};
 use crate::plugin::{Restart, WireBeadSystems};
 use crate::wire::{ImplicitCurve, Placed, Pose, WireShape};
 
@@ -378,18 +378,18 @@ fn draw_trails(beads: Query<&Trail>, style: Res<SceneStyle>, mut gizmos: Gizmos)
 }
 
 fn draw_forces(
-    beads: Query<(&Bead, Option<&DragTarget>), With<OnWire>>,
+    beads: Query<(&Bead, Option<&BeadDiagnostics>, Option<&DragTarget>), With<OnWire>>,
     params: Res<crate::SimParams>,
     view: Res<FramedView>,
     style: Res<SceneStyle>,
     mut gizmos: Gizmos,
 ) {
     let g = params.gravity.length().max(1e-3) as f32;
-    for (bead, drag) in &beads {
+    for (bead, diagnostics, drag) in &beads {
         // Forces are drawn in units of the bead's weight.
         let per_newton = style.force_scale * view.size.y / (bead.mass() as f32 * g);
         let at = bead.position.as_vec2();
-        let force = bead.constraint_force.as_vec2() * per_newton;
+        let force = diagnostics.map_or(Vec2::ZERO, |d| d.constraint_force.as_vec2()) * per_newton;
         if force.length() > 1e-4 * view.size.y {
             gizmos.arrow_2d(at, at + force, style.constraint_force);
         }
