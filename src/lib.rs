@@ -37,6 +37,7 @@
 //! | [`KeyboardControlsPlugin`] | Space restarts, P pauses, N steps once: headless-testable |
 //! | [`DragTarget`] | the user's drag: a spring `k (target - x)` while present |
 //! | [`BeadDiagnostics`], [`Diverged`], [`BeadDiverged`] | `C`, `Ċ`, λ and energy each step; divergence reports |
+//! | [`SimClock`], [`ParallelStep`] | steps and seconds since the last restart; when the step splits over threads |
 //! | [`ScenePresetPlugin`], [`ScenePreset`] | scenes as RON assets (`*.scene.ron`), hot-reloaded |
 //! | [`solver`], [`wire`], [`reference`](mod@reference) | the pure math: eq. 1.9, the integrators, the shapes, the exact pendulum period |
 //!
