@@ -217,14 +217,14 @@ fn cached_wire<'c>(
     wires: &Wires,
     on: &OnWire,
 ) -> &'c Result<(WireShape, Pose), DivergenceReason> {
-    match cache {
-        Some((entity, _)) if *entity == on.0 => {}
-        _ => {
-            let found = wire_of(wires, on).map(|(wire, pose)| (wire.shape().clone(), pose));
-            *cache = Some((on.0, found));
-        }
+    if cache.as_ref().is_some_and(|(entity, _)| *entity != on.0) {
+        *cache = None;
     }
-    &cache.as_ref().expect("filled above").1
+    let (_, wire) = cache.get_or_insert_with(|| {
+        let found = wire_of(wires, on).map(|(wire, pose)| (wire.shape().clone(), pose));
+        (on.0, found)
+    });
+    wire
 }
 
 /// What stepping a run of beads needs, shared by the threads.
