@@ -426,11 +426,12 @@ macro_rules! lanes {
 /// It performs the operations of [`step`] on a
 /// [`Placed`](crate::wire::Placed) circle in the same order, lane by lane,
 /// so each lane's result is bit for bit what [`step`] returns; what differs
-/// is that the square roots and divisions of four beads run side by side
+/// is that the square roots and divisions of [`LANES`] beads run side by side
 /// instead of one after another. A lane the batch cannot finish (a
 /// non-finite state, the circle's centre, a step past the drift bound)
 /// comes back `None`: take that bead through [`step`], which reports why.
-/// `cfg.mass` is unused (each lane has its own); the force must be constant
+/// `cfg.mass` and `cfg.drift_bound` are unused (each lane has its own mass,
+/// and its bound is `bound_per_radius` times its radius); the force must be constant
 /// over the step (true of any [`LinearForce`] for one-stage integrators).
 #[inline(always)]
 pub fn euler_on_circles(
@@ -443,7 +444,7 @@ pub fn euler_on_circles(
     let semi_implicit = cfg.integrator == Integrator::SemiImplicitEuler;
     let z = [0.0; LANES];
     let (mut len, mut inv, mut nx, mut ny, mut lambda) = (z, z, z, z, z);
-    let (mut ax, mut ay, mut x1, mut y1, mut vx1, mut vy1) = (z, z, z, z, z, z);
+    let (mut x1, mut y1, mut vx1, mut vy1) = (z, z, z, z);
     let (mut len1, mut c1, mut cdot1, mut nn) = (z, z, z, z);
     // Circle::geometry at x0, after Placed's translation.
     lanes!(i => {
@@ -469,9 +470,9 @@ pub fn euler_on_circles(
     // The acceleration and the Euler update.
     lanes!(i => {
         let inv_m = b.mass[i].recip();
-        ax[i] = (b.fx[i] + lambda[i] * nx[i]) * inv_m;
-        ay[i] = (b.fy[i] + lambda[i] * ny[i]) * inv_m;
-        (vx1[i], vy1[i]) = (b.vx[i] + h * ax[i], b.vy[i] + h * ay[i]);
+        let ax = (b.fx[i] + lambda[i] * nx[i]) * inv_m;
+        let ay = (b.fy[i] + lambda[i] * ny[i]) * inv_m;
+        (vx1[i], vy1[i]) = (b.vx[i] + h * ax, b.vy[i] + h * ay);
         let (ux, uy) = if semi_implicit { (vx1[i], vy1[i]) } else { (b.vx[i], b.vy[i]) };
         (x1[i], y1[i]) = (b.x[i] + h * ux, b.y[i] + h * uy);
     });

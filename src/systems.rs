@@ -256,7 +256,7 @@ impl StepContext<'_, '_, '_> {
         for i in 0..beads.len() {
             let wire = cached_wire(&mut cache, self.wires, &on_wires[i]);
             if let (Some(cfg), Ok((WireShape::Circle(circle), pose))) = (&self.batch, wire)
-                && pose.rotation == DVec2::X
+                && pose.is_unrotated()
             {
                 let bead = &beads[i];
                 let mass = bead.mass();
@@ -395,9 +395,9 @@ type Run<'w> = (
     Option<&'w mut [BeadDiagnostics]>,
 );
 
-/// Cuts one table's beads into runs of about a quarter of each thread's
-/// share, so a slow thread does not hold the others up. Marks the beads
-/// and diagnostics changed.
+/// Cuts one table's beads into runs: one for a single thread, else about a
+/// quarter of each thread's share, so a slow thread does not hold the
+/// others up. Marks the beads and diagnostics changed.
 fn split_table<'w>(
     (entities, beads, on_wires, diagnostics): (
         &'w [Entity],
@@ -407,7 +407,8 @@ fn split_table<'w>(
     ),
     threads: usize,
 ) -> Vec<Run<'w>> {
-    let n = entities.len().div_ceil(4 * threads).max(1);
+    let runs = if threads > 1 { 4 * threads } else { 1 };
+    let n = entities.len().div_ceil(runs).max(1);
     let beads = ContiguousMut::split(beads).0;
     let diagnostics = diagnostics.map(|d| ContiguousMut::split(d).0);
     let diagnostic_runs = diagnostics

@@ -393,6 +393,11 @@ impl Pose {
         self.origin + self.matrix() * p
     }
 
+    /// Whether the pose only translates (the rotation is exactly none).
+    pub fn is_unrotated(&self) -> bool {
+        self.rotation == DVec2::X
+    }
+
     /// A local direction in world coordinates.
     pub fn rotate(&self, d: DVec2) -> DVec2 {
         self.matrix() * d
@@ -433,7 +438,7 @@ impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Placed<'_, C> {
     }
     #[inline(always)]
     fn geometry(&self, p: DVec2) -> Geometry {
-        if self.unrotated() {
+        if self.pose.is_unrotated() {
             // The common case needs no rotation, only the translation.
             self.curve.geometry(p - self.pose.origin)
         } else {
@@ -443,10 +448,6 @@ impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Placed<'_, C> {
 }
 
 impl<C: ImplicitCurve + ?Sized> Placed<'_, C> {
-    fn unrotated(&self) -> bool {
-        self.pose.rotation == DVec2::X
-    }
-
     #[inline(never)]
     fn rotated_geometry(&self, p: DVec2) -> Geometry {
         let local = self.curve.geometry(self.pose.to_local(p));
