@@ -4,6 +4,7 @@
 use std::sync::{Mutex, PoisonError};
 
 use bevy::ecs::change_detection::ContiguousMut;
+use bevy::ecs::storage::SparseSet;
 use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -207,37 +208,61 @@ pub fn wire_of<'a>(wires: &'a Wires, on: &OnWire) -> Result<(&'a Wire, Pose), Di
     Ok((wire, pose))
 }
 
-/// The wire a bead's last neighbour was on and its pose, kept per thread:
-/// beads sharing a wire are stored together, so most of them skip the
-/// lookup. (A copy, not a borrow: the compute pool's tasks outlive borrows.)
-type WireCache = Option<(Entity, Result<(WireShape, Pose), DivergenceReason>)>;
+/// A wire's shape and pose for the step, or why beads cannot be stepped on
+/// it.
+type PlacedWire = Result<(WireShape, Pose), DivergenceReason>;
 
-fn cached_wire<'c>(
-    cache: &'c mut WireCache,
-    wires: &Wires,
-    on: &OnWire,
-) -> &'c Result<(WireShape, Pose), DivergenceReason> {
-    if cache.as_ref().is_some_and(|(entity, _)| *entity != on.0) {
-        *cache = None;
+/// Every wire's shape and pose, kept by [`step_beads`] from change
+/// detection (a copy made when a wire changes, not each step), so a bead
+/// finds its wire with one indexed read instead of a query lookup.
+#[derive(Default)]
+pub struct WireTable(SparseSet<Entity, (Entity, PlacedWire)>);
+
+impl WireTable {
+    /// Takes in the wires that changed or were added since the last call,
+    /// and drops the ones whose `Wire` or `WirePose` was removed.
+    fn refresh<'a>(
+        &mut self,
+        removed: impl IntoIterator<Item = Entity>,
+        changed: impl IntoIterator<Item = (Entity, &'a Wire, &'a WirePose)>,
+    ) {
+        for entity in removed {
+            if self.0.get(entity).is_some_and(|(e, _)| *e == entity) {
+                self.0.remove(entity);
+            }
+        }
+        for (entity, wire, pose) in changed {
+            let placed = pose
+                .get()
+                .map(|pose| (wire.shape().clone(), pose))
+                .map_err(|e| DivergenceReason::InvalidWire(e.to_string()));
+            self.0.insert(entity, (entity, placed));
+        }
     }
-    let (_, wire) = cache.get_or_insert_with(|| {
-        let found = wire_of(wires, on).map(|(wire, pose)| (wire.shape().clone(), pose));
-        (on.0, found)
-    });
-    wire
+
+    /// The shape and pose of the wire a bead is on.
+    fn get(&self, on: &OnWire) -> Result<&(WireShape, Pose), DivergenceReason> {
+        match self.0.get(on.0) {
+            Some((entity, placed)) if *entity == on.0 => placed.as_ref().map_err(Clone::clone),
+            _ => Err(DivergenceReason::InvalidWire(format!(
+                "entity {} has no Wire",
+                on.0
+            ))),
+        }
+    }
 }
 
 /// What stepping a run of beads needs, shared by the threads.
-struct StepContext<'a, 'w, 's> {
+struct StepContext<'a> {
     params: &'a SimParams,
-    wires: &'a Wires<'w, 's>,
+    wires: &'a WireTable,
     found: &'a Found,
     time: f64,
     /// The step's config when it is one [`solver::euler_on_circles`] takes.
     batch: Option<StepConfig>,
 }
 
-impl StepContext<'_, '_, '_> {
+impl StepContext<'_> {
     /// Steps a run of beads stored side by side (`diagnostics`, when
     /// present, lines up with `beads`). Beads on unrotated circles go
     /// through the batched step, [`solver::LANES`] at a time, when the
@@ -249,12 +274,11 @@ impl StepContext<'_, '_, '_> {
         on_wires: &[OnWire],
         mut diagnostics: Option<&mut [BeadDiagnostics]>,
     ) {
-        let mut cache = WireCache::None;
         let mut lanes = solver::CircleLanes::default();
         let mut waiting = [0; solver::LANES];
         let mut queued = 0;
         for i in 0..beads.len() {
-            let wire = cached_wire(&mut cache, self.wires, &on_wires[i]);
+            let wire = self.wires.get(&on_wires[i]);
             if let (Some(cfg), Ok((WireShape::Circle(circle), pose))) = (&self.batch, wire)
                 && pose.is_unrotated()
             {
@@ -274,17 +298,13 @@ impl StepContext<'_, '_, '_> {
                 if queued == solver::LANES {
                     let bound = self.params.divergence_bound;
                     let outs = solver::euler_on_circles(&lanes, cfg, bound);
-                    for (&j, out) in waiting.iter().zip(outs) {
+                    for (lane, &j) in waiting.iter().enumerate() {
                         let diagnostics = diagnostics.as_deref_mut().map(|d| &mut d[j]);
-                        match out {
+                        match outs.lane(lane) {
                             Some(out) => self.finish(&mut beads[j], diagnostics, out),
-                            None => self.step_one(
-                                entities[j],
-                                &mut beads[j],
-                                diagnostics,
-                                &mut cache,
-                                &on_wires[j],
-                            ),
+                            None => {
+                                self.step_one(entities[j], &mut beads[j], diagnostics, &on_wires[j])
+                            }
                         }
                     }
                     queued = 0;
@@ -292,23 +312,11 @@ impl StepContext<'_, '_, '_> {
                 continue;
             }
             let diagnostics = diagnostics.as_deref_mut().map(|d| &mut d[i]);
-            self.step_one(
-                entities[i],
-                &mut beads[i],
-                diagnostics,
-                &mut cache,
-                &on_wires[i],
-            );
+            self.step_one(entities[i], &mut beads[i], diagnostics, &on_wires[i]);
         }
         for &j in &waiting[..queued] {
             let diagnostics = diagnostics.as_deref_mut().map(|d| &mut d[j]);
-            self.step_one(
-                entities[j],
-                &mut beads[j],
-                diagnostics,
-                &mut cache,
-                &on_wires[j],
-            );
+            self.step_one(entities[j], &mut beads[j], diagnostics, &on_wires[j]);
         }
     }
 
@@ -327,11 +335,10 @@ impl StepContext<'_, '_, '_> {
         entity: Entity,
         bead: &mut Bead,
         diagnostics: Option<&mut BeadDiagnostics>,
-        cache: &mut WireCache,
         on_wire: &OnWire,
     ) {
-        let result = match cached_wire(cache, self.wires, on_wire) {
-            Err(reason) => Err(reason.clone()),
+        let result = match self.wires.get(on_wire) {
+            Err(reason) => Err(reason),
             Ok((shape, pose)) => with_curve!(shape, curve => {
                 self.step_bead(&Placed { curve, pose: *pose }, bead)
             }),
@@ -432,11 +439,16 @@ pub fn step_beads(
     params: Res<SimParams>,
     clock: Res<SimClock>,
     parallel: Res<ParallelStep>,
-    wires: Wires,
+    mut wires: Local<WireTable>,
+    changed: Query<(Entity, &Wire, &WirePose), Or<(Changed<Wire>, Changed<WirePose>)>>,
+    mut removed_wires: RemovedComponents<Wire>,
+    mut removed_poses: RemovedComponents<WirePose>,
     mut beads: Query<(Entity, &mut Bead, &OnWire, Option<&mut BeadDiagnostics>), Without<Diverged>>,
     mut found: Local<Found>,
     mut divergences: Divergences,
 ) {
+    let removed = removed_wires.read().chain(removed_poses.read());
+    wires.refresh(removed, changed);
     let batch = step_config(&params, 1.0, 1.0);
     let eulerian = matches!(
         batch.integrator,

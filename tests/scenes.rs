@@ -268,3 +268,71 @@ fn drag_pulls_the_bead_toward_the_target_and_release_stops_it() {
     run_steps(&mut app, 1);
     assert_eq!(seen(&app), DVec2::ZERO);
 }
+
+/// `C` of a bead at `p` on a circle of radius `r` centred at `o`.
+fn circle_c(p: DVec2, o: DVec2, r: f64) -> f64 {
+    (p - o).length() - r
+}
+
+#[test]
+fn a_wire_moved_reshaped_or_taken_away_between_steps_is_what_its_beads_see() {
+    let mut app = app(SimParams::default());
+    let wire = spawn_wire(&mut app, Wire::circle(1.0).unwrap(), Transform::default());
+    let b = spawn_bead(
+        &mut app,
+        wire,
+        BeadParams {
+            initial_position: DVec2::new(1.0, 0.0),
+            ..default()
+        },
+    );
+    run_steps(&mut app, 10);
+    let c = diagnostics(&app, b).c;
+    assert!(c.abs() < 1e-3, "on its wire: C = {c}");
+
+    // Moved: the next step measures C from the new centre.
+    let centre = DVec2::new(f64::from(0.2f32), 0.0);
+    app.world_mut()
+        .entity_mut(wire)
+        .insert(Transform::from_xyz(0.2, 0.0, 0.0));
+    run_steps(&mut app, 1);
+    let (p, c) = (bead(&app, b).position, diagnostics(&app, b).c);
+    let expected = circle_c(p, centre, 1.0);
+    assert!(expected.abs() > 0.05, "the move puts the bead off the wire");
+    assert!(
+        (c - expected).abs() < 1e-12,
+        "C = {c}, from the moved wire {expected}"
+    );
+
+    // Reshaped: the next step uses the new radius.
+    app.world_mut()
+        .entity_mut(wire)
+        .insert(Wire::circle(1.5).unwrap());
+    run_steps(&mut app, 1);
+    let (p, c) = (bead(&app, b).position, diagnostics(&app, b).c);
+    let expected = circle_c(p, centre, 1.5);
+    assert!(
+        expected < -0.3,
+        "the new radius puts the bead inside: {expected}"
+    );
+    assert!(
+        (c - expected).abs() < 1e-12,
+        "C = {c}, on the new radius {expected}"
+    );
+
+    // Taken away: the bead stops with a reason in words.
+    app.world_mut().entity_mut(wire).remove::<Wire>();
+    let before = bead(&app, b).position;
+    run_steps(&mut app, 1);
+    let diverged = app.world().get::<Diverged>(b).expect("diverged");
+    assert!(
+        matches!(&diverged.reason, wirebead::components::DivergenceReason::InvalidWire(why) if why.contains("has no Wire")),
+        "{}",
+        diverged.reason
+    );
+    assert_eq!(
+        bead(&app, b).position,
+        before,
+        "a stopped bead keeps its state"
+    );
+}

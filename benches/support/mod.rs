@@ -249,7 +249,7 @@ impl RawLoop {
             );
         }
         let outs = solver::euler_on_circles(&lanes, &self.cfg, self.bound_per_radius);
-        std::array::from_fn(|lane| match (beads.get(lane), outs[lane]) {
+        std::array::from_fn(|lane| match (beads.get(lane), outs.lane(lane)) {
             (Some(_), Some(out)) if beads.len() == solver::LANES => Ok(out),
             (Some(bead), _) => self.step_one(bead),
             (None, _) => Err(solver::SolveError::NonFinite),
