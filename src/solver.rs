@@ -359,7 +359,7 @@ pub fn step<C: ImplicitCurve + ?Sized>(
     integrate(curve, state, force, &first, cfg)
 }
 
-/// How many beads [`euler_on_circles`] steps at once.
+/// How many beads [`step_on_circles`] steps at once.
 pub const LANES: usize = 8;
 
 /// [`LANES`] beads on circles, as arrays of their scalars (one entry per
@@ -374,10 +374,16 @@ pub struct CircleLanes {
     pub vx: [f64; LANES],
     /// Velocity y.
     pub vy: [f64; LANES],
-    /// External force x at the position.
+    /// The external force's [`LinearForce::force`], x.
     pub fx: [f64; LANES],
-    /// External force y at the position.
+    /// The external force's [`LinearForce::force`], y.
     pub fy: [f64; LANES],
+    /// The external force's [`LinearForce::stiffness`].
+    pub stiffness: [f64; LANES],
+    /// The external force's [`LinearForce::at`], x.
+    pub at_x: [f64; LANES],
+    /// The external force's [`LinearForce::at`], y.
+    pub at_y: [f64; LANES],
     /// Mass.
     pub mass: [f64; LANES],
     /// The circle's centre, x.
@@ -395,21 +401,23 @@ impl CircleLanes {
         &mut self,
         lane: usize,
         state: BeadState,
-        force: DVec2,
+        force: &LinearForce,
         mass: f64,
         centre: DVec2,
         radius: f64,
     ) {
         (self.x[lane], self.y[lane]) = (state.position.x, state.position.y);
         (self.vx[lane], self.vy[lane]) = (state.velocity.x, state.velocity.y);
-        (self.fx[lane], self.fy[lane]) = (force.x, force.y);
+        (self.fx[lane], self.fy[lane]) = (force.force.x, force.force.y);
+        self.stiffness[lane] = force.stiffness;
+        (self.at_x[lane], self.at_y[lane]) = (force.at.x, force.at.y);
         self.mass[lane] = mass;
         (self.ox[lane], self.oy[lane]) = (centre.x, centre.y);
         self.radius[lane] = radius;
     }
 }
 
-/// What [`euler_on_circles`] returns: each lane's step, as arrays of the
+/// What [`step_on_circles`] returns: each lane's step, as arrays of the
 /// fields of a [`StepOutput`] (one entry per bead), and which lanes it
 /// finished.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -465,9 +473,15 @@ macro_rules! lanes {
     };
 }
 
-/// The explicit or semi-implicit Euler step of eq. 1.9 (with the config's
-/// gains: Baumgarte or none) for [`LANES`] beads on unrotated
-/// [`Circle`](crate::wire::Circle)s at once.
+/// Whether [`step_on_circles`] takes steps of this config: explicit or
+/// semi-implicit Euler or RK4, with Baumgarte stabilization or none.
+pub fn batches(cfg: &StepConfig) -> bool {
+    cfg.integrator != Integrator::Rattle && cfg.stabilization != Stabilization::Projection
+}
+
+/// A step of eq. 1.9 for [`LANES`] beads on unrotated
+/// [`Circle`](crate::wire::Circle)s at once, for the configs
+/// [`batches`] accepts.
 ///
 /// It performs the operations of [`step`] on a
 /// [`Placed`](crate::wire::Placed) circle in the same order, lane by lane,
@@ -476,105 +490,179 @@ macro_rules! lanes {
 /// instead of one after another. A lane the batch cannot finish (a
 /// non-finite state, the circle's centre, a step past the drift bound)
 /// comes back not [`done`](CircleSteps::done): take that bead through
-/// [`step`], which reports why.
-/// `cfg.mass` and `cfg.drift_bound` are unused (each lane has its own mass,
-/// and its bound is `bound_per_radius` times its radius); the force must be constant
-/// over the step (true of any [`LinearForce`] for one-stage integrators).
+/// [`step`], which reports why. A config [`batches`] refuses finishes no
+/// lane. `cfg.mass` and `cfg.drift_bound` are unused (each lane has its own
+/// mass, and its bound is `bound_per_radius` times its radius).
 ///
 /// On an x86-64 processor with AVX2 (checked once, at run time) the lanes
 /// run four to an instruction instead of two; the operations, and so the
 /// bits of the results, are the same either way.
 #[inline]
-pub fn euler_on_circles(b: &CircleLanes, cfg: &StepConfig, bound_per_radius: f64) -> CircleSteps {
+pub fn step_on_circles(b: &CircleLanes, cfg: &StepConfig, bound_per_radius: f64) -> CircleSteps {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the processor has just been found to support AVX2.
-        return unsafe { euler_on_circles_avx2(b, cfg, bound_per_radius) };
+        return unsafe { step_on_circles_avx2(b, cfg, bound_per_radius) };
     }
-    euler_on_circles_portable(b, cfg, bound_per_radius)
+    step_on_circles_portable(b, cfg, bound_per_radius)
 }
 
-/// [`euler_on_circles`] compiled for AVX2.
+/// [`step_on_circles`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn euler_on_circles_avx2(b: &CircleLanes, cfg: &StepConfig, bound_per_radius: f64) -> CircleSteps {
-    euler_on_circles_portable(b, cfg, bound_per_radius)
+fn step_on_circles_avx2(b: &CircleLanes, cfg: &StepConfig, bound_per_radius: f64) -> CircleSteps {
+    step_on_circles_portable(b, cfg, bound_per_radius)
 }
 
-/// [`euler_on_circles`] for any processor.
+/// Eq. 1.9 solved on each lane's circle, as [`solve`] solves it.
+#[derive(Clone, Copy, Default)]
+struct LaneSolve {
+    /// `|x - centre|`.
+    len: [f64; LANES],
+    /// The normal (the gradient of `C`).
+    nx: [f64; LANES],
+    ny: [f64; LANES],
+    /// `|N|²`.
+    nn: [f64; LANES],
+    lambda: [f64; LANES],
+    /// `(f + λN) / m`.
+    ax: [f64; LANES],
+    ay: [f64; LANES],
+}
+
+impl LaneSolve {
+    /// Whether `nonsingular` accepts the lane's normal.
+    #[inline(always)]
+    fn regular(&self, i: usize) -> bool {
+        (self.len[i] != 0.0) & self.nn[i].is_finite() & (self.nn[i] > 1e-24)
+    }
+}
+
+/// [`solve`] on each lane at `(x, y)` moving at `(vx, vy)`, with
+/// `Circle::geometry` after `Placed`'s translation and
+/// [`LinearForce::at`].
 #[inline(always)]
-fn euler_on_circles_portable(
+fn solve_lanes(
+    b: &CircleLanes,
+    [x, y, vx, vy]: [&[f64; LANES]; 4],
+    alpha: f64,
+    beta: f64,
+) -> LaneSolve {
+    let mut s = LaneSolve::default();
+    let mut inv = [0.0; LANES];
+    lanes!(i => {
+        let (px, py) = (x[i] - b.ox[i], y[i] - b.oy[i]);
+        s.len[i] = (px * px + py * py).sqrt();
+        inv[i] = 1.0 / s.len[i];
+        (s.nx[i], s.ny[i]) = (px * inv[i], py * inv[i]);
+    });
+    // λ of eq. 1.9, with H = (I - n nᵀ)/|x| as Circle::geometry builds it.
+    lanes!(i => {
+        let (nx, ny) = (s.nx[i], s.ny[i]);
+        let (h00, h10) = ((1.0 - nx * nx) * inv[i], (-nx * ny) * inv[i]);
+        let (h01, h11) = ((-nx * ny) * inv[i], (1.0 - ny * ny) * inv[i]);
+        let (hvx, hvy) = (h00 * vx[i] + h01 * vy[i], h10 * vx[i] + h11 * vy[i]);
+        let vhv = vx[i] * hvx + vy[i] * hvy;
+        let c = s.len[i] - b.radius[i];
+        let m = b.mass[i];
+        let k = b.stiffness[i];
+        let fx = b.fx[i] - k * (x[i] - b.at_x[i]);
+        let fy = b.fy[i] - k * (y[i] - b.at_y[i]);
+        s.nn[i] = nx * nx + ny * ny;
+        let ndv = nx * vx[i] + ny * vy[i];
+        let ndf = nx * fx + ny * fy;
+        s.lambda[i] = (-m * vhv - m * alpha * c - m * beta * ndv - ndf) / s.nn[i];
+        let inv_m = m.recip();
+        s.ax[i] = (fx + s.lambda[i] * nx) * inv_m;
+        s.ay[i] = (fy + s.lambda[i] * ny) * inv_m;
+    });
+    s
+}
+
+/// `a + t k`, lane by lane.
+#[inline(always)]
+fn axpy(a: &[f64; LANES], t: f64, k: &[f64; LANES]) -> [f64; LANES] {
+    std::array::from_fn(|i| a[i] + t * k[i])
+}
+
+/// [`step_on_circles`] for any processor.
+#[inline(always)]
+fn step_on_circles_portable(
     b: &CircleLanes,
     cfg: &StepConfig,
     bound_per_radius: f64,
 ) -> CircleSteps {
     let h = cfg.dt;
     let (alpha, beta) = cfg.gains();
-    let semi_implicit = cfg.integrator == Integrator::SemiImplicitEuler;
-    let z = [0.0; LANES];
-    let (mut len, mut inv, mut nx, mut ny, mut lambda) = (z, z, z, z, z);
-    let (mut x1, mut y1, mut vx1, mut vy1) = (z, z, z, z);
-    let (mut len1, mut c1, mut cdot1, mut nn) = (z, z, z, z);
-    // Circle::geometry at x0, after Placed's translation.
-    lanes!(i => {
-        let (px, py) = (b.x[i] - b.ox[i], b.y[i] - b.oy[i]);
-        len[i] = (px * px + py * py).sqrt();
-        inv[i] = 1.0 / len[i];
-        (nx[i], ny[i]) = (px * inv[i], py * inv[i]);
-    });
-    // λ of eq. 1.9, with H = (I - n nᵀ)/|x| as Circle::geometry builds it.
-    lanes!(i => {
-        let (h00, h10) = ((1.0 - nx[i] * nx[i]) * inv[i], (-nx[i] * ny[i]) * inv[i]);
-        let (h01, h11) = ((-nx[i] * ny[i]) * inv[i], (1.0 - ny[i] * ny[i]) * inv[i]);
-        let (vx, vy) = (b.vx[i], b.vy[i]);
-        let (hvx, hvy) = (h00 * vx + h01 * vy, h10 * vx + h11 * vy);
-        let vhv = vx * hvx + vy * hvy;
-        let c = len[i] - b.radius[i];
-        let m = b.mass[i];
-        nn[i] = nx[i] * nx[i] + ny[i] * ny[i];
-        let ndv = nx[i] * vx + ny[i] * vy;
-        let ndf = nx[i] * b.fx[i] + ny[i] * b.fy[i];
-        lambda[i] = (-m * vhv - m * alpha * c - m * beta * ndv - ndf) / nn[i];
-    });
-    // The acceleration and the Euler update.
-    lanes!(i => {
-        let inv_m = b.mass[i].recip();
-        let ax = (b.fx[i] + lambda[i] * nx[i]) * inv_m;
-        let ay = (b.fy[i] + lambda[i] * ny[i]) * inv_m;
-        (vx1[i], vy1[i]) = (b.vx[i] + h * ax, b.vy[i] + h * ay);
-        let (ux, uy) = if semi_implicit { (vx1[i], vy1[i]) } else { (b.vx[i], b.vy[i]) };
-        (x1[i], y1[i]) = (b.x[i] + h * ux, b.y[i] + h * uy);
-    });
-    // C and Ċ at the new state.
-    lanes!(i => {
-        let (px, py) = (x1[i] - b.ox[i], y1[i] - b.oy[i]);
-        len1[i] = (px * px + py * py).sqrt();
-        let k = 1.0 / len1[i];
-        c1[i] = len1[i] - b.radius[i];
-        cdot1[i] = (px * k) * vx1[i] + (py * k) * vy1[i];
-    });
-    // Which lanes finished as `step` would: `&`, not `&&`, so the checks
-    // vectorize too.
+    let first = solve_lanes(b, [&b.x, &b.y, &b.vx, &b.vy], alpha, beta);
+    let mut regular = [batches(cfg); LANES];
+    lanes!(i => regular[i] &= first.regular(i));
+    // `integrate`'s update.
+    let (x1, y1, vx1, vy1) = match cfg.integrator {
+        Integrator::ExplicitEuler => (
+            axpy(&b.x, h, &b.vx),
+            axpy(&b.y, h, &b.vy),
+            axpy(&b.vx, h, &first.ax),
+            axpy(&b.vy, h, &first.ay),
+        ),
+        Integrator::Rk4 => {
+            let half = 0.5 * h;
+            let stage = |t: f64, vx: &[f64; LANES], vy: &[f64; LANES], s: &LaneSolve| {
+                let x = axpy(&b.x, t, vx);
+                let y = axpy(&b.y, t, vy);
+                let (vx, vy) = (axpy(&b.vx, t, &s.ax), axpy(&b.vy, t, &s.ay));
+                let solved = solve_lanes(b, [&x, &y, &vx, &vy], alpha, beta);
+                (vx, vy, solved)
+            };
+            let (vx2, vy2, s2) = stage(half, &b.vx, &b.vy, &first);
+            let (vx3, vy3, s3) = stage(half, &vx2, &vy2, &s2);
+            let (vx4, vy4, s4) = stage(h, &vx3, &vy3, &s3);
+            lanes!(i => regular[i] &= s2.regular(i) & s3.regular(i) & s4.regular(i));
+            let sixth = h / 6.0;
+            let sum =
+                |k1: &[f64; LANES], k2: &[f64; LANES], k3: &[f64; LANES], k4: &[f64; LANES]| {
+                    std::array::from_fn(|i| k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+                };
+            (
+                axpy(&b.x, sixth, &sum(&b.vx, &vx2, &vx3, &vx4)),
+                axpy(&b.y, sixth, &sum(&b.vy, &vy2, &vy3, &vy4)),
+                axpy(&b.vx, sixth, &sum(&first.ax, &s2.ax, &s3.ax, &s4.ax)),
+                axpy(&b.vy, sixth, &sum(&first.ay, &s2.ay, &s3.ay, &s4.ay)),
+            )
+        }
+        // Semi-implicit Euler (and what `batches` refuses, finished by no
+        // lane).
+        Integrator::SemiImplicitEuler | Integrator::Rattle => {
+            let (vx1, vy1) = (axpy(&b.vx, h, &first.ax), axpy(&b.vy, h, &first.ay));
+            (axpy(&b.x, h, &vx1), axpy(&b.y, h, &vy1), vx1, vy1)
+        }
+    };
     let mut out = CircleSteps {
         x: x1,
         y: y1,
         vx: vx1,
         vy: vy1,
-        lambda,
-        c: c1,
-        c_dot: cdot1,
+        lambda: first.lambda,
         ..CircleSteps::default()
     };
+    // λN; C and Ċ at the new state.
+    let mut len1 = [0.0; LANES];
     lanes!(i => {
-        (out.fx[i], out.fy[i]) = (lambda[i] * nx[i], lambda[i] * ny[i]);
+        (out.fx[i], out.fy[i]) = (first.lambda[i] * first.nx[i], first.lambda[i] * first.ny[i]);
+        let (px, py) = (x1[i] - b.ox[i], y1[i] - b.oy[i]);
+        len1[i] = (px * px + py * py).sqrt();
+        let k = 1.0 / len1[i];
+        out.c[i] = len1[i] - b.radius[i];
+        out.c_dot[i] = (px * k) * vx1[i] + (py * k) * vy1[i];
     });
+    // Which lanes finished as `step` would: `&`, not `&&`, so the checks
+    // vectorize too.
     lanes!(i => {
         let finite = |v: f64| v.is_finite();
         let states = finite(b.x[i]) & finite(b.y[i]) & finite(b.vx[i]) & finite(b.vy[i]);
         let ends = finite(x1[i]) & finite(y1[i]) & finite(vx1[i]) & finite(vy1[i]);
-        let regular = (len[i] != 0.0) & finite(nn[i]) & (nn[i] > 1e-24) & (len1[i] != 0.0);
-        let bounded = c1[i].abs() <= bound_per_radius * b.radius[i];
-        out.done[i] = states & ends & regular & bounded;
+        let bounded = out.c[i].abs() <= bound_per_radius * b.radius[i];
+        out.done[i] = states & ends & regular[i] & (len1[i] != 0.0) & bounded;
     });
     out
 }
@@ -721,11 +809,15 @@ mod tests {
     }
 
     #[test]
-    fn batched_euler_on_circles_is_bit_identical_to_step() {
+    fn batched_step_on_circles_is_bit_identical_to_step() {
         // Beads in all directions, at all speeds, on circles of different
         // sizes and centres, with a spring's stiffness on some.
         let bound = 0.5;
-        for integrator in [Integrator::ExplicitEuler, Integrator::SemiImplicitEuler] {
+        for integrator in [
+            Integrator::ExplicitEuler,
+            Integrator::SemiImplicitEuler,
+            Integrator::Rk4,
+        ] {
             for stabilization in [Stabilization::Baumgarte, Stabilization::None] {
                 let mut batch_cfg = cfg(integrator, stabilization, 1.0 / 60.0);
                 batch_cfg.mass = f64::NAN; // each lane has its own
@@ -746,15 +838,15 @@ mod tests {
                         let force = LinearForce {
                             force: mass * G + DVec2::new(j % 3.0, -(j % 2.0)),
                             stiffness: j % 4.0,
-                            at: state.position,
+                            at: state.position + DVec2::new(0.01, -0.02) * (j % 5.0),
                         };
-                        lanes.set(lane, state, force.at(state.position), mass, centre, radius);
+                        lanes.set(lane, state, &force, mass, centre, radius);
                         inputs.push((state, force, mass, centre, radius));
                     }
                     // The dispatching entry point and the portable code
                     // (the same where there is no AVX2).
-                    let outs = euler_on_circles(&lanes, &batch_cfg, bound);
-                    let portable = euler_on_circles_portable(&lanes, &batch_cfg, bound);
+                    let outs = step_on_circles(&lanes, &batch_cfg, bound);
+                    let portable = step_on_circles_portable(&lanes, &batch_cfg, bound);
                     let both = (0..LANES).flat_map(|i| [outs.lane(i), portable.lane(i)]);
                     let inputs = inputs.iter().flat_map(|i| [*i, *i]);
                     for (out, (state, force, mass, centre, radius)) in both.zip(inputs) {
@@ -792,7 +884,7 @@ mod tests {
     }
 
     #[test]
-    fn batched_euler_hands_back_the_lanes_it_cannot_finish() {
+    fn batched_step_hands_back_the_lanes_it_cannot_finish() {
         let centre = DVec2::new(1.0, 2.0);
         let mut lanes = CircleLanes::default();
         let at = |angle: f64| centre + DVec2::from_angle(angle);
@@ -804,19 +896,33 @@ mod tests {
         ];
         for (lane, (position, velocity)) in states.into_iter().enumerate() {
             let state = BeadState { position, velocity };
-            lanes.set(lane, state, G, 1.0, centre, 1.0);
+            lanes.set(lane, state, &LinearForce::constant(G), 1.0, centre, 1.0);
         }
         let cfg = cfg(
             Integrator::SemiImplicitEuler,
             Stabilization::Baumgarte,
             0.01,
         );
-        let outs = euler_on_circles(&lanes, &cfg, 1.0);
+        let outs = step_on_circles(&lanes, &cfg, 1.0);
         // The unused lanes 4 to 7 are all at their circle's centre.
         let mut done = [false; LANES];
         done[0] = true;
         assert_eq!(outs.done, done, "{outs:?}");
         assert!(outs.lane(0).is_some() && outs.lane(1).is_none());
+        // What `batches` refuses, the batch finishes no lane of.
+        for (integrator, stabilization) in [
+            (Integrator::Rattle, Stabilization::Baumgarte),
+            (Integrator::Rk4, Stabilization::Projection),
+            (Integrator::SemiImplicitEuler, Stabilization::Projection),
+        ] {
+            let refused = StepConfig {
+                integrator,
+                stabilization,
+                ..cfg
+            };
+            assert!(!batches(&refused));
+            assert_eq!(step_on_circles(&lanes, &refused, 1.0).done, [false; LANES]);
+        }
     }
 
     #[test]

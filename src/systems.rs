@@ -14,7 +14,7 @@ use crate::components::{
     Bead, BeadDiagnostics, Diverged, DivergenceReason, DragTarget, OnWire, PendingWire, Wire,
     WirePose,
 };
-use crate::params::{Integrator, PendingBead, PendingParams, SimParams, Stabilization};
+use crate::params::{PendingBead, PendingParams, SimParams};
 use crate::plugin::{BeadDiverged, ParallelStep, Restart, SimClock};
 use crate::solver::{self, LinearForce, StepConfig};
 use crate::wire::{ImplicitCurve, Placed, Pose, WireShape};
@@ -258,7 +258,7 @@ struct StepContext<'a> {
     wires: &'a WireTable,
     found: &'a Found,
     time: f64,
-    /// The step's config when it is one [`solver::euler_on_circles`] takes.
+    /// The step's config when it is one [`solver::step_on_circles`] takes.
     batch: Option<StepConfig>,
 }
 
@@ -284,11 +284,10 @@ impl StepContext<'_> {
             {
                 let bead = &beads[i];
                 let mass = bead.mass();
-                let force = self.force_on(bead).at(bead.position);
                 lanes.set(
                     queued,
                     bead.state(),
-                    force,
+                    &self.force_on(bead),
                     mass,
                     pose.origin,
                     circle.radius,
@@ -297,7 +296,7 @@ impl StepContext<'_> {
                 queued += 1;
                 if queued == solver::LANES {
                     let bound = self.params.divergence_bound;
-                    let outs = solver::euler_on_circles(&lanes, cfg, bound);
+                    let outs = solver::step_on_circles(&lanes, cfg, bound);
                     for (lane, &j) in waiting.iter().enumerate() {
                         let diagnostics = diagnostics.as_deref_mut().map(|d| &mut d[j]);
                         match outs.lane(lane) {
@@ -450,16 +449,12 @@ pub fn step_beads(
     let removed = removed_wires.read().chain(removed_poses.read());
     wires.refresh(removed, changed);
     let batch = step_config(&params, 1.0, 1.0);
-    let eulerian = matches!(
-        batch.integrator,
-        Integrator::ExplicitEuler | Integrator::SemiImplicitEuler
-    ) && batch.stabilization != Stabilization::Projection;
     let ctx = StepContext {
         params: &params,
         wires: &wires,
         found: &found,
         time: clock.time,
-        batch: eulerian.then_some(batch),
+        batch: solver::batches(&batch).then_some(batch),
     };
     let count = beads.iter().size_hint().1.unwrap_or(usize::MAX);
     let pool = ComputeTaskPool::try_get().filter(|_| count >= parallel.threshold);

@@ -228,32 +228,43 @@ impl RawLoop {
         }
     }
 
-    /// Steps `beads` (at most [`solver::LANES`]) as the plugin does: the
-    /// batched circle step, with lanes it hands back through `step`.
+    /// Steps `beads` as the plugin does: [`solver::LANES`] at a time
+    /// through the batched circle step, the lanes it hands back and the
+    /// last partial chunk through `step`. `store` gets each bead's index and
+    /// result.
     #[inline(always)]
-    fn step_lanes(
+    fn step_chunks(
         &self,
-        beads: &[RawBead],
-    ) -> [Result<solver::StepOutput, solver::SolveError>; solver::LANES] {
+        beads: &mut [RawBead],
+        mut store: impl FnMut(usize, &mut RawBead, Result<solver::StepOutput, solver::SolveError>),
+    ) {
         let mut lanes = solver::CircleLanes::default();
-        for (lane, bead) in beads.iter().enumerate() {
-            let force = bead.mass * self.gravity;
-            let pose = self.poses[bead.wire as usize];
-            lanes.set(
-                lane,
-                bead.state,
-                force,
-                bead.mass,
-                pose.origin,
-                self.circle.radius,
-            );
+        let mut chunks = beads.chunks_exact_mut(solver::LANES);
+        let mut start = 0;
+        for chunk in &mut chunks {
+            for (lane, bead) in chunk.iter().enumerate() {
+                let force = LinearForce::constant(bead.mass * self.gravity);
+                let pose = self.poses[bead.wire as usize];
+                lanes.set(
+                    lane,
+                    bead.state,
+                    &force,
+                    bead.mass,
+                    pose.origin,
+                    self.circle.radius,
+                );
+            }
+            let outs = solver::step_on_circles(&lanes, &self.cfg, self.bound_per_radius);
+            for (lane, bead) in chunk.iter_mut().enumerate() {
+                let out = outs.lane(lane).map_or_else(|| self.step_one(bead), Ok);
+                store(start + lane, bead, out);
+            }
+            start += solver::LANES;
         }
-        let outs = solver::euler_on_circles(&lanes, &self.cfg, self.bound_per_radius);
-        std::array::from_fn(|lane| match (beads.get(lane), outs.lane(lane)) {
-            (Some(_), Some(out)) if beads.len() == solver::LANES => Ok(out),
-            (Some(bead), _) => self.step_one(bead),
-            (None, _) => Err(solver::SolveError::NonFinite),
-        })
+        for (k, bead) in chunks.into_remainder().iter_mut().enumerate() {
+            let out = self.step_one(bead);
+            store(start + k, bead, out);
+        }
     }
 
     fn step_one(&self, bead: &RawBead) -> Result<solver::StepOutput, solver::SolveError> {
@@ -272,18 +283,13 @@ impl RawLoop {
     fn step_lean(&mut self) -> usize {
         let mut failed = 0;
         let mut beads = std::mem::take(&mut self.beads);
-        for chunk in beads.chunks_mut(solver::LANES) {
-            let outs = self.step_lanes(chunk);
-            for (bead, out) in chunk.iter_mut().zip(outs) {
-                match out {
-                    Ok(out) => {
-                        bead.state = out.state;
-                        bead.lambda = out.lambda;
-                    }
-                    Err(_) => failed += 1,
-                }
+        self.step_chunks(&mut beads, |_, bead, out| match out {
+            Ok(out) => {
+                bead.state = out.state;
+                bead.lambda = out.lambda;
             }
-        }
+            Err(_) => failed += 1,
+        });
         self.beads = beads;
         failed
     }
@@ -294,28 +300,19 @@ impl RawLoop {
             std::mem::take(&mut self.beads),
             std::mem::take(&mut self.extras),
         );
-        let chunks = beads
-            .chunks_mut(solver::LANES)
-            .zip(extras.chunks_mut(solver::LANES));
-        for (chunk, extra) in chunks {
-            let outs = self.step_lanes(chunk);
-            for ((bead, extra), out) in chunk.iter_mut().zip(extra).zip(outs) {
-                match out {
-                    Ok(out) => {
-                        bead.state = out.state;
-                        bead.lambda = out.lambda;
-                        let (kinetic, potential) =
-                            solver::energy(bead.mass, self.gravity, out.state);
-                        *extra = RawExtras {
-                            constraint_force: out.constraint_force,
-                            diagnostics: [out.c, out.c_dot, kinetic, potential],
-                            rendered: [out.state.position.x as f32, out.state.position.y as f32],
-                        };
-                    }
-                    Err(_) => failed += 1,
-                }
+        self.step_chunks(&mut beads, |i, bead, out| match out {
+            Ok(out) => {
+                bead.state = out.state;
+                bead.lambda = out.lambda;
+                let (kinetic, potential) = solver::energy(bead.mass, self.gravity, out.state);
+                extras[i] = RawExtras {
+                    constraint_force: out.constraint_force,
+                    diagnostics: [out.c, out.c_dot, kinetic, potential],
+                    rendered: [out.state.position.x as f32, out.state.position.y as f32],
+                };
             }
-        }
+            Err(_) => failed += 1,
+        });
         (self.beads, self.extras) = (beads, extras);
         failed
     }
