@@ -22,13 +22,15 @@ pub enum WireBeadSystems {
     Forces,
     /// Solves eq. 1.9 for each bead's constraint force under gravity plus
     /// the accumulated forces, integrates, applies post-stabilization,
-    /// checks for divergence and updates diagnostics. One pass over the
-    /// beads: the solve and the integrators are separate pure functions in
-    /// [`solver`](crate::solver), but a second pass would read every bead
-    /// from memory again (RK4 and RATTLE solve at each of their stages
-    /// anyway).
+    /// checks for divergence, updates the diagnostics and the `Transform`.
+    /// One pass over the beads: the solve and the integrators are separate
+    /// pure functions in [`solver`](crate::solver), but a second pass would
+    /// read every bead from memory again (RK4 and RATTLE solve at each of
+    /// their stages anyway).
     Step,
-    /// Writes each bead's `f64` position into its `Transform`.
+    /// Writes each bead's `f64` position into its `Transform` where the
+    /// bead changed other than by the step (the step writes the `Transform`
+    /// of each bead it steps, in the same pass).
     Writeback,
 }
 
@@ -169,6 +171,7 @@ impl Plugin for WireBeadPlugin {
         app.insert_resource(pending)
             .init_resource::<ParallelStep>()
             .init_resource::<SimClock>()
+            .init_resource::<systems::LastStep>()
             .add_message::<Restart>()
             .add_message::<BeadDiverged>()
             .register_type::<Bead>()

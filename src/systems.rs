@@ -3,9 +3,9 @@
 
 use std::sync::{Mutex, PoisonError};
 
-use bevy::ecs::change_detection::ContiguousMut;
+use bevy::ecs::change_detection::{ContiguousMut, Tick};
 use bevy::ecs::storage::SparseSet;
-use bevy::ecs::system::SystemParam;
+use bevy::ecs::system::{SystemChangeTick, SystemParam};
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy::tasks::ComputeTaskPool;
@@ -18,9 +18,6 @@ use crate::params::{PendingBead, PendingParams, SimParams};
 use crate::plugin::{BeadDiverged, ParallelStep, Restart, SimClock};
 use crate::solver::{self, LinearForce, StepConfig};
 use crate::wire::{ImplicitCurve, Placed, Pose, WireShape};
-
-/// Read access to every wire and its placement for this step.
-pub type Wires<'w, 's> = Query<'w, 's, (&'static Wire, &'static WirePose)>;
 
 /// Runs `f` on every item of `query`: on the compute task pool when the
 /// query has at least `parallel.threshold` items, in this thread otherwise.
@@ -197,17 +194,6 @@ macro_rules! with_curve {
     };
 }
 
-/// The wire a bead is on and its pose for this step.
-pub fn wire_of<'a>(wires: &'a Wires, on: &OnWire) -> Result<(&'a Wire, Pose), DivergenceReason> {
-    let (wire, pose) = wires
-        .get(on.0)
-        .map_err(|_| DivergenceReason::InvalidWire(format!("entity {} has no Wire", on.0)))?;
-    let pose = pose
-        .get()
-        .map_err(|e| DivergenceReason::InvalidWire(e.to_string()))?;
-    Ok((wire, pose))
-}
-
 /// A wire's shape and pose for the step, or why beads cannot be stepped on
 /// it.
 type PlacedWire = Result<(WireShape, Pose), DivergenceReason>;
@@ -267,22 +253,16 @@ impl StepContext<'_> {
     /// present, lines up with `beads`). Beads on unrotated circles go
     /// through the batched step, [`solver::LANES`] at a time, when the
     /// config allows; the others, and the lanes it hands back, one by one.
-    fn step_run(
-        &self,
-        entities: &[Entity],
-        beads: &mut [Bead],
-        on_wires: &[OnWire],
-        mut diagnostics: Option<&mut [BeadDiagnostics]>,
-    ) {
+    fn step_run(&self, mut run: Run) {
         let mut lanes = solver::CircleLanes::default();
         let mut waiting = [0; solver::LANES];
         let mut queued = 0;
-        for i in 0..beads.len() {
-            let wire = self.wires.get(&on_wires[i]);
+        for i in 0..run.beads.len() {
+            let wire = self.wires.get(&run.on_wires[i]);
             if let (Some(cfg), Ok((WireShape::Circle(circle), pose))) = (&self.batch, wire)
                 && pose.is_unrotated()
             {
-                let bead = &beads[i];
+                let bead = &run.beads[i];
                 let mass = bead.mass();
                 lanes.set(
                     queued,
@@ -298,24 +278,19 @@ impl StepContext<'_> {
                     let bound = self.params.divergence_bound;
                     let outs = solver::step_on_circles(&lanes, cfg, bound);
                     for (lane, &j) in waiting.iter().enumerate() {
-                        let diagnostics = diagnostics.as_deref_mut().map(|d| &mut d[j]);
                         match outs.lane(lane) {
-                            Some(out) => self.finish(&mut beads[j], diagnostics, out),
-                            None => {
-                                self.step_one(entities[j], &mut beads[j], diagnostics, &on_wires[j])
-                            }
+                            Some(out) => self.finish(run.slot(j), out),
+                            None => self.step_one(&mut run, j),
                         }
                     }
                     queued = 0;
                 }
                 continue;
             }
-            let diagnostics = diagnostics.as_deref_mut().map(|d| &mut d[i]);
-            self.step_one(entities[i], &mut beads[i], diagnostics, &on_wires[i]);
+            self.step_one(&mut run, i);
         }
         for &j in &waiting[..queued] {
-            let diagnostics = diagnostics.as_deref_mut().map(|d| &mut d[j]);
-            self.step_one(entities[j], &mut beads[j], diagnostics, &on_wires[j]);
+            self.step_one(&mut run, j);
         }
     }
 
@@ -328,23 +303,17 @@ impl StepContext<'_> {
         }
     }
 
-    /// One bead through [`solver::step`]; a failure is recorded.
-    fn step_one(
-        &self,
-        entity: Entity,
-        bead: &mut Bead,
-        diagnostics: Option<&mut BeadDiagnostics>,
-        on_wire: &OnWire,
-    ) {
-        let result = match self.wires.get(on_wire) {
+    /// Bead `i` of `run` through [`solver::step`]; a failure is recorded.
+    fn step_one(&self, run: &mut Run, i: usize) {
+        let result = match self.wires.get(&run.on_wires[i]) {
             Err(reason) => Err(reason),
             Ok((shape, pose)) => with_curve!(shape, curve => {
-                self.step_bead(&Placed { curve, pose: *pose }, bead)
+                self.step_bead(&Placed { curve, pose: *pose }, &run.beads[i])
             }),
         };
         match result {
-            Ok(out) => self.finish(bead, diagnostics, out),
-            Err(reason) => self.found.push(entity, reason, self.time),
+            Ok(out) => self.finish(run.slot(i), out),
+            Err(reason) => self.found.push(run.entities[i], reason, self.time),
         }
     }
 
@@ -363,14 +332,14 @@ impl StepContext<'_> {
     }
 
     /// Stores a step's result: the new state, λ, the consumed force, the
-    /// diagnostics.
+    /// diagnostics, the `Transform`'s translation.
     #[inline(always)]
-    fn finish(
-        &self,
-        bead: &mut Bead,
-        diagnostics: Option<&mut BeadDiagnostics>,
-        out: solver::StepOutput,
-    ) {
+    fn finish(&self, slot: Slot, out: solver::StepOutput) {
+        let Slot {
+            bead,
+            diagnostics,
+            transform,
+        } = slot;
         bead.position = out.state.position;
         bead.velocity = out.state.velocity;
         bead.lambda = out.lambda;
@@ -389,44 +358,88 @@ impl StepContext<'_> {
                 time: diagnostics.time + self.params.timestep,
             };
         }
+        if let Some(transform) = transform {
+            // A finished step's position is finite.
+            transform.translation.x = out.state.position.x as f32;
+            transform.translation.y = out.state.position.y as f32;
+        }
     }
 }
 
-/// A run of beads stored side by side, with their entities, wires and
-/// (when they have them) diagnostics.
-type Run<'w> = (
+/// A run of beads stored side by side: their entities, states and wires,
+/// and, when they have them, their diagnostics and transforms.
+struct Run<'w> {
+    entities: &'w [Entity],
+    beads: &'w mut [Bead],
+    on_wires: &'w [OnWire],
+    diagnostics: Option<&'w mut [BeadDiagnostics]>,
+    transforms: Option<&'w mut [Transform]>,
+}
+
+/// What one bead's step writes.
+struct Slot<'a> {
+    bead: &'a mut Bead,
+    diagnostics: Option<&'a mut BeadDiagnostics>,
+    transform: Option<&'a mut Transform>,
+}
+
+impl Run<'_> {
+    #[inline(always)]
+    fn slot(&mut self, i: usize) -> Slot<'_> {
+        Slot {
+            bead: &mut self.beads[i],
+            diagnostics: self.diagnostics.as_deref_mut().map(|d| &mut d[i]),
+            transform: self.transforms.as_deref_mut().map(|t| &mut t[i]),
+        }
+    }
+}
+
+/// The columns of one table of beads, as the step's query hands them out.
+type BeadTable<'w> = (
     &'w [Entity],
-    &'w mut [Bead],
+    ContiguousMut<'w, Bead>,
     &'w [OnWire],
-    Option<&'w mut [BeadDiagnostics]>,
+    Option<ContiguousMut<'w, BeadDiagnostics>>,
+    Option<ContiguousMut<'w, Transform>>,
 );
+
+/// An optional column cut into runs of `n`; `None` for every run if absent
+/// (marked changed if present).
+fn column_runs<'w, T>(
+    column: Option<ContiguousMut<'w, T>>,
+    n: usize,
+) -> impl Iterator<Item = Option<&'w mut [T]>> {
+    column
+        .into_iter()
+        .flat_map(move |c| ContiguousMut::split(c).0.chunks_mut(n).map(Some))
+        .chain(std::iter::repeat_with(|| None))
+}
 
 /// Cuts one table's beads into runs: one for a single thread, else about a
 /// quarter of each thread's share, so a slow thread does not hold the
-/// others up. Marks the beads and diagnostics changed.
+/// others up. Marks the beads, diagnostics and transforms changed.
 fn split_table<'w>(
-    (entities, beads, on_wires, diagnostics): (
-        &'w [Entity],
-        ContiguousMut<'w, Bead>,
-        &'w [OnWire],
-        Option<ContiguousMut<'w, BeadDiagnostics>>,
-    ),
+    (entities, beads, on_wires, diagnostics, transforms): BeadTable<'w>,
     threads: usize,
 ) -> Vec<Run<'w>> {
     let runs = if threads > 1 { 4 * threads } else { 1 };
     let n = entities.len().div_ceil(runs).max(1);
     let beads = ContiguousMut::split(beads).0;
-    let diagnostics = diagnostics.map(|d| ContiguousMut::split(d).0);
-    let diagnostic_runs = diagnostics
-        .into_iter()
-        .flat_map(|d| d.chunks_mut(n).map(Some))
-        .chain(std::iter::repeat_with(|| None));
     entities
         .chunks(n)
         .zip(beads.chunks_mut(n))
         .zip(on_wires.chunks(n))
-        .zip(diagnostic_runs)
-        .map(|(((e, b), o), d)| (e, b, o, d))
+        .zip(column_runs(diagnostics, n))
+        .zip(column_runs(transforms, n))
+        .map(
+            |((((entities, beads), on_wires), diagnostics), transforms)| Run {
+                entities,
+                beads,
+                on_wires,
+                diagnostics,
+                transforms,
+            },
+        )
         .collect()
 }
 
@@ -442,8 +455,19 @@ pub fn step_beads(
     changed: Query<(Entity, &Wire, &WirePose), Or<(Changed<Wire>, Changed<WirePose>)>>,
     mut removed_wires: RemovedComponents<Wire>,
     mut removed_poses: RemovedComponents<WirePose>,
-    mut beads: Query<(Entity, &mut Bead, &OnWire, Option<&mut BeadDiagnostics>), Without<Diverged>>,
+    mut beads: Query<
+        (
+            Entity,
+            &mut Bead,
+            &OnWire,
+            Option<&mut BeadDiagnostics>,
+            Option<&mut Transform>,
+        ),
+        Without<Diverged>,
+    >,
     mut found: Local<Found>,
+    mut stepped: ResMut<LastStep>,
+    ticks: SystemChangeTick,
     mut divergences: Divergences,
 ) {
     let removed = removed_wires.read().chain(removed_poses.read());
@@ -467,33 +491,43 @@ pub fn step_beads(
     match pool {
         Some(pool) if threads > 1 => {
             pool.scope(|scope| {
-                for (entities, beads, on_wires, diagnostics) in tables.flat_map(split) {
+                for run in tables.flat_map(split) {
                     let ctx = &ctx;
-                    scope
-                        .spawn(async move { ctx.step_run(entities, beads, on_wires, diagnostics) });
+                    scope.spawn(async move { ctx.step_run(run) });
                 }
             });
         }
         _ => {
-            for (entities, beads, on_wires, diagnostics) in tables.flat_map(split) {
-                ctx.step_run(entities, beads, on_wires, diagnostics);
+            for run in tables.flat_map(split) {
+                ctx.step_run(run);
             }
         }
     };
     found.report(&mut divergences);
+    stepped.0 = ticks.this_run();
 }
 
-/// Writes each bead's position into its `Transform` (x and y; z is kept).
-/// A non-finite position is never written.
+/// The change tick of the last run of [`step_beads`]: it wrote the
+/// `Transform` of every bead it changed then.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct LastStep(Tick);
+
+/// Writes each bead's position into its `Transform` (x and y; z is kept)
+/// where the bead changed other than by the last step (a restart, a
+/// game's own edit); [`step_beads`] writes the ones it steps. A non-finite
+/// position is never written.
 pub fn write_transforms(
     parallel: Res<ParallelStep>,
-    mut beads: Query<(&Bead, &mut Transform), Changed<Bead>>,
+    stepped: Res<LastStep>,
+    mut beads: Query<(Ref<Bead>, &mut Transform), Changed<Bead>>,
 ) {
     for_each_bead!(beads, parallel, |(bead, mut transform): (
-        &Bead,
+        Ref<Bead>,
         Mut<Transform>
     )| {
-        if bead.position.is_finite() {
+        // The step wrote the ones it changed last (without reading them
+        // again here).
+        if bead.last_changed() != stepped.0 && bead.position.is_finite() {
             transform.translation.x = bead.position.x as f32;
             transform.translation.y = bead.position.y as f32;
         }

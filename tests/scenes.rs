@@ -336,3 +336,29 @@ fn a_wire_moved_reshaped_or_taken_away_between_steps_is_what_its_beads_see() {
         "a stopped bead keeps its state"
     );
 }
+
+/// Moves every bead to (0.25, -0.5) after the step, before the writeback.
+fn move_after_step(mut beads: Query<&mut Bead>) {
+    for mut bead in &mut beads {
+        bead.position = DVec2::new(0.25, -0.5);
+    }
+}
+
+#[test]
+fn the_transform_follows_a_bead_moved_after_the_step_too() {
+    let mut app = app(SimParams::default());
+    let b = pendulum(&mut app, 1.0, 0.5);
+    run_steps(&mut app, 5);
+    let stepped = bead(&app, b).position;
+    let t = app.world().get::<Transform>(b).unwrap().translation;
+    assert_eq!((t.x, t.y), (stepped.x as f32, stepped.y as f32));
+    app.add_systems(
+        FixedUpdate,
+        move_after_step
+            .after(WireBeadSystems::Step)
+            .before(WireBeadSystems::Writeback),
+    );
+    run_steps(&mut app, 1);
+    let t = app.world().get::<Transform>(b).unwrap().translation;
+    assert_eq!((t.x, t.y), (0.25, -0.5));
+}

@@ -256,8 +256,14 @@ impl RawLoop {
             }
             let outs = solver::step_on_circles(&lanes, &self.cfg, self.bound_per_radius);
             for (lane, bead) in chunk.iter_mut().enumerate() {
-                let out = outs.lane(lane).map_or_else(|| self.step_one(bead), Ok);
-                store(start + lane, bead, out);
+                // Two calls, so a finished lane's result stays in registers.
+                match outs.lane(lane) {
+                    Some(out) => store(start + lane, bead, Ok(out)),
+                    None => {
+                        let out = self.step_one(bead);
+                        store(start + lane, bead, out);
+                    }
+                }
             }
             start += solver::LANES;
         }
