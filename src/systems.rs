@@ -313,7 +313,14 @@ impl StepContext<'_> {
         };
         match result {
             Ok(out) => self.finish(run.slot(i), out),
-            Err(reason) => self.found.push(run.entities[i], reason, self.time),
+            Err(reason) => {
+                // The bead keeps its state; its `Transform` shows it.
+                let slot = run.slot(i);
+                if let Some(transform) = slot.transform {
+                    place(transform, slot.bead.position);
+                }
+                self.found.push(run.entities[i], reason, self.time);
+            }
         }
     }
 
@@ -359,7 +366,7 @@ impl StepContext<'_> {
             };
         }
         if let Some(transform) = transform {
-            // A finished step's position is finite.
+            // A finished step's position is finite: no check.
             transform.translation.x = out.state.position.x as f32;
             transform.translation.y = out.state.position.y as f32;
         }
@@ -527,11 +534,20 @@ pub fn write_transforms(
     )| {
         // The step wrote the ones it changed last (without reading them
         // again here).
-        if bead.last_changed() != stepped.0 && bead.position.is_finite() {
-            transform.translation.x = bead.position.x as f32;
-            transform.translation.y = bead.position.y as f32;
+        if bead.last_changed() != stepped.0 {
+            place(&mut transform, bead.position);
         }
     });
+}
+
+/// Writes a bead's position into its `Transform` (x and y, rounded to
+/// `f32`; z is kept), unless it is not finite.
+#[inline(always)]
+fn place(transform: &mut Transform, position: DVec2) {
+    if position.is_finite() {
+        transform.translation.x = position.x as f32;
+        transform.translation.y = position.y as f32;
+    }
 }
 
 fn step_config(params: &SimParams, mass: f64, wire_scale: f64) -> StepConfig {

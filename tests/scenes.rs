@@ -362,3 +362,22 @@ fn the_transform_follows_a_bead_moved_after_the_step_too() {
     let t = app.world().get::<Transform>(b).unwrap().translation;
     assert_eq!((t.x, t.y), (0.25, -0.5));
 }
+
+#[test]
+fn a_bead_put_where_it_cannot_step_shows_where_it_was_put() {
+    let mut app = app(SimParams::default());
+    let b = pendulum(&mut app, 1.0, 0.5);
+    run_steps(&mut app, 5);
+    // The centre of its circle, where the constraint has no normal.
+    app.world_mut().get_mut::<Bead>(b).unwrap().position = DVec2::ZERO;
+    run_steps(&mut app, 1);
+    let diverged = app.world().get::<Diverged>(b).expect("diverged");
+    assert!(
+        diverged.reason.to_string().contains("singular"),
+        "{}",
+        diverged.reason
+    );
+    assert_eq!(bead(&app, b).position, DVec2::ZERO);
+    let t = app.world().get::<Transform>(b).unwrap().translation;
+    assert_eq!((t.x, t.y), (0.0, 0.0));
+}
