@@ -592,11 +592,13 @@ fn step_on_circles_portable(
     cfg: &StepConfig,
     bound_per_radius: f64,
 ) -> CircleSteps {
+    if !batches(cfg) {
+        return CircleSteps::default();
+    }
     let h = cfg.dt;
     let (alpha, beta) = cfg.gains();
     let first = solve_lanes(b, [&b.x, &b.y, &b.vx, &b.vy], alpha, beta);
-    let mut regular = [batches(cfg); LANES];
-    lanes!(i => regular[i] &= first.regular(i));
+    let mut regular: [bool; LANES] = std::array::from_fn(|i| first.regular(i));
     // `integrate`'s update.
     let (x1, y1, vx1, vy1) = match cfg.integrator {
         Integrator::ExplicitEuler => (
@@ -630,8 +632,7 @@ fn step_on_circles_portable(
                 axpy(&b.vy, sixth, &sum(&first.ay, &s2.ay, &s3.ay, &s4.ay)),
             )
         }
-        // Semi-implicit Euler (and what `batches` refuses, finished by no
-        // lane).
+        // Semi-implicit Euler (RATTLE returned above).
         Integrator::SemiImplicitEuler | Integrator::Rattle => {
             let (vx1, vy1) = (axpy(&b.vx, h, &first.ax), axpy(&b.vy, h, &first.ay));
             (axpy(&b.x, h, &vx1), axpy(&b.y, h, &vy1), vx1, vy1)

@@ -277,15 +277,8 @@ fn circle_c(p: DVec2, o: DVec2, r: f64) -> f64 {
 #[test]
 fn a_wire_moved_reshaped_or_taken_away_between_steps_is_what_its_beads_see() {
     let mut app = app(SimParams::default());
-    let wire = spawn_wire(&mut app, Wire::circle(1.0).unwrap(), Transform::default());
-    let b = spawn_bead(
-        &mut app,
-        wire,
-        BeadParams {
-            initial_position: DVec2::new(1.0, 0.0),
-            ..default()
-        },
-    );
+    let b = circle_bead(&mut app, 1.0, DVec2::new(1.0, 0.0), DVec2::ZERO);
+    let wire = app.world().get::<OnWire>(b).unwrap().0;
     run_steps(&mut app, 10);
     let c = diagnostics(&app, b).c;
     assert!(c.abs() < 1e-3, "on its wire: C = {c}");
