@@ -1,4 +1,4 @@
-//! Demonstrates the interactive scene: the seed's application in a window.
+//! Demonstrates the interactive scene: the assignment's application in a window.
 //!
 //! Drag the bead with the mouse (a spring `k (cursor - bead)` pulls it),
 //! edit every parameter in the panel and press Space to apply them, watch the
@@ -24,7 +24,7 @@ use wirebead::prelude::*;
 #[command(version, about)]
 struct Args {
     /// Scene preset to start with (an asset path under `assets/`).
-    #[arg(long, default_value = "scenes/seed_circle.scene.ron")]
+    #[arg(long, default_value = "scenes/assignment_circle.scene.ron")]
     preset: String,
     /// Exit after this many frames (status 0, or non-zero if anything failed).
     #[arg(long)]

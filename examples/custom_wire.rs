@@ -49,7 +49,7 @@ struct Args {
 fn main() -> AppExit {
     let args = Args::parse();
     let params = SimParams {
-        integrator: Integrator::Rattle,
+        method: Method::Rattle,
         ..SimParams::default()
     };
     App::new()

@@ -5,8 +5,7 @@
 use bevy::input::InputSystems;
 use bevy::prelude::*;
 
-use crate::plugin::Restart;
-use crate::systems::apply_restart;
+use crate::plugin::{Restart, WireBeadSystems};
 
 /// The keys the controls listen to.
 #[derive(Resource, Clone, Debug, PartialEq, Eq)]
@@ -61,7 +60,9 @@ impl Plugin for KeyboardControlsPlugin {
             .init_resource::<StepRequests>()
             .add_systems(
                 PreUpdate,
-                keyboard_controls.after(InputSystems).before(apply_restart),
+                keyboard_controls
+                    .after(InputSystems)
+                    .before(WireBeadSystems::Restart),
             )
             .add_systems(Update, run_requested_steps);
     }

@@ -5,6 +5,7 @@
 //! force `λ∇C`, with λ chosen so that the drift obeys `C̈ = -αC - βĊ`
 //! (Baumgarte), or by post-stabilization projection, or by RATTLE, which holds
 //! the constraint to solver tolerance and keeps the energy error bounded.
+//! The equations, numbered as the code cites them, are in [`solver`].
 //!
 //! ## Add the plugin
 //!
@@ -30,59 +31,73 @@
 //! | item | what it is |
 //! |---|---|
 //! | [`WireBeadPlugin`] | the simulation: components, parameters, the step in `FixedUpdate` |
-//! | [`WireBeadSystems`] | the step's chained sets: `Prepare → Forces → Step → Writeback` |
+//! | [`WireBeadSystems`] | the sets: `Restart` in `PreUpdate`; `Prepare → Forces → Step → Writeback` in `FixedUpdate` |
 //! | [`Wire`], [`Bead`], [`OnWire`] | a wire placed by its `Transform`; a bead on it |
-//! | [`SimParams`], [`PendingParams`], [`PendingBead`] | applied and edited parameters; [`Restart`] applies the edits |
-//! | `gui::WireBeadGuiPlugin` | the windowed scene (feature `gui`): picking drag, egui panel, plots |
+//! | [`SimParams`], [`PendingParams`], [`PendingBead`], [`PendingWire`] | applied and edited parameters; [`Restart`] applies the edits |
+//! | [`Method`] | an [`Integrator`] with its [`Stabilization`] (RATTLE takes none) |
 //! | [`KeyboardControlsPlugin`] | Space restarts, P pauses, N steps once: headless-testable |
 //! | [`DragTarget`] | the user's drag: a spring `k (target - x)` while present |
 //! | [`BeadDiagnostics`], [`Diverged`], [`BeadDiverged`] | `C`, `Ċ`, λ and energy each step; divergence reports |
 //! | [`SimClock`], [`ParallelStep`] | steps and seconds since the last restart; when the step splits over threads |
 //! | [`ScenePresetPlugin`], [`ScenePreset`] | scenes as RON assets (`*.scene.ron`), hot-reloaded |
-//! | [`solver`], [`wire`], [`reference`](mod@reference) | the pure math: eq. 1.9, the integrators, the shapes, the exact pendulum period |
+//! | `gui::WireBeadGuiPlugin` | the windowed scene (feature `gui`): picking drag, egui panel, plots |
+//!
+//! ## The modules, bottom up
+//!
+//! Each module uses only the ones above it in this list.
+//!
+//! | module | what it holds |
+//! |---|---|
+//! | [`geometry`] | [`ImplicitCurve`] (`C`, `∇C`, the Hessian), one file per shape, [`Pose`](geometry::Pose) |
+//! | [`reference`](mod@reference) | exact answers: the pendulum's period |
+//! | [`solver`] | the pure math: eq. (3), the integrators, RATTLE, projection, the batched lanes |
+//! | `dynamics` | the components and resources above (re-exported here) |
+//! | [`plugin`] | the sets, the systems, the plugin |
+//! | [`controls`], [`preset`] | keyboard controls; scene files |
+//! | [`headless`] | the one headless harness the tests, benches and tools build on |
+//! | `gui` | the windowed scene |
 //!
 //! ## Feature flags
 //!
 //! | feature | default | what it adds |
 //! |---|---|---|
 //! | `gui` | yes | the windowed scene: rendering, picking, the egui panel and plots |
+//! | `parallel` | yes | Bevy's `multi_threaded`: the step splits over the compute pool |
 //!
 //! With `default-features = false` the crate needs only Bevy's headless core.
 #![warn(missing_docs)]
 
-#[cfg(feature = "analysis")]
-pub mod analysis;
-pub mod components;
 pub mod controls;
+mod dynamics;
+pub mod geometry;
 #[cfg(feature = "gui")]
 pub mod gui;
-pub mod params;
+pub mod headless;
 pub mod plugin;
 pub mod preset;
 pub mod reference;
 pub mod solver;
-pub mod systems;
-pub mod wire;
+mod validate;
 
-pub use components::{
-    Bead, BeadDiagnostics, Diverged, DivergenceReason, DragTarget, OnWire, Wire, WireBeads,
-    WirePose,
-};
 pub use controls::KeyboardControlsPlugin;
-pub use params::{
-    BeadParams, Integrator, ParamError, PendingBead, PendingParams, SimParams, Stabilization,
+pub use dynamics::{
+    Bead, BeadDiagnostics, BeadDiverged, BeadParams, Diverged, DivergenceReason, DragTarget,
+    MAX_TIMESTEP, MIN_TIMESTEP, OnWire, PendingBead, PendingParams, PendingWire, SimParams, Wire,
+    WireBeads, pose_of,
 };
-pub use plugin::{BeadDiverged, ParallelStep, Restart, SimClock, WireBeadPlugin, WireBeadSystems};
+pub use geometry::{ImplicitCurve, WireKind, WireShape};
+pub use plugin::{ParallelStep, Restart, SimClock, WireBeadPlugin, WireBeadSystems};
 pub use preset::{ActivePreset, LoadPreset, ScenePreset, ScenePresetPlugin};
-pub use wire::{ImplicitCurve, WireShape};
+pub use solver::{Integrator, Method, Stabilization};
+pub use validate::ParamError;
 
 /// The types most apps need: `use wirebead::prelude::*;`.
 pub mod prelude {
     pub use crate::{
         Bead, BeadDiagnostics, BeadDiverged, BeadParams, Diverged, DragTarget, ImplicitCurve,
-        Integrator, KeyboardControlsPlugin, LoadPreset, OnWire, ParallelStep, PendingBead,
-        PendingParams, Restart, ScenePreset, ScenePresetPlugin, SimClock, SimParams, Stabilization,
-        Wire, WireBeadPlugin, WireBeadSystems, WireBeads, WireShape,
+        Integrator, KeyboardControlsPlugin, LoadPreset, Method, OnWire, ParallelStep, ParamError,
+        PendingBead, PendingParams, Restart, ScenePreset, ScenePresetPlugin, SimClock, SimParams,
+        Stabilization, Wire, WireBeadPlugin, WireBeadSystems, WireBeads, WireKind, WireShape,
     };
 }
 

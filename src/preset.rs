@@ -3,7 +3,7 @@
 //!
 //! ```ron
 //! (
-//!     name: "The seed's circle",
+//!     name: "The assignment's circle",
 //!     params: (alpha: 100.0, beta: 20.0),
 //!     wires: [
 //!         (
@@ -20,15 +20,15 @@
 //! records the error in [`ActivePreset::error`].
 
 use bevy::asset::io::Reader;
-use bevy::asset::{AssetLoadFailedEvent, AssetLoader, LoadContext};
+use bevy::asset::{AssetLoadError, AssetLoadFailedEvent, AssetLoader, LoadContext};
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::components::{Bead, OnWire, Wire};
-use crate::params::{BeadParams, ParamError, PendingParams, SimParams};
-use crate::plugin::Restart;
-use crate::wire::WireShape;
+use crate::dynamics::{Bead, BeadParams, OnWire, PendingParams, SimParams, Wire};
+use crate::geometry::WireShape;
+use crate::plugin::{Restart, WireBeadSystems};
+use crate::validate::{ParamError, finite, finite_vector};
 
 /// One wire of a preset and the beads on it.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -62,7 +62,12 @@ pub struct ScenePreset {
 #[derive(Debug, thiserror::Error)]
 pub enum PresetError {
     /// The file is not valid RON for a preset.
-    #[error("malformed scene file: {0}")]
+    #[error(
+        "malformed scene file at line {}, column {}: {}",
+        .0.span.start.line,
+        .0.span.start.col,
+        .0.code
+    )]
     Parse(#[from] ron::error::SpannedError),
     /// The file could not be read.
     #[error("cannot read scene file: {0}")]
@@ -108,16 +113,8 @@ impl ScenePreset {
             wire.shape
                 .validate()
                 .map_err(|source| PresetError::Wire { index, source })?;
-            crate::params::check_vector("wire position", wire.position)
-                .and_then(|_| {
-                    wire.angle_degrees
-                        .is_finite()
-                        .then_some(())
-                        .ok_or(ParamError::NotFinite {
-                            name: "wire angle",
-                            value: wire.angle_degrees,
-                        })
-                })
+            finite_vector("wire position", wire.position)
+                .and_then(|_| finite("wire angle", wire.angle_degrees))
                 .map_err(|source| PresetError::Wire { index, source })?;
             for (bead, params) in wire.beads.iter().enumerate() {
                 params.validate().map_err(|source| PresetError::Bead {
@@ -222,7 +219,7 @@ impl Plugin for ScenePresetPlugin {
                     apply_loaded_preset,
                 )
                     .chain()
-                    .before(crate::systems::apply_restart),
+                    .before(WireBeadSystems::Restart),
             );
     }
 }
@@ -247,13 +244,25 @@ pub fn report_preset_errors(
 ) {
     for failure in failures.read() {
         if failure.id == active.handle.id() {
-            let message = format!("{}: {}", failure.path, failure.error);
-            error!(
-                "wirebead: scene preset not applied, the previous scene keeps running: {message}"
-            );
+            let message = format!("{}: {}", failure.path, load_error_in_words(&failure.error));
+            error!("wirebead: scene file {message}; the running scene was kept");
             active.error = Some(message);
         }
     }
+}
+
+/// What went wrong loading a scene file, in one line: the loader's own
+/// [`PresetError`] where there is one (not the asset server's wrapping of
+/// it, which may carry a backtrace), else the first line of the error.
+fn load_error_in_words(error: &AssetLoadError) -> String {
+    let text = match error {
+        AssetLoadError::AssetLoaderError(e) => match e.error().downcast_ref::<PresetError>() {
+            Some(preset) => return preset.to_string(),
+            None => e.error().to_string(),
+        },
+        other => other.to_string(),
+    };
+    text.lines().next().unwrap_or_default().to_owned()
 }
 
 /// Replaces the scene when the active preset loads or its file changes.
@@ -309,7 +318,7 @@ mod tests {
     fn a_preset_parses_with_defaults_filled_in() {
         let preset = ScenePreset::from_ron(GOOD).unwrap();
         assert_eq!(preset.params.alpha, 50.0);
-        assert_eq!(preset.params.integrator, crate::Integrator::Rattle);
+        assert_eq!(preset.params.method, crate::Method::Rattle);
         assert_eq!(preset.params.beta, SimParams::default().beta);
         assert_eq!(preset.wires[1].beads[0], BeadParams::default());
         assert_eq!(preset.wires[0].angle_degrees, 30.0);
@@ -320,7 +329,10 @@ mod tests {
         let err = ScenePreset::from_ron("(name: \"x\", wires: [ (shape: Circle((radius: 1.0)) ]")
             .unwrap_err();
         let text = err.to_string();
-        assert!(text.starts_with("malformed scene file: 1:"), "{text}");
+        assert!(
+            text.starts_with("malformed scene file at line 1, column "),
+            "{text}"
+        );
         let err = ScenePreset::from_ron(&GOOD.replace("radius: 2.0", "radius: 0.0")).unwrap_err();
         assert_eq!(
             err.to_string(),

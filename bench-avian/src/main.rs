@@ -6,7 +6,7 @@
 //! ```
 //!
 //! Prints a markdown table: energy change, max radial error and period
-//! error of each of our integrator × stabilization pairs and of avian2d (a
+//! error of each of our methods and of avian2d (a
 //! body on a `DistanceJoint` to a static anchor), and the wall time per
 //! bead-step at N = 1 and N = 10,000 pendulums.
 
@@ -18,8 +18,8 @@ use std::time::{Duration, Instant};
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use bevy::time::TimeUpdateStrategy;
 use clap::Parser;
+use wirebead::headless::Headless;
 use wirebead::prelude::*;
 use wirebead::reference::{pendulum_period, period_from_crossings};
 
@@ -49,28 +49,14 @@ struct Row {
 
 /// Our plugin with `n` pendulums, each on its own circle 3 m apart, in an
 /// app built like avian's: `MinimalPlugins`, one fixed step per update.
-fn our_app(
-    n: usize,
-    integrator: Integrator,
-    stabilization: Stabilization,
-    dt: f64,
-) -> (App, Entity) {
-    let mut app = App::new();
+fn our_app(n: usize, method: Method, dt: f64) -> (App, Entity) {
     let params = SimParams {
         timestep: dt,
         gravity: DVec2::new(0.0, -GRAVITY),
-        integrator,
-        stabilization,
+        method,
         ..SimParams::default()
     };
-    app.add_plugins((
-        MinimalPlugins,
-        WireBeadPlugin::new(params).expect("valid parameters"),
-    ))
-    .insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
-    app.world_mut()
-        .resource_mut::<Time<Virtual>>()
-        .set_max_delta(Duration::from_secs(1));
+    let mut app = Headless::new(WireBeadPlugin::new(params).expect("valid parameters")).build();
     let mut first = None;
     for i in 0..n {
         let origin = Vec3::new(3.0 * i as f32, 0.0, 0.0);
@@ -86,21 +72,13 @@ fn our_app(
         let id = app.world_mut().spawn((bead, OnWire(wire))).id();
         first.get_or_insert(id);
     }
-    // The first update starts the clocks and runs no fixed step.
-    app.update();
     (app, first.expect("at least one pendulum"))
 }
 
 /// Steps our plugin; returns (energy change, max radial error, period,
 /// wall seconds in the stepping loop).
-fn run_ours(
-    n: usize,
-    integrator: Integrator,
-    stabilization: Stabilization,
-    dt: f64,
-    steps: usize,
-) -> (f64, f64, Option<f64>, f64) {
-    let (mut app, first) = our_app(n, integrator, stabilization, dt);
+fn run_ours(n: usize, method: Method, dt: f64, steps: usize) -> (f64, f64, Option<f64>, f64) {
+    let (mut app, first) = our_app(n, method, dt);
     let energy = |b: &Bead| 0.5 * b.velocity.length_squared() + GRAVITY * b.position.y;
     let e0 = energy(app.world().get::<Bead>(first).expect("bead"));
     let mut samples = Vec::with_capacity(steps + 1);
@@ -118,14 +96,14 @@ fn run_ours(
             return (f64::NAN, f64::NAN, None, seconds);
         }
         let bead = app.world().get::<Bead>(first).expect("bead");
-        let diagnostics = app.world().get::<BeadDiagnostics>(first).expect("bead");
+        let clock = app.world().resource::<SimClock>();
         assert_eq!(
-            diagnostics.steps as usize,
+            clock.steps as usize,
             samples.len() + 1,
             "one step per update"
         );
         max_radial = max_radial.max((bead.position.length() - RADIUS).abs());
-        samples.push((diagnostics.time, bead.position.x));
+        samples.push((clock.time, bead.position.x));
     }
     let bead = app.world().get::<Bead>(first).expect("bead");
     (
@@ -143,20 +121,18 @@ fn main() {
     let dt = 1.0 / 60.0;
     let exact = pendulum_period(RADIUS, GRAVITY, std::f64::consts::FRAC_PI_2);
     let mut rows = Vec::new();
-    for &integrator in Integrator::ALL {
-        for &stabilization in Stabilization::ALL {
-            let (de, radial, period, one) = run_ours(1, integrator, stabilization, dt, args.steps);
-            let (.., many) = run_ours(args.many, integrator, stabilization, dt, args.steps);
-            rows.push(Row {
-                name: format!("wirebead {integrator} + {stabilization}"),
-                energy_change: de,
-                max_radial_error: radial,
-                period_error: period.map(|p| (p - exact) / exact),
-                ns_one: one * 1e9 / args.steps as f64,
-                ns_many: many * 1e9 / (args.steps * args.many) as f64,
-            });
-            eprintln!("done: {}", rows.last().map_or("", |r| r.name.as_str()));
-        }
+    for method in Method::ALL {
+        let (de, radial, period, one) = run_ours(1, method, dt, args.steps);
+        let (.., many) = run_ours(args.many, method, dt, args.steps);
+        rows.push(Row {
+            name: format!("wirebead {method}"),
+            energy_change: de,
+            max_radial_error: radial,
+            period_error: period.map(|p| (p - exact) / exact),
+            ns_one: one * 1e9 / args.steps as f64,
+            ns_many: many * 1e9 / (args.steps * args.many) as f64,
+        });
+        eprintln!("done: {}", rows.last().map_or("", |r| r.name.as_str()));
     }
     let one = avian_side::run_avian(1, dt, args.steps, None);
     let many = avian_side::run_avian(args.many, dt, args.steps, None);

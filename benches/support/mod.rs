@@ -3,12 +3,12 @@
 
 #![allow(dead_code)]
 
-use bevy::app::TaskPoolPlugin;
 use bevy::math::DVec2;
 use bevy::prelude::*;
+use wirebead::geometry::{Circle, Placed, Pose};
+use wirebead::headless::Headless;
 use wirebead::prelude::*;
-use wirebead::solver::{self, BeadState, LinearForce, StepConfig};
-use wirebead::wire::{Circle, Placed, Pose};
+use wirebead::solver::{self, BeadState, LinearForce, StepSettings};
 
 /// How the beads are put on wires.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -86,21 +86,16 @@ fn on_circle(origin: DVec2, angle: f64) -> DVec2 {
 /// An app with the plugin and `n` beads at rest, ready for
 /// `world_mut().run_schedule(FixedUpdate)` (one step per call).
 pub fn plugin_app(n: usize, layout: Layout, threads: Threads, kind: Kind) -> App {
-    let mut app = App::new();
     let plugin = match kind {
         Kind::Full => WireBeadPlugin::default(),
         Kind::Lean => WireBeadPlugin::default().lean(),
     };
-    app.add_plugins((
-        TaskPoolPlugin {
-            task_pool_options: wirebead::plugin::compute_on_all_cores(),
-        },
-        plugin,
-    ));
-    if threads == Threads::Single {
-        app.insert_resource(ParallelStep::OFF);
-        wirebead::plugin::use_single_threaded_executors(&mut app);
+    let harness = Headless::new(plugin).on_all_cores();
+    let mut app = match threads {
+        Threads::Single => harness.single_threaded().parallel(ParallelStep::OFF),
+        Threads::Parallel => harness,
     }
+    .build();
     let world = app.world_mut();
     match layout {
         Layout::SharedWire => {
@@ -126,8 +121,6 @@ pub fn plugin_app(n: usize, layout: Layout, threads: Threads, kind: Kind) -> App
             }));
         }
     }
-    app.finish();
-    app.cleanup();
     app
 }
 
@@ -138,8 +131,6 @@ pub struct RawBead {
     pub state: BeadState,
     /// Mass.
     pub mass: f64,
-    /// λ of the last step.
-    pub lambda: f64,
     /// Index of its wire's pose.
     pub wire: u32,
 }
@@ -147,6 +138,8 @@ pub struct RawBead {
 /// What a full bead adds: diagnostics and the rendered position.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RawExtras {
+    /// λ.
+    pub lambda: f64,
     /// `λN`.
     pub constraint_force: DVec2,
     /// `C`, `Ċ`, kinetic and potential energy.
@@ -165,12 +158,10 @@ pub struct RawLoop {
     pub poses: Vec<Pose>,
     /// The shared shape.
     pub circle: Circle,
-    /// The step's constants.
-    pub cfg: StepConfig,
+    /// The step's settings.
+    pub settings: StepSettings,
     /// Gravity.
     pub gravity: DVec2,
-    /// The divergence bound, in radii.
-    pub bound_per_radius: f64,
 }
 
 impl RawLoop {
@@ -192,7 +183,6 @@ impl RawLoop {
                     velocity: DVec2::ZERO,
                 },
                 mass: 1.0,
-                lambda: 0.0,
                 wire: wire as u32,
             })
             .collect();
@@ -205,17 +195,8 @@ impl RawLoop {
             extras,
             poses,
             circle: Circle { radius: 1.0 },
-            cfg: StepConfig {
-                dt: params.timestep,
-                mass: 1.0,
-                alpha: params.alpha,
-                beta: params.beta,
-                integrator: params.integrator,
-                stabilization: params.stabilization,
-                drift_bound: params.divergence_bound,
-            },
+            settings: params.step_settings(),
             gravity: params.gravity,
-            bound_per_radius: params.divergence_bound,
         }
     }
 
@@ -254,7 +235,7 @@ impl RawLoop {
                     self.circle.radius,
                 );
             }
-            let outs = solver::step_on_circles(&lanes, &self.cfg, self.bound_per_radius);
+            let outs = solver::step_on_circles(&lanes, &self.settings);
             for (lane, bead) in chunk.iter_mut().enumerate() {
                 // Two calls, so a finished lane's result stays in registers.
                 match outs.lane(lane) {
@@ -279,21 +260,14 @@ impl RawLoop {
             pose: self.poses[bead.wire as usize],
         };
         let force = LinearForce::constant(bead.mass * self.gravity);
-        let cfg = StepConfig {
-            mass: bead.mass,
-            ..self.cfg
-        };
-        solver::step(&placed, bead.state, &force, &cfg)
+        solver::step(&placed, bead.state, &force, bead.mass, &self.settings)
     }
 
     fn step_lean(&mut self) -> usize {
         let mut failed = 0;
         let mut beads = std::mem::take(&mut self.beads);
         self.step_chunks(&mut beads, |_, bead, out| match out {
-            Ok(out) => {
-                bead.state = out.state;
-                bead.lambda = out.lambda;
-            }
+            Ok(out) => bead.state = out.state,
             Err(_) => failed += 1,
         });
         self.beads = beads;
@@ -309,9 +283,9 @@ impl RawLoop {
         self.step_chunks(&mut beads, |i, bead, out| match out {
             Ok(out) => {
                 bead.state = out.state;
-                bead.lambda = out.lambda;
-                let (kinetic, potential) = solver::energy(bead.mass, self.gravity, out.state);
+                let (kinetic, potential) = out.state.energy(bead.mass, self.gravity);
                 extras[i] = RawExtras {
+                    lambda: out.lambda,
                     constraint_force: out.constraint_force,
                     diagnostics: [out.c, out.c_dot, kinetic, potential],
                     rendered: [out.state.position.x as f32, out.state.position.y as f32],

@@ -5,15 +5,15 @@
 
 use std::path::PathBuf;
 
+use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
 use serde::{Deserialize, Serialize};
 
-use crate::components::{Bead, Diverged, DragTarget, Wire};
 use crate::gui::render::{FramedView, SceneCamera, wire_points};
 use crate::preset::ActivePreset;
-use crate::wire::Pose;
+use crate::{Bead, Diverged, DragTarget, Wire, pose_of};
 
 /// Where one bead is.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -115,52 +115,33 @@ fn write_report(path: &PathBuf, report: &FrameReport) -> Result<(), String> {
     std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
-fn automation(
-    mut state: ResMut<AutomationState>,
-    real: Res<Time<Real>>,
-    mut virtual_time: ResMut<Time<Virtual>>,
-    windows: Query<&Window>,
-    cameras: Query<(&Camera, &GlobalTransform), With<SceneCamera>>,
-    beads: Query<(&Bead, Option<&DragTarget>, Option<&Diverged>, &Transform)>,
-    wires: Query<(&Wire, &Transform)>,
-    view: Res<FramedView>,
-    active: Res<ActivePreset>,
-    mut exit: MessageWriter<AppExit>,
-    mut commands: Commands,
-) {
-    state.frame += 1;
-    let frame = state.frame;
-    if frame > 30 {
-        state.timed_frames += 1;
-        state.timed_seconds += real.delta_secs_f64();
-    }
-    // Follow a drag.
-    for (bead, target, _, _) in &beads {
-        if let Some(target) = target {
-            state.drag_path.push(bead.position);
-            state.drag_target = Some(target.get());
-        }
-    }
-    // Measured against where the cursor ended up.
-    let drag = state
-        .drag_target
-        .zip(state.drag_path.first())
-        .map(|(target, start)| DragReport {
-            bead_start: start.to_array(),
-            target: target.to_array(),
-            start_distance: (*start - target).length(),
-            closest_distance: state
-                .drag_path
-                .iter()
-                .map(|p| (*p - target).length())
-                .fold(f64::INFINITY, f64::min),
-        });
-    let mean_frame_ms = 1e3 * state.timed_seconds / f64::from(state.timed_frames.max(1));
-    let report = || -> FrameReport {
-        let window = windows.iter().next();
+/// What a [`FrameReport`] is made from.
+#[derive(SystemParam)]
+struct ReportView<'w, 's> {
+    windows: Query<'w, 's, &'static Window>,
+    cameras: Query<'w, 's, (&'static Camera, &'static GlobalTransform), With<SceneCamera>>,
+    beads: Query<
+        'w,
+        's,
+        (
+            &'static Bead,
+            Option<&'static DragTarget>,
+            Option<&'static Diverged>,
+            &'static Transform,
+        ),
+    >,
+    wires: Query<'w, 's, (&'static Wire, &'static Transform)>,
+    view: Res<'w, FramedView>,
+    active: Res<'w, ActivePreset>,
+}
+
+impl ReportView<'_, '_> {
+    /// Where every bead and wire is on screen now.
+    fn report(&self, frame: u32, drag: Option<DragReport>, mean_frame_ms: f64) -> FrameReport {
+        let window = self.windows.iter().next();
         let scale = window.map_or(1.0, |w| w.scale_factor());
         let size = window.map_or([0, 0], |w| [w.physical_width(), w.physical_height()]);
-        let camera = cameras.iter().next();
+        let camera = self.cameras.iter().next();
         let to_pixel = |p: DVec2| -> Option<[f32; 2]> {
             let (camera, transform) = camera?;
             let px = camera
@@ -175,24 +156,26 @@ fn automation(
         FrameReport {
             frame,
             window: size,
-            beads: beads
+            beads: self
+                .beads
                 .iter()
                 .filter_map(|(bead, _, diverged, transform)| {
                     Some(BeadReport {
                         world: bead.position.to_array(),
                         pixel: to_pixel(bead.position)?,
-                        radius_px: transform.scale.x / view.size.y.max(1e-9) * size[1] as f32,
+                        radius_px: transform.scale.x / self.view.size.y.max(1e-9) * size[1] as f32,
                         diverged: diverged.map(|d| d.reason.to_string()),
                     })
                 })
                 .collect(),
-            wires: wires
+            wires: self
+                .wires
                 .iter()
                 .map(|(wire, transform)| WireReport {
                     shape: wire.shape().name().to_owned(),
                     pixels: wire_points(
                         wire.shape(),
-                        &Pose::from_transform(transform).unwrap_or_default(),
+                        &pose_of(transform).unwrap_or_default(),
                         None,
                     )
                     .into_iter()
@@ -201,20 +184,91 @@ fn automation(
                     .collect(),
                 })
                 .collect(),
-            drag: drag.clone(),
-            preset: active.running.clone(),
-            preset_error: active.error.clone(),
+            drag,
+            preset: self.active.running.clone(),
+            preset_error: self.active.error.clone(),
             mean_frame_ms,
         }
-    };
+    }
+}
+
+impl AutomationState {
+    /// Records the dragged beads' positions and the drag target.
+    fn follow_drag<'a>(&mut self, dragged: impl Iterator<Item = (&'a Bead, &'a DragTarget)>) {
+        for (bead, target) in dragged {
+            self.drag_path.push(bead.position);
+            self.drag_target = Some(target.get());
+        }
+    }
+
+    /// The drag so far, measured against where the cursor ended up.
+    fn drag_report(&self) -> Option<DragReport> {
+        let (target, start) = self.drag_target.zip(self.drag_path.first())?;
+        Some(DragReport {
+            bead_start: start.to_array(),
+            target: target.to_array(),
+            start_distance: (*start - target).length(),
+            closest_distance: self
+                .drag_path
+                .iter()
+                .map(|p| (*p - target).length())
+                .fold(f64::INFINITY, f64::min),
+        })
+    }
+
+    /// The mean frame time after the first 30 frames, in milliseconds.
+    fn mean_frame_ms(&self) -> f64 {
+        1e3 * self.timed_seconds / f64::from(self.timed_frames.max(1))
+    }
+
+    /// What went wrong in the whole run, judged at its last frame.
+    fn judge_run(&mut self, active: &ActivePreset, last: &FrameReport) {
+        if let Some(error) = &active.error {
+            self.failures.push(format!("scene file {error}"));
+        }
+        if active.running.is_none() && !active.path.is_empty() {
+            let failure = format!("the scene preset {} never ran", active.path);
+            self.failures.push(failure);
+        }
+        if last.beads.is_empty() {
+            self.failures
+                .push("there was no bead in the scene".to_owned());
+        }
+    }
+}
+
+/// Counts frames; writes the ready report, the screenshot with its report
+/// and the last report; exits when the frames are done.
+fn automation(
+    mut state: ResMut<AutomationState>,
+    real: Res<Time<Real>>,
+    mut virtual_time: ResMut<Time<Virtual>>,
+    scene: ReportView,
+    mut exit: MessageWriter<AppExit>,
+    mut commands: Commands,
+) {
+    state.frame += 1;
+    let frame = state.frame;
+    if frame > 30 {
+        state.timed_frames += 1;
+        state.timed_seconds += real.delta_secs_f64();
+    }
+    state.follow_drag(
+        scene
+            .beads
+            .iter()
+            .filter_map(|(bead, target, ..)| Some((bead, target?))),
+    );
+    let report =
+        |state: &AutomationState| scene.report(frame, state.drag_report(), state.mean_frame_ms());
 
     if let Some(path) = state.config.ready.clone()
         && !state.ready_written
         && frame >= 30
-        && active.running.is_some()
+        && scene.active.running.is_some()
     {
         state.ready_written = true;
-        if let Err(e) = write_report(&path, &report()) {
+        if let Err(e) = write_report(&path, &report(&state)) {
             state.failures.push(e);
         }
     }
@@ -232,7 +286,7 @@ fn automation(
             commands
                 .spawn(Screenshot::primary_window())
                 .observe(save_to_disk(path.clone()));
-            if let Err(e) = write_report(&path.with_extension("ron"), &report()) {
+            if let Err(e) = write_report(&path.with_extension("ron"), &report(&state)) {
                 state.failures.push(e);
             }
         }
@@ -249,25 +303,14 @@ fn automation(
         let failure = format!("the screenshot {} was not saved", path.display());
         state.failures.push(failure);
     }
-    if let Some(error) = &active.error {
-        let failure = format!("scene file error: {error}");
-        state.failures.push(failure);
-    }
-    if active.running.is_none() && !active.path.is_empty() {
-        let failure = format!("the scene preset {} never ran", active.path);
-        state.failures.push(failure);
-    }
-    let last = report();
-    if last.beads.is_empty() {
-        state
-            .failures
-            .push("there was no bead in the scene".to_owned());
-    }
+    let last = report(&state);
+    state.judge_run(&scene.active, &last);
     if let Some(path) = state.config.report.clone()
         && let Err(e) = write_report(&path, &last)
     {
         state.failures.push(e);
     }
+    let mean_frame_ms = state.mean_frame_ms();
     info!("wirebead: {frame} frames, mean frame time {mean_frame_ms:.2} ms");
     if state.failures.is_empty() {
         exit.write(AppExit::Success);

@@ -1,6 +1,6 @@
 //! Drag a bead with the mouse: on grab the bead gets a [`DragTarget`] at the
 //! cursor, which follows the cursor until release. The simulation turns it
-//! into the seed's spring force `k (cursor - bead)`. Egui windows block
+//! into the assignment's spring force `k (cursor - bead)`. Egui windows block
 //! picking, so a drag over the panel never grabs a bead.
 //!
 //! A drag grabs the bead the picking ray hit or, failing that, the bead
@@ -9,8 +9,8 @@
 
 use bevy::prelude::*;
 
-use crate::components::{Bead, DragTarget};
 use crate::gui::render::{SceneCamera, screen_to_world};
+use crate::{Bead, DragTarget};
 
 /// The bead the panel shows: the last one grabbed, or the first one.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]

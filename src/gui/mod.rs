@@ -6,7 +6,7 @@
 //! |---|---|
 //! | [`WireBeadGuiPlugin`] | everything below plus [`crate::ScenePresetPlugin`] and [`crate::KeyboardControlsPlugin`] |
 //! | [`SceneRenderPlugin`] | camera framing, wire gizmos, bead meshes, trails, force arrows |
-//! | [`BeadDragPlugin`] | mesh picking: drag a bead with the mouse (the seed's spring) |
+//! | [`BeadDragPlugin`] | mesh picking: drag a bead with the mouse (the assignment's spring) |
 //! | [`PanelPlugin`] | the egui panel and plots |
 //! | [`AutomationPlugin`] | run N frames, screenshot, reports, exit status |
 //!

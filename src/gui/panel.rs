@@ -1,4 +1,4 @@
-//! The egui panel: every parameter of the seed's panel plus gravity, wire
+//! The egui panel: every parameter of the assignment's panel plus gravity, wire
 //! shape and size, integrator and stabilization; a marker while edits are
 //! pending; live plots of `C`, energy and λ; divergence and scene-file
 //! errors in plain words.
@@ -15,16 +15,15 @@ use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 use egui_plot::{Line, Plot, PlotPoints};
 
-use crate::components::{Bead, BeadDiagnostics, Diverged, OnWire, PendingWire, Wire};
 use crate::controls::{ControlKeys, StepRequests};
 use crate::gui::drag::SelectedBead;
 use crate::gui::render::SceneStyle;
-use crate::params::{
-    BeadParams, Integrator, ParamError, PendingBead, PendingParams, SimParams, Stabilization,
-};
-use crate::plugin::{Restart, WireBeadSystems};
 use crate::preset::{ActivePreset, LoadPreset};
-use crate::wire::{Circle, Ellipse, Line as LineShape, Parabola, Pose, Sine, WireShape};
+use crate::{
+    Bead, BeadDiagnostics, BeadParams, Diverged, Integrator, OnWire, ParamError, PendingBead,
+    PendingParams, PendingWire, Restart, SimClock, SimParams, Stabilization, Wire, WireBeadSystems,
+    WireKind, WireShape, pose_of,
+};
 
 /// The presets the panel offers: `(label, asset path)`.
 #[derive(Resource, Clone, Debug)]
@@ -34,7 +33,10 @@ impl Default for PresetCatalog {
     fn default() -> Self {
         Self(
             [
-                ("The seed's circle", "scenes/seed_circle.scene.ron"),
+                (
+                    "The assignment's circle",
+                    "scenes/assignment_circle.scene.ron",
+                ),
                 ("Tilted ellipse", "scenes/ellipse.scene.ron"),
                 ("Sine track", "scenes/sine_track.scene.ron"),
                 ("Many beads", "scenes/multi_bead.scene.ron"),
@@ -108,43 +110,26 @@ pub fn keep_selection(mut selected: ResMut<SelectedBead>, beads: Query<Entity, W
 /// Appends the selected bead's diagnostics to the plot history.
 pub fn record_history(
     selected: Res<SelectedBead>,
+    clock: Res<SimClock>,
     beads: Query<&BeadDiagnostics>,
     mut history: ResMut<PlotHistory>,
 ) {
     let Some(entity) = selected.0 else { return };
     let Ok(d) = beads.get(entity) else { return };
-    if history.bead != Some(entity) || history.samples.back().is_some_and(|s| s.t > d.time) {
+    let t = clock.time;
+    if history.bead != Some(entity) || history.samples.back().is_some_and(|s| s.t > t) {
         history.samples.clear();
         history.bead = Some(entity);
     }
     history.samples.push_back(PlotSample {
-        t: d.time,
+        t,
         c: d.c,
         energy: d.energy(),
         lambda: d.lambda,
     });
-    let horizon = d.time - history.seconds;
+    let horizon = t - history.seconds;
     while history.samples.front().is_some_and(|s| s.t < horizon) {
         history.samples.pop_front();
-    }
-}
-
-/// A shape of the given kind sized like `scale`.
-fn shape_of_kind(kind: &str, scale: f64) -> WireShape {
-    match kind {
-        "ellipse" => WireShape::Ellipse(Ellipse {
-            a: 1.5 * scale,
-            b: scale,
-        }),
-        "line" => WireShape::Line(LineShape),
-        "parabola" => WireShape::Parabola(Parabola {
-            focal_length: 0.5 * scale,
-        }),
-        "sine" => WireShape::Sine(Sine {
-            amplitude: 0.3 * scale,
-            wavelength: 2.0 * scale,
-        }),
-        _ => WireShape::Circle(Circle { radius: scale }),
     }
 }
 
@@ -163,18 +148,26 @@ fn vector(ui: &mut egui::Ui, label: &str, value: &mut DVec2, speed: f64) {
     ui.end_row();
 }
 
+/// A plot of the last seconds with labelled axes: time in seconds, the
+/// value in `unit` with tick labels in scientific notation, so that a range
+/// of 1e-16 reads as rounding noise and not as a swing.
 fn plot(
     ui: &mut egui::Ui,
     id: &str,
     name: &str,
+    unit: &str,
     points: impl Iterator<Item = [f64; 2]>,
     colour: egui::Color32,
 ) {
     Plot::new(id)
-        .height(80.0)
+        .height(90.0)
         .allow_drag(false)
         .allow_zoom(false)
         .allow_scroll(false)
+        .x_axis_label("t (s)")
+        .y_axis_label(unit)
+        .y_axis_min_width(48.0)
+        .y_axis_formatter(|mark, _| format!("{:.1e}", mark.value))
         .show(ui, |plot_ui| {
             plot_ui.line(Line::new(name, points.collect::<PlotPoints>()).color(colour));
         });
@@ -213,271 +206,308 @@ pub struct PanelView<'w, 's> {
     >,
     pending_beads: Query<'w, 's, (), With<PendingBead>>,
     pending_wires: Query<'w, 's, (), With<PendingWire>>,
+    clock: Res<'w, SimClock>,
 }
 
-/// The panel.
+/// What the panel's controls ask of the world this frame.
+#[derive(SystemParam)]
+pub struct PanelActions<'w, 's> {
+    pending: ResMut<'w, PendingParams>,
+    time: ResMut<'w, Time<Virtual>>,
+    steps: ResMut<'w, StepRequests>,
+    restarts: MessageWriter<'w, Restart>,
+    loads: MessageWriter<'w, LoadPreset>,
+    commands: Commands<'w, 's>,
+}
+
+/// The result of an edit: `None` where nothing was edited.
+type Edit = Option<Result<(), ParamError>>;
+
+const ERROR_RED: egui::Color32 = egui::Color32::from_rgb(255, 90, 90);
+const PENDING_ORANGE: egui::Color32 = egui::Color32::from_rgb(255, 190, 60);
+
+/// The panel: the scene and run state, the selected bead and its wire, the
+/// solver's parameters and the plots, in a window that scrolls when it is
+/// taller than the screen.
 pub fn panel(
     mut contexts: EguiContexts,
     view: PanelView,
-    mut pending: ResMut<PendingParams>,
-    mut time: ResMut<Time<Virtual>>,
-    mut steps: ResMut<StepRequests>,
-    mut restarts: MessageWriter<Restart>,
-    mut loads: MessageWriter<LoadPreset>,
+    mut actions: PanelActions,
     mut refused: Local<Option<String>>,
-    mut commands: Commands,
 ) -> Result {
-    let PanelView {
-        style,
-        keys,
-        catalog,
-        active,
-        history,
-        params,
-        selected,
-        beads,
-        wires,
-        pending_beads,
-        pending_wires,
-    } = view;
     let ctx = contexts.ctx_mut()?;
-    let mut outcome: Option<Result<(), ParamError>> = None;
-
-    egui::Area::new(egui::Id::new("wirebead-help"))
-        .anchor(egui::Align2::LEFT_BOTTOM, [8.0, -8.0])
-        .show(ctx, |ui| {
-            ui.colored_label(egui::Color32::LIGHT_GRAY, keys.help());
-        });
-
+    help_line(ctx, &view.keys);
     let height = (ctx.content_rect().height() - 40.0).max(200.0);
+    let mut outcome: Edit = None;
     egui::Window::new("wirebead")
         .anchor(egui::Align2::RIGHT_TOP, [-6.0, 6.0])
-        .fixed_size([style.panel_width - 30.0, height])
+        .default_width(view.style.panel_width - 30.0)
+        .max_height(height)
         .resizable(false)
         .collapsible(true)
-        .vscroll(true)
         .show(ctx, |ui| {
-            // Scene and run state.
-            ui.horizontal(|ui| {
-                ui.label("Scene");
-                let current = active.running.clone().unwrap_or_else(|| "—".into());
-                egui::ComboBox::from_id_salt("preset")
-                    .selected_text(current)
-                    .show_ui(ui, |ui| {
-                        for (label, path) in &catalog.0 {
-                            if ui.selectable_label(active.path == *path, label).clicked() {
-                                loads.write(LoadPreset(path.clone()));
-                            }
-                        }
-                    });
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                scene_section(ui, &view, &mut actions, refused.as_deref());
+                outcome = bead_section(ui, &view, &mut actions.commands)
+                    .or(solver_section(ui, &mut actions.pending));
+                plots_section(ui, &view.history);
             });
-            if let Some(error) = &active.error {
-                ui.colored_label(
-                    egui::Color32::from_rgb(255, 90, 90),
-                    format!("Scene file error: {error}"),
-                );
-            }
-            ui.horizontal(|ui| {
-                if ui.button(format!("Restart ({:?})", keys.restart)).clicked() {
-                    restarts.write(Restart);
-                }
-                let pause = if time.is_paused() { "Resume" } else { "Pause" };
-                if ui.button(pause).clicked() {
-                    if time.is_paused() {
-                        time.unpause();
-                    } else {
-                        time.pause();
-                    }
-                }
-                if ui
-                    .add_enabled(time.is_paused(), egui::Button::new("Step"))
-                    .clicked()
-                {
-                    steps.0 += 1;
-                }
-            });
-            let edits_pending =
-                pending.get() != &*params || !pending_beads.is_empty() || !pending_wires.is_empty();
-            if edits_pending {
-                ui.colored_label(
-                    egui::Color32::from_rgb(255, 190, 60),
-                    "● Edits pending: press Space to apply",
-                );
-            }
-            for (entity, _, _, _, _, diverged) in &beads {
-                if let Some(d) = diverged {
-                    ui.colored_label(
-                        egui::Color32::from_rgb(255, 90, 90),
-                        format!(
-                            "Bead {entity} diverged at t = {:.2} s: {}. Press Space to restart.",
-                            d.time, d.reason
-                        ),
-                    );
-                }
-            }
-            if let Some(message) = refused.as_ref() {
-                ui.colored_label(
-                    egui::Color32::from_rgb(255, 90, 90),
-                    format!("Refused: {message}"),
-                );
-            }
-
-            // The selected bead and its wire.
-            let bead = selected.0.and_then(|e| beads.get(e).ok());
-            if let Some((entity, bead, diagnostics, on_wire, pending_bead, _)) = bead {
-                ui.separator();
-                ui.strong(format!("Bead {entity}"));
-                let mut draft: BeadParams = pending_bead.map_or(*bead.params(), |p| *p.get());
-                let before = draft;
-                egui::Grid::new("bead").num_columns(2).show(ui, |ui| {
-                    number(ui, "mass", &mut draft.mass, 0.01);
-                    vector(ui, "initial position", &mut draft.initial_position, 0.01);
-                    vector(ui, "initial velocity", &mut draft.initial_velocity, 0.01);
-                });
-
-                if let Some((wire, transform, pending_wire)) =
-                    on_wire.and_then(|on| wires.get(on.0).ok())
-                {
-                    let mut shape =
-                        pending_wire.map_or_else(|| wire.shape().clone(), |p| p.shape().clone());
-                    let before_shape = format!("{shape:?}");
-                    ui.strong("Wire");
-                    egui::Grid::new("wire").num_columns(2).show(ui, |ui| {
-                        ui.label("shape");
-                        let mut kind = shape.name();
-                        egui::ComboBox::from_id_salt("shape")
-                            .selected_text(kind)
-                            .show_ui(ui, |ui| {
-                                for k in ["circle", "ellipse", "line", "parabola", "sine"] {
-                                    ui.selectable_value(&mut kind, k, k);
-                                }
-                            });
-                        ui.end_row();
-                        if kind != shape.name() {
-                            shape = shape_of_kind(kind, shape.curve().scale());
-                        }
-                        match &mut shape {
-                            WireShape::Circle(c) => number(ui, "radius", &mut c.radius, 0.01),
-                            WireShape::Ellipse(e) => {
-                                number(ui, "semi-axis a", &mut e.a, 0.01);
-                                number(ui, "semi-axis b", &mut e.b, 0.01);
-                            }
-                            WireShape::Parabola(p) => {
-                                number(ui, "focal length", &mut p.focal_length, 0.01)
-                            }
-                            WireShape::Sine(s) => {
-                                number(ui, "amplitude", &mut s.amplitude, 0.01);
-                                number(ui, "wavelength", &mut s.wavelength, 0.01);
-                            }
-                            WireShape::Line(_) | WireShape::Custom(_) => {}
-                        }
-                    });
-                    if format!("{shape:?}") != before_shape {
-                        let result = PendingWire::new(shape.clone()).map(|edit| {
-                            commands.entity(on_wire.unwrap().0).insert(edit);
-                            // Start the bead at the new wire's lowest point.
-                            let pose = Pose::from_transform(transform).unwrap_or_default();
-                            draft.initial_position = pose.to_world(shape.bottom());
-                        });
-                        outcome = Some(result);
-                    }
-                }
-                if draft != before {
-                    outcome = Some(PendingBead::new(draft).map(|edit| {
-                        commands.entity(entity).insert(edit);
-                    }));
-                }
-
-                ui.separator();
-                egui::Grid::new("values").num_columns(4).show(ui, |ui| {
-                    ui.label("C");
-                    ui.monospace(format!("{:+.3e}", diagnostics.c));
-                    ui.label("Ċ");
-                    ui.monospace(format!("{:+.3e}", diagnostics.c_dot));
-                    ui.end_row();
-                    ui.label("λ");
-                    ui.monospace(format!("{:+.3e}", diagnostics.lambda));
-                    ui.label("E");
-                    ui.monospace(format!("{:+.4}", diagnostics.energy()));
-                    ui.end_row();
-                    ui.label("t");
-                    ui.monospace(format!("{:.2} s", diagnostics.time));
-                    ui.label("steps");
-                    ui.monospace(format!("{}", diagnostics.steps));
-                    ui.end_row();
-                });
-            }
-
-            // The shared parameters.
-            ui.separator();
-            ui.strong("Solver");
-            let mut draft = pending.get().clone();
-            egui::Grid::new("solver").num_columns(2).show(ui, |ui| {
-                number(ui, "timestep (s)", &mut draft.timestep, 0.0005);
-                number(ui, "spring constant α", &mut draft.alpha, 1.0);
-                number(ui, "damping constant β", &mut draft.beta, 0.1);
-                number(ui, "drag scale k", &mut draft.drag_stiffness, 0.1);
-                vector(ui, "gravity", &mut draft.gravity, 0.01);
-                ui.label("integrator");
-                egui::ComboBox::from_id_salt("integrator")
-                    .selected_text(draft.integrator.name())
-                    .show_ui(ui, |ui| {
-                        for &i in Integrator::ALL {
-                            ui.selectable_value(&mut draft.integrator, i, i.name());
-                        }
-                    });
-                ui.end_row();
-                ui.label("stabilization");
-                egui::ComboBox::from_id_salt("stabilization")
-                    .selected_text(draft.stabilization.name())
-                    .show_ui(ui, |ui| {
-                        for &s in Stabilization::ALL {
-                            ui.selectable_value(&mut draft.stabilization, s, s.name());
-                        }
-                    });
-                ui.end_row();
-                number(ui, "divergence bound", &mut draft.divergence_bound, 0.01);
-            });
-            if &draft != pending.get() {
-                outcome = Some(pending.set(draft));
-            }
-
-            // Plots of the last seconds.
-            ui.separator();
-            let samples = &history.samples;
-            ui.label("drift C");
-            plot(
-                ui,
-                "plot-c",
-                "C",
-                samples.iter().map(|s| [s.t, s.c]),
-                egui::Color32::LIGHT_BLUE,
-            );
-            ui.label("energy E");
-            plot(
-                ui,
-                "plot-e",
-                "E",
-                samples.iter().map(|s| [s.t, s.energy]),
-                egui::Color32::LIGHT_GREEN,
-            );
-            ui.label("λ");
-            plot(
-                ui,
-                "plot-l",
-                "λ",
-                samples.iter().map(|s| [s.t, s.lambda]),
-                egui::Color32::GOLD,
-            );
         });
-
     match outcome {
         Some(Ok(())) => *refused = None,
         Some(Err(error)) => {
-            warn!("wirebead: edit refused: {error}");
+            warn!("wirebead: edit refused: {error}; the previous value was kept");
             *refused = Some(error.to_string());
         }
         None => {}
     }
     Ok(())
+}
+
+/// The keys, at the bottom left of the window.
+fn help_line(ctx: &egui::Context, keys: &ControlKeys) {
+    egui::Area::new(egui::Id::new("wirebead-help"))
+        .anchor(egui::Align2::LEFT_BOTTOM, [8.0, -8.0])
+        .show(ctx, |ui| {
+            ui.colored_label(egui::Color32::LIGHT_GRAY, keys.help());
+        });
+}
+
+/// The scene menu, its file error, the run buttons, and what is pending,
+/// diverged or refused.
+fn scene_section(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    actions: &mut PanelActions,
+    refused: Option<&str>,
+) {
+    ui.horizontal(|ui| {
+        ui.label("Scene");
+        let current = view.active.running.clone().unwrap_or_else(|| "—".into());
+        egui::ComboBox::from_id_salt("preset")
+            .selected_text(current)
+            .show_ui(ui, |ui| {
+                for (label, path) in &view.catalog.0 {
+                    if ui
+                        .selectable_label(view.active.path == *path, label)
+                        .clicked()
+                    {
+                        actions.loads.write(LoadPreset(path.clone()));
+                    }
+                }
+            });
+    });
+    if let Some(error) = &view.active.error {
+        ui.colored_label(
+            ERROR_RED,
+            format!("Scene file {error}; the running scene was kept."),
+        );
+    }
+    ui.horizontal(|ui| {
+        if ui
+            .button(format!("Restart ({:?})", view.keys.restart))
+            .clicked()
+        {
+            actions.restarts.write(Restart);
+        }
+        let time = &mut actions.time;
+        let pause = if time.is_paused() { "Resume" } else { "Pause" };
+        if ui.button(pause).clicked() {
+            if time.is_paused() {
+                time.unpause();
+            } else {
+                time.pause();
+            }
+        }
+        if ui
+            .add_enabled(time.is_paused(), egui::Button::new("Step"))
+            .clicked()
+        {
+            actions.steps.0 += 1;
+        }
+    });
+    let edits_pending = actions.pending.get() != &*view.params
+        || !view.pending_beads.is_empty()
+        || !view.pending_wires.is_empty();
+    if edits_pending {
+        ui.colored_label(PENDING_ORANGE, "● Edits pending: press Space to apply");
+    }
+    for (entity, _, _, _, _, diverged) in &view.beads {
+        if let Some(d) = diverged {
+            ui.colored_label(
+                ERROR_RED,
+                format!(
+                    "Bead {entity} diverged at t = {:.2} s: {}. Press Space to restart.",
+                    d.time, d.reason
+                ),
+            );
+        }
+    }
+    if let Some(message) = refused {
+        ui.colored_label(ERROR_RED, format!("Refused: {message}"));
+    }
+}
+
+/// The selected bead's parameters, its wire's shape, and its diagnostics.
+fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) -> Edit {
+    let (entity, bead, diagnostics, on_wire, pending_bead, _) =
+        view.selected.0.and_then(|e| view.beads.get(e).ok())?;
+    ui.separator();
+    ui.strong(format!("Bead {entity}"));
+    let mut draft: BeadParams = pending_bead.map_or(*bead.params(), |p| *p.get());
+    let before = draft;
+    egui::Grid::new("bead").num_columns(2).show(ui, |ui| {
+        number(ui, "mass", &mut draft.mass, 0.01);
+        vector(ui, "initial position", &mut draft.initial_position, 0.01);
+        vector(ui, "initial velocity", &mut draft.initial_velocity, 0.01);
+    });
+    let mut outcome = None;
+    if let Some(on_wire) = on_wire
+        && let Ok((wire, transform, pending_wire)) = view.wires.get(on_wire.0)
+    {
+        let shape = pending_wire.map_or_else(|| wire.shape().clone(), |p| p.shape().clone());
+        if let Some(edited) = wire_editor(ui, &shape) {
+            outcome = Some(PendingWire::new(edited.clone()).map(|edit| {
+                commands.entity(on_wire.0).insert(edit);
+                // Start the bead at the new wire's lowest point.
+                let pose = pose_of(transform).unwrap_or_default();
+                draft.initial_position = pose.to_world(edited.bottom());
+            }));
+        }
+    }
+    if draft != before {
+        outcome = Some(PendingBead::new(draft).map(|edit| {
+            commands.entity(entity).insert(edit);
+        }));
+    }
+
+    ui.separator();
+    let clock = &view.clock;
+    egui::Grid::new("values").num_columns(4).show(ui, |ui| {
+        ui.label("C");
+        ui.monospace(format!("{:+.3e}", diagnostics.c));
+        ui.label("Ċ");
+        ui.monospace(format!("{:+.3e}", diagnostics.c_dot));
+        ui.end_row();
+        ui.label("λ");
+        ui.monospace(format!("{:+.3e}", diagnostics.lambda));
+        ui.label("E");
+        ui.monospace(format!("{:+.4}", diagnostics.energy()));
+        ui.end_row();
+        ui.label("t");
+        ui.monospace(format!("{:.2} s", clock.time));
+        ui.label("steps");
+        ui.monospace(format!("{}", clock.steps));
+        ui.end_row();
+    });
+    outcome
+}
+
+/// The wire's kind (from [`WireKind::ALL`]) and dimensions; the edited
+/// shape if anything changed.
+fn wire_editor(ui: &mut egui::Ui, shape: &WireShape) -> Option<WireShape> {
+    let mut edited = shape.clone();
+    ui.strong("Wire");
+    egui::Grid::new("wire").num_columns(2).show(ui, |ui| {
+        ui.label("shape");
+        let mut kind = edited.kind();
+        egui::ComboBox::from_id_salt("shape")
+            .selected_text(edited.name())
+            .show_ui(ui, |ui| {
+                for k in WireKind::ALL {
+                    ui.selectable_value(&mut kind, Some(k), k.name());
+                }
+            });
+        ui.end_row();
+        if let Some(kind) = kind.filter(|k| Some(*k) != edited.kind()) {
+            edited = kind.shape(edited.curve().scale());
+        }
+        match &mut edited {
+            WireShape::Circle(c) => number(ui, "radius", &mut c.radius, 0.01),
+            WireShape::Ellipse(e) => {
+                number(ui, "semi-axis a", &mut e.a, 0.01);
+                number(ui, "semi-axis b", &mut e.b, 0.01);
+            }
+            WireShape::Parabola(p) => number(ui, "focal length", &mut p.focal_length, 0.01),
+            WireShape::Sine(s) => {
+                number(ui, "amplitude", &mut s.amplitude, 0.01);
+                number(ui, "wavelength", &mut s.wavelength, 0.01);
+            }
+            WireShape::Line(_) | WireShape::Custom(_) => {}
+        }
+    });
+    (format!("{edited:?}") != format!("{shape:?}")).then_some(edited)
+}
+
+/// The parameters every bead shares.
+fn solver_section(ui: &mut egui::Ui, pending: &mut PendingParams) -> Edit {
+    ui.separator();
+    ui.strong("Solver");
+    let mut draft = pending.get().clone();
+    egui::Grid::new("solver").num_columns(2).show(ui, |ui| {
+        number(ui, "timestep (s)", &mut draft.timestep, 0.0005);
+        number(ui, "spring constant α", &mut draft.alpha, 1.0);
+        number(ui, "damping constant β", &mut draft.beta, 0.1);
+        number(ui, "drag scale k", &mut draft.drag_stiffness, 0.1);
+        vector(ui, "gravity", &mut draft.gravity, 0.01);
+        ui.label("integrator");
+        let mut integrator = draft.method.integrator();
+        egui::ComboBox::from_id_salt("integrator")
+            .selected_text(integrator.name())
+            .show_ui(ui, |ui| {
+                for &i in Integrator::ALL {
+                    ui.selectable_value(&mut integrator, i, i.name());
+                }
+            });
+        draft.method = draft.method.with_integrator(integrator);
+        ui.end_row();
+        ui.label("stabilization");
+        match draft.method.stabilization() {
+            Some(mut stabilization) => {
+                egui::ComboBox::from_id_salt("stabilization")
+                    .selected_text(stabilization.name())
+                    .show_ui(ui, |ui| {
+                        for &s in Stabilization::ALL {
+                            ui.selectable_value(&mut stabilization, s, s.name());
+                        }
+                    });
+                draft.method = draft.method.with_stabilization(stabilization);
+            }
+            None => {
+                ui.label("none: RATTLE holds the wire itself");
+            }
+        }
+        ui.end_row();
+        number(ui, "divergence bound", &mut draft.divergence_bound, 0.01);
+    });
+    (&draft != pending.get()).then(|| pending.set(draft))
+}
+
+/// Plots of the selected bead's last seconds, each with its axes labelled.
+fn plots_section(ui: &mut egui::Ui, history: &PlotHistory) {
+    ui.separator();
+    let samples = &history.samples;
+    for (id, label, unit, colour, value) in [
+        (
+            "plot-c",
+            "drift C",
+            "m",
+            egui::Color32::LIGHT_BLUE,
+            (|s: &PlotSample| s.c) as fn(&PlotSample) -> f64,
+        ),
+        ("plot-e", "energy E", "J", egui::Color32::LIGHT_GREEN, |s| {
+            s.energy
+        }),
+        ("plot-l", "λ", "N", egui::Color32::GOLD, |s| s.lambda),
+    ] {
+        ui.label(format!("{label} ({unit})"));
+        plot(
+            ui,
+            id,
+            label,
+            unit,
+            samples.iter().map(|s| [s.t, value(s)]),
+            colour,
+        );
+    }
 }

@@ -9,9 +9,8 @@ use bevy::camera::ScalingMode;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::components::{Bead, BeadDiagnostics, DragTarget, OnWire, Wire};
-use crate::plugin::{Restart, WireBeadSystems};
-use crate::wire::{ImplicitCurve, Placed, Pose, WireShape};
+use crate::geometry::{ImplicitCurve, Placed, Pose, WireShape};
+use crate::{Bead, BeadDiagnostics, DragTarget, OnWire, Restart, Wire, WireBeadSystems, pose_of};
 
 /// Colours and sizes of the scene.
 #[derive(Resource, Clone, Debug)]
@@ -215,7 +214,7 @@ pub fn wire_points(shape: &WireShape, pose: &Pose, half_span: Option<f64>) -> Ve
 }
 
 fn wire_pose(transform: &Transform) -> Pose {
-    Pose::from_transform(transform).unwrap_or_default()
+    pose_of(transform).unwrap_or_default()
 }
 
 /// Frames every wire (and every bead's start) in the part of the window
@@ -419,7 +418,7 @@ pub fn screen_to_world(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::wire::Circle;
+    use crate::geometry::Circle;
 
     /// Marching squares on a moved circle: every segment end lies on the
     /// circle to within the interpolation error, and the segments add up to

@@ -1,0 +1,202 @@
+//! `wirebead-analysis`: the assignment's figures and every method against the
+//! exact pendulum, headless, through the same plugin.
+//!
+//! ```sh
+//! cargo run --release -p wirebead-analysis -- simulate --alpha 0 --out run.csv
+//! cargo run --release -p wirebead-analysis -- figures --out-dir docs/figures
+//! cargo run --release -p wirebead-analysis -- compare --out-dir docs/compare
+//! ```
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use bevy::math::DVec2;
+use clap::{Args, Parser, Subcommand};
+use wirebead::prelude::*;
+use wirebead_analysis::{self as analysis, RunConfig};
+
+/// Headless runs, the assignment's figures, and the method comparison.
+#[derive(Parser, Debug)]
+#[command(version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run one simulation and write a CSV (`t,x,y,vx,vy,c,c_dot,lambda,energy`).
+    Simulate(SimulateArgs),
+    /// Reproduce the assignment's three studies: trajectory, drift and energy PNGs,
+    /// the CSV behind each, and summary.md.
+    Figures {
+        /// Where to write everything.
+        #[arg(long)]
+        out_dir: PathBuf,
+        /// Simulated seconds per run.
+        #[arg(long, default_value_t = 10.0)]
+        duration: f64,
+    },
+    /// Every integrator × stabilization on the pendulum against the exact
+    /// period: a markdown table and a log–log error-versus-dt plot.
+    Compare {
+        /// Where to write everything.
+        #[arg(long)]
+        out_dir: PathBuf,
+        /// Release angle from the bottom, degrees.
+        #[arg(long, default_value_t = 135.0)]
+        theta0: f64,
+        /// Circle radius.
+        #[arg(long, default_value_t = 1.0)]
+        radius: f64,
+        /// Gravity magnitude.
+        #[arg(long, default_value_t = 9.81)]
+        gravity: f64,
+        /// Simulated seconds per run.
+        #[arg(long, default_value_t = 10.0)]
+        duration: f64,
+        /// Timesteps, comma-separated; fractions like 1/60 are accepted.
+        #[arg(long, value_delimiter = ',', value_parser = parse_seconds,
+              default_value = "1/30,1/60,1/120,1/240")]
+        dt: Vec<f64>,
+    },
+}
+
+#[derive(Args, Debug)]
+struct SimulateArgs {
+    /// Wire shape.
+    #[arg(long, default_value = "circle", value_parser = parse_wire)]
+    wire: WireKind,
+    /// Wire size (a circle's radius).
+    #[arg(long, default_value_t = 1.0)]
+    radius: f64,
+    /// Bead mass.
+    #[arg(long, default_value_t = 1.0)]
+    mass: f64,
+    /// Gravity's y component.
+    #[arg(long, default_value_t = -9.81, allow_negative_numbers = true)]
+    gravity: f64,
+    /// Timestep in seconds (fractions like 1/60 are accepted).
+    #[arg(long, default_value = "1/60", value_parser = parse_seconds)]
+    dt: f64,
+    /// Simulated seconds.
+    #[arg(long, default_value_t = 10.0)]
+    duration: f64,
+    /// Initial x (default: the bottom of the wire).
+    #[arg(long, allow_negative_numbers = true)]
+    x0: Option<f64>,
+    /// Initial y (default: the bottom of the wire).
+    #[arg(long, allow_negative_numbers = true)]
+    y0: Option<f64>,
+    /// Initial velocity x.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    vx0: f64,
+    /// Initial velocity y.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    vy0: f64,
+    /// Baumgarte α (default: the plugin's).
+    #[arg(long, allow_negative_numbers = true)]
+    alpha: Option<f64>,
+    /// Baumgarte β (default: the plugin's).
+    #[arg(long, allow_negative_numbers = true)]
+    beta: Option<f64>,
+    /// Drag spring constant k (default: the plugin's; no drag runs headless).
+    #[arg(long, allow_negative_numbers = true)]
+    k: Option<f64>,
+    /// explicit-euler, semi-implicit-euler, rk4 or rattle.
+    #[arg(long, default_value = "semi-implicit-euler")]
+    integrator: Integrator,
+    /// baumgarte (the default), projection or none; rattle takes none.
+    #[arg(long)]
+    stabilization: Option<Stabilization>,
+    /// The CSV to write.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    let value = match s.split_once('/') {
+        Some((n, d)) => {
+            let n: f64 = n.trim().parse().map_err(|e| format!("{s:?}: {e}"))?;
+            let d: f64 = d.trim().parse().map_err(|e| format!("{s:?}: {e}"))?;
+            n / d
+        }
+        None => s.trim().parse().map_err(|e| format!("{s:?}: {e}"))?,
+    };
+    Ok(value)
+}
+
+fn parse_wire(s: &str) -> Result<WireKind, String> {
+    s.parse().map_err(|e: wirebead::ParamError| e.to_string())
+}
+
+fn simulate(args: SimulateArgs) -> Result<ExitCode, Box<dyn std::error::Error>> {
+    let defaults = SimParams::default();
+    let shape = args.wire.shape(args.radius);
+    let bottom = shape.bottom();
+    let config = RunConfig {
+        wire: shape,
+        params: SimParams {
+            timestep: args.dt,
+            gravity: DVec2::new(0.0, args.gravity),
+            alpha: args.alpha.unwrap_or(defaults.alpha),
+            beta: args.beta.unwrap_or(defaults.beta),
+            drag_stiffness: args.k.unwrap_or(defaults.drag_stiffness),
+            method: Method::new(args.integrator, args.stabilization)?,
+            ..defaults
+        },
+        bead: BeadParams {
+            mass: args.mass,
+            initial_position: DVec2::new(args.x0.unwrap_or(bottom.x), args.y0.unwrap_or(bottom.y)),
+            initial_velocity: DVec2::new(args.vx0, args.vy0),
+        },
+        duration: args.duration,
+    };
+    let out = analysis::simulate(&config)?;
+    analysis::write_csv(&args.out, &out.rows)?;
+    eprintln!("wrote {} rows to {}", out.rows.len(), args.out.display());
+    Ok(match out.diverged {
+        Some((t, why)) => {
+            eprintln!("error: the run diverged at t = {t:.4} s: {why}");
+            ExitCode::from(3)
+        }
+        None => ExitCode::SUCCESS,
+    })
+}
+
+fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
+    match cli.command {
+        Command::Simulate(args) => simulate(args),
+        Command::Figures { out_dir, duration } => {
+            let written = analysis::figures(&out_dir, duration)?;
+            eprintln!("wrote {} files to {}", written.len(), out_dir.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Compare {
+            out_dir,
+            theta0,
+            radius,
+            gravity,
+            duration,
+            dt,
+        } => {
+            std::fs::create_dir_all(&out_dir)?;
+            let table = analysis::compare(radius, gravity, theta0, duration, &dt)?;
+            let md = analysis::comparison_markdown(&table, radius, gravity, theta0, duration);
+            std::fs::write(out_dir.join("compare.md"), &md)?;
+            analysis::plot_convergence(&out_dir.join("convergence.png"), &table)?;
+            print!("{md}");
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,135 @@
+//! The analysis tool's library on small settings: CSV schema, the assignment's
+//! drift claim in the figures' runs, and PNGs that decode and are not blank.
+
+use std::path::PathBuf;
+
+use wirebead::prelude::*;
+use wirebead_analysis::{self as analysis, FIGURE_SIZE, RunConfig};
+
+fn out_dir(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn read_csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let header = reader
+        .headers()
+        .unwrap()
+        .iter()
+        .map(str::to_owned)
+        .collect();
+    let rows = reader
+        .records()
+        .map(|r| {
+            r.unwrap()
+                .iter()
+                .map(|v| v.parse::<f64>().unwrap())
+                .collect()
+        })
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn simulate_writes_one_row_per_step_with_the_schema() {
+    let dir = out_dir("simulate");
+    let mut config: RunConfig = analysis::assignment_setup(1.0);
+    config.params.method = Method::Rattle;
+    let out = analysis::simulate(&config).unwrap();
+    let path = dir.join("run.csv");
+    analysis::write_csv(&path, &out.rows).unwrap();
+    let (header, rows) = read_csv(&path);
+    assert_eq!(header.join(","), "t,x,y,vx,vy,c,c_dot,lambda,energy");
+    assert_eq!(rows.len(), 61, "t = 0 and 60 steps");
+    assert_eq!(rows[0][0], 0.0);
+    assert_eq!(rows[0][1..5], [0.0, -1.0, 4.0, 0.0]);
+    assert!((rows[60][0] - 1.0).abs() < 1e-9);
+    // RATTLE keeps the bead on the unit circle.
+    assert!(rows.iter().all(|r| (r[1].hypot(r[2]) - 1.0).abs() < 1e-12));
+}
+
+#[test]
+fn simulate_refuses_bad_input_and_reports_divergence() {
+    let mut config = analysis::assignment_setup(1.0);
+    config.bead.mass = -1.0;
+    assert_eq!(
+        analysis::simulate(&config).unwrap_err().to_string(),
+        "mass must be positive and finite, got -1"
+    );
+    let mut config = analysis::assignment_setup(10.0);
+    config.params.method = Method::ExplicitEuler(Stabilization::Baumgarte);
+    config.params.timestep = 0.05;
+    let out = analysis::simulate(&config).unwrap();
+    let (t, why) = out.diverged.expect("explicit Euler at 0.05 s blows up");
+    assert!(why.contains("drifted"), "{why}");
+    assert!(
+        (out.rows.last().unwrap().t - t).abs() <= 0.05 + 1e-9,
+        "rows stop at the divergence"
+    );
+    assert!(out.rows.iter().all(|r| r.position.is_finite()));
+}
+
+#[test]
+fn figures_reproduce_the_assignment_studies() {
+    let dir = out_dir("figures");
+    analysis::figures(&dir, 3.0).unwrap();
+    // α = 0 drifts more than the large α.
+    let max_drift = |stem: &str| {
+        let (_, rows) = read_csv(&dir.join(format!("{stem}.csv")));
+        rows.iter().map(|r| r[5].abs()).fold(0.0, f64::max)
+    };
+    let (none, large) = (max_drift("alpha_0"), max_drift("alpha_1000"));
+    assert!(
+        none > 10.0 * large,
+        "max |C|: α = 0 {none:e}, α = 1000 {large:e}"
+    );
+    for study in ["alpha", "beta", "timestep"] {
+        for (kind, size) in [
+            ("trajectory", FIGURE_SIZE),
+            ("drift", (FIGURE_SIZE.0, FIGURE_SIZE.1 / 2)),
+            ("energy", (FIGURE_SIZE.0, FIGURE_SIZE.1 / 2)),
+        ] {
+            let path = dir.join(format!("{study}_{kind}.png"));
+            let image = image::open(&path)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+                .to_rgb8();
+            assert_eq!(image.dimensions(), size, "{}", path.display());
+            let coloured = image
+                .pixels()
+                .filter(|p| p.0.iter().any(|&c| c < 200))
+                .count();
+            let fraction = coloured as f64 / (size.0 * size.1) as f64;
+            assert!(
+                fraction > 0.01 && fraction < 0.6,
+                "{}: {:.1}% drawn",
+                path.display(),
+                100.0 * fraction
+            );
+        }
+    }
+    let summary = std::fs::read_to_string(dir.join("summary.md")).unwrap();
+    assert_eq!(
+        summary
+            .lines()
+            .filter(|l| l.starts_with("| alpha")
+                || l.starts_with("| beta")
+                || l.starts_with("| timestep"))
+            .count(),
+        9
+    );
+}
+
+#[test]
+fn compare_ranks_rattle_above_euler() {
+    let table = analysis::compare(1.0, 9.81, 90.0, 6.0, &[1.0 / 60.0]).unwrap();
+    assert_eq!(table.len(), Method::ALL.len());
+    let find = |m| table.iter().find(|r| r.method == m).unwrap();
+    let rattle = find(Method::Rattle);
+    let assignment = find(Method::SemiImplicitEuler(Stabilization::Baumgarte));
+    assert!(rattle.max_drift < 1e-12);
+    assert!(rattle.period_error.unwrap().abs() < 1e-3);
+    assert!(rattle.energy_error * 100.0 < assignment.energy_error);
+}

@@ -1,0 +1,82 @@
+//! What a step reports: [`BeadDiagnostics`] each step, and [`Diverged`]
+//! with a [`BeadDiverged`] message when a bead stops.
+
+use std::fmt;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use crate::solver::SolveError;
+
+/// Per-bead diagnostics, updated after every step (on beads that have
+/// them: see [`WireBeadPlugin::lean`](crate::WireBeadPlugin::lean)). The
+/// time and the step count since the last restart are the
+/// [`SimClock`](crate::SimClock)'s.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
+#[reflect(Component)]
+pub struct BeadDiagnostics {
+    /// The constraint value `C` (the drift off the wire).
+    pub c: f64,
+    /// Its rate `Ċ`.
+    pub c_dot: f64,
+    /// The constraint multiplier λ of the last step (for RATTLE the mean of
+    /// its position and velocity multipliers).
+    pub lambda: f64,
+    /// The constraint force `λN` of the last step (for RATTLE the mean of
+    /// its two multipliers' forces).
+    pub constraint_force: DVec2,
+    /// `½ m |v|²`.
+    pub kinetic: f64,
+    /// `-m g·x`.
+    pub potential: f64,
+}
+
+impl BeadDiagnostics {
+    /// Kinetic plus potential energy.
+    pub fn energy(&self) -> f64 {
+        self.kinetic + self.potential
+    }
+}
+
+/// Why a bead stopped.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DivergenceReason {
+    /// The step failed: a singular point, a Newton solve that did not
+    /// converge, a non-finite result, or drift past the configured bound.
+    Solve(SolveError),
+    /// The state was already non-finite before the step (written from
+    /// outside).
+    NonFiniteState,
+    /// The bead's wire entity has no [`Wire`](crate::Wire) or its
+    /// `Transform` is not finite.
+    InvalidWire(String),
+}
+
+impl fmt::Display for DivergenceReason {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Solve(e) => e.fmt(f),
+            Self::NonFiniteState => f.write_str("its position or velocity is not finite"),
+            Self::InvalidWire(why) => write!(f, "its wire is invalid: {why}"),
+        }
+    }
+}
+
+/// Marks a bead that diverged: it no longer moves until a restart.
+#[derive(Component, Clone, Debug, PartialEq)]
+pub struct Diverged {
+    /// Why.
+    pub reason: DivergenceReason,
+    /// The simulated time ([`SimClock`](crate::SimClock)) at the end of the
+    /// step that found it.
+    pub time: f64,
+}
+
+/// Sent when a bead diverges: which bead and why.
+#[derive(Message, Clone, Debug)]
+pub struct BeadDiverged {
+    /// The bead.
+    pub bead: Entity,
+    /// Why it stopped.
+    pub reason: DivergenceReason,
+}

@@ -1,0 +1,137 @@
+//! [`Wire`]: a shape placed by its entity's `Transform`; [`OnWire`] puts a
+//! bead on it.
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+
+use crate::geometry::{Circle, Ellipse, ImplicitCurve, Line, Parabola, Pose, Sine, WireShape};
+use crate::validate::ParamError;
+
+/// A wire: a shape placed in the plane by the entity's `Transform`
+/// (translation x, y and rotation about z; the wire should be a top-level
+/// entity, since the plugin reads `Transform`, not `GlobalTransform`).
+///
+/// Built only through validating constructors, so a wire in the world always
+/// has valid dimensions.
+#[derive(Component, Clone, Debug)]
+#[require(Transform, WirePose)]
+pub struct Wire {
+    shape: WireShape,
+}
+
+impl Wire {
+    /// A wire of any shape, if its dimensions are valid.
+    pub fn new(shape: WireShape) -> Result<Self, ParamError> {
+        shape.validate()?;
+        Ok(Self { shape })
+    }
+
+    /// A circle of the given radius about the entity's origin.
+    pub fn circle(radius: f64) -> Result<Self, ParamError> {
+        Self::new(WireShape::Circle(Circle { radius }))
+    }
+
+    /// An ellipse with semi-axes `a` (local x) and `b` (local y).
+    pub fn ellipse(a: f64, b: f64) -> Result<Self, ParamError> {
+        Self::new(WireShape::Ellipse(Ellipse { a, b }))
+    }
+
+    /// The infinite line along the entity's local x axis.
+    pub fn line() -> Self {
+        Self {
+            shape: WireShape::Line(Line),
+        }
+    }
+
+    /// The parabola `y = x²/(4f)`.
+    pub fn parabola(focal_length: f64) -> Result<Self, ParamError> {
+        Self::new(WireShape::Parabola(Parabola { focal_length }))
+    }
+
+    /// The sine track `y = A sin(2πx/λ)`.
+    pub fn sine(amplitude: f64, wavelength: f64) -> Result<Self, ParamError> {
+        Self::new(WireShape::Sine(Sine {
+            amplitude,
+            wavelength,
+        }))
+    }
+
+    /// A wire along a curve of the game's own.
+    pub fn custom(curve: impl ImplicitCurve + Send + Sync + 'static) -> Self {
+        Self {
+            shape: WireShape::Custom(Arc::new(curve)),
+        }
+    }
+
+    /// The shape.
+    pub fn shape(&self) -> &WireShape {
+        &self.shape
+    }
+}
+
+/// Where a wire sits for the current step: its `Transform` read once, in
+/// [`WireBeadSystems::Prepare`](crate::WireBeadSystems::Prepare), so the
+/// beads on it do not each convert it. Kept by the plugin.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub(crate) struct WirePose(Option<Pose>);
+
+impl Default for WirePose {
+    fn default() -> Self {
+        Self(Some(Pose::IDENTITY))
+    }
+}
+
+impl WirePose {
+    /// The pose of `transform`, or none if it is not finite.
+    pub(crate) fn from_transform(transform: &Transform) -> Self {
+        Self(pose_of(transform).ok())
+    }
+
+    /// The pose, or the error that the wire's transform is not finite.
+    pub(crate) fn get(&self) -> Result<Pose, ParamError> {
+        self.0.ok_or(ParamError::NotFinite {
+            name: "wire transform",
+            value: f64::NAN,
+        })
+    }
+}
+
+/// The in-plane pose of a wire's `Transform`, or an error if it is not
+/// finite.
+pub fn pose_of(transform: &Transform) -> Result<Pose, ParamError> {
+    Pose::from_translation_rotation(transform.translation, transform.rotation)
+}
+
+/// An edited shape for a wire, applied (and removed) by the next
+/// [`Restart`](crate::Restart). Built only from a valid shape.
+#[derive(Component, Clone, Debug)]
+pub struct PendingWire(Wire);
+
+impl PendingWire {
+    /// A pending edit, if `shape` is valid.
+    pub fn new(shape: WireShape) -> Result<Self, ParamError> {
+        Wire::new(shape).map(Self)
+    }
+
+    /// The edited shape.
+    pub fn shape(&self) -> &WireShape {
+        self.0.shape()
+    }
+
+    /// The wire it will become.
+    pub fn wire(&self) -> &Wire {
+        &self.0
+    }
+}
+
+/// Puts a bead on a wire. Several beads may share one wire; despawning the
+/// wire despawns its beads.
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
+#[relationship(relationship_target = WireBeads)]
+pub struct OnWire(pub Entity);
+
+/// The beads on a wire, kept by Bevy from their [`OnWire`].
+#[derive(Component, Debug, Default)]
+#[relationship_target(relationship = OnWire, linked_spawn)]
+pub struct WireBeads(Vec<Entity>);

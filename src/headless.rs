@@ -1,0 +1,143 @@
+//! The one headless harness: an app with `MinimalPlugins` and the plugin,
+//! stepped by hand, exactly `n` fixed steps at a time. The tests, the
+//! benchmarks, the avian2d comparison and the analysis tool all build their
+//! apps here.
+//!
+//! ```
+//! use bevy::math::DVec2;
+//! use wirebead::headless::{Headless, run_steps};
+//! use wirebead::prelude::*;
+//!
+//! let mut app = Headless::new(WireBeadPlugin::default()).single_threaded().build();
+//! let wire = app.world_mut().spawn(Wire::circle(1.0).unwrap()).id();
+//! let bead = Bead::at_rest(1.0, DVec2::new(1.0, 0.0)).unwrap();
+//! let bead = app.world_mut().spawn((bead, OnWire(wire))).id();
+//! run_steps(&mut app, 30); // half a second: near the bottom
+//! assert!(app.world().get::<Bead>(bead).unwrap().position.y < -0.5);
+//! ```
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+
+use crate::dynamics::SimParams;
+use crate::plugin::{
+    ParallelStep, WireBeadPlugin, compute_on_all_cores, use_single_threaded_executors,
+};
+use crate::preset::ScenePresetPlugin;
+
+/// Builds a headless app: [`Headless::new`], the options, [`Headless::build`].
+#[derive(Clone, Debug)]
+pub struct Headless {
+    plugin: WireBeadPlugin,
+    single_threaded: bool,
+    all_cores: bool,
+    parallel: Option<ParallelStep>,
+    assets: Option<PathBuf>,
+}
+
+impl Headless {
+    /// An app with `plugin`, Bevy's default executors and task pools.
+    pub fn new(plugin: WireBeadPlugin) -> Self {
+        Self {
+            plugin,
+            single_threaded: false,
+            all_cores: false,
+            parallel: None,
+            assets: None,
+        }
+    }
+
+    /// Single-threaded executors: for runs of a few beads, where waking the
+    /// thread pool for each tiny system costs more than the step.
+    pub fn single_threaded(self) -> Self {
+        Self {
+            single_threaded: true,
+            ..self
+        }
+    }
+
+    /// A compute pool with a thread for every core
+    /// ([`compute_on_all_cores`]).
+    pub fn on_all_cores(self) -> Self {
+        Self {
+            all_cores: true,
+            ..self
+        }
+    }
+
+    /// When the step splits over threads.
+    pub fn parallel(self, parallel: ParallelStep) -> Self {
+        Self {
+            parallel: Some(parallel),
+            ..self
+        }
+    }
+
+    /// Bevy's `AssetPlugin` reading from `dir`, and the
+    /// [`ScenePresetPlugin`].
+    pub fn assets(self, dir: impl Into<PathBuf>) -> Self {
+        Self {
+            assets: Some(dir.into()),
+            ..self
+        }
+    }
+
+    /// The app, after its first update (which starts the clocks and runs
+    /// `Startup`, but no fixed step). Each later `app.update()` runs one
+    /// fixed step until [`run_steps`] says otherwise.
+    pub fn build(self) -> App {
+        let mut app = App::new();
+        let minimal = MinimalPlugins.set(TaskPoolPlugin {
+            task_pool_options: if self.all_cores {
+                compute_on_all_cores()
+            } else {
+                TaskPoolOptions::default()
+            },
+        });
+        app.add_plugins((minimal, self.plugin));
+        if let Some(dir) = self.assets {
+            app.add_plugins((
+                AssetPlugin {
+                    file_path: dir.to_string_lossy().into_owned(),
+                    ..default()
+                },
+                ScenePresetPlugin,
+            ));
+        }
+        if let Some(parallel) = self.parallel {
+            app.insert_resource(parallel);
+        }
+        app.insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
+        // Enough for any batch of steps `run_steps` asks for at once.
+        app.world_mut()
+            .resource_mut::<Time<Virtual>>()
+            .set_max_delta(Duration::from_secs(1_000_000));
+        if self.single_threaded {
+            use_single_threaded_executors(&mut app);
+        }
+        app.update();
+        app
+    }
+}
+
+/// Runs exactly `n` fixed steps in one update (and `n` per update after
+/// it).
+pub fn run_steps(app: &mut App, n: u32) {
+    app.insert_resource(TimeUpdateStrategy::FixedTimesteps(n));
+    app.update();
+}
+
+/// Runs for `seconds` of simulated time, rounded to whole steps of the
+/// applied timestep.
+pub fn run_for(app: &mut App, seconds: f64) {
+    let dt = app.world().resource::<SimParams>().timestep;
+    run_steps(app, (seconds / dt).round() as u32);
+}
+
+/// Runs updates with no fixed step (loading assets, handling messages).
+pub fn idle(app: &mut App) {
+    run_steps(app, 0);
+}

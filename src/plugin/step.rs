@@ -1,0 +1,399 @@
+//! [`WireBeadSystems::Prepare`](crate::WireBeadSystems::Prepare) and
+//! [`WireBeadSystems::Step`](crate::WireBeadSystems::Step): the systems that
+//! move beads. They only move data between the ECS and
+//! [`solver`](crate::solver).
+
+use std::sync::{Mutex, PoisonError};
+
+use bevy::ecs::change_detection::ContiguousMut;
+use bevy::ecs::storage::SparseSet;
+use bevy::ecs::system::{SystemChangeTick, SystemParam};
+use bevy::prelude::*;
+use bevy::tasks::ComputeTaskPool;
+
+use super::parallel::ParallelStep;
+use super::restart::SimClock;
+use super::writeback::{LastStep, place};
+use crate::dynamics::{
+    Bead, BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason, OnWire, SimParams, Wire,
+    WirePose,
+};
+use crate::geometry::{ImplicitCurve, Placed, Pose, WireShape};
+use crate::solver::{self, StepOutput, StepSettings};
+
+/// Prepares the step: places every wire (reads each changed wire
+/// `Transform` once, so the beads do not) and advances the [`SimClock`].
+pub(crate) fn prepare_step(
+    params: Res<SimParams>,
+    mut clock: ResMut<SimClock>,
+    mut wires: Query<(&Transform, &mut WirePose), Changed<Transform>>,
+) {
+    for (transform, mut pose) in &mut wires {
+        *pose = WirePose::from_transform(transform);
+    }
+    clock.steps += 1;
+    clock.time += params.timestep;
+}
+
+/// Divergences found inside a (possibly parallel) loop, reported after it.
+#[derive(Default)]
+pub(crate) struct FoundDivergences(Mutex<Vec<(Entity, DivergenceReason, f64)>>);
+
+impl FoundDivergences {
+    fn push(&self, bead: Entity, reason: DivergenceReason, time: f64) {
+        self.0
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .push((bead, reason, time));
+    }
+
+    fn report(&mut self, divergences: &mut Divergences) {
+        let found = self.0.get_mut().unwrap_or_else(PoisonError::into_inner);
+        for (bead, reason, time) in found.drain(..) {
+            divergences.report(bead, reason, time);
+        }
+    }
+}
+
+/// Marks beads diverged: inserts [`Diverged`], sends [`BeadDiverged`] and
+/// logs a warning.
+#[derive(SystemParam)]
+pub(crate) struct Divergences<'w, 's> {
+    commands: Commands<'w, 's>,
+    messages: MessageWriter<'w, BeadDiverged>,
+}
+
+impl Divergences<'_, '_> {
+    /// Reports that `bead` stopped at simulated time `time`.
+    fn report(&mut self, bead: Entity, reason: DivergenceReason, time: f64) {
+        warn!(
+            "wirebead: bead {bead} diverged at t = {time:.4} s: {reason}; press Space (send Restart) to recover"
+        );
+        self.commands.entity(bead).try_insert(Diverged {
+            reason: reason.clone(),
+            time,
+        });
+        self.messages.write(BeadDiverged { bead, reason });
+    }
+}
+
+/// Runs `$body` with `$curve` bound to the shape's concrete curve, so the
+/// solver is inlined for each built-in shape.
+macro_rules! with_curve {
+    ($shape:expr, $curve:ident => $body:expr) => {
+        match $shape {
+            WireShape::Circle($curve) => $body,
+            WireShape::Ellipse($curve) => $body,
+            WireShape::Line($curve) => $body,
+            WireShape::Parabola($curve) => $body,
+            WireShape::Sine($curve) => $body,
+            WireShape::Custom(custom) => {
+                let $curve = custom.as_ref();
+                $body
+            }
+        }
+    };
+}
+
+/// A wire's shape and pose for the step, or why beads cannot be stepped on
+/// it.
+type PlacedWire = Result<(WireShape, Pose), DivergenceReason>;
+
+/// Every wire's shape and pose, kept by [`step_beads`] from change
+/// detection (a copy made when a wire changes, not each step), so a bead
+/// finds its wire with one indexed read instead of a query lookup.
+#[derive(Default)]
+pub(crate) struct WireTable(SparseSet<Entity, (Entity, PlacedWire)>);
+
+impl WireTable {
+    /// Takes in the wires that changed or were added since the last call,
+    /// and drops the ones whose `Wire` or `WirePose` was removed.
+    fn refresh<'a>(
+        &mut self,
+        removed: impl IntoIterator<Item = Entity>,
+        changed: impl IntoIterator<Item = (Entity, &'a Wire, &'a WirePose)>,
+    ) {
+        for entity in removed {
+            if self.0.get(entity).is_some_and(|(e, _)| *e == entity) {
+                self.0.remove(entity);
+            }
+        }
+        for (entity, wire, pose) in changed {
+            let placed = pose
+                .get()
+                .map(|pose| (wire.shape().clone(), pose))
+                .map_err(|e| DivergenceReason::InvalidWire(e.to_string()));
+            self.0.insert(entity, (entity, placed));
+        }
+    }
+
+    /// The shape and pose of the wire a bead is on.
+    fn get(&self, on: &OnWire) -> Result<&(WireShape, Pose), DivergenceReason> {
+        match self.0.get(on.0) {
+            Some((entity, placed)) if *entity == on.0 => placed.as_ref().map_err(Clone::clone),
+            _ => Err(DivergenceReason::InvalidWire(format!(
+                "entity {} has no Wire",
+                on.0
+            ))),
+        }
+    }
+}
+
+/// What stepping a run of beads needs, shared by the threads.
+struct StepContext<'a> {
+    params: &'a SimParams,
+    settings: StepSettings,
+    wires: &'a WireTable,
+    found: &'a FoundDivergences,
+    time: f64,
+}
+
+impl StepContext<'_> {
+    /// Steps a run of beads stored side by side. Beads on unrotated circles
+    /// go through the batched step, [`solver::LANES`] at a time, when the
+    /// method allows; the others, and the lanes it hands back, one by one.
+    fn step_run(&self, mut run: BeadRun) {
+        let batched = solver::is_batched(self.settings.method);
+        let mut lanes = solver::CircleLanes::default();
+        let mut waiting = [0; solver::LANES];
+        let mut queued = 0;
+        for i in 0..run.beads.len() {
+            let wire = self.wires.get(&run.on_wires[i]);
+            if batched
+                && let Ok((WireShape::Circle(circle), pose)) = wire
+                && pose.is_unrotated()
+            {
+                let bead = &run.beads[i];
+                lanes.set(
+                    queued,
+                    bead.state(),
+                    &bead.step_force(self.params.gravity),
+                    bead.mass(),
+                    pose.origin,
+                    circle.radius,
+                );
+                waiting[queued] = i;
+                queued += 1;
+                if queued == solver::LANES {
+                    let outs = solver::step_on_circles(&lanes, &self.settings);
+                    for (lane, &j) in waiting.iter().enumerate() {
+                        match outs.lane(lane) {
+                            Some(out) => self.finish(run.outputs(j), out),
+                            None => self.step_one(&mut run, j),
+                        }
+                    }
+                    queued = 0;
+                }
+                continue;
+            }
+            self.step_one(&mut run, i);
+        }
+        for &j in &waiting[..queued] {
+            self.step_one(&mut run, j);
+        }
+    }
+
+    /// Bead `i` of `run` through [`solver::step`]; a failure is recorded.
+    fn step_one(&self, run: &mut BeadRun, i: usize) {
+        let result = match self.wires.get(&run.on_wires[i]) {
+            Err(reason) => Err(reason),
+            Ok((shape, pose)) => with_curve!(shape, curve => {
+                self.step_bead(&Placed { curve, pose: *pose }, &run.beads[i])
+            }),
+        };
+        match result {
+            Ok(out) => self.finish(run.outputs(i), out),
+            Err(reason) => {
+                // The bead keeps its state; its `Transform` shows it.
+                let outputs = run.outputs(i);
+                if let Some(transform) = outputs.transform {
+                    place(transform, outputs.bead.position);
+                }
+                self.found.push(run.entities[i], reason, self.time);
+            }
+        }
+    }
+
+    /// Eq. (3) and the integrator for one bead.
+    fn step_bead<C: ImplicitCurve + ?Sized>(
+        &self,
+        placed: &Placed<C>,
+        bead: &Bead,
+    ) -> Result<StepOutput, DivergenceReason> {
+        let state = bead.state();
+        if !state.is_finite() {
+            return Err(DivergenceReason::NonFiniteState);
+        }
+        let force = bead.step_force(self.params.gravity);
+        solver::step(placed, state, &force, bead.mass(), &self.settings)
+            .map_err(DivergenceReason::Solve)
+    }
+
+    /// Stores a step's result: the new state (which consumes the force),
+    /// the diagnostics, the `Transform`'s translation.
+    #[inline(always)]
+    fn finish(&self, outputs: BeadOutputs, out: StepOutput) {
+        let BeadOutputs {
+            bead,
+            diagnostics,
+            transform,
+        } = outputs;
+        bead.advance_to(out.state);
+        if let Some(diagnostics) = diagnostics {
+            let (kinetic, potential) = out.state.energy(bead.mass(), self.params.gravity);
+            *diagnostics = BeadDiagnostics {
+                c: out.c,
+                c_dot: out.c_dot,
+                lambda: out.lambda,
+                constraint_force: out.constraint_force,
+                kinetic,
+                potential,
+            };
+        }
+        if let Some(transform) = transform {
+            // A finished step's position is finite: no check.
+            transform.translation.x = out.state.position.x as f32;
+            transform.translation.y = out.state.position.y as f32;
+        }
+    }
+}
+
+/// A run of beads stored side by side: their entities, states and wires,
+/// and, when they have them, their diagnostics and transforms.
+struct BeadRun<'w> {
+    entities: &'w [Entity],
+    beads: &'w mut [Bead],
+    on_wires: &'w [OnWire],
+    diagnostics: Option<&'w mut [BeadDiagnostics]>,
+    transforms: Option<&'w mut [Transform]>,
+}
+
+/// What one bead's step writes.
+struct BeadOutputs<'a> {
+    bead: &'a mut Bead,
+    diagnostics: Option<&'a mut BeadDiagnostics>,
+    transform: Option<&'a mut Transform>,
+}
+
+impl BeadRun<'_> {
+    #[inline(always)]
+    fn outputs(&mut self, i: usize) -> BeadOutputs<'_> {
+        BeadOutputs {
+            bead: &mut self.beads[i],
+            diagnostics: self.diagnostics.as_deref_mut().map(|d| &mut d[i]),
+            transform: self.transforms.as_deref_mut().map(|t| &mut t[i]),
+        }
+    }
+}
+
+/// The columns of one table of beads, as the step's query hands them out.
+type BeadTable<'w> = (
+    &'w [Entity],
+    ContiguousMut<'w, Bead>,
+    &'w [OnWire],
+    Option<ContiguousMut<'w, BeadDiagnostics>>,
+    Option<ContiguousMut<'w, Transform>>,
+);
+
+/// An optional column cut into runs of `n`; `None` for every run if absent
+/// (marked changed if present).
+fn column_runs<'w, T>(
+    column: Option<ContiguousMut<'w, T>>,
+    n: usize,
+) -> impl Iterator<Item = Option<&'w mut [T]>> {
+    column
+        .into_iter()
+        .flat_map(move |c| ContiguousMut::split(c).0.chunks_mut(n).map(Some))
+        .chain(std::iter::repeat_with(|| None))
+}
+
+/// Cuts one table's beads into runs: one for a single thread, else about a
+/// quarter of each thread's share, so a slow thread does not hold the
+/// others up. Marks the beads, diagnostics and transforms changed.
+fn split_table<'w>(
+    (entities, beads, on_wires, diagnostics, transforms): BeadTable<'w>,
+    threads: usize,
+) -> Vec<BeadRun<'w>> {
+    let runs = if threads > 1 { 4 * threads } else { 1 };
+    let n = entities.len().div_ceil(runs).max(1);
+    let beads = ContiguousMut::split(beads).0;
+    entities
+        .chunks(n)
+        .zip(beads.chunks_mut(n))
+        .zip(on_wires.chunks(n))
+        .zip(column_runs(diagnostics, n))
+        .zip(column_runs(transforms, n))
+        .map(
+            |((((entities, beads), on_wires), diagnostics), transforms)| BeadRun {
+                entities,
+                beads,
+                on_wires,
+                diagnostics,
+                transforms,
+            },
+        )
+        .collect()
+}
+
+/// Steps every bead that has not diverged: solve, integrate, check, update
+/// diagnostics (see [`WireBeadSystems::Step`](crate::WireBeadSystems::Step)).
+/// Walks the beads table by table as slices, split over the compute task
+/// pool from [`ParallelStep::threshold`] beads up.
+pub(crate) fn step_beads(
+    params: Res<SimParams>,
+    clock: Res<SimClock>,
+    parallel: Res<ParallelStep>,
+    mut wires: Local<WireTable>,
+    changed: Query<(Entity, &Wire, &WirePose), Or<(Changed<Wire>, Changed<WirePose>)>>,
+    mut removed_wires: RemovedComponents<Wire>,
+    mut removed_poses: RemovedComponents<WirePose>,
+    mut beads: Query<
+        (
+            Entity,
+            &mut Bead,
+            &OnWire,
+            Option<&mut BeadDiagnostics>,
+            Option<&mut Transform>,
+        ),
+        Without<Diverged>,
+    >,
+    mut found: Local<FoundDivergences>,
+    mut stepped: ResMut<LastStep>,
+    ticks: SystemChangeTick,
+    mut divergences: Divergences,
+) {
+    let removed = removed_wires.read().chain(removed_poses.read());
+    wires.refresh(removed, changed);
+    let ctx = StepContext {
+        params: &params,
+        settings: params.step_settings(),
+        wires: &wires,
+        found: &found,
+        time: clock.time,
+    };
+    let count = beads.iter().size_hint().1.unwrap_or(usize::MAX);
+    let pool = ComputeTaskPool::try_get().filter(|_| count >= parallel.threshold);
+    let threads = pool.map_or(1, |pool| pool.thread_num().max(1));
+    let Ok(tables) = beads.contiguous_iter_mut() else {
+        error!("wirebead: the bead query is not table-dense; no bead was stepped");
+        return;
+    };
+    let split = |table| split_table(table, threads);
+    match pool {
+        Some(pool) if threads > 1 => {
+            pool.scope(|scope| {
+                for run in tables.flat_map(split) {
+                    let ctx = &ctx;
+                    scope.spawn(async move { ctx.step_run(run) });
+                }
+            });
+        }
+        _ => {
+            for run in tables.flat_map(split) {
+                ctx.step_run(run);
+            }
+        }
+    };
+    found.report(&mut divergences);
+    stepped.0 = ticks.this_run();
+}

@@ -1,0 +1,47 @@
+//! [`WireBeadSystems::Writeback`](crate::WireBeadSystems::Writeback): `f64`
+//! positions into `Transform`s, converted at this edge.
+
+use bevy::ecs::change_detection::Tick;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use super::parallel::ParallelStep;
+use crate::dynamics::Bead;
+
+/// The change tick of the last run of the step: it wrote the `Transform`
+/// of every bead it changed then.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub(crate) struct LastStep(pub(crate) Tick);
+
+/// Writes each bead's position into its `Transform` (x and y; z is kept)
+/// where the bead changed other than by the last step (a restart, a
+/// game's own edit); the step writes the ones it steps. A non-finite
+/// position is never written.
+pub(crate) fn write_transforms(
+    parallel: Res<ParallelStep>,
+    stepped: Res<LastStep>,
+    mut beads: Query<(Ref<Bead>, &mut Transform), Changed<Bead>>,
+) {
+    let write = |(bead, mut transform): (Ref<Bead>, Mut<Transform>)| {
+        // The step wrote the ones it changed last (without reading them
+        // again here).
+        if bead.last_changed() != stepped.0 {
+            place(&mut transform, bead.position);
+        }
+    };
+    if beads.iter().size_hint().1.unwrap_or(usize::MAX) >= parallel.threshold {
+        beads.par_iter_mut().for_each(write);
+    } else {
+        beads.iter_mut().for_each(write);
+    }
+}
+
+/// Writes a bead's position into its `Transform` (x and y, rounded to
+/// `f32`; z is kept), unless it is not finite.
+#[inline(always)]
+pub(crate) fn place(transform: &mut Transform, position: DVec2) {
+    if position.is_finite() {
+        transform.translation.x = position.x as f32;
+        transform.translation.y = position.y as f32;
+    }
+}

@@ -1,0 +1,38 @@
+//! The constraint solve and the integrators, as pure functions over plain
+//! values: nothing here knows about the ECS. One file per piece:
+//!
+//! | file | what it holds |
+//! |---|---|
+//! | `method` | [`Integrator`], [`Stabilization`] and the [`Method`] that pairs them |
+//! | `settings` | [`StepSettings`]: what is the same for every bead in a step |
+//! | `state` | [`BeadState`], [`LinearForce`] |
+//! | `solve` | λ of eq. (3) in closed form |
+//! | `euler`, `rk4`, `rattle`, `projection` | the integrators and post-stabilization, eqs. (6)–(9) |
+//! | `step` | [`step`]: a whole step of one bead, with the divergence check |
+//! | `lanes` | [`step_on_circles`]: [`LANES`] beads on circles at once, bit for bit [`step`] |
+//!
+//! The equations below are numbered as the code and the tests cite them.
+//!
+#![doc = include_str!("../../docs/method.md")]
+
+mod euler;
+mod lanes;
+mod method;
+mod projection;
+mod rattle;
+mod rk4;
+mod settings;
+mod solve;
+mod state;
+mod step;
+
+pub use euler::{explicit_euler, semi_implicit_euler};
+pub use lanes::{CircleLanes, CircleSteps, LANES, is_batched, step_on_circles};
+pub use method::{Integrator, Method, Stabilization};
+pub use projection::{NEWTON_ACCEPT, NEWTON_TOLERANCE, project};
+pub use rattle::rattle;
+pub use rk4::rk4;
+pub use settings::{Gains, StepSettings};
+pub use solve::{SolveError, Solved, lambda, solve};
+pub use state::{BeadState, LinearForce};
+pub use step::{Advance, StepOutput, constraint_state, step};

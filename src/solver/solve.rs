@@ -1,0 +1,160 @@
+//! The constraint force of eq. (3): λ for one bead on one wire, in closed
+//! form.
+
+use bevy::math::DVec2;
+
+use super::settings::Gains;
+use super::state::{BeadState, LinearForce};
+use crate::geometry::{Geometry, ImplicitCurve};
+
+/// Why a step could not be taken.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum SolveError {
+    /// `∇C` vanishes (or is not finite) where the bead is: there is no
+    /// normal to push along.
+    #[error("the bead is at a singular point of its wire ({x}, {y}), where the normal ∇C vanishes")]
+    Singular {
+        /// x of the point.
+        x: f64,
+        /// y of the point.
+        y: f64,
+    },
+    /// The RATTLE or projection Newton iteration did not reach tolerance.
+    #[error(
+        "the constraint solve did not converge: |C| = {residual:e} after {iterations} iterations"
+    )]
+    NoConvergence {
+        /// Newton iterations taken.
+        iterations: u32,
+        /// The remaining `|C|`.
+        residual: f64,
+    },
+    /// The new state has a NaN or infinite component.
+    #[error("the state became non-finite")]
+    NonFinite,
+    /// The step left the bead farther off its wire than the bound: the
+    /// simulation has blown up.
+    #[error("the bead drifted {c:.3e} off its wire, past the bound {bound:.3e}")]
+    DriftExceeded {
+        /// The drift `C` after the step (before any projection).
+        c: f64,
+        /// The bound, in world units.
+        bound: f64,
+    },
+}
+
+/// The constraint force at one state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Solved {
+    /// λ of eq. (3).
+    pub lambda: f64,
+    /// `λN`.
+    pub constraint_force: DVec2,
+    /// `(f + λN)/m`.
+    pub acceleration: DVec2,
+}
+
+/// `|N|²` where the bead is at `x`, or [`SolveError::Singular`] where the
+/// normal vanishes or is not finite.
+#[inline(always)]
+pub(crate) fn normal_length_squared(normal: DVec2, x: DVec2) -> Result<f64, SolveError> {
+    let nn = normal.length_squared();
+    if nn.is_finite() && nn > 1e-24 {
+        Ok(nn)
+    } else {
+        Err(SolveError::Singular { x: x.x, y: x.y })
+    }
+}
+
+/// λ of eq. (3) for a bead of mass `mass` in `state` under the force `f`,
+/// where the wire's geometry is `g`.
+#[inline(always)]
+pub fn lambda(
+    g: &Geometry,
+    state: BeadState,
+    f: DVec2,
+    mass: f64,
+    gains: Gains,
+) -> Result<f64, SolveError> {
+    let BeadState {
+        position: x,
+        velocity: v,
+    } = state;
+    let nn = normal_length_squared(g.normal, x)?;
+    let vhv = v.dot(g.hessian * v);
+    let Gains { alpha, beta } = gains;
+    Ok((-mass * vhv - mass * alpha * g.c - mass * beta * g.normal.dot(v) - g.normal.dot(f)) / nn)
+}
+
+/// Solves eq. (3) at `state` and returns λ, `λN` and the acceleration.
+#[inline(always)]
+pub fn solve<C: ImplicitCurve + ?Sized>(
+    curve: &C,
+    state: BeadState,
+    force: &LinearForce,
+    mass: f64,
+    gains: Gains,
+) -> Result<Solved, SolveError> {
+    let g = curve.geometry(state.position);
+    let f = force.at(state.position);
+    let lambda = lambda(&g, state, f, mass, gains)?;
+    let constraint_force = lambda * g.normal;
+    Ok(Solved {
+        lambda,
+        constraint_force,
+        // The reciprocal does not wait for λ; a division here would.
+        acceleration: (f + constraint_force) * mass.recip(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{Circle, Ellipse, Placed, Pose};
+    use approx::assert_relative_eq;
+
+    const G: DVec2 = DVec2::new(0.0, -9.81);
+
+    #[test]
+    fn lambda_on_circle_is_the_centripetal_and_gravity_balance() {
+        // At the bottom of a unit circle moving at speed u: λ = -(m u²/r + m|g|)
+        // (pointing inward, N points outward).
+        let circle = Circle { radius: 1.0 };
+        let u = 3.0;
+        let state = BeadState {
+            position: DVec2::new(0.0, -1.0),
+            velocity: DVec2::new(u, 0.0),
+        };
+        let s = solve(
+            &circle,
+            state,
+            &LinearForce::constant(2.0 * G),
+            2.0,
+            Gains::NONE,
+        )
+        .unwrap();
+        assert_relative_eq!(s.lambda, -(2.0 * u * u + 2.0 * 9.81), epsilon = 1e-12);
+        assert_relative_eq!(s.acceleration.y, u * u, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn baumgarte_lambda_makes_c_double_dot_follow_the_law() {
+        // Check C̈ = -αC - βĊ numerically on an ellipse, off the wire, placed and rotated.
+        let ellipse = Ellipse { a: 2.0, b: 1.0 };
+        let placed = Placed {
+            curve: &ellipse,
+            pose: Pose::new(DVec2::new(0.5, 0.2), 0.4),
+        };
+        let state = BeadState {
+            position: placed.pose.to_world(DVec2::new(1.2, 0.9)),
+            velocity: DVec2::new(0.3, -0.8),
+        };
+        let force = LinearForce::constant(DVec2::new(0.7, -9.81));
+        let (alpha, beta, m) = (50.0, 7.0, 1.5);
+        let s = solve(&placed, state, &force, m, Gains { alpha, beta }).unwrap();
+        let g = placed.geometry(state.position);
+        let c_dot = g.normal.dot(state.velocity);
+        let c_ddot = state.velocity.dot(g.hessian * state.velocity) + g.normal.dot(s.acceleration);
+        assert_relative_eq!(c_ddot, -alpha * g.c - beta * c_dot, epsilon = 1e-12);
+    }
+}

@@ -1,0 +1,192 @@
+//! One whole step of one bead: the method's integrator, the divergence
+//! check, the projection where the method asks for it, and `C`, `Ċ` at the
+//! end.
+
+use bevy::math::DVec2;
+
+use super::euler::{explicit_euler, semi_implicit_euler};
+use super::method::Method;
+use super::projection::project;
+use super::rattle::rattle;
+use super::rk4::rk4;
+use super::settings::StepSettings;
+use super::solve::{SolveError, solve};
+use super::state::{BeadState, LinearForce};
+use crate::geometry::ImplicitCurve;
+
+/// What an integrator hands back: the new state and the constraint force
+/// it applied.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Advance {
+    /// The new state.
+    pub state: BeadState,
+    /// The constraint multiplier the step applied (for RATTLE the mean of
+    /// its position and velocity multipliers).
+    pub lambda: f64,
+    /// The constraint force the step applied.
+    pub constraint_force: DVec2,
+}
+
+/// The result of one step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepOutput {
+    /// The new state.
+    pub state: BeadState,
+    /// The constraint multiplier the step applied (for RATTLE the mean of
+    /// its position and velocity multipliers).
+    pub lambda: f64,
+    /// The constraint force the step applied.
+    pub constraint_force: DVec2,
+    /// `C` at the new state.
+    pub c: f64,
+    /// `Ċ` at the new state.
+    pub c_dot: f64,
+}
+
+/// One step of a bead of mass `mass` from `state` on `curve` under
+/// `force` (gravity included): the method's integrator, then the
+/// divergence check (a non-finite state, or `|C|` past the bound), then
+/// post-stabilization where the method projects.
+#[inline(always)]
+pub fn step<C: ImplicitCurve + ?Sized>(
+    curve: &C,
+    state: BeadState,
+    force: &LinearForce,
+    mass: f64,
+    settings: &StepSettings,
+) -> Result<StepOutput, SolveError> {
+    let h = settings.dt;
+    let gains = settings.gains();
+    let advance = match settings.method {
+        Method::Rattle => rattle(curve, state, force, mass, h)?,
+        Method::ExplicitEuler(_) => {
+            explicit_euler(state, &solve(curve, state, force, mass, gains)?, h)
+        }
+        Method::SemiImplicitEuler(_) => {
+            semi_implicit_euler(state, &solve(curve, state, force, mass, gains)?, h)
+        }
+        Method::Rk4(_) => {
+            let first = solve(curve, state, force, mass, gains)?;
+            rk4(curve, state, force, mass, gains, &first, h)?
+        }
+    };
+    if !advance.state.is_finite() {
+        return Err(SolveError::NonFinite);
+    }
+    let g = curve.geometry(advance.state.position);
+    let bound = settings.drift_bound * curve.scale();
+    if g.c.is_nan() || g.c.abs() > bound {
+        return Err(SolveError::DriftExceeded { c: g.c, bound });
+    }
+    let (state, (c, c_dot)) = if settings.method.projects() {
+        let projected = project(curve, advance.state)?;
+        (projected, constraint_state(curve, projected))
+    } else {
+        (advance.state, (g.c, g.normal.dot(advance.state.velocity)))
+    };
+    Ok(StepOutput {
+        state,
+        lambda: advance.lambda,
+        constraint_force: advance.constraint_force,
+        c,
+        c_dot,
+    })
+}
+
+/// `C` and `Ċ = N·ẋ` at a state: how far off its wire the bead is, and how
+/// fast it leaves it.
+pub fn constraint_state<C: ImplicitCurve + ?Sized>(curve: &C, state: BeadState) -> (f64, f64) {
+    let g = curve.geometry(state.position);
+    (g.c, g.normal.dot(state.velocity))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{Circle, Sine};
+    use crate::solver::{NEWTON_ACCEPT, Stabilization};
+
+    const G: DVec2 = DVec2::new(0.0, -9.81);
+
+    fn settings(method: Method, dt: f64) -> StepSettings {
+        StepSettings {
+            dt,
+            method,
+            alpha: 100.0,
+            beta: 20.0,
+            drift_bound: 1.0,
+        }
+    }
+
+    #[test]
+    fn singular_point_is_an_error_not_a_nan() {
+        let circle = Circle { radius: 1.0 };
+        let state = BeadState::default();
+        for method in Method::ALL {
+            let err = step(
+                &circle,
+                state,
+                &LinearForce::constant(G),
+                1.0,
+                &settings(method, 0.01),
+            )
+            .unwrap_err();
+            assert_eq!(err, SolveError::Singular { x: 0.0, y: 0.0 });
+        }
+    }
+
+    #[test]
+    fn rattle_and_projection_hold_the_constraint_to_tolerance() {
+        let sine = Sine {
+            amplitude: 0.5,
+            wavelength: 3.0,
+        };
+        for method in [
+            Method::Rattle,
+            Method::SemiImplicitEuler(Stabilization::Projection),
+            Method::Rk4(Stabilization::Projection),
+        ] {
+            let mut state = BeadState {
+                position: DVec2::new(0.0, 0.0),
+                velocity: DVec2::new(2.0, 2.0 * 0.5 * std::f64::consts::TAU / 3.0),
+            };
+            let s = settings(method, 1.0 / 60.0);
+            for _ in 0..600 {
+                state = step(&sine, state, &LinearForce::constant(G), 1.0, &s)
+                    .unwrap()
+                    .state;
+                let (drift, drift_rate) = constraint_state(&sine, state);
+                assert!(
+                    drift.abs() <= NEWTON_ACCEPT * 3.0,
+                    "{method}: C = {drift:e}"
+                );
+                assert!(drift_rate.abs() <= 1e-12, "{method}: Ċ = {drift_rate:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn rk4_is_fourth_order_on_the_pendulum() {
+        // Halving dt divides the end-point error by about 16.
+        let circle = Circle { radius: 1.0 };
+        let start = BeadState {
+            position: DVec2::new(1.0, 0.0),
+            velocity: DVec2::ZERO,
+        };
+        let run = |dt: f64| {
+            let s = settings(Method::Rk4(Stabilization::None), dt);
+            let mut state = start;
+            for _ in 0..(1.0 / dt).round() as usize {
+                state = step(&circle, state, &LinearForce::constant(G), 1.0, &s)
+                    .unwrap()
+                    .state;
+            }
+            state.position
+        };
+        let reference = run(1.0 / 2560.0);
+        let e1 = (run(1.0 / 80.0) - reference).length();
+        let e2 = (run(1.0 / 160.0) - reference).length();
+        let order = (e1 / e2).log2();
+        assert!((3.7..4.3).contains(&order), "observed order {order}");
+    }
+}

@@ -1,0 +1,78 @@
+//! Keyboard controls, pressed through `ButtonInput<KeyCode>` with no window.
+
+use crate::common::*;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use wirebead::controls::KeyboardControlsPlugin;
+use wirebead::prelude::*;
+
+fn press(app: &mut App, key: KeyCode, steps: u32) {
+    app.world_mut()
+        .resource_mut::<ButtonInput<KeyCode>>()
+        .press(key);
+    run_steps(app, steps);
+    let mut keys = app.world_mut().resource_mut::<ButtonInput<KeyCode>>();
+    keys.release(key);
+    keys.clear();
+}
+
+fn scene() -> (App, Entity) {
+    let mut app = app(SimParams::default());
+    app.add_plugins(KeyboardControlsPlugin);
+    let wire = spawn_wire(&mut app, Wire::circle(1.0).unwrap(), Transform::default());
+    let bead = spawn_bead(
+        &mut app,
+        wire,
+        BeadParams {
+            initial_position: DVec2::new(1.0, 0.0),
+            ..default()
+        },
+    );
+    (app, bead)
+}
+
+#[test]
+fn space_restarts_and_applies_pending_params() {
+    let (mut app, bead_entity) = scene();
+    run_steps(&mut app, 30);
+    app.world_mut()
+        .resource_mut::<PendingParams>()
+        .update(|p| p.alpha = 250.0)
+        .unwrap();
+    let edit = PendingBead::new(BeadParams {
+        mass: 3.0,
+        initial_position: DVec2::new(-1.0, 0.0),
+        ..default()
+    })
+    .unwrap();
+    app.world_mut().entity_mut(bead_entity).insert(edit);
+    run_steps(&mut app, 5);
+    assert_eq!(
+        app.world().resource::<SimParams>().alpha,
+        100.0,
+        "not before Space"
+    );
+
+    press(&mut app, KeyCode::Space, 0);
+    assert_eq!(app.world().resource::<SimParams>().alpha, 250.0);
+    let b = bead(&app, bead_entity);
+    assert_eq!(
+        (b.mass(), b.position, b.velocity),
+        (3.0, DVec2::new(-1.0, 0.0), DVec2::ZERO)
+    );
+    assert_eq!(steps(&app), 0);
+}
+
+#[test]
+fn p_pauses_and_n_steps_exactly_once() {
+    let (mut app, _) = scene();
+    run_steps(&mut app, 10);
+    press(&mut app, KeyCode::KeyP, 0);
+    run_steps(&mut app, 10);
+    assert_eq!(steps(&app), 10, "paused: no steps");
+    press(&mut app, KeyCode::KeyN, 0);
+    assert_eq!(steps(&app), 11, "one step");
+    press(&mut app, KeyCode::KeyP, 0);
+    run_steps(&mut app, 10);
+    assert_eq!(steps(&app), 21, "running again");
+}

@@ -1,0 +1,18 @@
+//! The integration tests, one module per behaviour, linked into one test
+//! binary. Each runs the plugin headless through `wirebead::headless`;
+//! `window` checks the files `.ci/run` makes in a real window and is ignored
+//! by a plain `cargo test`.
+
+mod bad_input;
+mod baumgarte;
+mod common;
+mod controls;
+mod parallel;
+mod pendulum;
+mod precision;
+mod presets;
+mod readme;
+mod restart;
+mod scenes;
+#[cfg(feature = "gui")]
+mod window;

@@ -1,0 +1,145 @@
+//! Scene presets: the shipped files are valid, a preset loads as an asset and
+//! replaces the scene, and a malformed file leaves the running scene as it was.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use bevy::prelude::*;
+use wirebead::headless::{Headless, idle, run_steps};
+use wirebead::prelude::*;
+use wirebead::preset::{ActivePreset, FromPreset};
+
+const SHIPPED: &[&str] = &[
+    "assignment_circle.scene.ron",
+    "ellipse.scene.ron",
+    "sine_track.scene.ron",
+    "multi_bead.scene.ron",
+    "resting.scene.ron",
+];
+
+/// The shipped presets, found at run time: a test binary reused from another
+/// checkout must read this checkout's files.
+fn shipped_dir() -> PathBuf {
+    std::env::var_os("CARGO_MANIFEST_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_default()
+        .join("assets/scenes")
+}
+
+#[test]
+fn shipped_presets_are_valid_and_put_beads_on_their_wires() {
+    let dir = shipped_dir();
+    let mut beads = 0;
+    for name in SHIPPED {
+        let text = std::fs::read_to_string(dir.join(name)).unwrap();
+        let preset = ScenePreset::from_ron(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+        for wire in &preset.wires {
+            let pose =
+                wirebead::geometry::Pose::new(wire.position, wire.angle_degrees.to_radians());
+            let placed = wirebead::geometry::Placed {
+                curve: wire.shape.curve(),
+                pose,
+            };
+            for bead in &wire.beads {
+                use wirebead::ImplicitCurve;
+                let c = placed.value(bead.initial_position);
+                assert!(c.abs() < 1e-9, "{name}: a bead starts {c:e} off its wire");
+                beads += 1;
+            }
+        }
+    }
+    assert!(beads >= 7);
+}
+
+/// A headless app with assets read from `dir`.
+fn asset_app(dir: &std::path::Path) -> App {
+    let mut app = Headless::new(WireBeadPlugin::default()).assets(dir).build();
+    idle(&mut app);
+    app
+}
+
+/// Updates (with no fixed step) until `done` or 10 s pass.
+fn wait_for(app: &mut App, done: impl Fn(&ActivePreset) -> bool) {
+    for _ in 0..1000 {
+        idle(app);
+        if done(app.world().resource::<ActivePreset>()) {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    panic!("timed out: {:?}", app.world().resource::<ActivePreset>());
+}
+
+fn beads(app: &mut App) -> Vec<(Entity, Bead)> {
+    let mut query = app
+        .world_mut()
+        .query_filtered::<(Entity, &Bead), With<FromPreset>>();
+    let mut beads: Vec<(Entity, Bead)> = query
+        .iter(app.world())
+        .map(|(e, b)| (e, b.clone()))
+        .collect();
+    beads.sort_by_key(|(e, _)| *e);
+    beads
+}
+
+#[test]
+fn malformed_preset_reports_its_error_and_the_scene_runs_on() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("presets_malformed");
+    std::fs::create_dir_all(&dir).unwrap();
+    let shipped = shipped_dir().join("multi_bead.scene.ron");
+    std::fs::copy(shipped, dir.join("good.scene.ron")).unwrap();
+    std::fs::write(
+        dir.join("bad.scene.ron"),
+        "(name: \"bad\", wires: [ (shape: Circle((radius: -1.0)), beads: [()]) ])",
+    )
+    .unwrap();
+    std::fs::write(dir.join("broken.scene.ron"), "(name: \"broken\", wires: [").unwrap();
+
+    let mut app = asset_app(&dir);
+    app.world_mut()
+        .write_message(LoadPreset("good.scene.ron".into()));
+    wait_for(&mut app, |a| a.running.is_some());
+    assert_eq!(
+        app.world().resource::<ActivePreset>().running.as_deref(),
+        Some("Many beads")
+    );
+    assert_eq!(app.world().resource::<SimParams>().method, Method::Rattle);
+    run_steps(&mut app, 30);
+    let before = beads(&mut app);
+    assert_eq!(before.len(), 4);
+    let params = app.world().resource::<SimParams>().clone();
+
+    for (file, expected) in [
+        (
+            "bad.scene.ron",
+            "wire 0: radius must be positive and finite, got -1",
+        ),
+        (
+            "broken.scene.ron",
+            "malformed scene file at line 1, column ",
+        ),
+    ] {
+        app.world_mut().write_message(LoadPreset(file.into()));
+        wait_for(&mut app, |a| a.error.is_some());
+        let error = app
+            .world()
+            .resource::<ActivePreset>()
+            .error
+            .clone()
+            .unwrap();
+        assert!(error.contains(file) && error.contains(expected), "{error}");
+        // The scene is the one that was running, untouched.
+        assert_eq!(beads(&mut app), before);
+        assert_eq!(app.world().resource::<SimParams>(), &params);
+        assert_eq!(
+            app.world().resource::<ActivePreset>().running.as_deref(),
+            Some("Many beads")
+        );
+        app.world_mut().resource_mut::<ActivePreset>().error = None;
+    }
+    // And it still steps.
+    run_steps(&mut app, 10);
+    let after = beads(&mut app);
+    assert_eq!(after.len(), 4);
+    assert_ne!(after, before);
+}

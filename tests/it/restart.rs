@@ -1,0 +1,113 @@
+//! Edits are pending until a restart, as in the assignment's panel.
+
+use std::time::Duration;
+
+use crate::common::*;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use wirebead::prelude::*;
+
+fn scene() -> (App, Entity) {
+    let mut app = app(SimParams::default());
+    let bead = circle_bead(&mut app, 1.0, DVec2::new(1.0, 0.0), DVec2::ZERO);
+    (app, bead)
+}
+
+fn edit(app: &mut App, bead: Entity) {
+    app.world_mut()
+        .resource_mut::<PendingParams>()
+        .update(|p| {
+            p.timestep = 1.0 / 120.0;
+            p.alpha = 400.0;
+            p.beta = 40.0;
+            p.method = Method::Rattle;
+            p.gravity = DVec2::new(0.0, -3.0);
+        })
+        .unwrap();
+    let pending = PendingBead::new(BeadParams {
+        mass: 2.5,
+        initial_position: DVec2::new(0.0, -1.0),
+        initial_velocity: DVec2::new(2.0, 0.0),
+    })
+    .unwrap();
+    app.world_mut().entity_mut(bead).insert(pending);
+}
+
+#[test]
+fn edits_without_restart_change_nothing() {
+    let (mut control, control_bead) = scene();
+    let (mut edited, edited_bead) = scene();
+    run_steps(&mut control, 30);
+    run_steps(&mut edited, 30);
+    edit(&mut edited, edited_bead);
+    run_steps(&mut control, 90);
+    run_steps(&mut edited, 90);
+    assert_eq!(bead(&control, control_bead), bead(&edited, edited_bead));
+    assert_eq!(
+        edited.world().resource::<SimParams>(),
+        &SimParams::default()
+    );
+    assert_eq!(
+        edited.world().resource::<Time<Fixed>>().timestep(),
+        Duration::from_secs_f64(1.0 / 60.0)
+    );
+}
+
+#[test]
+fn restart_applies_pending_params_and_resets_state() {
+    let (mut app, bead_entity) = scene();
+    run_steps(&mut app, 45);
+    edit(&mut app, bead_entity);
+    app.world_mut().write_message(Restart);
+    run_steps(&mut app, 0);
+
+    let params = app.world().resource::<SimParams>().clone();
+    assert_eq!(&params, app.world().resource::<PendingParams>().get());
+    assert_eq!(params.method, Method::Rattle);
+    assert_eq!(
+        app.world().resource::<Time<Fixed>>().timestep(),
+        Duration::from_secs_f64(1.0 / 120.0)
+    );
+    let b = bead(&app, bead_entity);
+    assert_eq!(b.mass(), 2.5);
+    assert_eq!(b.position, DVec2::new(0.0, -1.0));
+    assert_eq!(b.velocity, DVec2::new(2.0, 0.0));
+    assert!(app.world().get::<PendingBead>(bead_entity).is_none());
+    let d = diagnostics(&app, bead_entity);
+    let clock = *app.world().resource::<SimClock>();
+    assert_eq!((clock.steps, clock.time), (0, 0.0));
+    assert_eq!(d.kinetic, 0.5 * 2.5 * 4.0);
+
+    // The next steps run with the new step and gravity: 120 steps are 1 s.
+    run_steps(&mut app, 120);
+    let clock = *app.world().resource::<SimClock>();
+    assert_eq!(clock.steps, 120);
+    assert!((clock.time - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn restart_recovers_a_diverged_bead() {
+    let (mut app, bead_entity) = scene();
+    app.world_mut()
+        .resource_mut::<PendingParams>()
+        .update(|p| {
+            p.method = Method::ExplicitEuler(Stabilization::Baumgarte);
+            p.timestep = 0.05;
+        })
+        .unwrap();
+    app.world_mut().write_message(Restart);
+    run_steps(&mut app, 0);
+    run_for(&mut app, 10.0);
+    assert!(app.world().get::<Diverged>(bead_entity).is_some());
+
+    app.world_mut()
+        .resource_mut::<PendingParams>()
+        .set(SimParams::default())
+        .unwrap();
+    app.world_mut().write_message(Restart);
+    run_steps(&mut app, 0);
+    assert!(app.world().get::<Diverged>(bead_entity).is_none());
+    run_steps(&mut app, 60);
+    assert!(app.world().get::<Diverged>(bead_entity).is_none());
+    assert_eq!(steps(&app), 60);
+}

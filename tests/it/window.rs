@@ -1,0 +1,147 @@
+//! Checks of the example in a real window. `.ci/run` runs the example under
+//! Xvfb with Mesa's software Vulkan, saves a screenshot and its report,
+//! drives a real mouse drag with xdotool and edits the running preset's
+//! file; these tests then check the pixels, the drag and the reload. They
+//! need those files, so they are ignored by a plain `cargo test`; `.ci/run`
+//! runs them with `--ignored` and `WIREBEAD_WINDOW_DIR` set.
+
+use std::path::PathBuf;
+
+use image::{Rgb, RgbImage};
+use wirebead::gui::FrameReport;
+
+fn dir() -> PathBuf {
+    PathBuf::from(
+        std::env::var("WIREBEAD_WINDOW_DIR").expect("WIREBEAD_WINDOW_DIR: run through .ci/run"),
+    )
+}
+
+fn report(name: &str) -> FrameReport {
+    let path = dir().join(name);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    ron::from_str(&text).unwrap()
+}
+
+fn rgb(colour: bevy::color::Color) -> Rgb<u8> {
+    let c = colour.to_srgba();
+    Rgb([c.red, c.green, c.blue].map(|v| (v * 255.0).round() as u8))
+}
+
+fn close(a: Rgb<u8>, b: Rgb<u8>, tolerance: i32) -> bool {
+    a.0.iter()
+        .zip(b.0)
+        .all(|(x, y)| (*x as i32 - y as i32).abs() <= tolerance)
+}
+
+/// Whether a pixel of `colour` lies within `radius` pixels of `at`.
+fn colour_near(image: &RgbImage, at: [f32; 2], radius: i32, colour: Rgb<u8>) -> bool {
+    let (x0, y0) = (at[0].round() as i32, at[1].round() as i32);
+    (-radius..=radius).any(|dy| {
+        (-radius..=radius).any(|dx| {
+            let (x, y) = (x0 + dx, y0 + dy);
+            x >= 0
+                && y >= 0
+                && (x as u32) < image.width()
+                && (y as u32) < image.height()
+                && close(*image.get_pixel(x as u32, y as u32), colour, 40)
+        })
+    })
+}
+
+#[test]
+#[ignore = "needs the screenshot .ci/run makes under Xvfb"]
+fn screenshot_shows_the_wire_and_the_bead_where_simulated() {
+    let image = image::open(dir().join("shot.png"))
+        .expect("screenshot")
+        .to_rgb8();
+    let report = report("shot.ron");
+    assert_eq!([image.width(), image.height()], report.window);
+    let style = wirebead::gui::SceneStyle::default();
+    let (wire_colour, bead_colour) = (rgb(style.wire), rgb(style.bead));
+
+    // The bead's colour is at the bead's simulated position.
+    assert!(!report.beads.is_empty());
+    for bead in &report.beads {
+        let r = (0.5 * bead.radius_px).max(2.0) as i32;
+        assert!(
+            colour_near(&image, bead.pixel, r, bead_colour),
+            "no bead colour at {:?}",
+            bead.pixel
+        );
+    }
+
+    // The wire's stroke is where the simulated wire is, and not beside it.
+    let mut on = 0;
+    let mut off = 0;
+    let mut total = 0;
+    for wire in &report.wires {
+        let n = wire.pixels.len();
+        for (i, p) in wire.pixels.iter().enumerate() {
+            let near_bead = report.beads.iter().any(|b| {
+                let d = ((p[0] - b.pixel[0]).powi(2) + (p[1] - b.pixel[1]).powi(2)).sqrt();
+                d < 3.0 * b.radius_px
+            });
+            if near_bead {
+                continue;
+            }
+            total += 1;
+            on += colour_near(&image, *p, 3, wire_colour) as usize;
+            // 20 px along the normal (from neighbouring samples) there is no stroke.
+            let (a, b) = (
+                wire.pixels[i.saturating_sub(1)],
+                wire.pixels[(i + 1).min(n - 1)],
+            );
+            let t = [b[0] - a[0], b[1] - a[1]];
+            let len = (t[0] * t[0] + t[1] * t[1]).sqrt().max(1e-3);
+            let beside = [p[0] - 20.0 * t[1] / len, p[1] + 20.0 * t[0] / len];
+            off += colour_near(&image, beside, 1, wire_colour) as usize;
+        }
+    }
+    assert!(total > 50, "too few wire samples in view: {total}");
+    let on_fraction = on as f64 / total as f64;
+    let off_fraction = off as f64 / total as f64;
+    assert!(
+        on_fraction > 0.6,
+        "wire colour found at only {:.0}% of the wire's points",
+        100.0 * on_fraction
+    );
+    assert!(
+        off_fraction < 0.1,
+        "wire colour 20 px off the wire at {:.0}% of points",
+        100.0 * off_fraction
+    );
+}
+
+#[test]
+#[ignore = "needs the xdotool drag .ci/run makes under Xvfb"]
+fn a_real_mouse_drag_pulls_the_bead_toward_the_cursor() {
+    let report = report("drag.ron");
+    let drag = report
+        .drag
+        .expect("the drag reached the bead through picking");
+    assert!(
+        drag.closest_distance < 0.5 * drag.start_distance,
+        "the bead came no closer than {:.3} to the cursor (from {:.3})",
+        drag.closest_distance,
+        drag.start_distance
+    );
+}
+
+#[test]
+#[ignore = "needs the hot-reload run .ci/run makes under Xvfb"]
+fn editing_the_running_preset_reloads_it() {
+    let ready = report("reload_ready.ron");
+    let end = report("reload.ron");
+    assert_eq!(ready.preset.as_deref(), Some("Bead at rest"));
+    assert_eq!(end.preset.as_deref(), Some("Bead at rest, edited"));
+    assert_eq!(end.preset_error, None);
+    // The edited preset hangs the bead at rest at the bottom of a circle of
+    // radius 2 instead of 1.
+    let [x, y] = end.beads[0].world;
+    assert!(
+        x.abs() < 1e-9 && (y + 2.0).abs() < 1e-9,
+        "bead at ({x}, {y})"
+    );
+    let [_, y0] = ready.beads[0].world;
+    assert!((y0 + 1.0).abs() < 1e-9, "bead started at y = {y0}");
+}
