@@ -73,6 +73,7 @@ pub mod geometry;
 #[cfg(feature = "gui")]
 pub mod gui;
 pub mod headless;
+mod lane;
 pub mod plugin;
 pub mod preset;
 pub mod reference;

@@ -4,6 +4,7 @@ use bevy::math::{DMat2, DVec2};
 use serde::{Deserialize, Serialize};
 
 use super::{Geometry, ImplicitCurve};
+use crate::lane::{Lane, Sym2, V2};
 
 /// A circle of radius `r` about the local origin: `C = |x| - r`, the assignment's
 /// wire. Singular at the centre.
@@ -28,8 +29,8 @@ impl ImplicitCurve for Circle {
     }
     #[inline]
     fn geometry(&self, p: DVec2) -> Geometry {
-        let len = p.length();
-        if len == 0.0 {
+        let g = circle_geometry(p.into(), self.radius);
+        if g.len == 0.0 {
             // ∇C is undefined at the centre; a zero normal is reported as singular.
             return Geometry {
                 c: -self.radius,
@@ -37,18 +38,45 @@ impl ImplicitCurve for Circle {
                 hessian: DMat2::ZERO,
             };
         }
-        let inv = 1.0 / len;
-        let n = p * inv;
-        // H = (I - n nᵀ) / |x|
-        let hessian = DMat2::from_cols(
-            DVec2::new(1.0 - n.x * n.x, -n.x * n.y) * inv,
-            DVec2::new(-n.x * n.y, 1.0 - n.y * n.y) * inv,
-        );
+        let Sym2 { xx, xy, yy } = g.hessian;
         Geometry {
-            c: len - self.radius,
-            normal: n,
-            hessian,
+            c: g.c,
+            normal: g.normal.into(),
+            hessian: DMat2::from_cols(DVec2::new(xx, xy), DVec2::new(xy, yy)),
         }
+    }
+}
+
+/// A circle's `C`, `∇C` and Hessian at `p` (relative to its centre), on
+/// lanes: one formula for [`Circle::geometry`] and the batched step.
+#[derive(Clone, Copy)]
+pub(crate) struct CircleGeometry<T> {
+    /// `|p|`: zero at the centre, where nothing else means anything.
+    pub(crate) len: T,
+    /// `C = |p| - r`.
+    pub(crate) c: T,
+    /// `∇C = p / |p|`.
+    pub(crate) normal: V2<T>,
+    /// `H = (I - n nᵀ) / |p|`.
+    pub(crate) hessian: Sym2<T>,
+}
+
+/// See [`CircleGeometry`].
+#[inline(always)]
+pub(crate) fn circle_geometry<T: Lane>(p: V2<T>, radius: T) -> CircleGeometry<T> {
+    let len = p.dot(p).sqrt();
+    let one = len.splat(1.0);
+    let inv = one / len;
+    let n = p.scale(inv);
+    CircleGeometry {
+        len,
+        c: len - radius,
+        normal: n,
+        hessian: Sym2 {
+            xx: (one - n.x * n.x) * inv,
+            xy: (-n.x * n.y) * inv,
+            yy: (one - n.y * n.y) * inv,
+        },
     }
 }
 

@@ -29,6 +29,7 @@ mod sine;
 use bevy::math::{DMat2, DVec2};
 
 pub use circle::Circle;
+pub(crate) use circle::circle_geometry;
 pub use ellipse::Ellipse;
 pub use line::Line;
 pub use parabola::Parabola;

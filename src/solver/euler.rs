@@ -4,30 +4,53 @@
 use super::Advance;
 use super::solve::Solved;
 use super::state::BeadState;
+use crate::lane::{Lane, V2};
 
-/// Explicit Euler: `x₁ = x₀ + h v₀`, `v₁ = v₀ + h a₀`.
+/// Explicit Euler on lanes: `x₁ = x₀ + h v₀`, `v₁ = v₀ + h a₀`.
 #[inline(always)]
-pub fn explicit_euler(state: BeadState, first: &Solved, h: f64) -> Advance {
+pub(crate) fn explicit_euler_lanes<T: Lane>(x: V2<T>, v: V2<T>, a: V2<T>, h: T) -> (V2<T>, V2<T>) {
+    (x.plus(h, v), v.plus(h, a))
+}
+
+/// Semi-implicit (symplectic) Euler on lanes: `v₁ = v₀ + h a₀`,
+/// `x₁ = x₀ + h v₁`.
+#[inline(always)]
+pub(crate) fn semi_implicit_euler_lanes<T: Lane>(
+    x: V2<T>,
+    v: V2<T>,
+    a: V2<T>,
+    h: T,
+) -> (V2<T>, V2<T>) {
+    let v1 = v.plus(h, a);
+    (x.plus(h, v1), v1)
+}
+
+/// Wraps a step on one lane as an [`Advance`].
+#[inline(always)]
+fn advance(first: &Solved, (x, v): (V2<f64>, V2<f64>)) -> Advance {
     Advance {
         state: BeadState {
-            position: state.position + h * state.velocity,
-            velocity: state.velocity + h * first.acceleration,
+            position: x.into(),
+            velocity: v.into(),
         },
         lambda: first.lambda,
         constraint_force: first.constraint_force,
     }
 }
 
+/// Explicit Euler: `x₁ = x₀ + h v₀`, `v₁ = v₀ + h a₀`.
+#[inline(always)]
+pub fn explicit_euler(state: BeadState, first: &Solved, h: f64) -> Advance {
+    let (x, v, a) = (state.position, state.velocity, first.acceleration);
+    advance(first, explicit_euler_lanes(x.into(), v.into(), a.into(), h))
+}
+
 /// Semi-implicit (symplectic) Euler: `v₁ = v₀ + h a₀`, `x₁ = x₀ + h v₁`.
 #[inline(always)]
 pub fn semi_implicit_euler(state: BeadState, first: &Solved, h: f64) -> Advance {
-    let v1 = state.velocity + h * first.acceleration;
-    Advance {
-        state: BeadState {
-            position: state.position + h * v1,
-            velocity: v1,
-        },
-        lambda: first.lambda,
-        constraint_force: first.constraint_force,
-    }
+    let (x, v, a) = (state.position, state.velocity, first.acceleration);
+    advance(
+        first,
+        semi_implicit_euler_lanes(x.into(), v.into(), a.into(), h),
+    )
 }

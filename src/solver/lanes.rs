@@ -1,18 +1,24 @@
-//! The batched step: [`LANES`] beads on unrotated circles at once, the
-//! same operations as [`step`] in the same order, so each lane's result is
-//! bit for bit what [`step`] returns.
+//! The batched step: [`LANES`] beads on unrotated circles at once. It runs
+//! the very functions [`step`] runs (eq. 3 in `solve`, the integrators,
+//! the circle's geometry), instantiated for eight lanes instead of one, so
+//! each lane's result is bit for bit what [`step`] returns.
 
-use bevy::math::DVec2;
+use std::convert::Infallible;
 
+use super::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use super::method::{Method, Stabilization};
-use super::settings::{Gains, StepSettings};
-use super::state::{BeadState, LinearForce};
+use super::rk4::rk4_lanes;
+use super::settings::StepSettings;
+use super::solve::{ConstraintForce, constraint_force};
+use super::state::{BeadState, LinearForce, LinearForceLanes};
 use super::step::StepOutput;
 #[cfg(doc)]
-use super::{solve::solve, step::step};
-
-/// How many beads [`step_on_circles`] steps at once.
-pub const LANES: usize = 8;
+use super::step::step;
+use crate::geometry::circle_geometry;
+pub use crate::lane::LANES;
+use crate::lane::{F64x8, Lane, V2, avx2};
+use bevy::math::DVec2;
+use pulp::x86::V3;
 
 /// [`LANES`] beads on circles, as arrays of their scalars (one entry per
 /// bead), the layout the batched step vectorizes over.
@@ -115,16 +121,6 @@ impl CircleSteps {
     }
 }
 
-/// Runs `$body` once per lane, as a loop the compiler turns into vector
-/// instructions.
-macro_rules! lanes {
-    ($i:ident => $body:expr) => {
-        for $i in 0..LANES {
-            $body;
-        }
-    };
-}
-
 /// Whether [`step_on_circles`] takes steps of this method: explicit or
 /// semi-implicit Euler or RK4, with Baumgarte stabilization or none.
 pub fn is_batched(method: Method) -> bool {
@@ -135,189 +131,99 @@ pub fn is_batched(method: Method) -> bool {
 }
 
 /// A step of eq. (3) for [`LANES`] beads on unrotated
-/// [`Circle`](crate::geometry::Circle)s at once, for the configs
-/// [`is_batched`] accepts.
+/// [`Circle`](crate::geometry::Circle)s at once, for the methods
+/// [`is_batched`] accepts, bit for bit what [`step`] returns for each.
 ///
-/// It performs the operations of [`step`] on a
-/// [`Placed`](crate::geometry::Placed) circle in the same order, lane by lane,
-/// so each lane's result is bit for bit what [`step`] returns; what differs
-/// is that the square roots and divisions of [`LANES`] beads run side by side
-/// instead of one after another. A lane the batch cannot finish (a
-/// non-finite state, the circle's centre, a step past the drift bound)
-/// comes back not [`done`](CircleSteps::done): take that bead through
-/// [`step`], which reports why. A method [`is_batched`] refuses finishes
-/// no lane. Each lane has its own mass; its drift bound is
+/// The lanes run as AVX2 vectors (pulp's `V3`, chosen at run time): the
+/// square roots and divisions of eight beads run side by side instead of
+/// one after another. A lane the batch cannot finish (a non-finite state,
+/// the circle's centre, a step past the drift bound) comes back not
+/// [`done`](CircleSteps::done): take that bead through [`step`], which
+/// reports why. A method [`is_batched`] refuses, or a processor without
+/// AVX2, finishes no lane. Each lane has its own mass; its drift bound is
 /// `settings.drift_bound` times its radius, as [`step`] takes it.
-///
-/// On an x86-64 processor with AVX2 (checked once, at run time) the lanes
-/// run four to an instruction instead of two; the operations, and so the
-/// bits of the results, are the same either way.
 #[inline]
 pub fn step_on_circles(b: &CircleLanes, settings: &StepSettings) -> CircleSteps {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the processor has just been found to support AVX2.
-        return unsafe { step_on_circles_avx2(b, settings) };
-    }
-    step_on_circles_portable(b, settings)
-}
-
-/// [`step_on_circles`] compiled for AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn step_on_circles_avx2(b: &CircleLanes, settings: &StepSettings) -> CircleSteps {
-    step_on_circles_portable(b, settings)
-}
-
-/// Eq. (3) solved on each lane's circle, as [`solve`] solves it.
-#[derive(Clone, Copy, Default)]
-struct LaneSolve {
-    /// `|x - centre|`.
-    len: [f64; LANES],
-    /// The normal (the gradient of `C`).
-    nx: [f64; LANES],
-    ny: [f64; LANES],
-    /// `|N|²`.
-    nn: [f64; LANES],
-    lambda: [f64; LANES],
-    /// `(f + λN) / m`.
-    ax: [f64; LANES],
-    ay: [f64; LANES],
-}
-
-impl LaneSolve {
-    /// Whether `nonsingular` accepts the lane's normal.
-    #[inline(always)]
-    fn regular(&self, i: usize) -> bool {
-        (self.len[i] != 0.0) & self.nn[i].is_finite() & (self.nn[i] > 1e-24)
+    match avx2() {
+        Some(simd) if is_batched(settings.method) => {
+            simd.vectorize(|| step_lanes(simd, b, settings))
+        }
+        _ => CircleSteps::default(),
     }
 }
 
-/// [`solve`] on each lane at `(x, y)` moving at `(vx, vy)`, with
-/// `Circle::geometry` after `Placed`'s translation and
-/// [`LinearForce::at`].
+/// Eqs. (3)–(4) on each lane's circle: the geometry, the solve and whether
+/// its normal is usable.
 #[inline(always)]
-fn solve_lanes(
-    b: &CircleLanes,
-    [x, y, vx, vy]: [&[f64; LANES]; 4],
-    alpha: f64,
-    beta: f64,
-) -> LaneSolve {
-    let mut s = LaneSolve::default();
-    let mut inv = [0.0; LANES];
-    lanes!(i => {
-        let (px, py) = (x[i] - b.ox[i], y[i] - b.oy[i]);
-        s.len[i] = (px * px + py * py).sqrt();
-        inv[i] = 1.0 / s.len[i];
-        (s.nx[i], s.ny[i]) = (px * inv[i], py * inv[i]);
-    });
-    // λ of eq. (3), with H = (I - n nᵀ)/|x| as Circle::geometry builds it.
-    lanes!(i => {
-        let (nx, ny) = (s.nx[i], s.ny[i]);
-        let (h00, h10) = ((1.0 - nx * nx) * inv[i], (-nx * ny) * inv[i]);
-        let (h01, h11) = ((-nx * ny) * inv[i], (1.0 - ny * ny) * inv[i]);
-        let (hvx, hvy) = (h00 * vx[i] + h01 * vy[i], h10 * vx[i] + h11 * vy[i]);
-        let vhv = vx[i] * hvx + vy[i] * hvy;
-        let c = s.len[i] - b.radius[i];
-        let m = b.mass[i];
-        let k = b.stiffness[i];
-        let fx = b.fx[i] - k * (x[i] - b.at_x[i]);
-        let fy = b.fy[i] - k * (y[i] - b.at_y[i]);
-        s.nn[i] = nx * nx + ny * ny;
-        let ndv = nx * vx[i] + ny * vy[i];
-        let ndf = nx * fx + ny * fy;
-        s.lambda[i] = (-m * vhv - m * alpha * c - m * beta * ndv - ndf) / s.nn[i];
-        let inv_m = m.recip();
-        s.ax[i] = (fx + s.lambda[i] * nx) * inv_m;
-        s.ay[i] = (fy + s.lambda[i] * ny) * inv_m;
-    });
-    s
+fn solve_on_circles<T: Lane>(
+    p: V2<T>,
+    v: V2<T>,
+    centre: V2<T>,
+    radius: T,
+    force: &LinearForceLanes<T>,
+    m: T,
+    settings: &StepSettings,
+) -> (ConstraintForce<T>, V2<T>, T::Mask) {
+    let g = circle_geometry(p - centre, radius);
+    let hv = g.hessian.apply(v);
+    let solved = constraint_force(g.normal, hv, g.c, v, force.at(p), m, settings.gains());
+    let nn = solved.nn;
+    let regular = g.len.is_nonzero() & nn.is_finite() & nn.gt(nn.splat(1e-24));
+    (solved, g.normal, regular)
 }
 
-/// `a + t k`, lane by lane.
+/// [`step_on_circles`] on the AVX2 lanes.
 #[inline(always)]
-fn axpy(a: &[f64; LANES], t: f64, k: &[f64; LANES]) -> [f64; LANES] {
-    std::array::from_fn(|i| a[i] + t * k[i])
-}
-
-/// [`step_on_circles`] for any processor.
-#[inline(always)]
-fn step_on_circles_portable(b: &CircleLanes, settings: &StepSettings) -> CircleSteps {
-    if !is_batched(settings.method) {
-        return CircleSteps::default();
-    }
-    let h = settings.dt;
-    let Gains { alpha, beta } = settings.gains();
-    let bound_per_radius = settings.drift_bound;
-    let first = solve_lanes(b, [&b.x, &b.y, &b.vx, &b.vy], alpha, beta);
-    let mut regular: [bool; LANES] = std::array::from_fn(|i| first.regular(i));
-    // `integrate`'s update.
-    let (x1, y1, vx1, vy1) = match settings.method {
-        Method::ExplicitEuler(_) => (
-            axpy(&b.x, h, &b.vx),
-            axpy(&b.y, h, &b.vy),
-            axpy(&b.vx, h, &first.ax),
-            axpy(&b.vy, h, &first.ay),
-        ),
+fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings) -> CircleSteps {
+    let load = |a: &[f64; LANES]| F64x8::load(simd, a);
+    let x = V2::new(load(&b.x), load(&b.y));
+    let v = V2::new(load(&b.vx), load(&b.vy));
+    let centre = V2::new(load(&b.ox), load(&b.oy));
+    let (radius, m) = (load(&b.radius), load(&b.mass));
+    let force = LinearForceLanes {
+        force: V2::new(load(&b.fx), load(&b.fy)),
+        stiffness: load(&b.stiffness),
+        at: V2::new(load(&b.at_x), load(&b.at_y)),
+    };
+    let h = m.splat(settings.dt);
+    let (first, normal, mut regular) = solve_on_circles(x, v, centre, radius, &force, m, settings);
+    let a = first.acceleration;
+    let (x1, v1) = match settings.method {
+        Method::ExplicitEuler(_) => explicit_euler_lanes(x, v, a, h),
         Method::Rk4(_) => {
-            let half = 0.5 * h;
-            let stage = |t: f64, vx: &[f64; LANES], vy: &[f64; LANES], s: &LaneSolve| {
-                let x = axpy(&b.x, t, vx);
-                let y = axpy(&b.y, t, vy);
-                let (vx, vy) = (axpy(&b.vx, t, &s.ax), axpy(&b.vy, t, &s.ay));
-                let solved = solve_lanes(b, [&x, &y, &vx, &vy], alpha, beta);
-                (vx, vy, solved)
+            let accel = |p, vel| {
+                let (solved, _, ok) = solve_on_circles(p, vel, centre, radius, &force, m, settings);
+                regular = regular & ok;
+                Ok::<_, Infallible>(solved.acceleration)
             };
-            let (vx2, vy2, s2) = stage(half, &b.vx, &b.vy, &first);
-            let (vx3, vy3, s3) = stage(half, &vx2, &vy2, &s2);
-            let (vx4, vy4, s4) = stage(h, &vx3, &vy3, &s3);
-            lanes!(i => regular[i] &= s2.regular(i) & s3.regular(i) & s4.regular(i));
-            let sixth = h / 6.0;
-            let sum =
-                |k1: &[f64; LANES], k2: &[f64; LANES], k3: &[f64; LANES], k4: &[f64; LANES]| {
-                    std::array::from_fn(|i| k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-                };
-            (
-                axpy(&b.x, sixth, &sum(&b.vx, &vx2, &vx3, &vx4)),
-                axpy(&b.y, sixth, &sum(&b.vy, &vy2, &vy3, &vy4)),
-                axpy(&b.vx, sixth, &sum(&first.ax, &s2.ax, &s3.ax, &s4.ax)),
-                axpy(&b.vy, sixth, &sum(&first.ay, &s2.ay, &s3.ay, &s4.ay)),
-            )
+            let Ok(stepped) = rk4_lanes(x, v, a, h, accel);
+            stepped
         }
-        // Semi-implicit Euler (RATTLE returned above).
-        Method::SemiImplicitEuler(_) | Method::Rattle => {
-            let (vx1, vy1) = (axpy(&b.vx, h, &first.ax), axpy(&b.vy, h, &first.ay));
-            (axpy(&b.x, h, &vx1), axpy(&b.y, h, &vy1), vx1, vy1)
-        }
+        // `is_batched` leaves semi-implicit Euler here.
+        Method::SemiImplicitEuler(_) | Method::Rattle => semi_implicit_euler_lanes(x, v, a, h),
     };
-    let mut out = CircleSteps {
-        x: x1,
-        y: y1,
-        vx: vx1,
-        vy: vy1,
-        lambda: first.lambda,
-        ..CircleSteps::default()
-    };
-    // λN; C and Ċ at the new state.
-    let mut len1 = [0.0; LANES];
-    lanes!(i => {
-        (out.fx[i], out.fy[i]) = (first.lambda[i] * first.nx[i], first.lambda[i] * first.ny[i]);
-        let (px, py) = (x1[i] - b.ox[i], y1[i] - b.oy[i]);
-        len1[i] = (px * px + py * py).sqrt();
-        let k = 1.0 / len1[i];
-        out.c[i] = len1[i] - b.radius[i];
-        out.c_dot[i] = (px * k) * vx1[i] + (py * k) * vy1[i];
-    });
-    // Which lanes finished as `step` would: `&`, not `&&`, so the checks
-    // vectorize too.
-    lanes!(i => {
-        let finite = |v: f64| v.is_finite();
-        let states = finite(b.x[i]) & finite(b.y[i]) & finite(b.vx[i]) & finite(b.vy[i]);
-        let ends = finite(x1[i]) & finite(y1[i]) & finite(vx1[i]) & finite(vy1[i]);
-        let bounded = out.c[i].abs() <= bound_per_radius * b.radius[i];
-        out.done[i] = states & ends & regular[i] & (len1[i] != 0.0) & bounded;
-    });
-    out
+    let constraint_force = normal.scale(first.lambda);
+    let end = circle_geometry(x1 - centre, radius);
+    let bound = m.splat(settings.drift_bound) * radius;
+    let done = x.is_finite()
+        & v.is_finite()
+        & x1.is_finite()
+        & v1.is_finite()
+        & regular
+        & end.len.is_nonzero()
+        & end.c.abs_le(bound);
+    CircleSteps {
+        x: x1.x.store(),
+        y: x1.y.store(),
+        vx: v1.x.store(),
+        vy: v1.y.store(),
+        lambda: first.lambda.store(),
+        fx: constraint_force.x.store(),
+        fy: constraint_force.y.store(),
+        c: end.c.store(),
+        c_dot: end.normal.dot(v1).store(),
+        done: done.store(),
+    }
 }
 
 #[cfg(test)]
@@ -340,6 +246,12 @@ mod tests {
 
     #[test]
     fn batched_step_on_circles_is_bit_identical_to_step() {
+        // Without AVX2 the batch finishes no lane and every bead takes
+        // `step` itself: there is nothing to compare.
+        assert!(
+            crate::lane::avx2().is_some(),
+            "this processor has no AVX2: the batched step is not used here"
+        );
         // Beads in all directions, at all speeds, on circles of different
         // sizes and centres, with a spring's stiffness on some.
         let bound = 0.5;
@@ -370,13 +282,12 @@ mod tests {
                     lanes.set(lane, state, &force, mass, centre, radius);
                     inputs.push((state, force, mass, centre, radius));
                 }
-                // The dispatching entry point and the portable code
                 // (the same where there is no AVX2).
                 let outs = step_on_circles(&lanes, &batch_settings);
-                let portable = step_on_circles_portable(&lanes, &batch_settings);
-                let both = (0..LANES).flat_map(|i| [outs.lane(i), portable.lane(i)]);
-                let inputs = inputs.iter().flat_map(|i| [*i, *i]);
-                for (out, (state, force, mass, centre, radius)) in both.zip(inputs) {
+                let each = (0..LANES).map(|i| outs.lane(i));
+                for (out, (state, force, mass, centre, radius)) in each.zip(&inputs) {
+                    let (state, force, mass, centre, radius) =
+                        (*state, *force, *mass, *centre, *radius);
                     let placed = Placed {
                         curve: &Circle { radius },
                         pose: Pose::new(centre, 0.0),

@@ -5,6 +5,32 @@ use super::settings::Gains;
 use super::solve::{SolveError, Solved, solve};
 use super::state::{BeadState, LinearForce};
 use crate::geometry::ImplicitCurve;
+use crate::lane::{Lane, V2};
+
+/// Eq. (7) on lanes: one step of length `h` from `(x, v)` with `a` the
+/// acceleration there; `accel` gives the acceleration at each later stage
+/// (eq. 4 solved afresh), or stops the step with its error.
+#[inline(always)]
+pub(crate) fn rk4_lanes<T: Lane, E>(
+    x: V2<T>,
+    v: V2<T>,
+    a: V2<T>,
+    h: T,
+    mut accel: impl FnMut(V2<T>, V2<T>) -> Result<V2<T>, E>,
+) -> Result<(V2<T>, V2<T>), E> {
+    let half = h.splat(0.5) * h;
+    let v2 = v.plus(half, a);
+    let a2 = accel(x.plus(half, v), v2)?;
+    let v3 = v.plus(half, a2);
+    let a3 = accel(x.plus(half, v2), v3)?;
+    let v4 = v.plus(h, a3);
+    let a4 = accel(x.plus(h, v3), v4)?;
+    let (two, sixth) = (h.splat(2.0), h / h.splat(6.0));
+    Ok((
+        x.plus(sixth, v + v2.scale(two) + v3.scale(two) + v4),
+        v.plus(sixth, a + a2.scale(two) + a3.scale(two) + a4),
+    ))
+}
 
 /// One RK4 step of length `h` from `state`, given `first`, the solve at
 /// `state`. λ and `λN` reported are those of the first stage.
@@ -18,32 +44,19 @@ pub fn rk4<C: ImplicitCurve + ?Sized>(
     first: &Solved,
     h: f64,
 ) -> Result<Advance, SolveError> {
-    let BeadState {
-        position: x,
-        velocity: v,
-    } = state;
-    let accel =
-        |s: BeadState| solve(curve, s, force, mass, gains).map(|solved| solved.acceleration);
-    let k1 = (v, first.acceleration);
-    let s2 = BeadState {
-        position: x + 0.5 * h * k1.0,
-        velocity: v + 0.5 * h * k1.1,
+    let accel = |x: V2<f64>, v: V2<f64>| {
+        let stage = BeadState {
+            position: x.into(),
+            velocity: v.into(),
+        };
+        solve(curve, stage, force, mass, gains).map(|solved| solved.acceleration.into())
     };
-    let k2 = (s2.velocity, accel(s2)?);
-    let s3 = BeadState {
-        position: x + 0.5 * h * k2.0,
-        velocity: v + 0.5 * h * k2.1,
-    };
-    let k3 = (s3.velocity, accel(s3)?);
-    let s4 = BeadState {
-        position: x + h * k3.0,
-        velocity: v + h * k3.1,
-    };
-    let k4 = (s4.velocity, accel(s4)?);
+    let (x, v, a) = (state.position, state.velocity, first.acceleration);
+    let (x1, v1) = rk4_lanes(x.into(), v.into(), a.into(), h, accel)?;
     Ok(Advance {
         state: BeadState {
-            position: x + h / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0),
-            velocity: v + h / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1),
+            position: x1.into(),
+            velocity: v1.into(),
         },
         lambda: first.lambda,
         constraint_force: first.constraint_force,

@@ -6,6 +6,7 @@ use bevy::math::DVec2;
 use super::settings::Gains;
 use super::state::{BeadState, LinearForce};
 use crate::geometry::{Geometry, ImplicitCurve};
+use crate::lane::{Lane, V2};
 
 /// Why a step could not be taken.
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
@@ -66,6 +67,67 @@ pub(crate) fn normal_length_squared(normal: DVec2, x: DVec2) -> Result<f64, Solv
     }
 }
 
+/// Eqs. (3) and (4) on lanes: what [`constraint_force`] returns.
+#[derive(Clone, Copy)]
+pub(crate) struct ConstraintForce<T> {
+    /// `|N|²`.
+    pub(crate) nn: T,
+    /// λ.
+    pub(crate) lambda: T,
+    /// `(f + λN) / m`.
+    pub(crate) acceleration: V2<T>,
+}
+
+/// λ of eq. (3) and the acceleration of eq. (4), written once for one
+/// bead (`f64`) and for eight side by side: `n` is `∇C`, `hv` is `H ẋ`,
+/// `c` is `C`, all where the bead is; `v` its velocity, `f` the force on
+/// it, `m` its mass. The caller checks `nn` (a vanishing normal).
+#[inline(always)]
+pub(crate) fn constraint_force<T: Lane>(
+    n: V2<T>,
+    hv: V2<T>,
+    c: T,
+    v: V2<T>,
+    f: V2<T>,
+    m: T,
+    gains: Gains,
+) -> ConstraintForce<T> {
+    let vhv = v.dot(hv);
+    let (alpha, beta) = (m.splat(gains.alpha), m.splat(gains.beta));
+    let nn = n.dot(n);
+    let lambda = (-m * vhv - m * alpha * c - m * beta * n.dot(v) - n.dot(f)) / nn;
+    ConstraintForce {
+        nn,
+        lambda,
+        // The reciprocal does not wait for λ; a division here would.
+        acceleration: (f + n.scale(lambda)).scale(m.recip()),
+    }
+}
+
+/// Eq. (3) where the wire's geometry is `g`, checked for a vanishing
+/// normal.
+#[inline(always)]
+fn constraint_force_at(
+    g: &Geometry,
+    state: BeadState,
+    f: DVec2,
+    mass: f64,
+    gains: Gains,
+) -> Result<ConstraintForce<f64>, SolveError> {
+    normal_length_squared(g.normal, state.position)?;
+    let v = state.velocity;
+    let hv = g.hessian * v;
+    Ok(constraint_force(
+        g.normal.into(),
+        hv.into(),
+        g.c,
+        v.into(),
+        f.into(),
+        mass,
+        gains,
+    ))
+}
+
 /// λ of eq. (3) for a bead of mass `mass` in `state` under the force `f`,
 /// where the wire's geometry is `g`.
 #[inline(always)]
@@ -76,14 +138,7 @@ pub fn lambda(
     mass: f64,
     gains: Gains,
 ) -> Result<f64, SolveError> {
-    let BeadState {
-        position: x,
-        velocity: v,
-    } = state;
-    let nn = normal_length_squared(g.normal, x)?;
-    let vhv = v.dot(g.hessian * v);
-    let Gains { alpha, beta } = gains;
-    Ok((-mass * vhv - mass * alpha * g.c - mass * beta * g.normal.dot(v) - g.normal.dot(f)) / nn)
+    constraint_force_at(g, state, f, mass, gains).map(|s| s.lambda)
 }
 
 /// Solves eq. (3) at `state` and returns λ, `λN` and the acceleration.
@@ -96,14 +151,11 @@ pub fn solve<C: ImplicitCurve + ?Sized>(
     gains: Gains,
 ) -> Result<Solved, SolveError> {
     let g = curve.geometry(state.position);
-    let f = force.at(state.position);
-    let lambda = lambda(&g, state, f, mass, gains)?;
-    let constraint_force = lambda * g.normal;
+    let solved = constraint_force_at(&g, state, force.at(state.position), mass, gains)?;
     Ok(Solved {
-        lambda,
-        constraint_force,
-        // The reciprocal does not wait for λ; a division here would.
-        acceleration: (f + constraint_force) * mass.recip(),
+        lambda: solved.lambda,
+        constraint_force: solved.lambda * g.normal,
+        acceleration: solved.acceleration.into(),
     })
 }
 

@@ -3,6 +3,8 @@
 
 use bevy::math::DVec2;
 
+use crate::lane::{Lane, V2};
+
 /// Position and velocity of one bead.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct BeadState {
@@ -51,7 +53,29 @@ impl LinearForce {
     /// `f(x)`.
     #[inline]
     pub fn at(&self, x: DVec2) -> DVec2 {
-        self.force - self.stiffness * (x - self.at)
+        LinearForceLanes {
+            force: self.force.into(),
+            stiffness: self.stiffness,
+            at: self.at.into(),
+        }
+        .at(x.into())
+        .into()
+    }
+}
+
+/// [`LinearForce`] on lanes.
+#[derive(Clone, Copy)]
+pub(crate) struct LinearForceLanes<T> {
+    pub(crate) force: V2<T>,
+    pub(crate) stiffness: T,
+    pub(crate) at: V2<T>,
+}
+
+impl<T: Lane> LinearForceLanes<T> {
+    /// Eq. (5): `f(x) = force - stiffness (x - at)`.
+    #[inline(always)]
+    pub(crate) fn at(&self, x: V2<T>) -> V2<T> {
+        self.force - (x - self.at).scale(self.stiffness)
     }
 }
 
