@@ -74,7 +74,7 @@ impl Lane for f64 {
     }
 }
 
-/// How many beads an [`F64x8`] holds.
+/// How many beads the batched step takes at once.
 pub const LANES: usize = 8;
 
 /// Eight `f64`s in two AVX2 registers, with the token that proves the

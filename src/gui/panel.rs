@@ -149,13 +149,13 @@ fn vector(ui: &mut egui::Ui, label: &str, value: &mut DVec2, speed: f64) {
 }
 
 /// A plot of the last seconds with labelled axes: time in seconds, the
-/// value in `unit` with tick labels in scientific notation, so that a range
-/// of 1e-16 reads as rounding noise and not as a swing.
+/// value (its unit is in the heading above) with tick labels in scientific
+/// notation, so that a range of 1e-16 reads as rounding noise and not as a
+/// swing.
 fn plot(
     ui: &mut egui::Ui,
     id: &str,
     name: &str,
-    unit: &str,
     points: impl Iterator<Item = [f64; 2]>,
     colour: egui::Color32,
 ) {
@@ -165,7 +165,6 @@ fn plot(
         .allow_zoom(false)
         .allow_scroll(false)
         .x_axis_label("t (s)")
-        .y_axis_label(unit)
         .y_axis_min_width(48.0)
         .y_axis_formatter(|mark, _| format!("{:.1e}", mark.value))
         .show(ui, |plot_ui| {
@@ -237,21 +236,22 @@ pub fn panel(
 ) -> Result {
     let ctx = contexts.ctx_mut()?;
     help_line(ctx, &view.keys);
-    let height = (ctx.content_rect().height() - 40.0).max(200.0);
+    // The window scrolls its content within the screen's height, less the
+    // title bar and the margins, so nothing is cut off at the bottom.
+    let height = (ctx.content_rect().height() - 80.0).max(200.0);
     let mut outcome: Edit = None;
     egui::Window::new("wirebead")
         .anchor(egui::Align2::RIGHT_TOP, [-6.0, 6.0])
-        .default_width(view.style.panel_width - 30.0)
-        .max_height(height)
+        .fixed_size([view.style.panel_width - 30.0, height])
         .resizable(false)
         .collapsible(true)
+        .vscroll(true)
         .show(ctx, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| {
-                scene_section(ui, &view, &mut actions, refused.as_deref());
-                outcome = bead_section(ui, &view, &mut actions.commands)
-                    .or(solver_section(ui, &mut actions.pending));
-                plots_section(ui, &view.history);
-            });
+            scene_section(ui, &view, &mut actions, refused.as_deref());
+            let bead = bead_section(ui, &view, &mut actions.commands);
+            let solver = solver_section(ui, &mut actions.pending);
+            outcome = solver.or(bead);
+            plots_section(ui, &view.history);
         });
     match outcome {
         Some(Ok(())) => *refused = None,
@@ -505,7 +505,6 @@ fn plots_section(ui: &mut egui::Ui, history: &PlotHistory) {
             ui,
             id,
             label,
-            unit,
             samples.iter().map(|s| [s.t, value(s)]),
             colour,
         );
