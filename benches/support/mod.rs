@@ -220,6 +220,7 @@ impl RawLoop {
         mut store: impl FnMut(usize, &mut RawBead, Result<solver::StepOutput, solver::SolveError>),
     ) {
         let mut lanes = solver::CircleLanes::default();
+        let mut outs = solver::CircleSteps::default();
         let mut chunks = beads.chunks_exact_mut(solver::LANES);
         let mut start = 0;
         for chunk in &mut chunks {
@@ -235,7 +236,7 @@ impl RawLoop {
                     self.circle.radius,
                 );
             }
-            let outs = solver::step_on_circles(&lanes, &self.settings);
+            solver::step_on_circles(&lanes, &self.settings, &mut outs);
             for (lane, bead) in chunk.iter_mut().enumerate() {
                 // Two calls, so a finished lane's result stays in registers.
                 match outs.lane(lane) {

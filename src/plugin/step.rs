@@ -155,6 +155,7 @@ impl StepContext<'_> {
     fn step_run(&self, mut run: BeadRun) {
         let batched = solver::is_batched(self.settings.method);
         let mut lanes = solver::CircleLanes::default();
+        let mut outs = solver::CircleSteps::default();
         let mut waiting = [0; solver::LANES];
         let mut queued = 0;
         for i in 0..run.beads.len() {
@@ -175,7 +176,7 @@ impl StepContext<'_> {
                 waiting[queued] = i;
                 queued += 1;
                 if queued == solver::LANES {
-                    let outs = solver::step_on_circles(&lanes, &self.settings);
+                    solver::step_on_circles(&lanes, &self.settings, &mut outs);
                     for (lane, &j) in waiting.iter().enumerate() {
                         match outs.lane(lane) {
                             Some(out) => self.finish(run.outputs(j), out),

@@ -7,7 +7,7 @@ use std::convert::Infallible;
 
 use super::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use super::method::{Method, Stabilization};
-use super::rk4::rk4_lanes;
+use super::rk4::{Stages, rk4_lanes};
 use super::settings::StepSettings;
 use super::solve::{ConstraintForce, constraint_force};
 use super::state::{BeadState, LinearForce, LinearForceLanes};
@@ -16,8 +16,11 @@ use super::step::StepOutput;
 use super::step::step;
 use crate::geometry::circle_geometry;
 pub use crate::lane::LANES;
-use crate::lane::{F64x8, Lane, V2, avx2};
+#[cfg(target_arch = "x86_64")]
+use crate::lane::{F64x8, avx2};
+use crate::lane::{Lane, V2};
 use bevy::math::DVec2;
+#[cfg(target_arch = "x86_64")]
 use pulp::x86::V3;
 
 /// [`LANES`] beads on circles, as arrays of their scalars (one entry per
@@ -134,7 +137,8 @@ pub fn is_batched(method: Method) -> bool {
 /// [`Circle`](crate::geometry::Circle)s at once, for the methods
 /// [`is_batched`] accepts, bit for bit what [`step`] returns for each.
 ///
-/// The lanes run as AVX2 vectors (pulp's `V3`, chosen at run time): the
+/// The lanes run as AVX2 vectors (pulp's `V3`, chosen at run time on
+/// x86-64; elsewhere every lane goes through [`step`]): the
 /// square roots and divisions of eight beads run side by side instead of
 /// one after another. A lane the batch cannot finish (a non-finite state,
 /// the circle's centre, a step past the drift bound) comes back not
@@ -142,18 +146,52 @@ pub fn is_batched(method: Method) -> bool {
 /// reports why. A method [`is_batched`] refuses, or a processor without
 /// AVX2, finishes no lane. Each lane has its own mass; its drift bound is
 /// `settings.drift_bound` times its radius, as [`step`] takes it.
+///
+/// The result goes into `out` (reused from call to call, so that nothing
+/// large is copied or cleared per call).
 #[inline]
-pub fn step_on_circles(b: &CircleLanes, settings: &StepSettings) -> CircleSteps {
+pub fn step_on_circles(b: &CircleLanes, settings: &StepSettings, out: &mut CircleSteps) {
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = (b, settings);
+        out.done = [false; LANES];
+    }
+    #[cfg(target_arch = "x86_64")]
     match avx2() {
-        Some(simd) if is_batched(settings.method) => {
-            simd.vectorize(|| step_lanes(simd, b, settings))
-        }
-        _ => CircleSteps::default(),
+        Some(simd) if is_batched(settings.method) => simd.vectorize(StepLanes {
+            simd,
+            b,
+            settings,
+            out,
+        }),
+        _ => out.done = [false; LANES],
+    }
+}
+
+/// [`step_lanes`] as pulp runs it: inside a function compiled with AVX2,
+/// into which every call down to the vector instructions is inlined (a
+/// closure is not always inlined, and outside that function each vector
+/// instruction would be a call).
+#[cfg(target_arch = "x86_64")]
+struct StepLanes<'a> {
+    simd: V3,
+    b: &'a CircleLanes,
+    settings: &'a StepSettings,
+    out: &'a mut CircleSteps,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl pulp::NullaryFnOnce for StepLanes<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn call(self) {
+        step_lanes(self.simd, self.b, self.settings, self.out);
     }
 }
 
 /// Eqs. (3)–(4) on each lane's circle: the geometry, the solve and whether
 /// its normal is usable.
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 #[inline(always)]
 fn solve_on_circles<T: Lane>(
     p: V2<T>,
@@ -172,9 +210,40 @@ fn solve_on_circles<T: Lane>(
     (solved, g.normal, regular)
 }
 
+/// The RK4 stages of the lanes: eq. (4) on each lane's circle, noting
+/// which lanes met a singular point.
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+struct CircleStages<'a, T: Lane> {
+    centre: V2<T>,
+    radius: T,
+    force: &'a LinearForceLanes<T>,
+    m: T,
+    settings: &'a StepSettings,
+    regular: T::Mask,
+}
+
+impl<T: Lane> Stages<T> for CircleStages<'_, T> {
+    type Error = Infallible;
+    #[inline(always)]
+    fn acceleration(&mut self, x: V2<T>, v: V2<T>) -> Result<V2<T>, Infallible> {
+        let (solved, _, ok) = solve_on_circles(
+            x,
+            v,
+            self.centre,
+            self.radius,
+            self.force,
+            self.m,
+            self.settings,
+        );
+        self.regular = self.regular & ok;
+        Ok(solved.acceleration)
+    }
+}
+
 /// [`step_on_circles`] on the AVX2 lanes.
+#[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings) -> CircleSteps {
+fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut CircleSteps) {
     let load = |a: &[f64; LANES]| F64x8::load(simd, a);
     let x = V2::new(load(&b.x), load(&b.y));
     let v = V2::new(load(&b.vx), load(&b.vy));
@@ -191,12 +260,16 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings) -> CircleSteps
     let (x1, v1) = match settings.method {
         Method::ExplicitEuler(_) => explicit_euler_lanes(x, v, a, h),
         Method::Rk4(_) => {
-            let accel = |p, vel| {
-                let (solved, _, ok) = solve_on_circles(p, vel, centre, radius, &force, m, settings);
-                regular = regular & ok;
-                Ok::<_, Infallible>(solved.acceleration)
+            let mut stages = CircleStages {
+                centre,
+                radius,
+                force: &force,
+                m,
+                settings,
+                regular,
             };
-            let Ok(stepped) = rk4_lanes(x, v, a, h, accel);
+            let Ok(stepped) = rk4_lanes(x, v, a, h, &mut stages);
+            regular = stages.regular;
             stepped
         }
         // `is_batched` leaves semi-implicit Euler here.
@@ -212,7 +285,7 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings) -> CircleSteps
         & regular
         & end.len.is_nonzero()
         & end.c.abs_le(bound);
-    CircleSteps {
+    *out = CircleSteps {
         x: x1.x.store(),
         y: x1.y.store(),
         vx: v1.x.store(),
@@ -223,7 +296,7 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings) -> CircleSteps
         c: end.c.store(),
         c_dot: end.normal.dot(v1).store(),
         done: done.store(),
-    }
+    };
 }
 
 #[cfg(test)]
@@ -283,7 +356,8 @@ mod tests {
                     inputs.push((state, force, mass, centre, radius));
                 }
                 // (the same where there is no AVX2).
-                let outs = step_on_circles(&lanes, &batch_settings);
+                let mut outs = CircleSteps::default();
+                step_on_circles(&lanes, &batch_settings, &mut outs);
                 let each = (0..LANES).map(|i| outs.lane(i));
                 for (out, (state, force, mass, centre, radius)) in each.zip(&inputs) {
                     let (state, force, mass, centre, radius) =
@@ -327,7 +401,8 @@ mod tests {
             lanes.set(lane, state, &LinearForce::constant(G), 1.0, centre, 1.0);
         }
         let s = settings(Method::SemiImplicitEuler(Stabilization::Baumgarte), 0.01);
-        let outs = step_on_circles(&lanes, &s);
+        let mut outs = CircleSteps::default();
+        step_on_circles(&lanes, &s, &mut outs);
         // The unused lanes 4 to 7 are all at their circle's centre.
         let mut done = [false; LANES];
         done[0] = true;
@@ -341,7 +416,9 @@ mod tests {
         ] {
             assert!(!is_batched(method));
             let refused = StepSettings { method, ..s };
-            assert_eq!(step_on_circles(&lanes, &refused).done, [false; LANES]);
+            outs.done = [true; LANES];
+            step_on_circles(&lanes, &refused, &mut outs);
+            assert_eq!(outs.done, [false; LANES]);
         }
     }
 }

@@ -1,0 +1,165 @@
+//! The number type the step's formulas are written over: [`Lane`] is `f64`
+//! for one bead, or [`F64x8`] for eight beads side by side, so each formula
+//! is written once and both paths compute the same bits.
+//!
+//! [`F64x8`] holds two four-lane AVX2 registers and exists only inside a
+//! function that pulp runs with AVX2 enabled: it carries pulp's `V3` token,
+//! which only [`V3::try_new`] hands out on a processor that has the
+//! instructions, and works through pulp's safe wrappers of the intrinsics. Every operation used here (`+ - * /`, `sqrt`,
+//! comparisons) is correctly rounded IEEE arithmetic in both the scalar and
+//! the vector instructions, and nothing is fused into an FMA, so a lane of
+//! [`F64x8`] computes bit for bit what `f64` computes.
+
+use std::ops::{Add, BitAnd, Div, Mul, Neg, Sub};
+
+#[cfg(target_arch = "x86_64")]
+mod avx2;
+#[cfg(target_arch = "x86_64")]
+pub(crate) use avx2::{F64x8, avx2};
+
+/// A number or a vector of numbers the step's formulas run on.
+pub(crate) trait Lane:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// Per-lane truth values.
+    type Mask: Copy + BitAnd<Output = Self::Mask>;
+    /// `v` in every lane.
+    fn splat(self, v: f64) -> Self;
+    /// The square root, correctly rounded.
+    fn sqrt(self) -> Self;
+    /// `1 / self`, as `f64::recip` computes it.
+    fn recip(self) -> Self;
+    /// Neither NaN nor infinite.
+    fn is_finite(self) -> Self::Mask;
+    /// `self != 0`.
+    fn is_nonzero(self) -> Self::Mask;
+    /// `self > other` (false where either is NaN).
+    fn gt(self, other: Self) -> Self::Mask;
+    /// `|self| <= bound` (false where either is NaN).
+    fn abs_le(self, bound: Self) -> Self::Mask;
+}
+
+impl Lane for f64 {
+    type Mask = bool;
+    #[inline(always)]
+    fn splat(self, v: f64) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn recip(self) -> Self {
+        f64::recip(self)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+    #[inline(always)]
+    fn is_nonzero(self) -> bool {
+        self != 0.0
+    }
+    #[inline(always)]
+    fn gt(self, other: Self) -> bool {
+        self > other
+    }
+    #[inline(always)]
+    fn abs_le(self, bound: Self) -> bool {
+        self.abs() <= bound
+    }
+}
+
+/// How many beads the batched step takes at once.
+pub const LANES: usize = 8;
+
+/// A 2-vector of lanes: `x` and `y` of one bead, or of eight.
+#[derive(Clone, Copy)]
+pub(crate) struct V2<T> {
+    pub(crate) x: T,
+    pub(crate) y: T,
+}
+
+impl<T: Lane> V2<T> {
+    /// `(x, y)`.
+    #[inline(always)]
+    pub(crate) fn new(x: T, y: T) -> Self {
+        Self { x, y }
+    }
+
+    /// `self · other`, as glam's `dot` sums it.
+    #[inline(always)]
+    pub(crate) fn dot(self, other: Self) -> T {
+        self.x * other.x + self.y * other.y
+    }
+
+    /// `t self`.
+    #[inline(always)]
+    pub(crate) fn scale(self, t: T) -> Self {
+        Self::new(t * self.x, t * self.y)
+    }
+
+    /// `self + t d`, as glam evaluates `a + t * d`.
+    #[inline(always)]
+    pub(crate) fn plus(self, t: T, d: Self) -> Self {
+        Self::new(self.x + t * d.x, self.y + t * d.y)
+    }
+
+    /// Both components finite.
+    #[inline(always)]
+    pub(crate) fn is_finite(self) -> T::Mask {
+        self.x.is_finite() & self.y.is_finite()
+    }
+}
+
+impl<T: Lane> Add for V2<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        Self::new(self.x + o.x, self.y + o.y)
+    }
+}
+
+impl<T: Lane> Sub for V2<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        Self::new(self.x - o.x, self.y - o.y)
+    }
+}
+
+impl From<bevy::math::DVec2> for V2<f64> {
+    #[inline(always)]
+    fn from(v: bevy::math::DVec2) -> Self {
+        Self::new(v.x, v.y)
+    }
+}
+
+impl From<V2<f64>> for bevy::math::DVec2 {
+    #[inline(always)]
+    fn from(v: V2<f64>) -> Self {
+        Self::new(v.x, v.y)
+    }
+}
+
+/// The symmetric 2×2 Hessian `H` of a constraint, as its three entries.
+#[derive(Clone, Copy)]
+pub(crate) struct Sym2<T> {
+    pub(crate) xx: T,
+    pub(crate) xy: T,
+    pub(crate) yy: T,
+}
+
+impl<T: Lane> Sym2<T> {
+    /// `H v`, as glam's `DMat2 * DVec2` sums it.
+    #[inline(always)]
+    pub(crate) fn apply(self, v: V2<T>) -> V2<T> {
+        V2::new(self.xx * v.x + self.xy * v.y, self.xy * v.x + self.yy * v.y)
+    }
+}
