@@ -139,6 +139,23 @@ fn number(ui: &mut egui::Ui, label: &str, value: &mut f64, speed: f64) {
     ui.end_row();
 }
 
+/// A menu of `all`, each shown by its `name`.
+fn choice<T: Copy + PartialEq>(
+    ui: &mut egui::Ui,
+    id: &str,
+    value: &mut T,
+    all: &[T],
+    name: fn(T) -> &'static str,
+) {
+    egui::ComboBox::from_id_salt(id)
+        .selected_text(name(*value))
+        .show_ui(ui, |ui| {
+            for &c in all {
+                ui.selectable_value(value, c, name(c));
+            }
+        });
+}
+
 fn vector(ui: &mut egui::Ui, label: &str, value: &mut DVec2, speed: f64) {
     ui.label(label);
     ui.horizontal(|ui| {
@@ -452,25 +469,26 @@ fn solver_section(ui: &mut egui::Ui, pending: &mut PendingParams) -> Edit {
         vector(ui, "gravity", &mut draft.gravity, 0.01);
         ui.label("integrator");
         let mut integrator = draft.method.integrator();
-        egui::ComboBox::from_id_salt("integrator")
-            .selected_text(integrator.name())
-            .show_ui(ui, |ui| {
-                for &i in Integrator::ALL {
-                    ui.selectable_value(&mut integrator, i, i.name());
-                }
-            });
+        choice(
+            ui,
+            "integrator",
+            &mut integrator,
+            Integrator::ALL,
+            Integrator::name,
+        );
         draft.method = draft.method.with_integrator(integrator);
         ui.end_row();
         ui.label("stabilization");
         match draft.method.stabilization() {
             Some(mut stabilization) => {
-                egui::ComboBox::from_id_salt("stabilization")
-                    .selected_text(stabilization.name())
-                    .show_ui(ui, |ui| {
-                        for &s in Stabilization::ALL {
-                            ui.selectable_value(&mut stabilization, s, s.name());
-                        }
-                    });
+                let all = Stabilization::ALL;
+                choice(
+                    ui,
+                    "stabilization",
+                    &mut stabilization,
+                    all,
+                    Stabilization::name,
+                );
                 draft.method = draft.method.with_stabilization(stabilization);
             }
             None => {

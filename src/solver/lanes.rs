@@ -304,18 +304,7 @@ mod tests {
     use super::*;
     use crate::geometry::{Circle, Placed, Pose};
     use crate::solver::step;
-
-    const G: DVec2 = DVec2::new(0.0, -9.81);
-
-    fn settings(method: Method, dt: f64) -> StepSettings {
-        StepSettings {
-            dt,
-            method,
-            alpha: 100.0,
-            beta: 20.0,
-            drift_bound: 1.0,
-        }
-    }
+    use crate::solver::test_support::{G, settings};
 
     #[test]
     fn batched_step_on_circles_is_bit_identical_to_step() {

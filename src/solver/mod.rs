@@ -36,3 +36,26 @@ pub use settings::{Gains, StepSettings};
 pub use solve::{SolveError, Solved, lambda, solve};
 pub use state::{BeadState, LinearForce};
 pub use step::{Advance, StepOutput, constraint_state, step};
+
+/// What the solver's unit tests share.
+#[cfg(test)]
+pub(crate) mod test_support {
+    use bevy::math::DVec2;
+
+    use super::{Method, StepSettings};
+
+    /// Earth's gravity, down.
+    pub(crate) const G: DVec2 = DVec2::new(0.0, -9.81);
+
+    /// The default gains (α = 100, β = 20) and a divergence bound of one
+    /// wire scale, with `method` and step `dt`.
+    pub(crate) fn settings(method: Method, dt: f64) -> StepSettings {
+        StepSettings {
+            dt,
+            method,
+            alpha: 100.0,
+            beta: 20.0,
+            drift_bound: 1.0,
+        }
+    }
+}

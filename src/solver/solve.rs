@@ -165,7 +165,7 @@ mod tests {
     use crate::geometry::{Circle, Ellipse, Placed, Pose};
     use approx::assert_relative_eq;
 
-    const G: DVec2 = DVec2::new(0.0, -9.81);
+    use crate::solver::test_support::G;
 
     #[test]
     fn lambda_on_circle_is_the_centripetal_and_gravity_balance() {

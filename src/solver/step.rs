@@ -104,19 +104,8 @@ pub fn constraint_state<C: ImplicitCurve + ?Sized>(curve: &C, state: BeadState) 
 mod tests {
     use super::*;
     use crate::geometry::{Circle, Sine};
+    use crate::solver::test_support::{G, settings};
     use crate::solver::{NEWTON_ACCEPT, Stabilization};
-
-    const G: DVec2 = DVec2::new(0.0, -9.81);
-
-    fn settings(method: Method, dt: f64) -> StepSettings {
-        StepSettings {
-            dt,
-            method,
-            alpha: 100.0,
-            beta: 20.0,
-            drift_bound: 1.0,
-        }
-    }
 
     #[test]
     fn singular_point_is_an_error_not_a_nan() {
