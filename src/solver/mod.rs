@@ -10,11 +10,13 @@
 //! | `euler`, `rk4`, `rattle`, `projection` | the integrators and post-stabilization, eqs. (6)–(9) |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
 //! | `lanes` | [`step_on_circles`]: [`LANES`] beads on circles at once, bit for bit [`step`] |
+//! | `coupled` | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (10)–(12) |
 //!
 //! The equations below are numbered as the code and the tests cite them.
 //!
 #![doc = include_str!("../../docs/method.md")]
 
+mod coupled;
 mod euler;
 mod lanes;
 mod method;
@@ -26,6 +28,10 @@ mod solve;
 mod state;
 mod step;
 
+pub use coupled::{
+    Constraint, Island, IslandError, IslandRow, IslandWork, MAX_HALVINGS, REDUNDANT_PIVOT, RowKind,
+    RowReport, SpringLink, islands,
+};
 pub use euler::{explicit_euler, semi_implicit_euler};
 pub use lanes::{CircleLanes, CircleSteps, LANES, is_batched, step_on_circles};
 pub use method::{Integrator, Method, Stabilization};

@@ -14,7 +14,8 @@ pub const NEWTON_TOLERANCE: f64 = 4.0 * f64::EPSILON;
 /// Where rounding keeps `|C|` from reaching [`NEWTON_TOLERANCE`], a residual
 /// below this (in wire scales) after the last iteration is accepted.
 pub const NEWTON_ACCEPT: f64 = 1e-10;
-const NEWTON_MAX_ITERATIONS: u32 = 20;
+/// The most Newton iterations a solve takes before it gives up.
+pub(crate) const NEWTON_MAX_ITERATIONS: u32 = 20;
 
 fn newton_done(residual: f64, scale: f64, last: bool) -> bool {
     residual <= NEWTON_TOLERANCE * scale || (last && residual <= NEWTON_ACCEPT * scale)

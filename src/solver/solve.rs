@@ -30,6 +30,17 @@ pub enum SolveError {
         /// The remaining `|C|`.
         residual: f64,
     },
+    /// An island was handed a different number of states or forces than
+    /// it has beads.
+    #[error("the island has {beads} beads but was given {states} states and {forces} forces")]
+    WrongLength {
+        /// The island's beads.
+        beads: usize,
+        /// The states given.
+        states: usize,
+        /// The forces given.
+        forces: usize,
+    },
     /// The new state has a NaN or infinite component.
     #[error("the state became non-finite")]
     NonFinite,

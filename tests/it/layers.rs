@@ -18,16 +18,27 @@ const LAYERS: &[&str] = &[
     "gui",
 ];
 
+/// The source files of `module`: its file, or every file in its folder
+/// and the folders below.
 fn sources(module: &str) -> Vec<PathBuf> {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let file = src.join(format!("{module}.rs"));
     if file.exists() {
         return vec![file];
     }
-    std::fs::read_dir(src.join(module))
-        .unwrap_or_else(|e| panic!("module {module}: {e}"))
-        .map(|entry| entry.unwrap().path())
-        .collect()
+    let mut files = Vec::new();
+    let mut folders = vec![src.join(module)];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).unwrap_or_else(|e| panic!("module {module}: {e}")) {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                folders.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    files
 }
 
 /// The `crate::…` modules a file names in its code (not in comments).

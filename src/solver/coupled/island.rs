@@ -1,0 +1,796 @@
+//! [`Island`]: beads joined by constraints and springs, stepped together by
+//! every method of [`Method`], eqs. (10)–(12).
+
+use bevy::math::DVec2;
+
+use super::constraint::{RowKind, SpringLink};
+use super::normal::{Factored, NormalMatrix};
+use crate::solver::method::Method;
+use crate::solver::projection::{NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE};
+use crate::solver::settings::{Gains, StepSettings};
+use crate::solver::solve::SolveError;
+use crate::solver::state::{BeadState, LinearForce};
+
+/// How many times a step may be halved when its Newton solve finds no
+/// root: at most 2⁶ = 64 substeps.
+pub const MAX_HALVINGS: u32 = 6;
+
+/// Why an island cannot be built: a constraint or spring that names a bead
+/// it cannot join.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum IslandError {
+    /// A bead's mass is not positive and finite.
+    #[error("bead {bead} has mass {mass}; a mass must be positive and finite")]
+    Mass {
+        /// The bead.
+        bead: usize,
+        /// Its mass.
+        mass: f64,
+    },
+    /// A constraint or spring names a bead the island does not have.
+    #[error("{item} names bead {bead}, but there are only {beads} beads")]
+    MissingBead {
+        /// The constraint or spring, in words.
+        item: String,
+        /// The index it named.
+        bead: usize,
+        /// How many beads there are.
+        beads: usize,
+    },
+    /// A constraint or spring joins a bead to itself.
+    #[error("{item} joins bead {bead} to itself")]
+    SameBead {
+        /// The constraint or spring, in words.
+        item: String,
+        /// The bead.
+        bead: usize,
+    },
+    /// A constraint names the wrong number of beads for its kind.
+    #[error("{item} names {got} beads, but it joins {expected}")]
+    Arity {
+        /// The constraint, in words.
+        item: String,
+        /// How many its kind joins.
+        expected: usize,
+        /// How many it named.
+        got: usize,
+    },
+    /// A length, stiffness or damping out of range.
+    #[error("{item}: {what} must be {range}, got {value}")]
+    Value {
+        /// The constraint or spring, in words.
+        item: String,
+        /// Which value.
+        what: &'static str,
+        /// What it must be.
+        range: &'static str,
+        /// What it was.
+        value: f64,
+    },
+    /// faer could not allocate the symbolic factorization.
+    #[error("the island's matrix could not be set up (out of memory)")]
+    OutOfMemory,
+}
+
+/// One constraint row of an island: what it is and the beads it joins
+/// (indices into the island's beads).
+#[derive(Clone, Debug)]
+pub struct IslandRow {
+    /// The kind of constraint.
+    pub kind: RowKind,
+    /// The beads, in the order the kind takes them.
+    pub beads: Vec<usize>,
+}
+
+/// What a step reports of one row.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RowReport {
+    /// The multiplier λ the step applied (for RATTLE the mean of its
+    /// position and velocity multipliers).
+    pub lambda: f64,
+    /// `C` after the step.
+    pub c: f64,
+    /// `Ċ` after the step.
+    pub c_dot: f64,
+}
+
+/// Beads joined by constraints (rows) and springs, stepped as one system:
+/// the topology, built once, and what it needs to solve eq. (10) fast (the
+/// pattern and symbolic factorization of `J W Jᵀ`). Positions, velocities
+/// and forces come with each step.
+pub struct Island {
+    inverse_mass: Vec<f64>,
+    rows: Vec<RowKind>,
+    /// Row `r`'s gradient entries are `row_start[r]..row_start[r + 1]`.
+    row_start: Vec<usize>,
+    /// The bead of each gradient entry.
+    entry_bead: Vec<usize>,
+    springs: Vec<SpringLink>,
+    normal: NormalMatrix,
+}
+
+/// The buffers one island's step works in, kept between steps so a step
+/// allocates nothing. Also what the last step reported.
+#[derive(Default)]
+pub struct IslandWork {
+    x0: Vec<DVec2>,
+    v0: Vec<DVec2>,
+    x: Vec<DVec2>,
+    v: Vec<DVec2>,
+    x_sum: Vec<DVec2>,
+    v_sum: Vec<DVec2>,
+    force: Vec<DVec2>,
+    acceleration: Vec<DVec2>,
+    gradient: Vec<DVec2>,
+    first_gradient: Vec<DVec2>,
+    c: Vec<f64>,
+    curvature: Vec<f64>,
+    rhs: Vec<f64>,
+    lambda: Vec<f64>,
+    values: Vec<f64>,
+    scratch: Vec<DVec2>,
+    factored: Factored,
+    reports: Vec<RowReport>,
+    substeps: u32,
+}
+
+impl IslandWork {
+    /// What the last successful step reported of each row.
+    pub fn rows(&self) -> &[RowReport] {
+        &self.reports
+    }
+
+    /// How many substeps the last step took: 1, or more where it was
+    /// halved (see [`Island::step`]).
+    pub fn substeps(&self) -> u32 {
+        self.substeps
+    }
+
+    /// How many rows the last factorization dropped as redundant.
+    pub fn redundant(&self) -> usize {
+        self.factored.redundant
+    }
+}
+
+fn describe(r: usize, kind: &RowKind) -> String {
+    let what = match kind {
+        RowKind::Wire { .. } => "wire",
+        RowKind::Rod { .. } => "rod",
+        RowKind::Axis { .. } => "pin",
+        RowKind::Custom(_) => "custom",
+    };
+    format!("constraint {r} ({what})")
+}
+
+impl Island {
+    /// An island of beads of the given masses, joined by `rows` and
+    /// `springs`; every index and value is checked.
+    pub fn new(
+        masses: &[f64],
+        rows: Vec<IslandRow>,
+        springs: Vec<SpringLink>,
+    ) -> Result<Self, IslandError> {
+        let beads = masses.len();
+        let mut inverse_mass = Vec::with_capacity(beads);
+        for (bead, &mass) in masses.iter().enumerate() {
+            if !(mass.is_finite() && mass > 0.0) {
+                return Err(IslandError::Mass { bead, mass });
+            }
+            inverse_mass.push(mass.recip());
+        }
+        let check_beads = |item: &dyn Fn() -> String, named: &[usize]| {
+            for (i, &bead) in named.iter().enumerate() {
+                if bead >= beads {
+                    return Err(IslandError::MissingBead {
+                        item: item(),
+                        bead,
+                        beads,
+                    });
+                }
+                if named[..i].contains(&bead) {
+                    return Err(IslandError::SameBead { item: item(), bead });
+                }
+            }
+            Ok(())
+        };
+        let mut row_start = vec![0];
+        let mut entry_bead = Vec::new();
+        let mut kinds = Vec::with_capacity(rows.len());
+        for (r, row) in rows.into_iter().enumerate() {
+            let item = || describe(r, &row.kind);
+            let expected = row.kind.arity().unwrap_or(row.beads.len().max(1));
+            if row.beads.len() != expected {
+                return Err(IslandError::Arity {
+                    item: item(),
+                    expected,
+                    got: row.beads.len(),
+                });
+            }
+            check_beads(&item, &row.beads)?;
+            let bad = |what, range, value| IslandError::Value {
+                item: item(),
+                what,
+                range,
+                value,
+            };
+            match &row.kind {
+                RowKind::Rod { length } if !(length.is_finite() && *length > 0.0) => {
+                    return Err(bad("length", "positive and finite", *length));
+                }
+                RowKind::Axis { axis, offset } => {
+                    let off = (axis.length() - 1.0).abs();
+                    if off.is_nan() || off >= 1e-12 {
+                        return Err(bad("|axis|", "1", axis.length()));
+                    }
+                    if !offset.is_finite() {
+                        return Err(bad("the point", "finite", *offset));
+                    }
+                }
+                _ => {}
+            }
+            entry_bead.extend_from_slice(&row.beads);
+            row_start.push(entry_bead.len());
+            kinds.push(row.kind);
+        }
+        for (s, spring) in springs.iter().enumerate() {
+            let item = || format!("spring {s}");
+            check_beads(&item, &[spring.a, spring.b])?;
+            for (what, value) in [
+                ("rest length", spring.rest_length),
+                ("stiffness", spring.stiffness),
+                ("damping", spring.damping),
+            ] {
+                if !(value.is_finite() && value >= 0.0) {
+                    return Err(IslandError::Value {
+                        item: item(),
+                        what,
+                        range: "zero or more and finite",
+                        value,
+                    });
+                }
+            }
+        }
+        let normal =
+            NormalMatrix::new(&row_start, &entry_bead, beads).ok_or(IslandError::OutOfMemory)?;
+        Ok(Self {
+            inverse_mass,
+            rows: kinds,
+            row_start,
+            entry_bead,
+            springs,
+            normal,
+        })
+    }
+
+    /// How many beads.
+    pub fn beads(&self) -> usize {
+        self.inverse_mass.len()
+    }
+
+    /// How many constraint rows.
+    pub fn rows(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Kinetic plus gravitational energy of the beads in `states`, plus the
+    /// springs' stored energy.
+    pub fn energy(&self, states: &[BeadState], gravity: DVec2) -> f64 {
+        let beads: f64 = states
+            .iter()
+            .zip(&self.inverse_mass)
+            .map(|(s, w)| {
+                let (kinetic, potential) = s.energy(w.recip(), gravity);
+                kinetic + potential
+            })
+            .sum();
+        let x: Vec<DVec2> = states.iter().map(|s| s.position).collect();
+        beads + self.springs.iter().map(|s| s.energy(&x)).sum::<f64>()
+    }
+
+    /// One step of every bead of the island under `settings`: `states`
+    /// (one per bead) advance, `forces` (one per bead, gravity included)
+    /// are the external forces. On an error the states are left as they
+    /// were. What the step reports of each row is in
+    /// [`IslandWork::rows`].
+    ///
+    /// Where a Newton solve (RATTLE's positions, projection) finds no
+    /// root, as when a rope's free end whips round faster than a step can
+    /// follow, the step is taken again as two halves, each halved again
+    /// if need be, down to 2^[`MAX_HALVINGS`] substeps;
+    /// [`IslandWork::substeps`] says how many the last step took.
+    pub fn step(
+        &self,
+        states: &mut [BeadState],
+        forces: &[LinearForce],
+        settings: &StepSettings,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        work.substeps = 0;
+        match self.advance(states, forces, settings, work) {
+            Err(SolveError::NoConvergence { .. }) => self.halve(states, forces, settings, work, 1),
+            other => other,
+        }
+    }
+
+    /// Two steps of half the length of `settings.dt`, each halved again
+    /// where its Newton solve fails, `depth` halvings deep.
+    fn halve(
+        &self,
+        states: &mut [BeadState],
+        forces: &[LinearForce],
+        settings: &StepSettings,
+        work: &mut IslandWork,
+        depth: u32,
+    ) -> Result<(), SolveError> {
+        let half = StepSettings {
+            dt: 0.5 * settings.dt,
+            ..*settings
+        };
+        let mut trial = states.to_vec();
+        for _ in 0..2 {
+            match self.advance(&mut trial, forces, &half, work) {
+                Err(SolveError::NoConvergence { .. }) if depth < MAX_HALVINGS => {
+                    self.halve(&mut trial, forces, &half, work, depth + 1)?;
+                }
+                other => other?,
+            }
+        }
+        states.copy_from_slice(&trial);
+        Ok(())
+    }
+
+    /// One step of length `settings.dt`, with no halving.
+    fn advance(
+        &self,
+        states: &mut [BeadState],
+        forces: &[LinearForce],
+        settings: &StepSettings,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        let n = self.beads();
+        if states.len() != n || forces.len() != n {
+            return Err(SolveError::WrongLength {
+                beads: n,
+                states: states.len(),
+                forces: forces.len(),
+            });
+        }
+        if states.iter().any(|s| !s.is_finite()) {
+            return Err(SolveError::NonFinite);
+        }
+        work.x0.clear();
+        work.x0.extend(states.iter().map(|s| s.position));
+        work.v0.clear();
+        work.v0.extend(states.iter().map(|s| s.velocity));
+        let h = settings.dt;
+        let gains = settings.gains();
+        match settings.method {
+            Method::Rattle => self.rattle(forces, h, work)?,
+            Method::ExplicitEuler(_) | Method::SemiImplicitEuler(_) => {
+                self.accelerate(forces, gains, work, Stage::Start)?;
+                let semi = matches!(settings.method, Method::SemiImplicitEuler(_));
+                for i in 0..n {
+                    let (x, v, a) = (work.x0[i], work.v0[i], work.acceleration[i]);
+                    let v1 = v + h * a;
+                    work.x[i] = x + h * if semi { v1 } else { v };
+                    work.v[i] = v1;
+                }
+                self.keep_lambda(work);
+            }
+            Method::Rk4(_) => self.rk4(forces, gains, h, work)?,
+        }
+        if work.x.iter().chain(&work.v).any(|p| !p.is_finite()) {
+            return Err(SolveError::NonFinite);
+        }
+        self.evaluate_at_new(work);
+        for r in 0..self.rows() {
+            let bound = settings.drift_bound * self.rows[r].scale();
+            let c = work.c[r];
+            if c.is_nan() || c.abs() > bound {
+                return Err(SolveError::DriftExceeded { c, bound });
+            }
+        }
+        if settings.method.projects() {
+            self.project(work)?;
+        }
+        for (r, report) in work.reports.iter_mut().enumerate() {
+            report.c = work.c[r];
+            report.c_dot = self.rate(r, &work.gradient, &work.v);
+        }
+        for (state, (x, v)) in states.iter_mut().zip(work.x.iter().zip(&work.v)) {
+            state.position = *x;
+            state.velocity = *v;
+        }
+        work.substeps += 1;
+        Ok(())
+    }
+
+    /// Evaluates every row at `(x, v)`: gradients, `C`, `J̇q̇`.
+    fn evaluate(
+        &self,
+        x: &[DVec2],
+        v: &[DVec2],
+        gradient: &mut Vec<DVec2>,
+        c: &mut Vec<f64>,
+        curvature: &mut Vec<f64>,
+        scratch: &mut Vec<DVec2>,
+    ) {
+        gradient.resize(self.entry_bead.len(), DVec2::ZERO);
+        c.resize(self.rows(), 0.0);
+        curvature.resize(self.rows(), 0.0);
+        for (r, kind) in self.rows.iter().enumerate() {
+            let range = self.row_start[r]..self.row_start[r + 1];
+            let (value, bend) = kind.evaluate(
+                &self.entry_bead[range.clone()],
+                x,
+                v,
+                &mut gradient[range],
+                scratch,
+            );
+            c[r] = value;
+            curvature[r] = bend;
+        }
+    }
+
+    /// Evaluates the rows where the step ended (`work.x`, `work.v`).
+    fn evaluate_at_new(&self, work: &mut IslandWork) {
+        self.evaluate(
+            &work.x,
+            &work.v,
+            &mut work.gradient,
+            &mut work.c,
+            &mut work.curvature,
+            &mut work.scratch,
+        );
+    }
+
+    /// `Ċ_r = Σ g·v` over row `r`'s entries.
+    fn rate(&self, r: usize, gradient: &[DVec2], v: &[DVec2]) -> f64 {
+        (self.row_start[r]..self.row_start[r + 1])
+            .map(|e| gradient[e].dot(v[self.entry_bead[e]]))
+            .sum()
+    }
+
+    /// The applied forces at `(x, v)`: each bead's external force, plus
+    /// the springs.
+    fn applied(&self, forces: &[LinearForce], x: &[DVec2], v: &[DVec2], out: &mut Vec<DVec2>) {
+        out.clear();
+        out.extend(forces.iter().zip(x).map(|(f, &p)| f.at(p)));
+        for spring in &self.springs {
+            let f = spring.force(x, v);
+            out[spring.a] += f;
+            out[spring.b] -= f;
+        }
+    }
+
+    /// Adds `W Jᵀ μ` (with `gradient`) to `out`.
+    fn push(&self, gradient: &[DVec2], mu: &[f64], out: &mut [DVec2]) {
+        for (r, &m) in mu.iter().enumerate() {
+            let entries = self.row_start[r]..self.row_start[r + 1];
+            for (&bead, g) in self.entry_bead[entries.clone()]
+                .iter()
+                .zip(&gradient[entries])
+            {
+                out[bead] += (m * self.inverse_mass[bead]) * *g;
+            }
+        }
+    }
+
+    /// Factors `J W Jᵀ` for `gradient`; a vanishing row is a singular
+    /// point, reported at its first bead's position `x`.
+    fn factor(
+        &self,
+        gradient: &[DVec2],
+        x: &[DVec2],
+        factored: &mut Factored,
+    ) -> Result<(), SolveError> {
+        self.normal
+            .factor(&self.inverse_mass, gradient, factored)
+            .map_err(|r| {
+                let p = x[self.entry_bead[self.row_start[r]]];
+                SolveError::Singular { x: p.x, y: p.y }
+            })
+    }
+
+    /// Eq. (10) at a stage `(x, v)`: λ, and the accelerations
+    /// `W (Q + Jᵀλ)` into `work.acceleration`, at `work.x, work.v` (set to
+    /// `work.x0, work.v0` first at the step's start).
+    fn accelerate(
+        &self,
+        forces: &[LinearForce],
+        gains: Gains,
+        work: &mut IslandWork,
+        stage: Stage,
+    ) -> Result<(), SolveError> {
+        if stage == Stage::Start {
+            work.x.clone_from(&work.x0);
+            work.v.clone_from(&work.v0);
+        }
+        let (x, v) = (&work.x, &work.v);
+        self.evaluate(
+            x,
+            v,
+            &mut work.gradient,
+            &mut work.c,
+            &mut work.curvature,
+            &mut work.scratch,
+        );
+        self.applied(forces, x, v, &mut work.force);
+        self.factor(&work.gradient, x, &mut work.factored)?;
+        work.lambda.clear();
+        for r in 0..self.rows() {
+            let pushed: f64 = (self.row_start[r]..self.row_start[r + 1])
+                .map(|e| {
+                    let bead = self.entry_bead[e];
+                    work.gradient[e].dot(self.inverse_mass[bead] * work.force[bead])
+                })
+                .sum();
+            let c_dot = self.rate(r, &work.gradient, v);
+            work.lambda
+                .push(-work.curvature[r] - pushed - gains.alpha * work.c[r] - gains.beta * c_dot);
+        }
+        self.normal.solve(&mut work.factored, &mut work.lambda);
+        work.acceleration.clear();
+        work.acceleration.extend(
+            work.force
+                .iter()
+                .zip(&self.inverse_mass)
+                .map(|(f, w)| *w * *f),
+        );
+        self.push(&work.gradient, &work.lambda, &mut work.acceleration);
+        Ok(())
+    }
+
+    /// Keeps the last solve's λ as the step's report.
+    fn keep_lambda(&self, work: &mut IslandWork) {
+        work.reports.clear();
+        work.reports
+            .extend(work.lambda.iter().map(|&lambda| RowReport {
+                lambda,
+                ..RowReport::default()
+            }));
+    }
+
+    /// Eq. (7) on the island: four solves of eq. (10); λ reported is the
+    /// first stage's.
+    fn rk4(
+        &self,
+        forces: &[LinearForce],
+        gains: Gains,
+        h: f64,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        self.accelerate(forces, gains, work, Stage::Start)?;
+        self.keep_lambda(work);
+        let n = self.beads();
+        work.x_sum.clone_from(&work.v0);
+        work.v_sum.clone_from(&work.acceleration);
+        for (weight, advance) in [(2.0, 0.5 * h), (2.0, 0.5 * h), (1.0, h)] {
+            // The stage's state from the previous stage's derivative, which
+            // is (work.v, work.acceleration).
+            for i in 0..n {
+                let (dx, dv) = (work.v[i], work.acceleration[i]);
+                work.x[i] = work.x0[i] + advance * dx;
+                work.v[i] = work.v0[i] + advance * dv;
+            }
+            self.accelerate(forces, gains, work, Stage::Later)?;
+            for i in 0..n {
+                work.x_sum[i] += weight * work.v[i];
+                work.v_sum[i] += weight * work.acceleration[i];
+            }
+        }
+        let sixth = h / 6.0;
+        for i in 0..n {
+            work.x[i] = work.x0[i] + sixth * work.x_sum[i];
+            work.v[i] = work.v0[i] + sixth * work.v_sum[i];
+        }
+        Ok(())
+    }
+
+    /// Newton's method for `C(x + W Jᵀ μ) = 0` from `work.x`, along the
+    /// gradients of `direction`: moves `work.x` onto the constraints and
+    /// returns with `work.lambda` holding the total μ.
+    ///
+    /// Along the current gradients (projection) each iteration factors
+    /// `J W Jᵀ` afresh. Along the first gradients (RATTLE) the Newton
+    /// matrix `J(x) W J₀ᵀ` is not symmetric: one row takes the exact step;
+    /// several start as a chord iteration on the factored `J₀ W J₀ᵀ` (no
+    /// new factorization, linear convergence at a rate set by how far the
+    /// rows turn over the step) and switch to exact Newton steps by sparse
+    /// LU once the chord stops shrinking `C` fourfold per iteration.
+    fn newton(&self, work: &mut IslandWork, direction: Direction) -> Result<(), SolveError> {
+        let rows = self.rows();
+        work.lambda.clear();
+        work.lambda.resize(rows, 0.0);
+        let mut exact = direction == Direction::First && rows == 1;
+        let mut previous = f64::INFINITY;
+        let mut i = 0;
+        loop {
+            self.evaluate(
+                &work.x,
+                &work.v,
+                &mut work.gradient,
+                &mut work.c,
+                &mut work.curvature,
+                &mut work.scratch,
+            );
+            let last = i == NEWTON_MAX_ITERATIONS;
+            let tolerance = if last {
+                NEWTON_ACCEPT
+            } else {
+                NEWTON_TOLERANCE
+            };
+            let mut done = true;
+            let mut worst = 0.0f64;
+            for r in 0..rows {
+                let scale = self.rows[r].scale().max(f64::MIN_POSITIVE);
+                let residual = work.c[r].abs();
+                worst = worst.max(residual / scale);
+                done &= residual <= tolerance * scale;
+            }
+            // Rounding keeps C from the tolerance where coordinates are
+            // large beside a row's scale: stop once it no longer shrinks.
+            let stalled = worst <= NEWTON_ACCEPT && worst > 0.5 * previous;
+            if done || stalled {
+                return self.same_branch(work, direction, worst);
+            }
+            if last || !worst.is_finite() {
+                return Err(SolveError::NoConvergence {
+                    iterations: NEWTON_MAX_ITERATIONS,
+                    residual: worst,
+                });
+            }
+            exact |= direction == Direction::First && worst > 0.25 * previous;
+            previous = worst;
+            work.rhs.clear();
+            work.rhs.extend(work.c.iter().map(|c| -c));
+            let along = match direction {
+                Direction::First => &work.first_gradient,
+                Direction::Current => {
+                    self.factor(&work.gradient, &work.x, &mut work.factored)?;
+                    &work.gradient
+                }
+            };
+            let solved_exactly = exact
+                && self.normal.solve_unsymmetric(
+                    &self.inverse_mass,
+                    &work.gradient,
+                    along,
+                    &mut work.values,
+                    &mut work.rhs,
+                );
+            if !solved_exactly {
+                // A singular Newton matrix (a redundant row): the chord step.
+                work.rhs.clear();
+                work.rhs.extend(work.c.iter().map(|c| -c));
+                self.normal.solve(&mut work.factored, &mut work.rhs);
+            }
+            for (total, step) in work.lambda.iter_mut().zip(&work.rhs) {
+                *total += step;
+            }
+            self.push(along, &work.rhs, &mut work.x);
+            i += 1;
+        }
+    }
+
+    /// Checks that a Newton solution is the continuation of the start: no
+    /// row's gradient may have turned by a right angle or more from the
+    /// direction it was moved along (a rod flipped end over end, a bead
+    /// carried across its wire's centre). Such a root is refused as no
+    /// convergence, so the step is halved.
+    fn same_branch(
+        &self,
+        work: &IslandWork,
+        direction: Direction,
+        residual: f64,
+    ) -> Result<(), SolveError> {
+        if direction == Direction::Current {
+            return Ok(());
+        }
+        for r in 0..self.rows() {
+            let turn: f64 = (self.row_start[r]..self.row_start[r + 1])
+                .map(|e| work.gradient[e].dot(work.first_gradient[e]))
+                .sum();
+            if turn.is_nan() || turn <= 0.0 {
+                return Err(SolveError::NoConvergence {
+                    iterations: NEWTON_MAX_ITERATIONS,
+                    residual,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Removes the velocity's component off the constraints:
+    /// `v ← v − W Jᵀ (J W Jᵀ)⁻¹ J v` at `work.x` (rows evaluated there).
+    /// Returns with the multipliers (of `−J v`) in `work.rhs`.
+    fn project_velocity(&self, work: &mut IslandWork) -> Result<(), SolveError> {
+        self.factor(&work.gradient, &work.x, &mut work.factored)?;
+        work.rhs.clear();
+        for r in 0..self.rows() {
+            work.rhs.push(-self.rate(r, &work.gradient, &work.v));
+        }
+        self.normal.solve(&mut work.factored, &mut work.rhs);
+        self.push(&work.gradient, &work.rhs, &mut work.v);
+        Ok(())
+    }
+
+    /// Post-stabilization, eq. (9) for an island: Newton steps along the
+    /// current gradients bring every `C` to zero, then the velocity is
+    /// projected onto `J v = 0`.
+    fn project(&self, work: &mut IslandWork) -> Result<(), SolveError> {
+        self.newton(work, Direction::Current)?;
+        self.evaluate_at_new(work);
+        self.project_velocity(work)
+    }
+
+    /// Eq. (8) for an island: SHAKE's position solve (Newton on all of the
+    /// island's `C` along `W J₀ᵀ`), then the linear velocity solve.
+    fn rattle(
+        &self,
+        forces: &[LinearForce],
+        h: f64,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        let n = self.beads();
+        self.evaluate(
+            &work.x0,
+            &work.v0,
+            &mut work.gradient,
+            &mut work.c,
+            &mut work.curvature,
+            &mut work.scratch,
+        );
+        self.factor(&work.gradient, &work.x0, &mut work.factored)?;
+        work.first_gradient.clone_from(&work.gradient);
+        self.applied(forces, &work.x0, &work.v0, &mut work.force);
+        work.x.clear();
+        work.v.clear();
+        for i in 0..n {
+            let w = self.inverse_mass[i];
+            work.x
+                .push(work.x0[i] + h * work.v0[i] + (0.5 * h * h * w) * work.force[i]);
+            work.v.push(work.v0[i]);
+        }
+        self.newton(work, Direction::First)?;
+        let to_lambda = 2.0 / (h * h);
+        work.reports.clear();
+        work.reports.extend(work.lambda.iter().map(|&mu| RowReport {
+            lambda: 0.5 * to_lambda * mu,
+            ..RowReport::default()
+        }));
+        // v½ and the second half kick, at the new positions.
+        for i in 0..n {
+            work.v[i] = (work.x[i] - work.x0[i]) / h;
+        }
+        self.applied(forces, &work.x, &work.v, &mut work.force);
+        for i in 0..n {
+            work.v[i] += (0.5 * h * self.inverse_mass[i]) * work.force[i];
+        }
+        self.evaluate_at_new(work);
+        self.project_velocity(work)?;
+        let to_mu = 2.0 / h;
+        for (report, nu) in work.reports.iter_mut().zip(&work.rhs) {
+            report.lambda += 0.5 * to_mu * nu;
+        }
+        Ok(())
+    }
+}
+
+/// Which state a solve of eq. (10) is at.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Stage {
+    /// The step's start, `work.x0, work.v0`.
+    Start,
+    /// A later stage, `work.x, work.v`.
+    Later,
+}
+
+/// The gradients a Newton iteration moves along.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Direction {
+    /// Those at the step's start (RATTLE), factored before the iteration.
+    First,
+    /// Those at each iterate (projection), factored at each.
+    Current,
+}

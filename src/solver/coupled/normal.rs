@@ -1,0 +1,356 @@
+//! The island's matrix `A = J W Jᵀ` of eq. (10): its sparsity pattern and
+//! symbolic factorization, built once per topology, and the numeric
+//! factorization and solves of each step.
+//!
+//! `A` is symmetric positive semidefinite, with a nonzero `(r, s)` wherever
+//! rows `r` and `s` share a bead. It is scaled to a unit diagonal
+//! (`S A S`, `S = diag(1/√A_rr)`) and factored `LDLᵀ` by faer's sparse
+//! Cholesky under an approximate-minimum-degree ordering, which for a chain
+//! or tree of rods eliminates leaf by leaf with no fill-in, so the cost is
+//! linear in the number of rows (Baraff 1996). A closed loop adds a little
+//! fill and still factors.
+//!
+//! Redundant constraints (the same rod twice; a chain pulled straight
+//! between two pins) make `A` singular. A pivot that falls below
+//! [`REDUNDANT_PIVOT`] of its row's scale is replaced by a huge one, which
+//! drops that row from the solve: its λ is zero and the other rows carry
+//! the load, so consistent redundant constraints hold with no NaN and no
+//! panic, and [`NormalMatrix::factor`] counts them.
+
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use bevy::math::DVec2;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::cholesky::{
+    LdltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+};
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, MatMut, Par, Side};
+
+/// A scaled pivot at or below this is taken as a redundant row.
+pub const REDUNDANT_PIVOT: f64 = 1e-10;
+/// What a redundant row's pivot is replaced by: its λ becomes zero.
+const DROPPED_PIVOT: f64 = 1e30;
+
+/// One product `w_bead · g_i · g_j` that makes up an entry of `A`.
+#[derive(Clone, Copy, Debug)]
+struct Term {
+    bead: usize,
+    /// The gradient entry of the entry's row.
+    left: usize,
+    /// The gradient entry of the entry's column.
+    right: usize,
+}
+
+/// faer's scratch memory, and the [`NormalMatrix::id`] it was made for.
+#[derive(Default)]
+struct Scratch {
+    owner: u64,
+    memory: Option<MemBuffer>,
+}
+
+/// `A`'s pattern (upper triangle, by columns) and its symbolic
+/// factorization.
+pub(crate) struct NormalMatrix {
+    /// Unique among the matrices of a run, so scratch memory made for
+    /// another matrix is never used for this one.
+    id: u64,
+    n: usize,
+    pattern: SymbolicSparseColMat<usize>,
+    /// Where each diagonal entry sits among the values.
+    diagonal: Vec<usize>,
+    /// The terms of value `k` are `terms[term_start[k]..term_start[k + 1]]`.
+    term_start: Vec<usize>,
+    terms: Vec<Term>,
+    /// `None` for a single row, solved in closed form.
+    symbolic: Option<SymbolicCholesky<usize>>,
+    /// The full pattern for the unsymmetric `J₁ W J₀ᵀ`, made when first
+    /// needed; `None` inside if faer could not set it up.
+    unsymmetric: OnceLock<Option<Unsymmetric>>,
+}
+
+/// The full (both triangles) pattern of `J₁ W J₀ᵀ` and its symbolic LU.
+struct Unsymmetric {
+    pattern: SymbolicSparseColMat<usize>,
+    /// For each value: the upper-triangle entry it comes from, and whether
+    /// it is that entry's mirror below the diagonal.
+    source: Vec<(usize, bool)>,
+    symbolic: SymbolicLu<usize>,
+}
+
+/// A factored `A`, kept between solves within a step.
+#[derive(Default)]
+pub(crate) struct Factored {
+    values: Vec<f64>,
+    scale: Vec<f64>,
+    l_values: Vec<f64>,
+    scratch: Scratch,
+    /// How many rows the factorization dropped as redundant.
+    pub(crate) redundant: usize,
+}
+
+impl NormalMatrix {
+    /// The pattern of `J W Jᵀ` for rows whose gradient entries are
+    /// `entries[row_start[r]..row_start[r + 1]]`, each naming a bead, and
+    /// its symbolic factorization; `None` if faer could not allocate it.
+    pub(crate) fn new(row_start: &[usize], entry_bead: &[usize], beads: usize) -> Option<Self> {
+        let n = row_start.len() - 1;
+        // The entries on each bead, by (row, entry).
+        let mut on_bead: Vec<Vec<(usize, usize)>> = vec![Vec::new(); beads];
+        for r in 0..n {
+            for e in row_start[r]..row_start[r + 1] {
+                on_bead[entry_bead[e]].push((r, e));
+            }
+        }
+        // Every term, keyed by (column, row) with row ≤ column.
+        let mut keyed = Vec::new();
+        for entries in &on_bead {
+            for &(r, er) in entries {
+                for &(s, es) in entries {
+                    if r <= s {
+                        let bead = entry_bead[er];
+                        keyed.push((
+                            s,
+                            r,
+                            Term {
+                                bead,
+                                left: er,
+                                right: es,
+                            },
+                        ));
+                    }
+                }
+            }
+        }
+        keyed.sort_by_key(|&(col, row, _)| (col, row));
+        let mut col_ptr = vec![0; n + 1];
+        let mut row_idx = Vec::new();
+        let mut term_start = Vec::new();
+        let mut terms = Vec::with_capacity(keyed.len());
+        let mut diagonal = vec![0; n];
+        let mut last = None;
+        for (col, row, term) in keyed {
+            if last != Some((col, row)) {
+                if row == col {
+                    diagonal[col] = row_idx.len();
+                }
+                row_idx.push(row);
+                term_start.push(terms.len());
+                col_ptr[col + 1] = row_idx.len();
+                last = Some((col, row));
+            }
+            terms.push(term);
+        }
+        term_start.push(terms.len());
+        for c in 0..n {
+            col_ptr[c + 1] = col_ptr[c + 1].max(col_ptr[c]);
+        }
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let symbolic = if n > 1 {
+            let symbolic = factorize_symbolic_cholesky(
+                pattern.as_ref(),
+                Side::Upper,
+                SymmetricOrdering::Amd,
+                Default::default(),
+            );
+            Some(symbolic.ok()?)
+        } else {
+            None
+        };
+        static NEXT_ID: AtomicU64 = AtomicU64::new(1);
+        Some(Self {
+            id: NEXT_ID.fetch_add(1, Ordering::Relaxed),
+            n,
+            pattern,
+            diagonal,
+            term_start,
+            terms,
+            symbolic,
+            unsymmetric: OnceLock::new(),
+        })
+    }
+
+    /// The stored entries of the upper triangle: `(column, value index, row)`.
+    fn upper_entries(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+        let (col_ptr, row_idx) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        (0..self.n).flat_map(move |col| {
+            (col_ptr[col]..col_ptr[col + 1]).map(move |k| (col, k, row_idx[k]))
+        })
+    }
+
+    /// The pattern of both triangles and its symbolic LU.
+    fn unsymmetric(&self) -> Option<&Unsymmetric> {
+        self.unsymmetric
+            .get_or_init(|| {
+                let mut keyed = Vec::new();
+                for (col, k, row) in self.upper_entries() {
+                    keyed.push((col, row, k, false));
+                    if row != col {
+                        keyed.push((row, col, k, true));
+                    }
+                }
+                keyed.sort_by_key(|&(col, row, _, _)| (col, row));
+                let mut full_col_ptr = vec![0; self.n + 1];
+                for &(col, ..) in &keyed {
+                    full_col_ptr[col + 1] += 1;
+                }
+                for c in 0..self.n {
+                    full_col_ptr[c + 1] += full_col_ptr[c];
+                }
+                let full_row_idx = keyed.iter().map(|&(_, row, ..)| row).collect();
+                let source = keyed.iter().map(|&(.., k, mirror)| (k, mirror)).collect();
+                let pattern = SymbolicSparseColMat::new_checked(
+                    self.n,
+                    self.n,
+                    full_col_ptr,
+                    None,
+                    full_row_idx,
+                );
+                let symbolic = SymbolicLu::try_new(pattern.as_ref()).ok()?;
+                Some(Unsymmetric {
+                    pattern,
+                    source,
+                    symbolic,
+                })
+            })
+            .as_ref()
+    }
+
+    /// Solves `J_now W J_firstᵀ x = rhs` in place (the exact Newton matrix
+    /// of RATTLE's position solve) by faer's sparse LU. Returns `false`
+    /// where the matrix is singular or faer could not factor it.
+    pub(crate) fn solve_unsymmetric(
+        &self,
+        inverse_mass: &[f64],
+        now: &[DVec2],
+        first: &[DVec2],
+        values: &mut Vec<f64>,
+        rhs: &mut [f64],
+    ) -> bool {
+        let Some(u) = self.unsymmetric() else {
+            return false;
+        };
+        values.clear();
+        values.extend(u.source.iter().map(|&(k, mirror)| {
+            self.terms[self.term_start[k]..self.term_start[k + 1]]
+                .iter()
+                .map(|t| {
+                    let (row, col) = if mirror {
+                        (t.right, t.left)
+                    } else {
+                        (t.left, t.right)
+                    };
+                    inverse_mass[t.bead] * now[row].dot(first[col])
+                })
+                .sum::<f64>()
+        }));
+        let matrix = SparseColMatRef::new(u.pattern.as_ref(), values);
+        let Ok(lu) = Lu::try_new_with_symbolic(u.symbolic.clone(), matrix) else {
+            return false;
+        };
+        lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, self.n, 1));
+        rhs.iter().all(|x| x.is_finite())
+    }
+
+    /// Fills and factors `A = J_left W J_rightᵀ` (the same gradients on
+    /// both sides for the symmetric `J W Jᵀ`). Returns the index of a row
+    /// whose diagonal vanishes (a singular point: no direction to push
+    /// along) as the error.
+    pub(crate) fn factor(
+        &self,
+        inverse_mass: &[f64],
+        gradient: &[DVec2],
+        f: &mut Factored,
+    ) -> Result<(), usize> {
+        let nnz = self.term_start.len() - 1;
+        f.values.clear();
+        f.values.extend((0..nnz).map(|k| {
+            self.terms[self.term_start[k]..self.term_start[k + 1]]
+                .iter()
+                .map(|t| inverse_mass[t.bead] * gradient[t.left].dot(gradient[t.right]))
+                .sum::<f64>()
+        }));
+        f.scale.clear();
+        for (r, &k) in self.diagonal.iter().enumerate() {
+            let d = f.values[k];
+            if !(d.is_finite() && d > 1e-300) {
+                return Err(r);
+            }
+            f.scale.push(d.sqrt().recip());
+        }
+        f.redundant = 0;
+        let Some(symbolic) = &self.symbolic else {
+            return Ok(());
+        };
+        for (col, k, row) in self.upper_entries() {
+            f.values[k] *= f.scale[row] * f.scale[col];
+        }
+        f.l_values.clear();
+        f.l_values.resize(symbolic.len_val(), 0.0);
+        let memory = self.scratch(symbolic, &mut f.scratch);
+        let a = SparseColMatRef::new(self.pattern.as_ref(), &f.values);
+        symbolic
+            .factorize_numeric_ldlt(
+                &mut f.l_values,
+                a,
+                Side::Upper,
+                LdltRegularization {
+                    dynamic_regularization_signs: None,
+                    dynamic_regularization_delta: DROPPED_PIVOT,
+                    dynamic_regularization_epsilon: REDUNDANT_PIVOT,
+                },
+                Par::Seq,
+                MemStack::new(memory),
+                Default::default(),
+            )
+            .map_err(|_| 0usize)?;
+        f.redundant = f.l_values.iter().filter(|&&v| v == DROPPED_PIVOT).count();
+        Ok(())
+    }
+
+    /// Solves `A λ = rhs` in place with the last factorization.
+    pub(crate) fn solve(&self, f: &mut Factored, rhs: &mut [f64]) {
+        let Some(symbolic) = &self.symbolic else {
+            rhs[0] /= f.values[self.diagonal[0]];
+            return;
+        };
+        for (b, s) in rhs.iter_mut().zip(&f.scale) {
+            *b *= s;
+        }
+        let ldlt = LdltRef::new(symbolic, &f.l_values);
+        let memory = self.scratch(symbolic, &mut f.scratch);
+        ldlt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(rhs, self.n, 1),
+            Par::Seq,
+            MemStack::new(memory),
+        );
+        for (b, s) in rhs.iter_mut().zip(&f.scale) {
+            *b *= s;
+        }
+    }
+
+    /// The scratch memory faer's factorization and solve need, made once
+    /// for this matrix.
+    fn scratch<'a>(
+        &self,
+        symbolic: &SymbolicCholesky<usize>,
+        scratch: &'a mut Scratch,
+    ) -> &'a mut MemBuffer {
+        if scratch.owner != self.id {
+            scratch.memory = None;
+            scratch.owner = self.id;
+        }
+        scratch.memory.get_or_insert_with(|| {
+            MemBuffer::new(
+                symbolic
+                    .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
+                    .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
+            )
+        })
+    }
+}

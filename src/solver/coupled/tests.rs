@@ -1,0 +1,558 @@
+//! Islands against the single-bead solver and against physics: a double
+//! pendulum, a pendulum on a cart, a rope, a ring with a redundant row, a
+//! spring, and bad input.
+
+use std::f64::consts::{PI, TAU};
+use std::sync::Arc;
+
+use bevy::math::DVec2;
+
+use super::*;
+use crate::geometry::{Circle, Ellipse, Line, Pose, WireShape};
+use crate::solver::test_support::{G, settings};
+use crate::solver::{BeadState, LinearForce, Method, Stabilization, StepSettings, step};
+
+fn rod(a: usize, b: usize, length: f64) -> IslandRow {
+    IslandRow {
+        kind: RowKind::Rod { length },
+        beads: vec![a, b],
+    }
+}
+
+fn wire(bead: usize, shape: WireShape, pose: Pose) -> IslandRow {
+    IslandRow {
+        kind: RowKind::Wire { shape, pose },
+        beads: vec![bead],
+    }
+}
+
+/// The two rows that hold `bead` at `at`.
+fn pin(bead: usize, at: DVec2) -> [IslandRow; 2] {
+    [DVec2::X, DVec2::Y].map(|axis| IslandRow {
+        kind: RowKind::Axis {
+            axis,
+            offset: axis.dot(at),
+        },
+        beads: vec![bead],
+    })
+}
+
+fn at_rest(positions: &[DVec2]) -> Vec<BeadState> {
+    positions
+        .iter()
+        .map(|&position| BeadState {
+            position,
+            velocity: DVec2::ZERO,
+        })
+        .collect()
+}
+
+fn weights(masses: &[f64]) -> Vec<LinearForce> {
+    masses
+        .iter()
+        .map(|m| LinearForce::constant(*m * G))
+        .collect()
+}
+
+/// Runs `steps` steps, calling `each` after every one.
+fn run(
+    island: &Island,
+    states: &mut [BeadState],
+    forces: &[LinearForce],
+    s: &StepSettings,
+    steps: usize,
+    mut each: impl FnMut(&[BeadState], &IslandWork),
+) {
+    let mut work = IslandWork::default();
+    for i in 0..steps {
+        island
+            .step(states, forces, s, &mut work)
+            .unwrap_or_else(|e| panic!("{}: step {i}: {e}", s.method));
+        each(states, &work);
+    }
+}
+
+fn max_drift(work: &IslandWork, scale: f64) -> f64 {
+    work.rows()
+        .iter()
+        .map(|r| r.c.abs() / scale)
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn one_wire_row_steps_as_the_single_bead_solver() {
+    let ellipse = Ellipse { a: 1.5, b: 1.0 };
+    let pose = Pose::new(DVec2::new(0.2, -0.1), 0.3);
+    let placed = crate::geometry::Placed {
+        curve: &ellipse,
+        pose,
+    };
+    let start = BeadState {
+        position: pose.to_world(DVec2::new(1.5, 0.0)),
+        velocity: DVec2::ZERO,
+    };
+    let island = Island::new(
+        &[2.0],
+        vec![wire(0, WireShape::Ellipse(ellipse), pose)],
+        vec![],
+    )
+    .unwrap();
+    let force = LinearForce::constant(2.0 * G);
+    for method in Method::ALL {
+        if matches!(method, Method::ExplicitEuler(_)) {
+            continue; // diverges on its own at this step; compared below at a smaller one
+        }
+        let s = settings(method, 1.0 / 120.0);
+        let mut single = start;
+        let mut states = vec![start];
+        let mut work = IslandWork::default();
+        for _ in 0..240 {
+            single = step(&placed, single, &force, 2.0, &s).unwrap().state;
+            island.step(&mut states, &[force], &s, &mut work).unwrap();
+        }
+        let gap = (single.position - states[0].position).length()
+            + (single.velocity - states[0].velocity).length();
+        assert!(
+            gap < 1e-9,
+            "{method}: the island is {gap:e} from the single bead"
+        );
+    }
+    let s = settings(Method::ExplicitEuler(Stabilization::Baumgarte), 1e-3);
+    let (mut single, mut states) = (start, vec![start]);
+    let mut work = IslandWork::default();
+    for _ in 0..500 {
+        single = step(&placed, single, &force, 2.0, &s).unwrap().state;
+        island.step(&mut states, &[force], &s, &mut work).unwrap();
+    }
+    assert!((single.position - states[0].position).length() < 1e-9);
+}
+
+/// A pivot pinned at the origin, two rods of length 1, released
+/// horizontal: the double pendulum.
+fn double_pendulum() -> (Island, Vec<BeadState>, Vec<LinearForce>) {
+    let masses = [1.0, 1.0, 1.0];
+    let mut rows: Vec<IslandRow> = pin(0, DVec2::ZERO).into();
+    rows.push(rod(0, 1, 1.0));
+    rows.push(rod(1, 2, 1.0));
+    let island = Island::new(&masses, rows, vec![]).unwrap();
+    let states = at_rest(&[DVec2::ZERO, DVec2::new(1.0, 0.0), DVec2::new(2.0, 0.0)]);
+    (island, states, weights(&masses))
+}
+
+#[test]
+fn double_pendulum_holds_its_rods_and_its_energy() {
+    // Chaotic, so only the invariants are tested: the rods to the Newton
+    // tolerance (RATTLE, projection) and the energy, whose scale is
+    // m g L = 9.81 J. RATTLE's error stays bounded at O(h²); RK4 with
+    // projection is fourth order.
+    for (method, dt, energy_tolerance) in [
+        (Method::Rattle, 1.0 / 240.0, 0.05),
+        (Method::Rk4(Stabilization::Projection), 1.0 / 240.0, 0.05),
+    ] {
+        let (island, mut states, forces) = double_pendulum();
+        let e0 = island.energy(&states, G);
+        let mut worst = (0.0f64, 0.0f64);
+        run(
+            &island,
+            &mut states,
+            &forces,
+            &settings(method, dt),
+            (10.0 / dt) as usize,
+            |states, work| {
+                worst.0 = worst.0.max(max_drift(work, 1.0));
+                worst.1 = worst.1.max((island.energy(states, G) - e0).abs());
+            },
+        );
+        assert!(worst.0 <= 1e-12, "{method}: |C| reached {:e}", worst.0);
+        assert!(
+            worst.1 <= energy_tolerance,
+            "{method}: energy moved by {:e} J",
+            worst.1
+        );
+    }
+}
+
+#[test]
+fn baumgarte_keeps_the_double_pendulums_drift_below_none() {
+    let drift_after = |stabilization| {
+        let (island, mut states, forces) = double_pendulum();
+        let mut work = IslandWork::default();
+        let s = settings(Method::SemiImplicitEuler(stabilization), 1.0 / 240.0);
+        let mut worst = 0.0f64;
+        for _ in 0..1200 {
+            island.step(&mut states, &forces, &s, &mut work).unwrap();
+            worst = worst.max(max_drift(&work, 1.0));
+        }
+        worst
+    };
+    let (baumgarte, none) = (
+        drift_after(Stabilization::Baumgarte),
+        drift_after(Stabilization::None),
+    );
+    assert!(
+        baumgarte < 0.2 * none,
+        "drift with Baumgarte {baumgarte:e}, without {none:e}"
+    );
+}
+
+#[test]
+fn pendulum_on_a_cart_conserves_momentum_and_swings_at_the_coupled_frequency() {
+    // Cart of mass M on a horizontal line, bob of mass m on a rod of
+    // length l: ω² = (g/l)(M + m)/M for small swings.
+    let (cart, bob, l) = (2.0, 1.0, 1.0);
+    let theta: f64 = 1f64.to_radians();
+    let island = Island::new(
+        &[cart, bob],
+        vec![
+            wire(0, WireShape::Line(Line), Pose::default()),
+            rod(0, 1, l),
+        ],
+        vec![],
+    )
+    .unwrap();
+    let mut states = at_rest(&[DVec2::ZERO, DVec2::new(l * theta.sin(), -l * theta.cos())]);
+    let forces = weights(&[cart, bob]);
+    let dt = 1.0 / 1000.0;
+    let mut crossings = Vec::new();
+    let mut previous = states[1].position.x - states[0].position.x;
+    let mut t = 0.0;
+    let mut momentum = 0.0f64;
+    run(
+        &island,
+        &mut states,
+        &forces,
+        &settings(Method::Rattle, dt),
+        8000,
+        |states, _| {
+            t += dt;
+            let offset = states[1].position.x - states[0].position.x;
+            if previous > 0.0 && offset <= 0.0 {
+                crossings.push(t - dt * offset / (offset - previous));
+            }
+            previous = offset;
+            let p = cart * states[0].velocity.x + bob * states[1].velocity.x;
+            momentum = momentum.max(p.abs());
+        },
+    );
+    let periods = (crossings.len() - 1) as f64;
+    let measured = (crossings[crossings.len() - 1] - crossings[0]) / periods;
+    let exact = TAU / ((9.81 / l) * (cart + bob) / cart).sqrt();
+    assert!(
+        (measured / exact - 1.0).abs() < 1e-3,
+        "period {measured} against {exact}"
+    );
+    assert!(momentum < 1e-12, "horizontal momentum reached {momentum:e}");
+}
+
+#[test]
+fn a_horizontal_rope_keeps_every_rod_and_its_energy() {
+    // 20 rods of 0.1 m from a pin, released horizontal, RATTLE for 10 s:
+    // the free end whips round, where the chord iteration turns to exact
+    // Newton steps. The whip's tension spikes make the taut rope's
+    // transverse modes (ω² ≈ 2T/(mL)) stiff: at 1/60 s and 1/240 s the
+    // energy error reaches a large part of the energy released, so this
+    // runs at 1/960 s.
+    let (n, l, steps_per_second) = (20, 0.1, 960.0);
+    let masses = vec![1.0; n + 1];
+    let mut rows: Vec<IslandRow> = pin(0, DVec2::ZERO).into();
+    rows.extend((0..n).map(|i| rod(i, i + 1, l)));
+    let island = Island::new(&masses, rows, vec![]).unwrap();
+    let mut states = at_rest(
+        &(0..=n)
+            .map(|i| DVec2::new(l * i as f64, 0.0))
+            .collect::<Vec<_>>(),
+    );
+    let e0 = island.energy(&states, G);
+    let (mut worst, mut energy, mut halved) = (0.0f64, 0.0f64, 0);
+    run(
+        &island,
+        &mut states,
+        &weights(&masses),
+        &settings(Method::Rattle, 1.0 / steps_per_second),
+        (10.0 * steps_per_second) as usize,
+        |states, work| {
+            worst = worst.max(max_drift(work, l));
+            energy = energy.max((island.energy(states, G) - e0).abs());
+            halved += usize::from(work.substeps() > 1);
+        },
+    );
+    assert!(worst <= 1e-12, "max |C|/L = {worst:e}");
+    // The rope's fall releases m g L n(n+1)/2 = 206 J; at this step
+    // RATTLE's energy error stays under 1 % of it (0.6 J measured; 0.11 J
+    // at a step four times smaller), and no step needs halving.
+    assert!(energy <= 0.01 * 206.0, "energy moved by {energy} J");
+    assert_eq!(halved, 0, "{halved} steps were halved");
+}
+
+/// Six beads on a unit circle joined in a closed ring of rods: twelve
+/// rows on twelve coordinates with one motion left, so one row is
+/// redundant.
+fn ring() -> (Island, Vec<BeadState>) {
+    let n = 6;
+    let circle = WireShape::Circle(Circle { radius: 1.0 });
+    let chord = 2.0 * (PI / n as f64).sin();
+    let mut rows: Vec<IslandRow> = (0..n)
+        .map(|i| wire(i, circle.clone(), Pose::default()))
+        .collect();
+    rows.extend((0..n).map(|i| rod(i, (i + 1) % n, chord)));
+    let island = Island::new(&vec![1.0; n], rows, vec![]).unwrap();
+    let states = (0..n)
+        .map(|i| {
+            let angle = TAU * i as f64 / n as f64;
+            let radial = DVec2::from_angle(angle);
+            BeadState {
+                position: radial,
+                velocity: 2.0 * radial.perp(),
+            }
+        })
+        .collect();
+    (island, states)
+}
+
+#[test]
+fn a_ring_with_a_redundant_row_turns_steadily() {
+    // Gravity exerts no torque on the symmetric ring, so it turns at a
+    // constant rate, here 2 rad/s.
+    for method in [Method::Rattle, Method::Rk4(Stabilization::Projection)] {
+        let (island, mut states) = ring();
+        let forces = weights(&[1.0; 6]);
+        let mut worst = (0.0f64, 0.0f64);
+        let mut redundant = 0;
+        run(
+            &island,
+            &mut states,
+            &forces,
+            &settings(method, 1.0 / 60.0),
+            600,
+            |states, work| {
+                redundant = redundant.max(work.redundant());
+                worst.0 = worst.0.max(max_drift(work, 1.0));
+                for s in states {
+                    let rate = s.position.perp_dot(s.velocity) / s.position.length_squared();
+                    worst.1 = worst.1.max((rate - 2.0).abs());
+                }
+            },
+        );
+        assert!(redundant >= 1, "{method}: no row was found redundant");
+        assert!(worst.0 <= 1e-12, "{method}: |C| reached {:e}", worst.0);
+        // RK4's phase error on a uniform turn, (ωh)⁵/120 a step, is
+        // 3.5e-10 here: 2e-7 over 600 steps.
+        assert!(worst.1 <= 2e-7, "{method}: the rate moved by {:e}", worst.1);
+    }
+}
+
+#[test]
+fn the_same_rod_twice_moves_as_one_rod() {
+    let pendulum = |rods: usize| {
+        let mut rows: Vec<IslandRow> = pin(0, DVec2::ZERO).into();
+        rows.extend((0..rods).map(|_| rod(0, 1, 1.0)));
+        let island = Island::new(&[1.0, 1.0], rows, vec![]).unwrap();
+        let mut states = at_rest(&[DVec2::ZERO, DVec2::new(1.0, 0.0)]);
+        let mut lambdas = Vec::new();
+        run(
+            &island,
+            &mut states,
+            &weights(&[1.0, 1.0]),
+            &settings(Method::Rk4(Stabilization::Baumgarte), 1.0 / 120.0),
+            240,
+            |_, work| lambdas.push(work.rows()[2..].iter().map(|r| r.lambda).sum::<f64>()),
+        );
+        (states[1], lambdas)
+    };
+    let ((one, one_lambda), (two, two_lambda)) = (pendulum(1), pendulum(2));
+    assert!(two.is_finite());
+    assert!((one.position - two.position).length() < 1e-9);
+    for (a, b) in one_lambda.iter().zip(&two_lambda) {
+        assert!((a - b).abs() < 1e-9 * a.abs().max(1.0), "λ {a} against {b}");
+    }
+}
+
+#[test]
+fn a_spring_between_beads_on_a_line_oscillates_at_its_frequency() {
+    // Relative motion of two masses joined by a spring: ω² = k (1/m₁ + 1/m₂).
+    let (m1, m2, k) = (1.0, 2.0, 50.0);
+    let line = WireShape::Line(Line);
+    let island = Island::new(
+        &[m1, m2],
+        vec![
+            wire(0, line.clone(), Pose::default()),
+            wire(1, line, Pose::default()),
+        ],
+        vec![SpringLink {
+            a: 0,
+            b: 1,
+            rest_length: 1.0,
+            stiffness: k,
+            damping: 0.0,
+        }],
+    )
+    .unwrap();
+    let mut states = at_rest(&[DVec2::ZERO, DVec2::new(1.2, 0.0)]);
+    let dt = 1e-3;
+    let (mut t, mut previous, mut crossings) = (0.0, 0.2, Vec::new());
+    run(
+        &island,
+        &mut states,
+        &weights(&[m1, m2]),
+        &settings(Method::Rk4(Stabilization::Projection), dt),
+        3000,
+        |states, _| {
+            t += dt;
+            let stretch = states[1].position.x - states[0].position.x - 1.0;
+            if previous > 0.0 && stretch <= 0.0 {
+                crossings.push(t - dt * stretch / (stretch - previous));
+            }
+            previous = stretch;
+        },
+    );
+    // The first downward crossing is a quarter period in.
+    let omega = (k * (1.0 / m1 + 1.0 / m2)).sqrt();
+    assert!((crossings[0] - 0.25 * TAU / omega).abs() < 1e-6);
+    assert!((crossings[1] - crossings[0] - TAU / omega).abs() < 1e-6);
+}
+
+/// A rod written as a game's own constraint.
+struct DistanceConstraint(f64);
+
+impl Constraint for DistanceConstraint {
+    fn value(&self, x: &[DVec2]) -> f64 {
+        (x[0] - x[1]).length() - self.0
+    }
+    fn gradient(&self, x: &[DVec2], gradient: &mut [DVec2]) {
+        let n = (x[0] - x[1]).normalize();
+        gradient[0] = n;
+        gradient[1] = -n;
+    }
+    fn curvature(&self, x: &[DVec2], v: &[DVec2]) -> f64 {
+        let d = x[0] - x[1];
+        let u = v[0] - v[1];
+        let along = u.dot(d) / d.length();
+        (u.length_squared() - along * along) / d.length()
+    }
+}
+
+#[test]
+fn a_custom_constraint_steps_as_the_built_in_rod() {
+    let run_with = |kind: RowKind| {
+        let mut rows: Vec<IslandRow> = pin(0, DVec2::ZERO).into();
+        rows.push(IslandRow {
+            kind,
+            beads: vec![0, 1],
+        });
+        let island = Island::new(&[1.0, 3.0], rows, vec![]).unwrap();
+        let mut states = at_rest(&[DVec2::ZERO, DVec2::new(0.6, -0.8)]);
+        run(
+            &island,
+            &mut states,
+            &weights(&[1.0, 3.0]),
+            &settings(Method::Rattle, 1.0 / 60.0),
+            300,
+            |_, _| {},
+        );
+        states[1]
+    };
+    let built_in = run_with(RowKind::Rod { length: 1.0 });
+    let custom = run_with(RowKind::Custom(Arc::new(DistanceConstraint(1.0))));
+    assert!((built_in.position - custom.position).length() < 1e-12);
+}
+
+#[test]
+fn bad_islands_are_refused_in_words() {
+    let refuse = |masses: &[f64], rows: Vec<IslandRow>| {
+        Island::new(masses, rows, vec![])
+            .err()
+            .expect("refused")
+            .to_string()
+    };
+    assert_eq!(
+        refuse(&[1.0], vec![rod(0, 0, 1.0)]),
+        "constraint 0 (rod) joins bead 0 to itself"
+    );
+    assert_eq!(
+        refuse(&[1.0], vec![rod(0, 3, 1.0)]),
+        "constraint 0 (rod) names bead 3, but there are only 1 beads"
+    );
+    assert_eq!(
+        refuse(&[1.0, 1.0], vec![rod(0, 1, 0.0)]),
+        "constraint 0 (rod): length must be positive and finite, got 0"
+    );
+    assert_eq!(
+        refuse(&[1.0, -2.0], vec![rod(0, 1, 1.0)]),
+        "bead 1 has mass -2; a mass must be positive and finite"
+    );
+    let spring = SpringLink {
+        a: 0,
+        b: 1,
+        rest_length: f64::NAN,
+        stiffness: 1.0,
+        damping: 0.0,
+    };
+    assert_eq!(
+        Island::new(&[1.0, 1.0], vec![], vec![spring])
+            .err()
+            .expect("refused")
+            .to_string(),
+        "spring 0: rest length must be zero or more and finite, got NaN"
+    );
+}
+
+#[test]
+fn a_rod_of_two_coincident_beads_is_a_singular_point_not_a_nan() {
+    let (island, _, forces) = double_pendulum();
+    let mut states = at_rest(&[DVec2::ZERO, DVec2::ZERO, DVec2::new(1.0, 0.0)]);
+    let before = states.clone();
+    for method in Method::ALL {
+        let err = island
+            .step(
+                &mut states,
+                &forces,
+                &settings(method, 0.01),
+                &mut IslandWork::default(),
+            )
+            .unwrap_err();
+        assert!(
+            matches!(err, crate::solver::SolveError::Singular { .. }),
+            "{method}: {err}"
+        );
+        assert_eq!(states, before, "{method}: the state changed");
+    }
+}
+
+#[test]
+fn a_step_with_no_rattle_solution_is_halved() {
+    // A bead on a rod of 0.1 m whirling at 15 m/s: in 1/60 s it would
+    // travel 0.25 m, more than the rod can reach along its old direction,
+    // so RATTLE's position solve has no root; quarter steps (0.0625 m,
+    // 36° of turn) do.
+    let (l, speed) = (0.1, 15.0);
+    let rows: Vec<IslandRow> = pin(0, DVec2::ZERO)
+        .into_iter()
+        .chain([rod(0, 1, l)])
+        .collect();
+    let island = Island::new(&[1.0, 1.0], rows, vec![]).unwrap();
+    let mut states = vec![
+        BeadState::default(),
+        BeadState {
+            position: DVec2::new(0.0, -l),
+            velocity: DVec2::new(speed, 0.0),
+        },
+    ];
+    let e0 = island.energy(&states, G);
+    let (mut fewest, mut worst, mut energy) = (u32::MAX, 0.0f64, 0.0f64);
+    run(
+        &island,
+        &mut states,
+        &weights(&[1.0, 1.0]),
+        &settings(Method::Rattle, 1.0 / 60.0),
+        120,
+        |states, work| {
+            fewest = fewest.min(work.substeps());
+            worst = worst.max(max_drift(work, l));
+            energy = energy.max((island.energy(states, G) - e0).abs());
+        },
+    );
+    assert!(fewest >= 4, "a step took only {fewest} substeps");
+    assert!(worst <= 1e-12, "max |C|/L = {worst:e}");
+    // ½ m v² = 112.5 J; RATTLE's bounded error at 36° a substep.
+    assert!(energy <= 0.01 * 112.5, "energy moved by {energy} J");
+}
