@@ -32,7 +32,9 @@
 //! |---|---|
 //! | [`WireBeadPlugin`] | the simulation: components, parameters, the step in `FixedUpdate` |
 //! | [`WireBeadSystems`] | the sets: `Restart` in `PreUpdate`; `Prepare → Forces → Step → Writeback` in `FixedUpdate` |
-//! | [`Wire`], [`Bead`], [`OnWire`] | a wire placed by its `Transform`; a bead on it |
+//! | [`Wire`], [`Bead`], [`OnWire`] | a wire placed by its `Transform`; a bead on it (or free, on none) |
+//! | [`Rod`], [`Pin`], [`Joint`], [`Spring`] | links between beads, each on an entity of its own; [`Constraint`] for a game's own joint |
+//! | [`Islands`], [`ConstraintDiagnostics`] | the beads links join, solved together (`J W Jᵀ λ = …`); each link's `C`, `Ċ`, λ |
 //! | [`SimParams`], [`PendingParams`], [`PendingBead`], [`PendingWire`] | applied and edited parameters; [`Restart`] applies the edits |
 //! | [`Method`] | an [`Integrator`] with its [`Stabilization`] (RATTLE takes none) |
 //! | [`KeyboardControlsPlugin`] | Space restarts, P pauses, N steps once: headless-testable |
@@ -82,23 +84,26 @@ mod validate;
 
 pub use controls::KeyboardControlsPlugin;
 pub use dynamics::{
-    Bead, BeadDiagnostics, BeadDiverged, BeadParams, Diverged, DivergenceReason, DragTarget,
-    MAX_TIMESTEP, MIN_TIMESTEP, OnWire, PendingBead, PendingParams, PendingWire, SimParams, Wire,
-    WireBeads, pose_of,
+    Bead, BeadDiagnostics, BeadDiverged, BeadParams, ConstraintDiagnostics, Diverged,
+    DivergenceReason, DragTarget, Joint, MAX_TIMESTEP, MIN_TIMESTEP, OnWire, PendingBead,
+    PendingParams, PendingWire, Pin, Rod, SimParams, Spring, Wire, WireBeads, pose_of,
 };
 pub use geometry::{ImplicitCurve, WireKind, WireShape};
-pub use plugin::{ParallelStep, Restart, SimClock, WireBeadPlugin, WireBeadSystems};
+pub use plugin::{
+    IslandReport, Islands, ParallelStep, Restart, SimClock, WireBeadPlugin, WireBeadSystems,
+};
 pub use preset::{ActivePreset, LoadPreset, ScenePreset, ScenePresetPlugin};
-pub use solver::{Integrator, Method, Stabilization};
+pub use solver::{Constraint, Integrator, Method, Stabilization};
 pub use validate::ParamError;
 
 /// The types most apps need: `use wirebead::prelude::*;`.
 pub mod prelude {
     pub use crate::{
-        Bead, BeadDiagnostics, BeadDiverged, BeadParams, Diverged, DragTarget, ImplicitCurve,
-        Integrator, KeyboardControlsPlugin, LoadPreset, Method, OnWire, ParallelStep, ParamError,
-        PendingBead, PendingParams, Restart, ScenePreset, ScenePresetPlugin, SimClock, SimParams,
-        Stabilization, Wire, WireBeadPlugin, WireBeadSystems, WireBeads, WireKind, WireShape,
+        Bead, BeadDiagnostics, BeadDiverged, BeadParams, Constraint, ConstraintDiagnostics,
+        Diverged, DragTarget, ImplicitCurve, Integrator, Islands, Joint, KeyboardControlsPlugin,
+        LoadPreset, Method, OnWire, ParallelStep, ParamError, PendingBead, PendingParams, Pin,
+        Restart, Rod, ScenePreset, ScenePresetPlugin, SimClock, SimParams, Spring, Stabilization,
+        Wire, WireBeadPlugin, WireBeadSystems, WireBeads, WireKind, WireShape,
     };
 }
 

@@ -50,6 +50,9 @@ pub enum DivergenceReason {
     /// The bead's wire entity has no [`Wire`](crate::Wire) or its
     /// `Transform` is not finite.
     InvalidWire(String),
+    /// The constraints and springs that join the bead to others cannot be
+    /// solved together (a mass or a value out of range).
+    InvalidConstraint(String),
 }
 
 impl fmt::Display for DivergenceReason {
@@ -58,6 +61,7 @@ impl fmt::Display for DivergenceReason {
             Self::Solve(e) => e.fmt(f),
             Self::NonFiniteState => f.write_str("its position or velocity is not finite"),
             Self::InvalidWire(why) => write!(f, "its wire is invalid: {why}"),
+            Self::InvalidConstraint(why) => write!(f, "its island is invalid: {why}"),
         }
     }
 }

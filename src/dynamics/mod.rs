@@ -1,15 +1,18 @@
 //! The ECS nouns a game spawns and reads: [`Wire`] and [`OnWire`], [`Bead`]
-//! and its edits, the parameters, the diagnostics. Plain data with
+//! and its edits, the links between beads ([`Rod`], [`Pin`], [`Spring`],
+//! [`Joint`]), the parameters, the diagnostics. Plain data with
 //! validating constructors; the step that moves them is in
 //! [`plugin`](crate::plugin), the math it calls in [`solver`](crate::solver).
 
 mod bead;
 mod diagnostics;
+mod links;
 mod params;
 mod wire;
 
 pub use bead::{Bead, BeadParams, DragTarget, PendingBead};
 pub use diagnostics::{BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason};
+pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
 pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, PendingParams, SimParams};
 pub(crate) use wire::WirePose;
 pub use wire::{OnWire, PendingWire, Wire, WireBeads, pose_of};

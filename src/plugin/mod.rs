@@ -7,6 +7,7 @@
 //! | `restart` | [`Restart`], [`SimClock`] and the systems that apply edits |
 //! | `forces` | the drag spring |
 //! | `step` | placing the wires and stepping the beads |
+//! | `islands` | [`Islands`]: beads joined by rods, pins, joints and springs, stepped together |
 //! | `writeback` | `Transform`s from the `f64` state |
 //! | `parallel` | [`ParallelStep`] and task-pool helpers |
 //!
@@ -14,6 +15,7 @@
 //! against the sets.
 
 mod forces;
+mod islands;
 mod parallel;
 mod restart;
 mod schedule;
@@ -22,18 +24,22 @@ mod writeback;
 
 use bevy::prelude::*;
 
+pub use islands::{IslandReport, Islands};
 pub use parallel::{ParallelStep, compute_on_all_cores, use_single_threaded_executors};
 pub use restart::{Restart, SimClock};
 pub use schedule::WireBeadSystems;
 
 use forces::apply_drag;
+use islands::{prepare_islands, step_islands, topology_changed};
 use restart::{apply_restart, apply_timestep};
 use step::{prepare_step, step_beads};
 use writeback::write_transforms;
 
 use crate::dynamics::{
-    Bead, BeadDiagnostics, BeadDiverged, DragTarget, PendingBead, PendingParams, SimParams,
+    Bead, BeadDiagnostics, BeadDiverged, ConstraintDiagnostics, DragTarget, OnWire, PendingBead,
+    PendingParams, Pin, Rod, SimParams, Spring, Wire,
 };
+use bevy::ecs::lifecycle::{Add, Insert, Remove};
 use writeback::LastStep;
 
 /// Beads on wires: the simulation, headless. Add it to any app that has
@@ -120,11 +126,26 @@ impl Plugin for WireBeadPlugin {
         app.init_resource::<ParallelStep>()
             .init_resource::<SimClock>()
             .init_resource::<LastStep>()
+            .init_resource::<Islands>()
+            .add_observer(topology_changed::<Add, Bead>)
+            .add_observer(topology_changed::<Remove, Bead>)
+            .add_observer(topology_changed::<Insert, OnWire>)
+            .add_observer(topology_changed::<Remove, OnWire>)
+            .add_observer(topology_changed::<Insert, Wire>)
+            .add_observer(topology_changed::<Remove, Wire>)
+            .add_observer(topology_changed::<Remove, Rod>)
+            .add_observer(topology_changed::<Remove, Pin>)
+            .add_observer(topology_changed::<Remove, Spring>)
+            .add_observer(topology_changed::<Remove, crate::dynamics::Joint>)
             .add_message::<Restart>()
             .add_message::<BeadDiverged>()
             .register_type::<Bead>()
             .register_type::<BeadDiagnostics>()
             .register_type::<DragTarget>()
+            .register_type::<Rod>()
+            .register_type::<Pin>()
+            .register_type::<Spring>()
+            .register_type::<ConstraintDiagnostics>()
             .register_type::<PendingBead>()
             .register_type::<SimParams>()
             .register_type::<ParallelStep>()
@@ -135,9 +156,11 @@ impl Plugin for WireBeadPlugin {
             .add_systems(
                 FixedUpdate,
                 (
-                    prepare_step.in_set(WireBeadSystems::Prepare),
+                    (prepare_step, prepare_islands)
+                        .chain()
+                        .in_set(WireBeadSystems::Prepare),
                     apply_drag.in_set(WireBeadSystems::Forces),
-                    step_beads.in_set(WireBeadSystems::Step),
+                    (step_beads, step_islands).in_set(WireBeadSystems::Step),
                     write_transforms.in_set(WireBeadSystems::Writeback),
                 ),
             );

@@ -3,6 +3,8 @@
 
 use bevy::prelude::*;
 
+use super::islands::Islands;
+
 use crate::dynamics::{
     Bead, BeadDiagnostics, Diverged, OnWire, PendingBead, PendingParams, PendingWire, SimParams,
     Wire, pose_of,
@@ -65,11 +67,14 @@ pub(crate) fn apply_restart(
         Option<&OnWire>,
         Option<&PendingBead>,
     )>,
+    mut islands: ResMut<Islands>,
     mut commands: Commands,
 ) {
     if restarts.read().count() == 0 {
         return;
     }
+    // Masses and wire shapes may change: the islands are built afresh.
+    islands.mark_dirty();
     for (entity, mut wire, _, edit) in &mut wires {
         if let Some(edit) = edit {
             *wire = edit.wire().clone();

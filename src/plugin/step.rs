@@ -11,6 +11,7 @@ use bevy::ecs::system::{SystemChangeTick, SystemParam};
 use bevy::prelude::*;
 use bevy::tasks::ComputeTaskPool;
 
+use super::islands::InIsland;
 use super::parallel::ParallelStep;
 use super::restart::SimClock;
 use super::writeback::{LastStep, place};
@@ -65,7 +66,7 @@ pub(crate) struct Divergences<'w, 's> {
 
 impl Divergences<'_, '_> {
     /// Reports that `bead` stopped at simulated time `time`.
-    fn report(&mut self, bead: Entity, reason: DivergenceReason, time: f64) {
+    pub(crate) fn report(&mut self, bead: Entity, reason: DivergenceReason, time: f64) {
         warn!(
             "wirebead: bead {bead} diverged at t = {time:.4} s: {reason}; press Space (send Restart) to recover"
         );
@@ -356,7 +357,7 @@ pub(crate) fn step_beads(
             Option<&mut BeadDiagnostics>,
             Option<&mut Transform>,
         ),
-        Without<Diverged>,
+        (Without<Diverged>, Without<InIsland>),
     >,
     mut found: Local<FoundDivergences>,
     mut stepped: ResMut<LastStep>,

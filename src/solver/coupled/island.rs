@@ -5,6 +5,7 @@ use bevy::math::DVec2;
 
 use super::constraint::{RowKind, SpringLink};
 use super::normal::{Factored, NormalMatrix};
+use crate::geometry::Pose;
 use crate::solver::method::Method;
 use crate::solver::projection::{NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE};
 use crate::solver::settings::{Gains, StepSettings};
@@ -131,6 +132,7 @@ pub struct IslandWork {
     scratch: Vec<DVec2>,
     factored: Factored,
     reports: Vec<RowReport>,
+    bead_forces: Vec<DVec2>,
     substeps: u32,
 }
 
@@ -138,6 +140,12 @@ impl IslandWork {
     /// What the last successful step reported of each row.
     pub fn rows(&self) -> &[RowReport] {
         &self.reports
+    }
+
+    /// The constraint force `Σ λ ∇C` on each bead at the end of the last
+    /// step (λ as [`IslandWork::rows`] reports it).
+    pub fn constraint_forces(&self) -> &[DVec2] {
+        &self.bead_forces
     }
 
     /// How many substeps the last step took: 1, or more where it was
@@ -260,6 +268,14 @@ impl Island {
             springs,
             normal,
         })
+    }
+
+    /// Moves the wire of row `row` to `pose` (a wire that moves between
+    /// steps); rows of other kinds are left as they are.
+    pub fn place_wire(&mut self, row: usize, pose: Pose) {
+        if let Some(RowKind::Wire { pose: placed, .. }) = self.rows.get_mut(row) {
+            *placed = pose;
+        }
     }
 
     /// How many beads.
@@ -393,9 +409,18 @@ impl Island {
         if settings.method.projects() {
             self.project(work)?;
         }
+        work.bead_forces.clear();
+        work.bead_forces.resize(n, DVec2::ZERO);
         for (r, report) in work.reports.iter_mut().enumerate() {
             report.c = work.c[r];
             report.c_dot = self.rate(r, &work.gradient, &work.v);
+            let entries = self.row_start[r]..self.row_start[r + 1];
+            for (&bead, g) in self.entry_bead[entries.clone()]
+                .iter()
+                .zip(&work.gradient[entries])
+            {
+                work.bead_forces[bead] += report.lambda * *g;
+            }
         }
         for (state, (x, v)) in states.iter_mut().zip(work.x.iter().zip(&work.v)) {
             state.position = *x;
@@ -516,7 +541,9 @@ impl Island {
             &mut work.scratch,
         );
         self.applied(forces, x, v, &mut work.force);
-        self.factor(&work.gradient, x, &mut work.factored)?;
+        if self.rows() > 0 {
+            self.factor(&work.gradient, x, &mut work.factored)?;
+        }
         work.lambda.clear();
         for r in 0..self.rows() {
             let pushed: f64 = (self.row_start[r]..self.row_start[r + 1])
@@ -705,6 +732,9 @@ impl Island {
     /// `v ← v − W Jᵀ (J W Jᵀ)⁻¹ J v` at `work.x` (rows evaluated there).
     /// Returns with the multipliers (of `−J v`) in `work.rhs`.
     fn project_velocity(&self, work: &mut IslandWork) -> Result<(), SolveError> {
+        if self.rows() == 0 {
+            return Ok(());
+        }
         self.factor(&work.gradient, &work.x, &mut work.factored)?;
         work.rhs.clear();
         for r in 0..self.rows() {
@@ -741,7 +771,9 @@ impl Island {
             &mut work.curvature,
             &mut work.scratch,
         );
-        self.factor(&work.gradient, &work.x0, &mut work.factored)?;
+        if self.rows() > 0 {
+            self.factor(&work.gradient, &work.x0, &mut work.factored)?;
+        }
         work.first_gradient.clone_from(&work.gradient);
         self.applied(forces, &work.x0, &work.v0, &mut work.force);
         work.x.clear();

@@ -315,7 +315,9 @@ impl NormalMatrix {
     /// Solves `A λ = rhs` in place with the last factorization.
     pub(crate) fn solve(&self, f: &mut Factored, rhs: &mut [f64]) {
         let Some(symbolic) = &self.symbolic else {
-            rhs[0] /= f.values[self.diagonal[0]];
+            if let (Some(b), Some(&k)) = (rhs.first_mut(), self.diagonal.first()) {
+                *b /= f.values[k];
+            }
             return;
         };
         for (b, s) in rhs.iter_mut().zip(&f.scale) {

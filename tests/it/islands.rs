@@ -1,0 +1,193 @@
+//! Beads joined by rods, pins and springs in the plugin: the systems only
+//! move data (the same steps as the pure island solver, bit for bit),
+//! free beads fly, and bad links are left out in words.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use wirebead::geometry::{Line, Pose, WireShape};
+use wirebead::prelude::*;
+use wirebead::solver::{BeadState, Island, IslandRow, IslandWork, LinearForce, RowKind};
+
+use crate::common::{app, bead, params, run_steps};
+
+/// A cart of mass 2 on a horizontal line, a bob of mass 1 on a rod of
+/// length 1, 30° out. Returns (cart, bob, rod).
+fn cart_and_bob(app: &mut App) -> (Entity, Entity, Entity) {
+    let world = app.world_mut();
+    let line = world.spawn(Wire::line()).id();
+    let cart = world
+        .spawn((Bead::at_rest(2.0, DVec2::ZERO).unwrap(), OnWire(line)))
+        .id();
+    let bob_at = DVec2::new(0.5, -(0.75f64).sqrt());
+    let bob = world.spawn(Bead::at_rest(1.0, bob_at).unwrap()).id();
+    let rod = world.spawn(Rod::new(cart, bob, 1.0).unwrap()).id();
+    (cart, bob, rod)
+}
+
+#[test]
+fn the_plugin_steps_a_pendulum_on_a_cart_as_the_island_solver_does() {
+    let p = params(Method::Rattle, 1.0 / 60.0);
+    let mut app = app(p.clone());
+    let (cart, bob, rod) = cart_and_bob(&mut app);
+    run_steps(&mut app, 120);
+
+    let island = Island::new(
+        &[2.0, 1.0],
+        vec![
+            IslandRow {
+                kind: RowKind::Wire {
+                    shape: WireShape::Line(Line),
+                    pose: Pose::default(),
+                },
+                beads: vec![0],
+            },
+            IslandRow {
+                kind: RowKind::Rod { length: 1.0 },
+                beads: vec![0, 1],
+            },
+        ],
+        vec![],
+    )
+    .unwrap();
+    let mut states = vec![
+        BeadState::default(),
+        BeadState {
+            position: DVec2::new(0.5, -(0.75f64).sqrt()),
+            velocity: DVec2::ZERO,
+        },
+    ];
+    let forces = [
+        LinearForce::constant(2.0 * p.gravity),
+        LinearForce::constant(p.gravity),
+    ];
+    let mut work = IslandWork::default();
+    for _ in 0..120 {
+        island
+            .step(&mut states, &forces, &p.step_settings(), &mut work)
+            .unwrap();
+    }
+    assert_eq!(bead(&app, cart).state(), states[0]);
+    assert_eq!(bead(&app, bob).state(), states[1]);
+    let rod = app.world().get::<ConstraintDiagnostics>(rod).unwrap();
+    assert!(rod.c.abs() <= 1e-12, "the rod drifted {:e}", rod.c);
+    assert!(rod.lambda < 0.0, "a hanging rod pulls: λ = {}", rod.lambda);
+    let momentum = 2.0 * bead(&app, cart).velocity.x + bead(&app, bob).velocity.x;
+    assert!(momentum.abs() < 1e-12, "horizontal momentum {momentum:e}");
+    let islands = app.world().resource::<Islands>();
+    let report = islands.of(bob).expect("the bob is in an island");
+    assert_eq!((report.beads.len(), report.rows), (2, 2));
+    let transform = app.world().get::<Transform>(bob).unwrap();
+    assert_eq!(transform.translation.x, states[1].position.x as f32);
+}
+
+#[test]
+fn a_free_bead_flies_a_parabola() {
+    // RK4 is exact for constant acceleration.
+    let mut app = app(params(Method::Rk4(Stabilization::Baumgarte), 0.01));
+    let v0 = DVec2::new(3.0, 4.0);
+    let free = Bead::new(BeadParams {
+        mass: 1.5,
+        initial_position: DVec2::ZERO,
+        initial_velocity: v0,
+    })
+    .unwrap();
+    let free = app.world_mut().spawn(free).id();
+    run_steps(&mut app, 50);
+    let t = 0.5;
+    let g = DVec2::new(0.0, -9.81);
+    let expect = v0 * t + 0.5 * g * t * t;
+    let got = bead(&app, free).position;
+    assert!((got - expect).length() < 1e-12, "{got} against {expect}");
+}
+
+#[test]
+fn a_rod_to_an_entity_that_is_no_bead_is_left_out() {
+    let mut app = app(params(Method::Rattle, 0.01));
+    let stranger = app.world_mut().spawn_empty().id();
+    let free = app
+        .world_mut()
+        .spawn(Bead::at_rest(1.0, DVec2::ZERO).unwrap())
+        .id();
+    app.world_mut()
+        .spawn(Rod::new(free, stranger, 1.0).unwrap());
+    run_steps(&mut app, 10);
+    // The bead falls freely: the rod was left out, nothing panicked.
+    let y = bead(&app, free).position.y;
+    assert!(y < -0.04 && y.is_finite(), "y = {y}");
+    assert!(app.world().get::<Diverged>(free).is_none());
+}
+
+#[test]
+fn links_refuse_a_bead_joined_to_itself_in_words() {
+    let mut app = app(SimParams::default());
+    let b = app.world_mut().spawn_empty().id();
+    assert_eq!(
+        Rod::new(b, b, 1.0).unwrap_err().to_string(),
+        "a rod must join two different beads"
+    );
+    assert_eq!(
+        Spring::new(b, b, 1.0, 10.0, 0.0).unwrap_err().to_string(),
+        "a spring must join two different beads"
+    );
+    assert_eq!(
+        Rod::new(b, Entity::PLACEHOLDER, -1.0)
+            .unwrap_err()
+            .to_string(),
+        "rod length must be positive and finite, got -1"
+    );
+    assert_eq!(
+        Pin::new(b, DVec2::new(f64::NAN, 0.0))
+            .unwrap_err()
+            .to_string(),
+        "pin point must be finite, got (NaN, 0)"
+    );
+}
+
+#[test]
+fn removing_the_rod_lets_the_bob_fall_freely() {
+    let mut app = app(params(Method::Rk4(Stabilization::Baumgarte), 0.01));
+    let (_, bob, rod) = cart_and_bob(&mut app);
+    run_steps(&mut app, 5);
+    app.world_mut().despawn(rod);
+    let before = bead(&app, bob);
+    run_steps(&mut app, 10);
+    // Ten free steps from the state it had: exact for RK4.
+    let t = 0.1;
+    let expect = before.position + before.velocity * t + 0.5 * DVec2::new(0.0, -9.81) * t * t;
+    let got = bead(&app, bob).position;
+    assert!((got - expect).length() < 1e-12, "{got} against {expect}");
+}
+
+#[test]
+fn an_island_that_fails_stops_whole_and_keeps_its_state() {
+    let mut app = app(params(Method::Rattle, 0.01));
+    let world = app.world_mut();
+    let top = world.spawn(Bead::at_rest(1.0, DVec2::ZERO).unwrap()).id();
+    let bob = world.spawn(Bead::at_rest(1.0, DVec2::ZERO).unwrap()).id();
+    world.spawn(Pin::new(top, DVec2::ZERO).unwrap());
+    world.spawn(Rod::new(top, bob, 1.0).unwrap());
+    run_steps(&mut app, 3);
+    for b in [top, bob] {
+        let diverged = app.world().get::<Diverged>(b).expect("diverged");
+        assert!(
+            diverged.reason.to_string().contains("singular point"),
+            "{}",
+            diverged.reason
+        );
+        assert_eq!(bead(&app, b).position, DVec2::ZERO);
+        assert!(app.world().get::<Transform>(b).unwrap().is_finite());
+    }
+}
+
+#[test]
+fn a_restart_returns_an_island_to_its_start() {
+    let mut app = app(params(Method::Rattle, 1.0 / 60.0));
+    let (cart, bob, _) = cart_and_bob(&mut app);
+    run_steps(&mut app, 30);
+    let first = (bead(&app, cart).state(), bead(&app, bob).state());
+    app.world_mut().write_message(Restart);
+    run_steps(&mut app, 0);
+    assert_eq!(bead(&app, bob).position, DVec2::new(0.5, -(0.75f64).sqrt()));
+    run_steps(&mut app, 30);
+    assert_eq!((bead(&app, cart).state(), bead(&app, bob).state()), first);
+}
