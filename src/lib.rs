@@ -92,7 +92,7 @@ pub use geometry::{ImplicitCurve, WireKind, WireShape};
 pub use plugin::{
     IslandReport, Islands, ParallelStep, Restart, SimClock, WireBeadPlugin, WireBeadSystems,
 };
-pub use preset::{ActivePreset, LoadPreset, ScenePreset, ScenePresetPlugin};
+pub use preset::{ActivePreset, LoadPreset, SceneLink, ScenePreset, ScenePresetPlugin};
 pub use solver::{Constraint, Integrator, Method, Stabilization};
 pub use validate::ParamError;
 

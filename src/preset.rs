@@ -1,18 +1,24 @@
-//! Scene presets: RON files that set the wires, the beads and the
-//! parameters, loaded as Bevy assets (`*.scene.ron`).
+//! Scene presets: RON files that set the wires, the beads, the links
+//! between beads and the parameters, loaded as Bevy assets
+//! (`*.scene.ron`).
 //!
 //! ```ron
 //! (
-//!     name: "The assignment's circle",
-//!     params: (alpha: 100.0, beta: 20.0),
-//!     wires: [
-//!         (
-//!             shape: Circle((radius: 1.0)),
-//!             beads: [(mass: 1.0, initial_position: (0.0, -1.0), initial_velocity: (3.0, 0.0))],
-//!         ),
-//!     ],
+//!     name: "Pendulum on a cart",
+//!     params: (integrator: Rattle),
+//!     wires: [(shape: Line(()), beads: [(name: "cart", mass: 2.0, initial_position: (0.0, 0.0))])],
+//!     beads: [(name: "bob", mass: 1.0, initial_position: (0.0, -1.0))],
+//!     constraints: [Rod((a: "cart", b: "bob", length: 1.0))],
+//!     springs: [],
 //! )
 //! ```
+//!
+//! `beads` outside `wires` are free (on no wire). Links name beads by
+//! their `name`; a bead without one is `bead0`, `bead1`, … by its place in
+//! the file (the wires' beads in order, then the free ones). A pin is
+//! `Pin((bead: "top", at: (0.0, 2.0)))`, a spring
+//! `(a: "p", b: "q", rest_length: 1.0, stiffness: 50.0, damping: 0.1)`.
+//! `beads`, `constraints` and `springs` may be left out.
 //!
 //! [`ScenePresetPlugin`] loads the file named by [`ActivePreset`], applies it
 //! when it loads and again whenever the file changes (with Bevy's
@@ -25,10 +31,103 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::dynamics::{Bead, BeadParams, OnWire, PendingParams, SimParams, Wire};
+use crate::dynamics::{Bead, BeadParams, OnWire, PendingParams, Pin, Rod, SimParams, Spring, Wire};
 use crate::geometry::WireShape;
 use crate::plugin::{Restart, WireBeadSystems};
-use crate::validate::{ParamError, finite, finite_vector};
+use crate::validate::{ParamError, finite, finite_vector, non_negative, positive};
+
+/// A bead of a scene file: its name (optional) and its parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct BeadPreset {
+    /// The name links refer to it by; empty for none (it is then
+    /// `bead<i>`, `i` its place in the file).
+    pub name: String,
+    /// Mass in kg.
+    pub mass: f64,
+    /// Where a restart puts the bead.
+    pub initial_position: DVec2,
+    /// The velocity a restart gives it.
+    pub initial_velocity: DVec2,
+}
+
+impl Default for BeadPreset {
+    fn default() -> Self {
+        let params = BeadParams::default();
+        Self {
+            name: String::new(),
+            mass: params.mass,
+            initial_position: params.initial_position,
+            initial_velocity: params.initial_velocity,
+        }
+    }
+}
+
+impl BeadPreset {
+    /// The bead's parameters.
+    pub fn params(&self) -> BeadParams {
+        BeadParams {
+            mass: self.mass,
+            initial_position: self.initial_position,
+            initial_velocity: self.initial_velocity,
+        }
+    }
+}
+
+/// A rod of a scene file: `|x_a − x_b| = length`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RodPreset {
+    /// The first bead's name.
+    pub a: String,
+    /// The second bead's name.
+    pub b: String,
+    /// The rod's length.
+    pub length: f64,
+}
+
+/// A pin of a scene file: a bead held at a point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PinPreset {
+    /// The bead's name.
+    pub bead: String,
+    /// The point.
+    pub at: DVec2,
+}
+
+/// A constraint of a scene file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum ConstraintPreset {
+    /// See [`Rod`].
+    Rod(RodPreset),
+    /// See [`Pin`].
+    Pin(PinPreset),
+}
+
+impl ConstraintPreset {
+    /// `rod` or `pin`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Rod(_) => "rod",
+            Self::Pin(_) => "pin",
+        }
+    }
+}
+
+/// A spring of a scene file (see [`Spring`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpringPreset {
+    /// The first bead's name.
+    pub a: String,
+    /// The second bead's name.
+    pub b: String,
+    /// Rest length.
+    pub rest_length: f64,
+    /// Stiffness (N/m).
+    pub stiffness: f64,
+    /// Damping along the spring (N·s/m).
+    #[serde(default)]
+    pub damping: f64,
+}
 
 /// One wire of a preset and the beads on it.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -43,7 +142,7 @@ pub struct WirePreset {
     pub angle_degrees: f64,
     /// The beads on it.
     #[serde(default)]
-    pub beads: Vec<BeadParams>,
+    pub beads: Vec<BeadPreset>,
 }
 
 /// A whole scene: parameters, wires and beads.
@@ -55,7 +154,17 @@ pub struct ScenePreset {
     #[serde(default)]
     pub params: SimParams,
     /// The wires.
+    #[serde(default)]
     pub wires: Vec<WirePreset>,
+    /// The free beads, on no wire.
+    #[serde(default)]
+    pub beads: Vec<BeadPreset>,
+    /// Rods and pins.
+    #[serde(default)]
+    pub constraints: Vec<ConstraintPreset>,
+    /// Springs between beads.
+    #[serde(default)]
+    pub springs: Vec<SpringPreset>,
 }
 
 /// What is wrong with a scene file.
@@ -93,6 +202,25 @@ pub enum PresetError {
         /// What is wrong.
         source: ParamError,
     },
+    /// A free bead is invalid.
+    #[error("bead {name:?}: {source}")]
+    FreeBead {
+        /// Its name.
+        name: String,
+        /// What is wrong.
+        source: ParamError,
+    },
+    /// Two beads have one name.
+    #[error("two beads are named {0:?}")]
+    DuplicateName(String),
+    /// A constraint or spring is invalid.
+    #[error("{item}: {problem}")]
+    Link {
+        /// Which, in words: `constraint 0 (rod)`, `spring 1`.
+        item: String,
+        /// What is wrong.
+        problem: String,
+    },
     /// The scene has no bead.
     #[error("the scene has no bead")]
     Empty,
@@ -116,40 +244,216 @@ impl ScenePreset {
             finite_vector("wire position", wire.position)
                 .and_then(|_| finite("wire angle", wire.angle_degrees))
                 .map_err(|source| PresetError::Wire { index, source })?;
-            for (bead, params) in wire.beads.iter().enumerate() {
-                params.validate().map_err(|source| PresetError::Bead {
-                    wire: index,
-                    bead,
-                    source,
-                })?;
+            for (bead, preset) in wire.beads.iter().enumerate() {
+                preset
+                    .params()
+                    .validate()
+                    .map_err(|source| PresetError::Bead {
+                        wire: index,
+                        bead,
+                        source,
+                    })?;
             }
         }
-        if self.wires.iter().all(|w| w.beads.is_empty()) {
+        let names = self.bead_names();
+        let free_names = &names[self.wire_bead_count()..];
+        for (bead, name) in self.beads.iter().zip(free_names) {
+            bead.params()
+                .validate()
+                .map_err(|source| PresetError::FreeBead {
+                    name: name.clone(),
+                    source,
+                })?;
+        }
+        for (i, name) in names.iter().enumerate() {
+            if names[..i].contains(name) {
+                return Err(PresetError::DuplicateName(name.clone()));
+            }
+        }
+        self.resolve_links(&names)?;
+        if names.is_empty() {
             return Err(PresetError::Empty);
         }
         Ok(())
     }
 
-    /// Spawns the wires and beads (each tagged [`FromPreset`]); returns the
-    /// beads. Call on a validated preset.
+    /// Every bead of the file in order: the wires' beads, then the free
+    /// ones.
+    pub fn all_beads(&self) -> impl Iterator<Item = &BeadPreset> {
+        self.wires.iter().flat_map(|w| &w.beads).chain(&self.beads)
+    }
+
+    fn wire_bead_count(&self) -> usize {
+        self.wires.iter().map(|w| w.beads.len()).sum()
+    }
+
+    /// Each bead's name, in the file's order: its own, or `bead<i>`.
+    pub fn bead_names(&self) -> Vec<String> {
+        self.all_beads()
+            .enumerate()
+            .map(|(i, b)| {
+                if b.name.is_empty() {
+                    format!("bead{i}")
+                } else {
+                    b.name.clone()
+                }
+            })
+            .collect()
+    }
+
+    /// The constraints, then the springs, with the beads they name as
+    /// indices into [`ScenePreset::all_beads`], every value checked.
+    pub fn links(&self) -> Result<Vec<SceneLink>, PresetError> {
+        self.resolve_links(&self.bead_names())
+    }
+
+    fn resolve_links(&self, names: &[String]) -> Result<Vec<SceneLink>, PresetError> {
+        let find = |item: &dyn Fn() -> String, name: &str| {
+            names
+                .iter()
+                .position(|n| n == name)
+                .ok_or_else(|| PresetError::Link {
+                    item: item(),
+                    problem: format!("no bead is named {name:?}"),
+                })
+        };
+        let problem = |item: String| {
+            move |e: ParamError| PresetError::Link {
+                item,
+                problem: e.to_string(),
+            }
+        };
+        let mut links = Vec::new();
+        for (index, constraint) in self.constraints.iter().enumerate() {
+            let item = || format!("constraint {index} ({})", constraint.kind());
+            links.push(match constraint {
+                ConstraintPreset::Rod(rod) => {
+                    let (a, b) = (find(&item, &rod.a)?, find(&item, &rod.b)?);
+                    if a == b {
+                        return Err(problem(item())(ParamError::Incompatible(
+                            "a rod must join two different beads",
+                        )));
+                    }
+                    positive("rod length", rod.length).map_err(problem(item()))?;
+                    SceneLink::Rod {
+                        a,
+                        b,
+                        length: rod.length,
+                    }
+                }
+                ConstraintPreset::Pin(pin) => {
+                    let bead = find(&item, &pin.bead)?;
+                    finite_vector("pin point", pin.at).map_err(problem(item()))?;
+                    SceneLink::Pin { bead, at: pin.at }
+                }
+            });
+        }
+        for (index, spring) in self.springs.iter().enumerate() {
+            let item = || format!("spring {index}");
+            let (a, b) = (find(&item, &spring.a)?, find(&item, &spring.b)?);
+            if a == b {
+                return Err(problem(item())(ParamError::Incompatible(
+                    "a spring must join two different beads",
+                )));
+            }
+            for (name, value) in [
+                ("spring rest length", spring.rest_length),
+                ("spring stiffness", spring.stiffness),
+                ("spring damping", spring.damping),
+            ] {
+                non_negative(name, value).map_err(problem(item()))?;
+            }
+            links.push(SceneLink::Spring {
+                a,
+                b,
+                spring: spring.clone(),
+            });
+        }
+        Ok(links)
+    }
+
+    /// Spawns the wires, the beads (named with [`Name`]) and the links,
+    /// each tagged [`FromPreset`]; returns the beads in the file's order.
+    /// Call on a validated preset: anything invalid is left out.
     pub fn spawn(&self, commands: &mut Commands) -> Vec<Entity> {
+        let names = self.bead_names();
         let mut beads = Vec::new();
-        for wire in &self.wires {
-            let Ok(component) = Wire::new(wire.shape.clone()) else {
-                continue;
+        let mut spawn_bead =
+            |preset: &BeadPreset, wire: Option<Entity>, commands: &mut Commands| {
+                let name = Name::new(names[beads.len()].clone());
+                let Ok(bead) = Bead::new(preset.params()) else {
+                    beads.push(Entity::PLACEHOLDER);
+                    return;
+                };
+                let mut entity = commands.spawn((bead, name, FromPreset));
+                if let Some(wire) = wire {
+                    entity.insert(OnWire(wire));
+                }
+                beads.push(entity.id());
             };
+        for wire in &self.wires {
             let transform =
                 Transform::from_xyz(wire.position.x as f32, wire.position.y as f32, 0.0)
                     .with_rotation(Quat::from_rotation_z(wire.angle_degrees.to_radians() as f32));
-            let wire_entity = commands.spawn((component, transform, FromPreset)).id();
-            for params in &wire.beads {
-                if let Ok(bead) = Bead::new(*params) {
-                    beads.push(commands.spawn((bead, OnWire(wire_entity), FromPreset)).id());
+            let wire_entity = Wire::new(wire.shape.clone())
+                .ok()
+                .map(|component| commands.spawn((component, transform, FromPreset)).id());
+            for preset in &wire.beads {
+                spawn_bead(preset, wire_entity, commands);
+            }
+        }
+        for preset in &self.beads {
+            spawn_bead(preset, None, commands);
+        }
+        for link in self.resolve_links(&names).unwrap_or_default() {
+            let spawned = match link {
+                SceneLink::Rod { a, b, length } => Rod::new(beads[a], beads[b], length)
+                    .map(|rod| commands.spawn((rod, FromPreset)).id()),
+                SceneLink::Pin { bead, at } => {
+                    Pin::new(beads[bead], at).map(|pin| commands.spawn((pin, FromPreset)).id())
                 }
+                SceneLink::Spring { a, b, spring: s } => {
+                    Spring::new(beads[a], beads[b], s.rest_length, s.stiffness, s.damping)
+                        .map(|spring| commands.spawn((spring, FromPreset)).id())
+                }
+            };
+            if let Err(e) = spawned {
+                warn!("wirebead: a link of the scene was left out: {e}");
             }
         }
         beads
     }
+}
+
+/// A link of a scene with its beads as indices into
+/// [`ScenePreset::all_beads`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneLink {
+    /// A rod between beads `a` and `b`.
+    Rod {
+        /// The first bead.
+        a: usize,
+        /// The second bead.
+        b: usize,
+        /// Its length.
+        length: f64,
+    },
+    /// A pin holding `bead` at `at`.
+    Pin {
+        /// The bead.
+        bead: usize,
+        /// The point.
+        at: DVec2,
+    },
+    /// A spring between beads `a` and `b`.
+    Spring {
+        /// The first bead.
+        a: usize,
+        /// The second bead.
+        b: usize,
+        /// Its law.
+        spring: SpringPreset,
+    },
 }
 
 /// Loads `*.scene.ron` files as [`ScenePreset`]s, validating them.
@@ -271,7 +575,7 @@ pub fn apply_loaded_preset(
     presets: Res<Assets<ScenePreset>>,
     mut active: ResMut<ActivePreset>,
     mut pending: ResMut<PendingParams>,
-    existing: Query<Entity, (With<FromPreset>, With<Wire>)>,
+    existing: Query<Entity, (With<FromPreset>, Without<OnWire>)>,
     mut restarts: MessageWriter<Restart>,
     mut commands: Commands,
 ) {
@@ -290,8 +594,9 @@ pub fn apply_loaded_preset(
         active.error = Some(err.to_string());
         return;
     }
-    for wire in &existing {
-        commands.entity(wire).despawn();
+    // Wires (which take their beads along), free beads and links.
+    for entity in &existing {
+        commands.entity(entity).try_despawn();
     }
     preset.spawn(&mut commands);
     active.running = Some(preset.name.clone());
@@ -320,7 +625,7 @@ mod tests {
         assert_eq!(preset.params.alpha, 50.0);
         assert_eq!(preset.params.method, crate::Method::Rattle);
         assert_eq!(preset.params.beta, SimParams::default().beta);
-        assert_eq!(preset.wires[1].beads[0], BeadParams::default());
+        assert_eq!(preset.wires[1].beads[0].params(), BeadParams::default());
         assert_eq!(preset.wires[0].angle_degrees, 30.0);
     }
 
@@ -348,6 +653,67 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "invalid params: timestep must be positive and finite, got -0.1"
+        );
+    }
+
+    /// The format the issue fixes, verbatim.
+    const CART: &str = r#"(
+        name: "Pendulum on a cart",
+        params: (integrator: Rattle),
+        wires: [(shape: Line(()), beads: [(name: "cart", mass: 2.0, initial_position: (0.0, 0.0))])],
+        beads: [(name: "bob", mass: 1.0, initial_position: (0.0, -1.0)), (initial_position: (1.0, -1.0))],
+        constraints: [Rod((a: "cart", b: "bob", length: 1.0)), Pin((bead: "bead2", at: (1.0, -1.0)))],
+        springs: [(a: "bob", b: "bead2", rest_length: 1.0, stiffness: 50.0, damping: 0.1)],
+    )"#;
+
+    #[test]
+    fn a_coupled_scene_names_its_beads_and_links() {
+        let preset = ScenePreset::from_ron(CART).unwrap();
+        assert_eq!(preset.bead_names(), ["cart", "bob", "bead2"]);
+        assert_eq!(preset.all_beads().count(), 3);
+        assert_eq!(preset.constraints.len(), 2);
+        assert_eq!(preset.springs[0].damping, 0.1);
+        // Today's files, with no names, free beads or links, still load.
+        assert!(ScenePreset::from_ron(GOOD).unwrap().constraints.is_empty());
+    }
+
+    #[test]
+    fn bad_links_are_refused_naming_the_item() {
+        let refuse = |from: &str, to: &str| {
+            ScenePreset::from_ron(&CART.replace(from, to))
+                .unwrap_err()
+                .to_string()
+        };
+        assert_eq!(
+            refuse("b: \"bob\", length", "b: \"bobby\", length"),
+            "constraint 0 (rod): no bead is named \"bobby\""
+        );
+        assert_eq!(
+            refuse("b: \"bob\", length", "b: \"cart\", length"),
+            "constraint 0 (rod): a rod must join two different beads"
+        );
+        assert_eq!(
+            refuse("length: 1.0", "length: 0.0"),
+            "constraint 0 (rod): rod length must be positive and finite, got 0"
+        );
+        assert_eq!(
+            refuse("at: (1.0, -1.0)", "at: (NaN, -1.0)"),
+            "constraint 1 (pin): pin point must be finite, got (NaN, -1)"
+        );
+        assert_eq!(
+            refuse("(name: \"bob\"", "(name: \"cart\""),
+            "two beads are named \"cart\""
+        );
+        assert_eq!(
+            refuse("stiffness: 50.0", "stiffness: -50.0"),
+            "spring 0: spring stiffness must be zero or more and finite, got -50"
+        );
+        assert_eq!(
+            refuse(
+                "mass: 1.0, initial_position: (0.0, -1.0)",
+                "mass: 0.0, initial_position: (0.0, -1.0)"
+            ),
+            "bead \"bob\": mass must be positive and finite, got 0"
         );
     }
 }

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use bevy::prelude::*;
+use wirebead::SceneLink;
 use wirebead::headless::{Headless, idle, run_steps};
 use wirebead::prelude::*;
 use wirebead::preset::{ActivePreset, FromPreset};
@@ -15,6 +16,20 @@ const SHIPPED: &[&str] = &[
     "sine_track.scene.ron",
     "multi_bead.scene.ron",
     "resting.scene.ron",
+    "pendulum_on_cart.scene.ron",
+    "double_pendulum.scene.ron",
+    "rope.scene.ron",
+    "ring.scene.ron",
+    "spring_pair.scene.ron",
+];
+
+/// The shipped presets that join beads.
+const COUPLED: &[&str] = &[
+    "pendulum_on_cart.scene.ron",
+    "double_pendulum.scene.ron",
+    "rope.scene.ron",
+    "ring.scene.ron",
+    "spring_pair.scene.ron",
 ];
 
 /// The shipped presets, found at run time: a test binary reused from another
@@ -47,8 +62,69 @@ fn shipped_presets_are_valid_and_put_beads_on_their_wires() {
                 beads += 1;
             }
         }
+        let at: Vec<_> = preset.all_beads().map(|b| b.initial_position).collect();
+        for link in preset.links().unwrap() {
+            let c = match link {
+                SceneLink::Rod { a, b, length } => (at[a] - at[b]).length() - length,
+                SceneLink::Pin { bead, at: p } => (at[bead] - p).length(),
+                SceneLink::Spring { .. } => 0.0,
+            };
+            assert!(c.abs() < 1e-9, "{name}: {link:?} starts {c:e} off");
+        }
     }
     assert!(beads >= 7);
+}
+
+#[test]
+fn coupled_presets_run_ten_seconds_on_their_constraints() {
+    for name in COUPLED {
+        let text = std::fs::read_to_string(shipped_dir().join(name)).unwrap();
+        let preset = ScenePreset::from_ron(&text).unwrap();
+        let plugin = WireBeadPlugin::new(preset.params.clone()).unwrap();
+        let mut app = Headless::new(plugin).single_threaded().build();
+        preset.spawn(&mut app.world_mut().commands());
+        app.world_mut().flush();
+        run_steps(&mut app, 1);
+        let energy = |app: &App| {
+            app.world()
+                .resource::<Islands>()
+                .iter()
+                .map(|i| i.energy)
+                .sum::<f64>()
+        };
+        let e0 = energy(&app);
+        let mut worst = 0.0f64;
+        let mut drift = 0.0f64;
+        for _ in 0..599 {
+            run_steps(&mut app, 1);
+            let world = app.world_mut();
+            let mut links = world.query::<(&ConstraintDiagnostics, Option<&Rod>)>();
+            for (d, rod) in links.iter(world) {
+                worst = worst.max(d.c.abs() / rod.map_or(1.0, Rod::length));
+            }
+            let mut wires = world.query_filtered::<&BeadDiagnostics, With<OnWire>>();
+            for d in wires.iter(world) {
+                worst = worst.max(d.c.abs());
+            }
+            let mut diverged = world.query::<&Diverged>();
+            assert!(
+                diverged.iter(world).next().is_none(),
+                "{name}: a bead diverged"
+            );
+            drift = drift.max((energy(&app) - e0).abs());
+        }
+        assert!(worst <= 1e-9, "{name}: |C| reached {worst:e}");
+        // RATTLE's energy error stays bounded: under 2 % of the weight of
+        // the scene times its size (2 m). The spring pair's spring is
+        // damped, so its energy falls.
+        let weight: f64 = preset.all_beads().map(|b| b.mass * 9.81).sum();
+        if !name.starts_with("spring") {
+            assert!(
+                drift <= 0.02 * weight * 2.0,
+                "{name}: energy moved {drift} J"
+            );
+        }
+    }
 }
 
 /// A headless app with assets read from `dir`.
@@ -94,6 +170,11 @@ fn malformed_preset_reports_its_error_and_the_scene_runs_on() {
     )
     .unwrap();
     std::fs::write(dir.join("broken.scene.ron"), "(name: \"broken\", wires: [").unwrap();
+    std::fs::write(
+        dir.join("badlink.scene.ron"),
+        "(name: \"badlink\", beads: [(name: \"a\")], constraints: [Rod((a: \"a\", b: \"zz\", length: 1.0))])",
+    )
+    .unwrap();
 
     let mut app = asset_app(&dir);
     app.world_mut()
@@ -117,6 +198,10 @@ fn malformed_preset_reports_its_error_and_the_scene_runs_on() {
         (
             "broken.scene.ron",
             "malformed scene file at line 1, column ",
+        ),
+        (
+            "badlink.scene.ron",
+            "constraint 0 (rod): no bead is named \"zz\"",
         ),
     ] {
         app.world_mut().write_message(LoadPreset(file.into()));

@@ -556,3 +556,44 @@ fn a_step_with_no_rattle_solution_is_halved() {
     // ½ m v² = 112.5 J; RATTLE's bounded error at 36° a substep.
     assert!(energy <= 0.01 * 112.5, "energy moved by {energy} J");
 }
+
+#[test]
+fn rattle_keeps_a_spring_pair_on_a_track_to_second_order_in_energy() {
+    // Two beads on a bowl joined by a stretched spring (5.5 J stored):
+    // RATTLE's energy error is O(h²), so a step four times smaller cuts it
+    // about sixteenfold.
+    use crate::geometry::Parabola;
+    let energy_error = |dt: f64| {
+        let shape = WireShape::Parabola(Parabola { focal_length: 1.0 });
+        let pose = Pose::new(DVec2::new(0.0, -1.0), 0.0);
+        let spring = SpringLink {
+            a: 0,
+            b: 1,
+            rest_length: 1.5,
+            stiffness: 20.0,
+            damping: 0.0,
+        };
+        let island = Island::new(
+            &[1.0, 0.5],
+            vec![wire(0, shape.clone(), pose), wire(1, shape, pose)],
+            vec![spring],
+        )
+        .unwrap();
+        let mut states = at_rest(&[DVec2::new(-1.5, -0.4375), DVec2::new(0.7, -0.8775)]);
+        let e0 = island.energy(&states, G);
+        let mut worst = 0.0f64;
+        run(
+            &island,
+            &mut states,
+            &weights(&[1.0, 0.5]),
+            &settings(Method::Rattle, dt),
+            (5.0 / dt) as usize,
+            |s, _| worst = worst.max((island.energy(s, G) - e0).abs()),
+        );
+        worst
+    };
+    let (coarse, fine) = (energy_error(1.0 / 60.0), energy_error(1.0 / 240.0));
+    assert!(coarse < 0.05, "energy moved {coarse} J at 1/60 s");
+    let order = (coarse / fine).log(4.0);
+    assert!((1.8..2.2).contains(&order), "observed order {order}");
+}
