@@ -21,6 +21,13 @@ use wirebead::{
     SimParams, Wire, WireBeadPlugin, WireBeadSystems, WireShape,
 };
 
+mod scene;
+
+pub use scene::{
+    SceneComparison, SceneRow, SceneRun, compare_scene, load_scene, scene_comparison_markdown,
+    simulate_scene, write_scene_csv,
+};
+
 /// Errors of the analysis: a message naming what failed.
 pub type AnalysisResult<T> = Result<T, Box<dyn Error>>;
 

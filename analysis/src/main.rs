@@ -3,8 +3,10 @@
 //!
 //! ```sh
 //! cargo run --release -p wirebead-analysis -- simulate --alpha 0 --out run.csv
+//! cargo run --release -p wirebead-analysis -- simulate --scene assets/scenes/rope.scene.ron --out rope.csv
 //! cargo run --release -p wirebead-analysis -- figures --out-dir docs/figures
 //! cargo run --release -p wirebead-analysis -- compare --out-dir docs/compare
+//! cargo run --release -p wirebead-analysis -- compare --scene assets/scenes/double_pendulum.scene.ron --out-dir docs/compare
 //! ```
 
 use std::path::PathBuf;
@@ -25,7 +27,9 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run one simulation and write a CSV (`t,x,y,vx,vy,c,c_dot,lambda,energy`).
+    /// Run one simulation and write a CSV (`t,x,y,vx,vy,c,c_dot,lambda,energy`);
+    /// with `--scene`, any scene file (`t`, then `<bead>.x,<bead>.y,<bead>.vx,<bead>.vy`
+    /// for each bead, then `energy,max_abs_c`).
     Simulate(SimulateArgs),
     /// Reproduce the assignment's three studies: trajectory, drift and energy PNGs,
     /// the CSV behind each, and summary.md.
@@ -38,11 +42,16 @@ enum Command {
         duration: f64,
     },
     /// Every integrator × stabilization on the pendulum against the exact
-    /// period: a markdown table and a log–log error-versus-dt plot.
+    /// period: a markdown table and a log–log error-versus-dt plot. With
+    /// `--scene`, every method on any scene file: constraint error, energy
+    /// error and cost per step, as `<scene>.md`.
     Compare {
         /// Where to write everything.
         #[arg(long)]
         out_dir: PathBuf,
+        /// A scene file to compare the methods on instead of the pendulum.
+        #[arg(long, conflicts_with_all = ["theta0", "radius", "gravity"])]
+        scene: Option<PathBuf>,
         /// Release angle from the bottom, degrees.
         #[arg(long, default_value_t = 135.0)]
         theta0: f64,
@@ -64,6 +73,11 @@ enum Command {
 
 #[derive(Args, Debug)]
 struct SimulateArgs {
+    /// A scene file (`*.scene.ron`) to run instead of one bead on one wire;
+    /// its own parameters apply unless --dt, --integrator, --stabilization,
+    /// --alpha or --beta say otherwise.
+    #[arg(long, conflicts_with_all = ["wire", "radius", "mass", "gravity", "x0", "y0", "vx0", "vy0", "k"])]
+    scene: Option<PathBuf>,
     /// Wire shape.
     #[arg(long, default_value = "circle", value_parser = parse_wire)]
     wire: WireKind,
@@ -76,9 +90,10 @@ struct SimulateArgs {
     /// Gravity's y component.
     #[arg(long, default_value_t = -9.81, allow_negative_numbers = true)]
     gravity: f64,
-    /// Timestep in seconds (fractions like 1/60 are accepted).
-    #[arg(long, default_value = "1/60", value_parser = parse_seconds)]
-    dt: f64,
+    /// Timestep in seconds (fractions like 1/60 are accepted); default 1/60,
+    /// or the scene's.
+    #[arg(long, value_parser = parse_seconds)]
+    dt: Option<f64>,
     /// Simulated seconds.
     #[arg(long, default_value_t = 10.0)]
     duration: f64,
@@ -103,9 +118,10 @@ struct SimulateArgs {
     /// Drag spring constant k (default: the plugin's; no drag runs headless).
     #[arg(long, allow_negative_numbers = true)]
     k: Option<f64>,
-    /// explicit-euler, semi-implicit-euler, rk4 or rattle.
-    #[arg(long, default_value = "semi-implicit-euler")]
-    integrator: Integrator,
+    /// explicit-euler, semi-implicit-euler (the default), rk4 or rattle; or
+    /// the scene's.
+    #[arg(long)]
+    integrator: Option<Integrator>,
     /// baumgarte (the default), projection or none; rattle takes none.
     #[arg(long)]
     stabilization: Option<Stabilization>,
@@ -130,19 +146,62 @@ fn parse_wire(s: &str) -> Result<WireKind, String> {
     s.parse().map_err(|e: wirebead::ParamError| e.to_string())
 }
 
+/// Exit code 3, with a line saying why, where the run diverged.
+fn exit_code(diverged: Option<(f64, String)>) -> ExitCode {
+    match diverged {
+        Some((t, why)) => {
+            eprintln!("error: the run diverged at t = {t:.4} s: {why}");
+            ExitCode::from(3)
+        }
+        None => ExitCode::SUCCESS,
+    }
+}
+
+fn simulate_scene(
+    args: SimulateArgs,
+    path: &std::path::Path,
+) -> Result<ExitCode, Box<dyn std::error::Error>> {
+    let preset = analysis::load_scene(path)?;
+    let own = preset.params.clone();
+    let method = match (args.integrator, args.stabilization) {
+        (None, None) => own.method,
+        (integrator, stabilization) => Method::new(
+            integrator.unwrap_or(own.method.integrator()),
+            stabilization
+                .or(own.method.stabilization())
+                .filter(|_| integrator != Some(Integrator::Rattle) || args.stabilization.is_some()),
+        )?,
+    };
+    let params = SimParams {
+        timestep: args.dt.unwrap_or(own.timestep),
+        alpha: args.alpha.unwrap_or(own.alpha),
+        beta: args.beta.unwrap_or(own.beta),
+        method,
+        ..own
+    };
+    params.validate()?;
+    let run = analysis::simulate_scene(&preset, params, args.duration)?;
+    analysis::write_scene_csv(&args.out, &run)?;
+    eprintln!("wrote {} rows to {}", run.rows.len(), args.out.display());
+    Ok(exit_code(run.diverged))
+}
+
 fn simulate(args: SimulateArgs) -> Result<ExitCode, Box<dyn std::error::Error>> {
+    if let Some(path) = args.scene.clone() {
+        return simulate_scene(args, &path);
+    }
     let defaults = SimParams::default();
     let shape = args.wire.shape(args.radius);
     let bottom = shape.bottom();
     let config = RunConfig {
         wire: shape,
         params: SimParams {
-            timestep: args.dt,
+            timestep: args.dt.unwrap_or(defaults.timestep),
             gravity: DVec2::new(0.0, args.gravity),
             alpha: args.alpha.unwrap_or(defaults.alpha),
             beta: args.beta.unwrap_or(defaults.beta),
             drag_stiffness: args.k.unwrap_or(defaults.drag_stiffness),
-            method: Method::new(args.integrator, args.stabilization)?,
+            method: Method::new(args.integrator.unwrap_or_default(), args.stabilization)?,
             ..defaults
         },
         bead: BeadParams {
@@ -155,13 +214,7 @@ fn simulate(args: SimulateArgs) -> Result<ExitCode, Box<dyn std::error::Error>> 
     let out = analysis::simulate(&config)?;
     analysis::write_csv(&args.out, &out.rows)?;
     eprintln!("wrote {} rows to {}", out.rows.len(), args.out.display());
-    Ok(match out.diverged {
-        Some((t, why)) => {
-            eprintln!("error: the run diverged at t = {t:.4} s: {why}");
-            ExitCode::from(3)
-        }
-        None => ExitCode::SUCCESS,
-    })
+    Ok(exit_code(out.diverged))
 }
 
 fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
@@ -174,6 +227,26 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
         }
         Command::Compare {
             out_dir,
+            scene: Some(path),
+            duration,
+            dt,
+            ..
+        } => {
+            let preset = analysis::load_scene(&path)?;
+            std::fs::create_dir_all(&out_dir)?;
+            let table = analysis::compare_scene(&preset, duration, &dt)?;
+            let md = analysis::scene_comparison_markdown(&table, &preset, duration);
+            let stem = path
+                .file_name()
+                .and_then(|n| n.to_str())
+                .map_or("scene", |n| n.trim_end_matches(".scene.ron"));
+            std::fs::write(out_dir.join(format!("{stem}.md")), &md)?;
+            print!("{md}");
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Compare {
+            out_dir,
+            scene: None,
             theta0,
             radius,
             gravity,

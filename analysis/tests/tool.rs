@@ -133,3 +133,64 @@ fn compare_ranks_rattle_above_euler() {
     assert!(rattle.period_error.unwrap().abs() < 1e-3);
     assert!(rattle.energy_error * 100.0 < assignment.energy_error);
 }
+
+/// The shipped scene file `name`.
+fn shipped(name: &str) -> wirebead::ScenePreset {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/scenes")
+        .join(name);
+    analysis::load_scene(&path).unwrap()
+}
+
+#[test]
+fn simulate_scene_writes_a_column_set_per_named_bead() {
+    let dir = out_dir("simulate_scene");
+    let preset = shipped("pendulum_on_cart.scene.ron");
+    let run = analysis::simulate_scene(&preset, preset.params.clone(), 1.0).unwrap();
+    let path = dir.join("cart.csv");
+    analysis::write_scene_csv(&path, &run).unwrap();
+    let (header, rows) = read_csv(&path);
+    assert_eq!(
+        header.join(","),
+        "t,cart.x,cart.y,cart.vx,cart.vy,bob.x,bob.y,bob.vx,bob.vy,energy,max_abs_c"
+    );
+    assert_eq!(rows.len(), 61, "t = 0 and 60 steps");
+    assert_eq!(rows[0][5..7], [0.75f64.sqrt(), -0.5]);
+    for row in &rows {
+        // RATTLE: the rod and the rail to rounding; no horizontal momentum.
+        assert!(row[10] <= 1e-12, "max |C| = {:e}", row[10]);
+        assert!((2.0 * row[3] + row[7]).abs() < 1e-12);
+        assert!((row[9] - rows[0][9]).abs() < 1e-2, "energy {}", row[9]);
+    }
+}
+
+#[test]
+fn simulate_scene_names_unnamed_beads_and_stops_at_a_divergence() {
+    // Two unnamed free beads at one point, joined by a rod: singular.
+    let preset = wirebead::ScenePreset::from_ron(
+        "(name: \"bad\", beads: [(), ()], constraints: [Rod((a: \"bead0\", b: \"bead1\", length: 1.0))])",
+    )
+    .unwrap();
+    let run = analysis::simulate_scene(&preset, preset.params.clone(), 1.0).unwrap();
+    assert_eq!(run.names, ["bead0", "bead1"]);
+    let (t, why) = run
+        .diverged
+        .expect("a rod between coincident beads is singular");
+    assert!(why.contains("singular point"), "{why}");
+    assert!(t <= 1.0 / 60.0 + 1e-12);
+    assert_eq!(run.rows.len(), 1, "only the t = 0 row precedes it");
+}
+
+#[test]
+fn compare_scene_holds_rattle_to_rounding_on_the_double_pendulum() {
+    let preset = shipped("double_pendulum.scene.ron");
+    let table = analysis::compare_scene(&preset, 2.0, &[1.0 / 120.0]).unwrap();
+    assert_eq!(table.len(), Method::ALL.len());
+    let find = |m| table.iter().find(|r| r.method == m).unwrap();
+    let rattle = find(Method::Rattle);
+    assert!(rattle.max_abs_c < 1e-12, "{:e}", rattle.max_abs_c);
+    let none = find(Method::SemiImplicitEuler(Stabilization::None));
+    assert!(none.diverged.is_some() || none.max_abs_c > 1e3 * rattle.max_abs_c);
+    let md = analysis::scene_comparison_markdown(&table, &preset, 2.0);
+    assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 11);
+}
