@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::gui::render::{FramedView, SceneCamera, wire_points};
 use crate::preset::ActivePreset;
-use crate::{Bead, Diverged, DragTarget, Wire, pose_of};
+use crate::{Bead, Diverged, DragTarget, Pin, Rod, Wire, pose_of};
 
 /// Where one bead is.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -62,6 +62,12 @@ pub struct FrameReport {
     pub beads: Vec<BeadReport>,
     /// The wires.
     pub wires: Vec<WireReport>,
+    /// Each rod's two ends, in physical pixels.
+    #[serde(default)]
+    pub rods: Vec<[[f32; 2]; 2]>,
+    /// Each pin's point, in physical pixels.
+    #[serde(default)]
+    pub pins: Vec<[f32; 2]>,
     /// The drag seen so far, if any.
     pub drag: Option<DragReport>,
     /// The preset running.
@@ -131,6 +137,8 @@ struct ReportView<'w, 's> {
         ),
     >,
     wires: Query<'w, 's, (&'static Wire, &'static Transform)>,
+    rods: Query<'w, 's, &'static Rod>,
+    pins: Query<'w, 's, &'static Pin>,
     view: Res<'w, FramedView>,
     active: Res<'w, ActivePreset>,
 }
@@ -183,6 +191,22 @@ impl ReportView<'_, '_> {
                     .filter(in_window)
                     .collect(),
                 })
+                .collect(),
+            rods: self
+                .rods
+                .iter()
+                .filter_map(|rod| {
+                    let end = |i: usize| {
+                        let (bead, ..) = self.beads.get(rod.beads()[i]).ok()?;
+                        to_pixel(bead.position)
+                    };
+                    Some([end(0)?, end(1)?])
+                })
+                .collect(),
+            pins: self
+                .pins
+                .iter()
+                .filter_map(|pin| to_pixel(pin.at()))
                 .collect(),
             drag,
             preset: self.active.running.clone(),

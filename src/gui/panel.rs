@@ -20,9 +20,9 @@ use crate::gui::drag::SelectedBead;
 use crate::gui::render::SceneStyle;
 use crate::preset::{ActivePreset, LoadPreset};
 use crate::{
-    Bead, BeadDiagnostics, BeadParams, Diverged, Integrator, OnWire, ParamError, PendingBead,
-    PendingParams, PendingWire, Restart, SimClock, SimParams, Stabilization, Wire, WireBeadSystems,
-    WireKind, WireShape, pose_of,
+    Bead, BeadDiagnostics, BeadParams, ConstraintDiagnostics, Diverged, Integrator, Islands,
+    OnWire, ParamError, PendingBead, PendingParams, PendingWire, Pin, Restart, Rod, SimClock,
+    SimParams, Stabilization, Wire, WireBeadSystems, WireKind, WireShape, pose_of,
 };
 
 /// The presets the panel offers: `(label, asset path)`.
@@ -41,6 +41,14 @@ impl Default for PresetCatalog {
                 ("Sine track", "scenes/sine_track.scene.ron"),
                 ("Many beads", "scenes/multi_bead.scene.ron"),
                 ("Bead at rest", "scenes/resting.scene.ron"),
+                ("Pendulum on a cart", "scenes/pendulum_on_cart.scene.ron"),
+                ("Double pendulum", "scenes/double_pendulum.scene.ron"),
+                ("Rope on a rail", "scenes/rope.scene.ron"),
+                ("Ring of beads on a circle", "scenes/ring.scene.ron"),
+                (
+                    "Two beads and a spring on a track",
+                    "scenes/spring_pair.scene.ron",
+                ),
             ]
             .into_iter()
             .map(|(a, b)| (a.to_owned(), b.to_owned()))
@@ -220,6 +228,10 @@ pub struct PanelView<'w, 's> {
             Option<&'static PendingWire>,
         ),
     >,
+    rods: Query<'w, 's, (&'static Rod, &'static ConstraintDiagnostics)>,
+    pins: Query<'w, 's, (&'static Pin, &'static ConstraintDiagnostics)>,
+    names: Query<'w, 's, &'static Name>,
+    islands: Res<'w, Islands>,
     pending_beads: Query<'w, 's, (), With<PendingBead>>,
     pending_wires: Query<'w, 's, (), With<PendingWire>>,
     clock: Res<'w, SimClock>,
@@ -266,6 +278,7 @@ pub fn panel(
         .show(ctx, |ui| {
             scene_section(ui, &view, &mut actions, refused.as_deref());
             let bead = bead_section(ui, &view, &mut actions.commands);
+            constraints_section(ui, &view);
             let solver = solver_section(ui, &mut actions.pending);
             outcome = solver.or(bead);
             plots_section(ui, &view.history);
@@ -370,7 +383,7 @@ fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) ->
     let (entity, bead, diagnostics, on_wire, pending_bead, _) =
         view.selected.0.and_then(|e| view.beads.get(e).ok())?;
     ui.separator();
-    ui.strong(format!("Bead {entity}"));
+    ui.strong(format!("Bead {}", view.name(entity)));
     let mut draft: BeadParams = pending_bead.map_or(*bead.params(), |p| *p.get());
     let before = draft;
     egui::Grid::new("bead").num_columns(2).show(ui, |ui| {
@@ -416,8 +429,59 @@ fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) ->
         ui.label("steps");
         ui.monospace(format!("{}", clock.steps));
         ui.end_row();
+        if let Some(island) = view.islands.of(entity).filter(|i| i.rows > 0) {
+            ui.label("island E");
+            ui.monospace(format!("{:+.4}", island.energy));
+            ui.label("beads");
+            ui.monospace(format!("{}", island.beads.len()));
+            ui.end_row();
+        }
     });
     outcome
+}
+
+/// Every rod and pin with its drift `C` and multiplier λ (a rod under
+/// tension pulls: λ < 0).
+fn constraints_section(ui: &mut egui::Ui, view: &PanelView) {
+    if view.rods.is_empty() && view.pins.is_empty() {
+        return;
+    }
+    ui.separator();
+    egui::CollapsingHeader::new("Constraints")
+        .default_open(true)
+        .show(ui, |ui| {
+            egui::Grid::new("constraints")
+                .num_columns(3)
+                .striped(true)
+                .show(ui, |ui| {
+                    ui.strong("");
+                    ui.strong("C");
+                    ui.strong("λ");
+                    ui.end_row();
+                    let mut row = |label: String, d: &ConstraintDiagnostics| {
+                        ui.label(label);
+                        ui.monospace(format!("{:+.2e}", d.c));
+                        ui.monospace(format!("{:+.3e}", d.lambda));
+                        ui.end_row();
+                    };
+                    for (rod, d) in &view.rods {
+                        let [a, b] = rod.beads().map(|e| view.name(e));
+                        row(format!("rod {a}–{b}"), d);
+                    }
+                    for (pin, d) in &view.pins {
+                        row(format!("pin {}", view.name(pin.bead())), d);
+                    }
+                });
+        });
+}
+
+impl PanelView<'_, '_> {
+    /// A bead's name, or its entity where it has none.
+    fn name(&self, bead: Entity) -> String {
+        self.names
+            .get(bead)
+            .map_or_else(|_| bead.to_string(), |n| n.as_str().to_owned())
+    }
 }
 
 /// The wire's kind (from [`WireKind::ALL`]) and dimensions; the edited

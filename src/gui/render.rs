@@ -10,7 +10,10 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::geometry::{ImplicitCurve, Placed, Pose, WireShape};
-use crate::{Bead, BeadDiagnostics, DragTarget, OnWire, Restart, Wire, WireBeadSystems, pose_of};
+use crate::{
+    Bead, BeadDiagnostics, DragTarget, OnWire, Pin, Restart, Rod, Spring, Wire, WireBeadSystems,
+    pose_of,
+};
 
 /// Colours and sizes of the scene.
 #[derive(Resource, Clone, Debug)]
@@ -29,6 +32,12 @@ pub struct SceneStyle {
     pub constraint_force: Color,
     /// The drag spring.
     pub drag: Color,
+    /// Rods between beads.
+    pub rod: Color,
+    /// Pins: a small square at the point.
+    pub pin: Color,
+    /// Springs between beads, drawn as zigzags.
+    pub spring: Color,
     /// Bead radius as a fraction of the framed view's height.
     pub bead_radius: f32,
     /// Seconds of trail kept.
@@ -51,6 +60,9 @@ impl Default for SceneStyle {
             trail: Color::srgb(1.0, 0.85, 0.3),
             constraint_force: Color::srgb(0.4, 1.0, 0.4),
             drag: Color::srgb(1.0, 0.3, 0.8),
+            rod: Color::srgb(0.92, 0.92, 0.92),
+            pin: Color::srgb(1.0, 0.25, 0.25),
+            spring: Color::srgb(0.75, 0.55, 1.0),
             bead_radius: 0.025,
             trail_seconds: 2.0,
             panel_width: 340.0,
@@ -99,6 +111,7 @@ impl Plugin for SceneRenderPlugin {
                     size_and_colour_beads,
                     draw_wires,
                     draw_trails,
+                    draw_links,
                     draw_forces,
                 )
                     .chain(),
@@ -222,6 +235,8 @@ fn wire_pose(transform: &Transform) -> Pose {
 pub fn frame_camera(
     wires: Query<(&Wire, &Transform)>,
     beads: Query<&Bead>,
+    rods: Query<&Rod>,
+    on_wire: Query<(), With<OnWire>>,
     windows: Query<&Window>,
     style: Res<SceneStyle>,
     mut view: ResMut<FramedView>,
@@ -238,6 +253,15 @@ pub fn frame_camera(
         lo = lo.min(bead.params().initial_position);
         hi = hi.max(bead.params().initial_position);
     }
+    // Beads hanging on rods swing out as far as the rods reach: a rod
+    // with a bead on no wire widens the view by its length.
+    let reach: f64 = rods
+        .iter()
+        .filter(|rod| rod.beads().iter().any(|b| !on_wire.contains(*b)))
+        .map(Rod::length)
+        .sum();
+    lo -= DVec2::splat(reach);
+    hi += DVec2::splat(reach);
     if !(lo.is_finite() && hi.is_finite()) {
         return;
     }
@@ -376,8 +400,57 @@ fn draw_trails(beads: Query<&Trail>, style: Res<SceneStyle>, mut gizmos: Gizmos)
     }
 }
 
+/// Draws rods as lines between their beads, pins as small squares at
+/// their points and springs as zigzags.
+pub fn draw_links(
+    beads: Query<&Bead>,
+    rods: Query<&Rod>,
+    pins: Query<&Pin>,
+    springs: Query<&Spring>,
+    view: Res<FramedView>,
+    style: Res<SceneStyle>,
+    mut gizmos: Gizmos,
+) {
+    let at = |e: Entity| beads.get(e).ok().map(|b| b.position.as_vec2());
+    for rod in &rods {
+        if let (Some(a), Some(b)) = (at(rod.beads()[0]), at(rod.beads()[1])) {
+            gizmos.line_2d(a, b, style.rod);
+        }
+    }
+    let side = 1.2 * style.bead_radius * view.size.y;
+    for pin in &pins {
+        gizmos.rect_2d(
+            Isometry2d::from_translation(pin.at().as_vec2()),
+            Vec2::splat(side),
+            style.pin,
+        );
+    }
+    let width = 0.6 * style.bead_radius * view.size.y;
+    for spring in &springs {
+        if let (Some(a), Some(b)) = (at(spring.beads()[0]), at(spring.beads()[1])) {
+            gizmos.linestrip_2d(zigzag(a, b, 12, width), style.spring);
+        }
+    }
+}
+
+/// A zigzag of `turns` teeth of half-width `width` from `a` to `b`, with a
+/// straight lead at each end.
+pub fn zigzag(a: Vec2, b: Vec2, turns: usize, width: f32) -> Vec<Vec2> {
+    let d = b - a;
+    let normal = d.perp().normalize_or_zero() * width;
+    let (start, end) = (a + 0.1 * d, a + 0.9 * d);
+    let mut points = vec![a, start];
+    for i in 0..turns {
+        let t = (i as f32 + 0.5) / turns as f32;
+        let side = if i % 2 == 0 { 1.0 } else { -1.0 };
+        points.push(start.lerp(end, t) + side * normal);
+    }
+    points.extend([end, b]);
+    points
+}
+
 fn draw_forces(
-    beads: Query<(&Bead, Option<&BeadDiagnostics>, Option<&DragTarget>), With<OnWire>>,
+    beads: Query<(&Bead, Option<&BeadDiagnostics>, Option<&DragTarget>)>,
     params: Res<crate::SimParams>,
     view: Res<FramedView>,
     style: Res<SceneStyle>,

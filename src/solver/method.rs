@@ -189,6 +189,11 @@ impl Method {
         }
     }
 
+    /// Whether the integrator is one of the two Euler steps.
+    pub fn is_euler(self) -> bool {
+        matches!(self, Self::ExplicitEuler(_) | Self::SemiImplicitEuler(_))
+    }
+
     /// Whether the step projects onto the wire after integrating.
     pub fn projects(self) -> bool {
         self.stabilization() == Some(Stabilization::Projection)

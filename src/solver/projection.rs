@@ -1,5 +1,6 @@
 //! Newton's method on `C`, shared by RATTLE's position solve and
-//! post-stabilization projection, eq. (9).
+//! post-stabilization projection, eq. (9), and the energy-restoring
+//! velocity scale that completes the projection, eq. (9b).
 
 use bevy::math::DVec2;
 
@@ -82,11 +83,55 @@ pub fn project<C: ImplicitCurve + ?Sized>(
             residual,
         });
     }
-    let n = curve.gradient(x);
-    let nn = normal_length_squared(n, x)?;
-    let v = state.velocity - (n.dot(state.velocity) / nn) * n;
     Ok(BeadState {
         position: x,
-        velocity: v,
+        velocity: tangential(curve, x, state.velocity)?,
+    })
+}
+
+/// `v` without its component along the normal at `x`.
+fn tangential<C: ImplicitCurve + ?Sized>(
+    curve: &C,
+    x: DVec2,
+    v: DVec2,
+) -> Result<DVec2, SolveError> {
+    let n = curve.gradient(x);
+    let nn = normal_length_squared(n, x)?;
+    Ok(v - (n.dot(v) / nn) * n)
+}
+
+/// Eq. (9b): the factor that scales a projected velocity of kinetic
+/// energy `kinetic_now` to the kinetic energy `kinetic_target`; 1 where
+/// either is zero or not finite (nothing to scale, or nothing to scale to).
+pub(crate) fn kinetic_scale(kinetic_target: f64, kinetic_now: f64) -> f64 {
+    let ratio = kinetic_target / kinetic_now;
+    if ratio.is_finite() && ratio > 0.0 {
+        ratio.sqrt()
+    } else {
+        1.0
+    }
+}
+
+/// Eq. (9b) for one bead after an Euler step of length `h` from `start`:
+/// `projected`'s velocity scaled to the speed of `v₀ + h a_t`, the start
+/// velocity plus the step's kick without its normal part (`a_t` the
+/// applied acceleration's component along the wire at `x₀`), and its
+/// normal component, which the scale multiplies from rounding, removed
+/// again.
+pub(crate) fn restore_speed<C: ImplicitCurve + ?Sized>(
+    curve: &C,
+    start: BeadState,
+    projected: BeadState,
+    force: &super::state::LinearForce,
+    mass: f64,
+    h: f64,
+) -> Result<BeadState, SolveError> {
+    let x0 = start.position;
+    let tangential_kick = tangential(curve, x0, force.at(x0) / mass)?;
+    let target = (start.velocity + h * tangential_kick).length_squared();
+    let scale = kinetic_scale(target, projected.velocity.length_squared());
+    Ok(BeadState {
+        velocity: tangential(curve, projected.position, scale * projected.velocity)?,
+        ..projected
     })
 }

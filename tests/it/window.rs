@@ -145,3 +145,50 @@ fn editing_the_running_preset_reloads_it() {
     let [_, y0] = ready.beads[0].world;
     assert!((y0 + 1.0).abs() < 1e-9, "bead started at y = {y0}");
 }
+
+#[test]
+#[ignore = "needs the screenshot .ci/run makes under Xvfb"]
+fn screenshot_of_a_coupled_preset_shows_its_rod_between_its_beads() {
+    let image = image::open(dir().join("coupled.png"))
+        .expect("screenshot")
+        .to_rgb8();
+    let report = report("coupled.ron");
+    assert_eq!(report.preset.as_deref(), Some("Pendulum on a cart"));
+    let style = wirebead::gui::SceneStyle::default();
+    let (rod_colour, bead_colour) = (rgb(style.rod), rgb(style.bead));
+    assert_eq!(report.beads.len(), 2);
+    for bead in &report.beads {
+        let r = (0.5 * bead.radius_px).max(2.0) as i32;
+        assert!(
+            colour_near(&image, bead.pixel, r, bead_colour),
+            "no bead colour at {:?}",
+            bead.pixel
+        );
+    }
+    // The rod is drawn from bead to bead: its colour along the middle of
+    // the segment, and not 20 px to its side.
+    assert_eq!(report.rods.len(), 1);
+    let [a, b] = report.rods[0];
+    let (d, len) = {
+        let d = [b[0] - a[0], b[1] - a[1]];
+        (d, (d[0] * d[0] + d[1] * d[1]).sqrt())
+    };
+    assert!(len > 60.0, "the rod is only {len} px long");
+    let (mut on, mut beside) = (0, 0);
+    let samples = 20;
+    for i in 0..samples {
+        let t = 0.25 + 0.5 * i as f32 / (samples - 1) as f32;
+        let p = [a[0] + t * d[0], a[1] + t * d[1]];
+        on += colour_near(&image, p, 2, rod_colour) as usize;
+        let side = [p[0] - 20.0 * d[1] / len, p[1] + 20.0 * d[0] / len];
+        beside += colour_near(&image, side, 1, rod_colour) as usize;
+    }
+    assert!(
+        on >= 16,
+        "rod colour at {on} of {samples} points along the rod"
+    );
+    assert!(
+        beside <= 2,
+        "rod colour 20 px beside the rod at {beside} points"
+    );
+}

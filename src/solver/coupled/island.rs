@@ -7,7 +7,9 @@ use super::constraint::{RowKind, SpringLink};
 use super::normal::{Factored, NormalMatrix};
 use crate::geometry::Pose;
 use crate::solver::method::Method;
-use crate::solver::projection::{NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE};
+use crate::solver::projection::{
+    NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE, kinetic_scale,
+};
 use crate::solver::settings::{Gains, StepSettings};
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
@@ -407,7 +409,8 @@ impl Island {
             }
         }
         if settings.method.projects() {
-            self.project(work)?;
+            let euler = settings.method.is_euler().then_some(settings.dt);
+            self.project(forces, euler, work)?;
         }
         work.bead_forces.clear();
         work.bead_forces.resize(n, DVec2::ZERO);
@@ -745,13 +748,70 @@ impl Island {
         Ok(())
     }
 
-    /// Post-stabilization, eq. (9) for an island: Newton steps along the
-    /// current gradients bring every `C` to zero, then the velocity is
-    /// projected onto `J v = 0`.
-    fn project(&self, work: &mut IslandWork) -> Result<(), SolveError> {
+    /// Post-stabilization, eq. (11): Newton steps along the current
+    /// gradients bring every `C` to zero and the velocity is projected onto
+    /// `J v = 0`. After an Euler step of length `h` (`euler`), the
+    /// velocities are then scaled, by one factor for the island (which
+    /// keeps `J v = 0`), to the kinetic energy of `v₀ + h P₀ W Q`: the start
+    /// velocity plus the step's kick with its part off the constraints at
+    /// the start removed (`P₀` the mass-weighted projection onto
+    /// `J₀ v = 0`), eq. (9b).
+    fn project(
+        &self,
+        forces: &[LinearForce],
+        euler: Option<f64>,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
         self.newton(work, Direction::Current)?;
         self.evaluate_at_new(work);
-        self.project_velocity(work)
+        self.project_velocity(work)?;
+        let Some(h) = euler else {
+            return Ok(());
+        };
+        let kinetic = |v: &[DVec2]| -> f64 {
+            v.iter()
+                .zip(&self.inverse_mass)
+                .map(|(v, w)| 0.5 * v.length_squared() / w)
+                .sum()
+        };
+        let now = kinetic(&work.v);
+        // The applied kick W Q at the start, its part off J₀ removed.
+        self.evaluate(
+            &work.x0,
+            &work.v0,
+            &mut work.first_gradient,
+            &mut work.c,
+            &mut work.curvature,
+            &mut work.scratch,
+        );
+        self.applied(forces, &work.x0, &work.v0, &mut work.force);
+        for (f, w) in work.force.iter_mut().zip(&self.inverse_mass) {
+            *f *= *w;
+        }
+        if self.rows() > 0 {
+            self.factor(&work.first_gradient, &work.x0, &mut work.factored)?;
+            work.rhs.clear();
+            for r in 0..self.rows() {
+                work.rhs
+                    .push(-self.rate(r, &work.first_gradient, &work.force));
+            }
+            self.normal.solve(&mut work.factored, &mut work.rhs);
+            self.push(&work.first_gradient, &work.rhs, &mut work.force);
+        }
+        let target: f64 = work
+            .v0
+            .iter()
+            .zip(&work.force)
+            .zip(&self.inverse_mass)
+            .map(|((v, a), w)| 0.5 * (*v + h * *a).length_squared() / w)
+            .sum();
+        let scale = kinetic_scale(target, now);
+        for v in &mut work.v {
+            *v *= scale;
+        }
+        // The gradients where the step ended, for the report.
+        self.evaluate_at_new(work);
+        Ok(())
     }
 
     /// Eq. (8) for an island: SHAKE's position solve (Newton on all of the
