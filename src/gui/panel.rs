@@ -115,11 +115,14 @@ pub fn keep_selection(mut selected: ResMut<SelectedBead>, beads: Query<Entity, W
     }
 }
 
-/// Appends the selected bead's diagnostics to the plot history.
+/// Appends the selected bead's diagnostics to the plot history; for a
+/// bead joined to others, the energy is its island's (a rod does work on
+/// each of its beads, not on the two together).
 pub fn record_history(
     selected: Res<SelectedBead>,
     clock: Res<SimClock>,
     beads: Query<&BeadDiagnostics>,
+    islands: Res<Islands>,
     mut history: ResMut<PlotHistory>,
 ) {
     let Some(entity) = selected.0 else { return };
@@ -129,10 +132,14 @@ pub fn record_history(
         history.samples.clear();
         history.bead = Some(entity);
     }
+    let energy = islands
+        .of(entity)
+        .filter(|island| island.rows > 0)
+        .map_or(d.energy(), |island| island.energy);
     history.samples.push_back(PlotSample {
         t,
         c: d.c,
-        energy: d.energy(),
+        energy,
         lambda: d.lambda,
     });
     let horizon = t - history.seconds;

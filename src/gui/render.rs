@@ -2,7 +2,7 @@
 //! strokes, beads as meshes, fading trails, and force arrows. Simulation
 //! state is `f64`; it becomes `f32` here, at the edge.
 
-use std::collections::VecDeque;
+use std::collections::{HashMap, VecDeque};
 use std::f64::consts::TAU;
 
 use bevy::camera::ScalingMode;
@@ -289,11 +289,16 @@ pub fn frame_camera(
     }
 }
 
+/// Sizes each bead to the view, no wider than 40 % of the shortest rod it
+/// hangs on (so a rope of short rods reads as a rope), and colours the
+/// diverged ones.
 fn size_and_colour_beads(
     view: Res<FramedView>,
     style: Res<SceneStyle>,
+    rods: Query<&Rod>,
     mut beads: Query<
         (
+            Entity,
             &mut Transform,
             &MeshMaterial2d<ColorMaterial>,
             Has<crate::Diverged>,
@@ -303,8 +308,18 @@ fn size_and_colour_beads(
     mut materials: ResMut<Assets<ColorMaterial>>,
 ) {
     let radius = style.bead_radius * view.size.y;
-    for (mut transform, material, diverged) in &mut beads {
-        transform.scale = Vec3::splat(radius);
+    let mut shortest: HashMap<Entity, f32> = HashMap::new();
+    for rod in &rods {
+        for bead in rod.beads() {
+            let limit = shortest.entry(bead).or_insert(f32::INFINITY);
+            *limit = limit.min(0.4 * rod.length() as f32);
+        }
+    }
+    for (entity, mut transform, material, diverged) in &mut beads {
+        let r = shortest
+            .get(&entity)
+            .map_or(radius, |&limit| radius.min(limit));
+        transform.scale = Vec3::splat(r);
         transform.translation.z = 1.0;
         if let Some(mut m) = materials.get_mut(&material.0) {
             let colour = if diverged { style.diverged } else { style.bead };
@@ -449,19 +464,32 @@ pub fn zigzag(a: Vec2, b: Vec2, turns: usize, width: f32) -> Vec<Vec2> {
     points
 }
 
+/// Draws the constraint force on each bead on a wire and on the selected
+/// bead (a rope's every bead would hide the rope), and the drag spring.
 fn draw_forces(
-    beads: Query<(&Bead, Option<&BeadDiagnostics>, Option<&DragTarget>)>,
+    beads: Query<(
+        Entity,
+        &Bead,
+        Option<&BeadDiagnostics>,
+        Option<&DragTarget>,
+        Has<OnWire>,
+    )>,
+    selected: Option<Res<crate::gui::drag::SelectedBead>>,
     params: Res<crate::SimParams>,
     view: Res<FramedView>,
     style: Res<SceneStyle>,
     mut gizmos: Gizmos,
 ) {
     let g = params.gravity.length().max(1e-3) as f32;
-    for (bead, diagnostics, drag) in &beads {
+    for (entity, bead, diagnostics, drag, on_wire) in &beads {
         // Forces are drawn in units of the bead's weight.
         let per_newton = style.force_scale * view.size.y / (bead.mass() as f32 * g);
         let at = bead.position.as_vec2();
-        let force = diagnostics.map_or(Vec2::ZERO, |d| d.constraint_force.as_vec2()) * per_newton;
+        let shown = on_wire || selected.as_ref().is_some_and(|s| s.0 == Some(entity));
+        let force = diagnostics
+            .filter(|_| shown)
+            .map_or(Vec2::ZERO, |d| d.constraint_force.as_vec2())
+            * per_newton;
         if force.length() > 1e-4 * view.size.y {
             gizmos.arrow_2d(at, at + force, style.constraint_force);
         }
