@@ -6,6 +6,7 @@
 use std::fmt;
 use std::sync::Arc;
 
+use bevy::ecs::query::QueryFilter;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
@@ -69,20 +70,44 @@ impl Rod {
     }
 }
 
-/// Holds a bead at a fixed point: two rows, `x − p = 0`.
+/// Holds a bead at a point: two rows, `x − p = 0`. The point is fixed in
+/// the world ([`Pin::new`]) or fixed to another entity ([`Pin::on`]), whose
+/// `Transform` places it each step.
+///
+/// A pin on an entity that moves is held where the entity is at each
+/// step; its velocity does not enter the step (no `∂C/∂t` term), so the
+/// bead's velocity follows the point's with a step's lag.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
 #[reflect(Component)]
 #[require(ConstraintDiagnostics)]
 pub struct Pin {
     bead: Entity,
     at: DVec2,
+    anchor: Option<Entity>,
 }
 
 impl Pin {
-    /// A pin holding `bead` at `at`, if the point is finite.
+    /// A pin holding `bead` at the world point `at`, if it is finite.
     pub fn new(bead: Entity, at: DVec2) -> Result<Self, ParamError> {
         finite_vector("pin point", at)?;
-        Ok(Self { bead, at })
+        Ok(Self {
+            bead,
+            at,
+            anchor: None,
+        })
+    }
+
+    /// A pin holding `bead` at `offset` in the frame of `anchor`'s
+    /// `Transform` (its translation and its rotation about z), if the
+    /// offset is finite and the anchor is not the bead.
+    pub fn on(bead: Entity, anchor: Entity, offset: DVec2) -> Result<Self, ParamError> {
+        distinct(bead, anchor, "a pin cannot be anchored to its own bead")?;
+        finite_vector("pin offset", offset)?;
+        Ok(Self {
+            bead,
+            at: offset,
+            anchor: Some(anchor),
+        })
     }
 
     /// The bead.
@@ -90,9 +115,28 @@ impl Pin {
         self.bead
     }
 
-    /// Where it is held.
+    /// The point: in the world, or in the anchor's frame.
     pub fn at(&self) -> DVec2 {
         self.at
+    }
+
+    /// The entity the point is fixed to, if any.
+    pub fn anchor(&self) -> Option<Entity> {
+        self.anchor
+    }
+
+    /// The point in the world now: the fixed point, or the offset placed by
+    /// the anchor's `Transform` read from `transforms`; `None` where the
+    /// anchor has no finite `Transform` there.
+    pub fn locate<F: QueryFilter>(&self, transforms: &Query<&Transform, F>) -> Option<DVec2> {
+        match self.anchor {
+            None => Some(self.at),
+            Some(anchor) => {
+                let transform = transforms.get(anchor).ok()?;
+                let pose = super::wire::pose_of(transform).ok()?;
+                Some(pose.to_world(self.at))
+            }
+        }
     }
 }
 

@@ -139,6 +139,7 @@ struct ReportView<'w, 's> {
     wires: Query<'w, 's, (&'static Wire, &'static Transform)>,
     rods: Query<'w, 's, &'static Rod>,
     pins: Query<'w, 's, &'static Pin>,
+    transforms: Query<'w, 's, &'static Transform>,
     view: Res<'w, FramedView>,
     active: Res<'w, ActivePreset>,
 }

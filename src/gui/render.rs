@@ -421,6 +421,7 @@ pub fn draw_links(
     beads: Query<&Bead>,
     rods: Query<&Rod>,
     pins: Query<&Pin>,
+    transforms: Query<&Transform>,
     springs: Query<&Spring>,
     view: Res<FramedView>,
     style: Res<SceneStyle>,
@@ -433,9 +434,9 @@ pub fn draw_links(
         }
     }
     let side = 1.2 * style.bead_radius * view.size.y;
-    for pin in &pins {
+    for at in pins.iter().filter_map(|pin| pin.locate(&transforms)) {
         gizmos.rect_2d(
-            Isometry2d::from_translation(pin.at().as_vec2()),
+            Isometry2d::from_translation(at.as_vec2()),
             Vec2::splat(side),
             style.pin,
         );

@@ -62,6 +62,8 @@ struct CachedIsland {
     links: Vec<LinkRows>,
     /// The wire row of each bead on a wire: (bead, row, wire entity).
     wire_rows: Vec<(usize, usize, Entity)>,
+    /// The first row of each pin fixed to another entity, and the pin.
+    anchored: Vec<(usize, Entity)>,
 }
 
 /// The islands of the current topology: beads joined by constraints and
@@ -114,6 +116,20 @@ struct Pending {
     entity: Entity,
     rows: Vec<IslandRow>,
     pin: bool,
+    anchored: bool,
+}
+
+/// The two rows that hold a bead at `at`.
+fn pin_rows(at: DVec2) -> Vec<IslandRow> {
+    [DVec2::X, DVec2::Y]
+        .map(|axis| IslandRow {
+            kind: RowKind::Axis {
+                axis,
+                offset: axis.dot(at),
+            },
+            beads: vec![0],
+        })
+        .to_vec()
 }
 
 /// Rebuilds [`Islands`] where the topology changed, and keeps the
@@ -123,6 +139,7 @@ pub(crate) fn prepare_islands(
     links: Links,
     beads: Query<(Entity, &Bead, Option<&OnWire>, Has<InIsland>)>,
     wires: Query<(&Wire, &WirePose)>,
+    transforms: Query<&Transform>,
     mut commands: Commands,
     mut divergences: Divergences,
     clock: Res<SimClock>,
@@ -153,6 +170,7 @@ pub(crate) fn prepare_islands(
                         beads: vec![0, 1],
                     }],
                     pin: false,
+                    anchored: false,
                 },
                 beads.to_vec(),
             )),
@@ -163,20 +181,19 @@ pub(crate) fn prepare_islands(
             missing("pin", entity, pin.bead());
             continue;
         }
-        let rows = [DVec2::X, DVec2::Y]
-            .map(|axis| IslandRow {
-                kind: RowKind::Axis {
-                    axis,
-                    offset: axis.dot(pin.at()),
-                },
-                beads: vec![0],
-            })
-            .to_vec();
+        let Some(at) = pin.locate(&transforms) else {
+            warn!(
+                "wirebead: pin {entity} is fixed to {}, which has no finite Transform; the pin is left out",
+                pin.anchor().unwrap_or(Entity::PLACEHOLDER)
+            );
+            continue;
+        };
         named.push((
             Pending {
                 entity,
-                rows,
+                rows: pin_rows(at),
                 pin: true,
+                anchored: pin.anchor().is_some(),
             },
             vec![pin.bead()],
         ));
@@ -192,6 +209,7 @@ pub(crate) fn prepare_islands(
                         beads: (0..joint.beads().len()).collect(),
                     }],
                     pin: false,
+                    anchored: false,
                 },
                 joint.beads().to_vec(),
             )),
@@ -294,8 +312,12 @@ pub(crate) fn prepare_islands(
             }
         }
         let mut link_rows = Vec::new();
+        let mut anchored = Vec::new();
         for (pending, local) in links {
             let start = rows.len();
+            if pending.anchored {
+                anchored.push((start, pending.entity));
+            }
             link_rows.push(if pending.pin {
                 LinkRows::Pin(pending.entity, start)
             } else {
@@ -325,6 +347,7 @@ pub(crate) fn prepare_islands(
                 forces: Vec::with_capacity(group.len()),
                 links: link_rows,
                 wire_rows,
+                anchored,
             }),
             Err(reason) => {
                 for &bead in &entities {
@@ -363,6 +386,8 @@ pub(crate) fn step_islands(
         (With<InIsland>, Without<Diverged>),
     >,
     wires: Query<&WirePose>,
+    pins: Query<&Pin>,
+    transforms: Query<&Transform, Without<InIsland>>,
     mut diagnostics: Query<&mut ConstraintDiagnostics>,
     mut divergences: Divergences,
 ) {
@@ -381,6 +406,12 @@ pub(crate) fn step_islands(
         for &(_, row, wire) in &cached.wire_rows {
             if let Ok(Ok(pose)) = wires.get(wire).map(WirePose::get) {
                 cached.island.place_wire(row, pose);
+            }
+        }
+        for &(row, pin) in &cached.anchored {
+            if let Some(at) = pins.get(pin).ok().and_then(|p| p.locate(&transforms)) {
+                cached.island.place_axis(row, at.x);
+                cached.island.place_axis(row + 1, at.y);
             }
         }
         if let Err(e) = cached.island.step(

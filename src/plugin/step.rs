@@ -253,9 +253,7 @@ impl StepContext<'_> {
             };
         }
         if let Some(transform) = transform {
-            // A finished step's position is finite: no check.
-            transform.translation.x = out.state.position.x as f32;
-            transform.translation.y = out.state.position.y as f32;
+            place(transform, out.state.position);
         }
     }
 }

@@ -37,11 +37,13 @@ pub(crate) fn write_transforms(
 }
 
 /// Writes a bead's position into its `Transform` (x and y, rounded to
-/// `f32`; z is kept), unless it is not finite.
+/// `f32`; z is kept), unless it is not finite in `f32` (a NaN, or a
+/// coordinate past `f32::MAX`): then the `Transform` keeps its last value.
 #[inline(always)]
 pub(crate) fn place(transform: &mut Transform, position: DVec2) {
-    if position.is_finite() {
-        transform.translation.x = position.x as f32;
-        transform.translation.y = position.y as f32;
+    let at = position.as_vec2();
+    if at.is_finite() {
+        transform.translation.x = at.x;
+        transform.translation.y = at.y;
     }
 }

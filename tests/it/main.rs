@@ -7,6 +7,7 @@ mod bad_input;
 mod baumgarte;
 mod common;
 mod controls;
+mod fuzz;
 mod islands;
 mod layers;
 mod parallel;

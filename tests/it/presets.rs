@@ -10,7 +10,7 @@ use wirebead::headless::{Headless, idle, run_steps};
 use wirebead::prelude::*;
 use wirebead::preset::{ActivePreset, FromPreset};
 
-const SHIPPED: &[&str] = &[
+pub(crate) const SHIPPED: &[&str] = &[
     "assignment_circle.scene.ron",
     "ellipse.scene.ron",
     "sine_track.scene.ron",
@@ -34,7 +34,7 @@ const COUPLED: &[&str] = &[
 
 /// The shipped presets, found at run time: a test binary reused from another
 /// checkout must read this checkout's files.
-fn shipped_dir() -> PathBuf {
+pub(crate) fn shipped_dir() -> PathBuf {
     std::env::var_os("CARGO_MANIFEST_DIR")
         .map(PathBuf::from)
         .unwrap_or_default()

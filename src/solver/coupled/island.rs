@@ -280,6 +280,14 @@ impl Island {
         }
     }
 
+    /// Moves the line of the axis row `row` (one of a pin's rows) to
+    /// `axis·x = offset`; rows of other kinds are left as they are.
+    pub fn place_axis(&mut self, row: usize, offset: f64) {
+        if let Some(RowKind::Axis { offset: placed, .. }) = self.rows.get_mut(row) {
+            *placed = offset;
+        }
+    }
+
     /// How many beads.
     pub fn beads(&self) -> usize {
         self.inverse_mass.len()

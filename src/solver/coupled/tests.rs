@@ -217,13 +217,15 @@ fn pendulum_on_a_cart_conserves_momentum_and_swings_at_the_coupled_frequency() {
     let mut previous = states[1].position.x - states[0].position.x;
     let mut t = 0.0;
     let mut momentum = 0.0f64;
+    let mut drift = 0.0f64;
     run(
         &island,
         &mut states,
         &forces,
         &settings(Method::Rattle, dt),
         8000,
-        |states, _| {
+        |states, work| {
+            drift = drift.max(max_drift(work, 1.0));
             t += dt;
             let offset = states[1].position.x - states[0].position.x;
             if previous > 0.0 && offset <= 0.0 {
@@ -241,7 +243,13 @@ fn pendulum_on_a_cart_conserves_momentum_and_swings_at_the_coupled_frequency() {
         (measured / exact - 1.0).abs() < 1e-3,
         "period {measured} against {exact}"
     );
-    assert!(momentum < 1e-12, "horizontal momentum reached {momentum:e}");
+    // Zero to 1e-12 of m sqrt(g l) = 3.13 kg·m/s, and the rod and the rail
+    // to rounding.
+    assert!(
+        momentum < 1e-12 * bob * (9.81 * l).sqrt(),
+        "horizontal momentum reached {momentum:e}"
+    );
+    assert!(drift <= 1e-12, "|C| reached {drift:e}");
 }
 
 #[test]
@@ -622,4 +630,154 @@ fn euler_with_projection_adds_no_energy_to_an_island() {
     );
     assert!(worst.0 <= 1e-12, "|C| reached {:e}", worst.0);
     assert!(worst.1 < 0.05 * 9.81, "energy moved {} J", worst.1);
+}
+
+#[test]
+fn double_pendulum_energy_stays_bounded_over_1000_seconds_with_rattle() {
+    // Chaotic, so the energy error is compared between the first and the
+    // last tenth of the run: bounded means no larger at the end (within a
+    // factor 2 for the spread of a chaotic path), and the rods hold to
+    // rounding throughout.
+    let (island, mut states, forces) = double_pendulum();
+    let e0 = island.energy(&states, G);
+    let steps = 60_000;
+    let (mut first, mut last, mut drift) = (0.0f64, 0.0f64, 0.0f64);
+    let mut i = 0;
+    run(
+        &island,
+        &mut states,
+        &forces,
+        &settings(Method::Rattle, 1.0 / 60.0),
+        steps,
+        |states, work| {
+            let error = (island.energy(states, G) - e0).abs();
+            if i < steps / 10 {
+                first = first.max(error);
+            } else if i >= steps - steps / 10 {
+                last = last.max(error);
+            }
+            drift = drift.max(max_drift(work, 1.0));
+            i += 1;
+        },
+    );
+    assert!(drift <= 1e-12, "|C| reached {drift:e}");
+    assert!(
+        last <= 2.0 * first,
+        "energy error grew from {first:e} J to {last:e} J"
+    );
+    assert!(first < 0.05 * 9.81, "energy error {first:e} J");
+}
+
+#[test]
+fn double_pendulum_keeps_its_energy_to_1e_5_with_rk4_and_projection() {
+    // 100 s at 1/240 s: within 1e-5 of m g l = 9.81 J (6.7e-6 measured).
+    // RK4's own energy error, fourth order, is what is left: the
+    // projection neither adds nor removes energy here.
+    let (island, mut states, forces) = double_pendulum();
+    let e0 = island.energy(&states, G);
+    let mut worst = 0.0f64;
+    run(
+        &island,
+        &mut states,
+        &forces,
+        &settings(Method::Rk4(Stabilization::Projection), 1.0 / 240.0),
+        24_000,
+        |states, _| worst = worst.max((island.energy(states, G) - e0).abs()),
+    );
+    assert!(worst < 1e-5 * 9.81, "energy moved {worst:e} J");
+}
+
+#[test]
+fn a_hanging_chain_at_rest_pulls_with_the_weight_below_each_rod() {
+    // Eleven beads of masses 1.0, 1.1, … hanging from a pin on rods of
+    // 0.5 m: rod k carries the weight of the beads below it, T = −λ, to
+    // 1e-9 of it, whatever the method.
+    let n = 10;
+    let masses: Vec<f64> = (0..=n).map(|j| 1.0 + 0.1 * j as f64).collect();
+    let mut rows: Vec<IslandRow> = pin(0, DVec2::ZERO).into();
+    rows.extend((0..n).map(|k| rod(k, k + 1, 0.5)));
+    let island = Island::new(&masses, rows, vec![]).unwrap();
+    for method in Method::ALL {
+        let mut states = at_rest(
+            &(0..=n)
+                .map(|j| DVec2::new(0.0, -0.5 * j as f64))
+                .collect::<Vec<_>>(),
+        );
+        let mut work = IslandWork::default();
+        island
+            .step(
+                &mut states,
+                &weights(&masses),
+                &settings(method, 0.01),
+                &mut work,
+            )
+            .unwrap();
+        for k in 0..n {
+            let below: f64 = masses[k + 1..].iter().sum::<f64>() * 9.81;
+            let tension = -work.rows()[2 + k].lambda;
+            assert!(
+                (tension - below).abs() <= 1e-9 * below,
+                "{method}: rod {k} pulls {tension} N, the weight below is {below} N"
+            );
+        }
+    }
+}
+
+#[test]
+fn each_method_converges_at_its_order_on_the_pendulum_on_a_cart() {
+    // The bob's position after 1 s from 30°, against RK4 at 1/3840 s:
+    // halving dt divides the error by about 2^order.
+    let island = Island::new(
+        &[2.0, 1.0],
+        vec![
+            wire(0, WireShape::Line(Line), Pose::default()),
+            rod(0, 1, 1.0),
+        ],
+        vec![],
+    )
+    .unwrap();
+    let theta: f64 = 30f64.to_radians();
+    let start = at_rest(&[DVec2::ZERO, DVec2::new(theta.sin(), -theta.cos())]);
+    let forces = weights(&[2.0, 1.0]);
+    let end = |method, dt: f64| {
+        let mut states = start.clone();
+        run(
+            &island,
+            &mut states,
+            &forces,
+            &settings(method, dt),
+            (1.0 / dt).round() as usize,
+            |_, _| {},
+        );
+        states[1].position
+    };
+    let reference = end(Method::Rk4(Stabilization::None), 1.0 / 3840.0);
+    for (method, dt, order) in [
+        (
+            Method::ExplicitEuler(Stabilization::Baumgarte),
+            1.0 / 960.0,
+            1.0,
+        ),
+        (
+            Method::SemiImplicitEuler(Stabilization::Baumgarte),
+            1.0 / 960.0,
+            1.0,
+        ),
+        (
+            Method::SemiImplicitEuler(Stabilization::Projection),
+            1.0 / 960.0,
+            1.0,
+        ),
+        (Method::Rattle, 1.0 / 120.0, 2.0),
+        (Method::Rk4(Stabilization::None), 1.0 / 60.0, 4.0),
+        (Method::Rk4(Stabilization::Projection), 1.0 / 60.0, 4.0),
+    ] {
+        let coarse = (end(method, dt) - reference).length();
+        let fine = (end(method, dt / 2.0) - reference).length();
+        let observed = (coarse / fine).log2();
+        assert!(
+            (observed - order).abs() <= 0.35,
+            "{method}: observed order {observed:.2}, expected {order}"
+        );
+    }
 }
