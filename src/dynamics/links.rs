@@ -2,6 +2,10 @@
 //! constraints, [`Spring`] is a force. Each is a component on an entity of
 //! its own that names the beads it joins; beads so joined are stepped
 //! together as an island (see [`solver::Island`](crate::solver::Island)).
+//!
+//! The links are immutable components: to change one, insert a new one
+//! (or remove it). The plugin rebuilds the islands when a link, a bead or
+//! a wire is inserted or removed, and only then.
 
 use std::fmt;
 use std::sync::Arc;
@@ -42,6 +46,7 @@ fn distinct(a: Entity, b: Entity, what: &'static str) -> Result<(), ParamError> 
 /// A massless rigid rod: keeps two beads at a fixed distance,
 /// `|x_a − x_b| = length`.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
+#[component(immutable)]
 #[reflect(Component)]
 #[require(ConstraintDiagnostics)]
 pub struct Rod {
@@ -78,6 +83,7 @@ impl Rod {
 /// step; its velocity does not enter the step (no `∂C/∂t` term), so the
 /// bead's velocity follows the point's with a step's lag.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
+#[component(immutable)]
 #[reflect(Component)]
 #[require(ConstraintDiagnostics)]
 pub struct Pin {
@@ -145,6 +151,7 @@ impl Pin {
 /// `f = −(stiffness (|d| − rest_length) + damping (v_a − v_b)·u) u`, and
 /// the opposite on `b`.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
+#[component(immutable)]
 #[reflect(Component)]
 pub struct Spring {
     a: Entity,
@@ -192,6 +199,7 @@ impl Spring {
 /// [`Constraint`] implementation; the beads are handed to it in the order
 /// named here.
 #[derive(Component, Clone)]
+#[component(immutable)]
 #[require(ConstraintDiagnostics)]
 pub struct Joint {
     beads: Vec<Entity>,

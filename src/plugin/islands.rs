@@ -108,7 +108,6 @@ pub(crate) struct Links<'w, 's> {
     pins: Query<'w, 's, (Entity, &'static Pin)>,
     joints: Query<'w, 's, (Entity, &'static Joint)>,
     springs: Query<'w, 's, (Entity, &'static Spring)>,
-    changed: Query<'w, 's, (), Or<(Changed<Rod>, Changed<Pin>, Changed<Joint>, Changed<Spring>)>>,
 }
 
 /// A link while the islands are built: its rows and the beads it names.
@@ -132,7 +131,20 @@ fn pin_rows(at: DVec2) -> Vec<IslandRow> {
         .to_vec()
 }
 
-/// Rebuilds [`Islands`] where the topology changed, and keeps the
+/// Whether the islands need a rebuild: the run condition of
+/// [`prepare_islands`], so a step with nothing changed costs the executor
+/// no task.
+pub(crate) fn islands_changed(islands: Res<Islands>) -> bool {
+    islands.dirty
+}
+
+/// Whether there is an island to step: the run condition of
+/// [`step_islands`].
+pub(crate) fn any_island(islands: Res<Islands>) -> bool {
+    !islands.cached.is_empty()
+}
+
+/// Rebuilds [`Islands`] after the topology changed, and keeps the
 /// [`InIsland`] marker on exactly the beads in one.
 pub(crate) fn prepare_islands(
     mut islands: ResMut<Islands>,
@@ -144,9 +156,6 @@ pub(crate) fn prepare_islands(
     mut divergences: Divergences,
     clock: Res<SimClock>,
 ) {
-    if !islands.dirty && links.changed.is_empty() {
-        return;
-    }
     islands.dirty = false;
     islands.cached.clear();
     let is_bead = |e: Entity| beads.contains(e);
@@ -385,7 +394,7 @@ pub(crate) fn step_islands(
         ),
         (With<InIsland>, Without<Diverged>),
     >,
-    wires: Query<&WirePose>,
+    wires: Query<(Ref<Wire>, &WirePose)>,
     pins: Query<&Pin>,
     transforms: Query<&Transform, Without<InIsland>>,
     mut diagnostics: Query<&mut ConstraintDiagnostics>,
@@ -404,8 +413,12 @@ pub(crate) fn step_islands(
             cached.forces.push(bead.step_force(gravity));
         }
         for &(_, row, wire) in &cached.wire_rows {
-            if let Ok(Ok(pose)) = wires.get(wire).map(WirePose::get) {
-                cached.island.place_wire(row, pose);
+            let Ok((wire, pose)) = wires.get(wire) else {
+                continue;
+            };
+            if let Ok(pose) = pose.get() {
+                let reshaped = wire.is_changed().then(|| wire.shape().clone());
+                cached.island.place_wire(row, reshaped, pose);
             }
         }
         for &(row, pin) in &cached.anchored {

@@ -30,14 +30,14 @@ pub use restart::{Restart, SimClock};
 pub use schedule::WireBeadSystems;
 
 use forces::apply_drag;
-use islands::{prepare_islands, step_islands, topology_changed};
+use islands::{any_island, islands_changed, prepare_islands, step_islands, topology_changed};
 use restart::{apply_restart, apply_timestep};
 use step::{prepare_step, step_beads};
 use writeback::write_transforms;
 
 use crate::dynamics::{
-    Bead, BeadDiagnostics, BeadDiverged, ConstraintDiagnostics, DragTarget, OnWire, PendingBead,
-    PendingParams, Pin, Rod, SimParams, Spring, Wire,
+    Bead, BeadDiagnostics, BeadDiverged, ConstraintDiagnostics, DragTarget, Joint, OnWire,
+    PendingBead, PendingParams, Pin, Rod, SimParams, Spring, Wire,
 };
 use bevy::ecs::lifecycle::{Add, Insert, Remove};
 use writeback::LastStep;
@@ -133,10 +133,14 @@ impl Plugin for WireBeadPlugin {
             .add_observer(topology_changed::<Remove, OnWire>)
             .add_observer(topology_changed::<Insert, Wire>)
             .add_observer(topology_changed::<Remove, Wire>)
+            .add_observer(topology_changed::<Insert, Rod>)
             .add_observer(topology_changed::<Remove, Rod>)
+            .add_observer(topology_changed::<Insert, Pin>)
             .add_observer(topology_changed::<Remove, Pin>)
+            .add_observer(topology_changed::<Insert, Spring>)
             .add_observer(topology_changed::<Remove, Spring>)
-            .add_observer(topology_changed::<Remove, crate::dynamics::Joint>)
+            .add_observer(topology_changed::<Insert, Joint>)
+            .add_observer(topology_changed::<Remove, Joint>)
             .add_message::<Restart>()
             .add_message::<BeadDiverged>()
             .register_type::<Bead>()
@@ -156,11 +160,11 @@ impl Plugin for WireBeadPlugin {
             .add_systems(
                 FixedUpdate,
                 (
-                    (prepare_step, prepare_islands)
+                    (prepare_step, prepare_islands.run_if(islands_changed))
                         .chain()
                         .in_set(WireBeadSystems::Prepare),
                     apply_drag.in_set(WireBeadSystems::Forces),
-                    (step_beads, step_islands).in_set(WireBeadSystems::Step),
+                    (step_beads, step_islands.run_if(any_island)).in_set(WireBeadSystems::Step),
                     write_transforms.in_set(WireBeadSystems::Writeback),
                 ),
             );

@@ -5,7 +5,7 @@ use bevy::math::DVec2;
 
 use super::constraint::{RowKind, SpringLink};
 use super::normal::{Factored, NormalMatrix};
-use crate::geometry::Pose;
+use crate::geometry::{Pose, WireShape};
 use crate::solver::method::Method;
 use crate::solver::projection::{
     NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE, kinetic_scale,
@@ -273,10 +273,18 @@ impl Island {
     }
 
     /// Moves the wire of row `row` to `pose` (a wire that moves between
-    /// steps); rows of other kinds are left as they are.
-    pub fn place_wire(&mut self, row: usize, pose: Pose) {
-        if let Some(RowKind::Wire { pose: placed, .. }) = self.rows.get_mut(row) {
+    /// steps), and gives it `shape` where one is given (a wire edited in
+    /// place); rows of other kinds are left as they are.
+    pub fn place_wire(&mut self, row: usize, shape: Option<WireShape>, pose: Pose) {
+        if let Some(RowKind::Wire {
+            shape: placed_shape,
+            pose: placed,
+        }) = self.rows.get_mut(row)
+        {
             *placed = pose;
+            if let Some(shape) = shape {
+                *placed_shape = shape;
+            }
         }
     }
 
