@@ -207,7 +207,7 @@ impl ReportView<'_, '_> {
             pins: self
                 .pins
                 .iter()
-                .filter_map(|pin| to_pixel(pin.at()))
+                .filter_map(|pin| to_pixel(pin.locate(&self.transforms)?))
                 .collect(),
             drag,
             preset: self.active.running.clone(),

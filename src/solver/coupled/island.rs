@@ -476,7 +476,8 @@ impl Island {
         }
     }
 
-    /// Evaluates the rows where the step ended (`work.x`, `work.v`).
+    /// Evaluates the rows at the current state `work.x`, `work.v` (where
+    /// the step ended, or the stage or Newton iterate being worked on).
     fn evaluate_at_new(&self, work: &mut IslandWork) {
         self.evaluate(
             &work.x,
@@ -550,15 +551,8 @@ impl Island {
             work.x.clone_from(&work.x0);
             work.v.clone_from(&work.v0);
         }
+        self.evaluate_at_new(work);
         let (x, v) = (&work.x, &work.v);
-        self.evaluate(
-            x,
-            v,
-            &mut work.gradient,
-            &mut work.c,
-            &mut work.curvature,
-            &mut work.scratch,
-        );
         self.applied(forces, x, v, &mut work.force);
         if self.rows() > 0 {
             self.factor(&work.gradient, x, &mut work.factored)?;
@@ -652,14 +646,7 @@ impl Island {
         let mut previous = f64::INFINITY;
         let mut i = 0;
         loop {
-            self.evaluate(
-                &work.x,
-                &work.v,
-                &mut work.gradient,
-                &mut work.c,
-                &mut work.curvature,
-                &mut work.scratch,
-            );
+            self.evaluate_at_new(work);
             let last = i == NEWTON_MAX_ITERATIONS;
             let tolerance = if last {
                 NEWTON_ACCEPT
