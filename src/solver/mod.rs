@@ -35,7 +35,7 @@ pub use coupled::{
 pub use euler::{explicit_euler, semi_implicit_euler};
 pub use lanes::{CircleLanes, CircleSteps, LANES, is_batched, step_on_circles};
 pub use method::{Integrator, Method, Stabilization};
-pub use projection::{NEWTON_ACCEPT, NEWTON_TOLERANCE, project};
+pub use projection::{ENERGY_CORRECTION_LIMIT, NEWTON_ACCEPT, NEWTON_TOLERANCE, project};
 pub use rattle::rattle;
 pub use rk4::rk4;
 pub use settings::{Gains, StepSettings};

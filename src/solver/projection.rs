@@ -135,3 +135,42 @@ pub(crate) fn restore_speed<C: ImplicitCurve + ?Sized>(
         ..projected
     })
 }
+
+/// The largest relative change of speed eq. (9c) makes: a fourth-order
+/// step's energy error is far below it; a larger mismatch means a bead at
+/// a turning point or at rest, where the ratio of two near-zero kinetic
+/// energies says nothing, and the velocity is left as projected.
+pub const ENERGY_CORRECTION_LIMIT: f64 = 1e-3;
+
+/// Eq. (9c): the factor that brings a projected velocity of kinetic energy
+/// `kinetic_now` to the energy balance `kinetic_target` of a conservative
+/// system, or 1 where the change would exceed
+/// [`ENERGY_CORRECTION_LIMIT`].
+pub(crate) fn energy_scale(kinetic_target: f64, kinetic_now: f64) -> f64 {
+    let scale = kinetic_scale(kinetic_target, kinetic_now);
+    if (scale - 1.0).abs() <= ENERGY_CORRECTION_LIMIT {
+        scale
+    } else {
+        1.0
+    }
+}
+
+/// Eq. (9c) for one bead after an RK4 step from `start`: `projected`'s
+/// velocity scaled so that the energy is the start's, kinetic plus the
+/// potential of the linear force of eq. (5) (gravity and the drag spring),
+/// and its normal component removed again.
+pub(crate) fn restore_energy<C: ImplicitCurve + ?Sized>(
+    curve: &C,
+    start: BeadState,
+    projected: BeadState,
+    force: &super::state::LinearForce,
+    mass: f64,
+) -> Result<BeadState, SolveError> {
+    let target = 0.5 * mass * start.velocity.length_squared() + force.potential(start.position)
+        - force.potential(projected.position);
+    let scale = energy_scale(target, 0.5 * mass * projected.velocity.length_squared());
+    Ok(BeadState {
+        velocity: tangential(curve, projected.position, scale * projected.velocity)?,
+        ..projected
+    })
+}

@@ -50,6 +50,13 @@ impl LinearForce {
         }
     }
 
+    /// The potential of the force, `U(x) = −force·(x − at) + ½ S |x − at|²`
+    /// (so `f = −∇U`), zero at `at`: the force of eq. (5) is conservative.
+    pub fn potential(&self, x: DVec2) -> f64 {
+        let d = x - self.at;
+        -self.force.dot(d) + 0.5 * self.stiffness * d.length_squared()
+    }
+
     /// `f(x)`.
     #[inline]
     pub fn at(&self, x: DVec2) -> DVec2 {

@@ -6,7 +6,7 @@ use bevy::math::DVec2;
 
 use super::euler::{explicit_euler, semi_implicit_euler};
 use super::method::Method;
-use super::projection::{project, restore_speed};
+use super::projection::{project, restore_energy, restore_speed};
 use super::rattle::rattle;
 use super::rk4::rk4;
 use super::settings::StepSettings;
@@ -83,7 +83,7 @@ pub fn step<C: ImplicitCurve + ?Sized>(
         let projected = if settings.method.is_euler() {
             restore_speed(curve, state, projected, force, mass, h)?
         } else {
-            projected
+            restore_energy(curve, state, projected, force, mass)?
         };
         (projected, constraint_state(curve, projected))
     } else {
@@ -214,6 +214,41 @@ mod tests {
                 worst = worst.max((energy(&state) - energy(&start)).abs() / 9.81);
             }
             assert!(worst < bound, "{method}: energy moved {worst} m·g·r");
+        }
+    }
+
+    #[test]
+    fn rk4_with_projection_keeps_the_pendulums_energy_to_rounding() {
+        // Eq. (9c): the 135° pendulum (r = 1) for 10 s at 1/60 s keeps its
+        // energy to 1e-12 m·g·r (RK4 alone: 8.6e-6), and a bead at rest
+        // at the bottom stays at rest.
+        let circle = Circle { radius: 1.0 };
+        let theta0 = 135f64.to_radians();
+        let energy = |s: &BeadState| {
+            let (kinetic, potential) = s.energy(1.0, G);
+            kinetic + potential
+        };
+        let s = settings(Method::Rk4(Stabilization::Projection), 1.0 / 60.0);
+        for (start, bound) in [
+            (DVec2::new(theta0.sin(), -theta0.cos()), 1e-12),
+            (DVec2::new(0.0, -1.0), 1e-15),
+        ] {
+            let start = BeadState {
+                position: start,
+                velocity: DVec2::ZERO,
+            };
+            let mut state = start;
+            let mut worst = 0.0f64;
+            for _ in 0..600 {
+                state = step(&circle, state, &LinearForce::constant(G), 1.0, &s)
+                    .unwrap()
+                    .state;
+                worst = worst.max((energy(&state) - energy(&start)).abs() / 9.81);
+            }
+            assert!(
+                worst < bound,
+                "from {start:?}: energy moved {worst:e} m·g·r"
+            );
         }
     }
 }

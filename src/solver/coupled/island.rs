@@ -8,7 +8,7 @@ use super::normal::{Factored, NormalMatrix};
 use crate::geometry::{Pose, WireShape};
 use crate::solver::method::Method;
 use crate::solver::projection::{
-    NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE, kinetic_scale,
+    NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE, energy_scale, kinetic_scale,
 };
 use crate::solver::settings::{Gains, StepSettings};
 use crate::solver::solve::SolveError;
@@ -425,8 +425,12 @@ impl Island {
             }
         }
         if settings.method.projects() {
-            let euler = settings.method.is_euler().then_some(settings.dt);
-            self.project(forces, euler, work)?;
+            let restore = if settings.method.is_euler() {
+                Restore::Speed(settings.dt)
+            } else {
+                Restore::Energy
+            };
+            self.project(forces, restore, work)?;
         }
         work.bead_forces.clear();
         work.bead_forces.resize(n, DVec2::ZERO);
@@ -753,24 +757,22 @@ impl Island {
 
     /// Post-stabilization, eq. (11): Newton steps along the current
     /// gradients bring every `C` to zero and the velocity is projected onto
-    /// `J v = 0`. After an Euler step of length `h` (`euler`), the
-    /// velocities are then scaled, by one factor for the island (which
-    /// keeps `J v = 0`), to the kinetic energy of `v₀ + h P₀ W Q`: the start
+    /// `J v = 0`; then the velocities are scaled by one factor for the
+    /// island (which keeps `J v = 0`). After an Euler step of length `h`
+    /// the factor gives the kinetic energy of `v₀ + h P₀ W Q`: the start
     /// velocity plus the step's kick with its part off the constraints at
     /// the start removed (`P₀` the mass-weighted projection onto
-    /// `J₀ v = 0`), eq. (9b).
+    /// `J₀ v = 0`), eq. (9b). After RK4 it keeps the energy of a
+    /// conservative island (no spring damping) what it was, eq. (9c).
     fn project(
         &self,
         forces: &[LinearForce],
-        euler: Option<f64>,
+        restore: Restore,
         work: &mut IslandWork,
     ) -> Result<(), SolveError> {
         self.newton(work, Direction::Current)?;
         self.evaluate_at_new(work);
         self.project_velocity(work)?;
-        let Some(h) = euler else {
-            return Ok(());
-        };
         let kinetic = |v: &[DVec2]| -> f64 {
             v.iter()
                 .zip(&self.inverse_mass)
@@ -778,6 +780,24 @@ impl Island {
                 .sum()
         };
         let now = kinetic(&work.v);
+        let h = match restore {
+            Restore::Speed(h) => h,
+            Restore::Energy => {
+                if self.springs.iter().any(|s| s.damping != 0.0) {
+                    return Ok(());
+                }
+                let potential = |x: &[DVec2]| -> f64 {
+                    let applied: f64 = forces.iter().zip(x).map(|(f, x)| f.potential(*x)).sum();
+                    applied + self.springs.iter().map(|s| s.energy(x)).sum::<f64>()
+                };
+                let target = kinetic(&work.v0) + potential(&work.x0) - potential(&work.x);
+                let scale = energy_scale(target, now);
+                for v in &mut work.v {
+                    *v *= scale;
+                }
+                return Ok(());
+            }
+        };
         // The applied kick W Q at the start, its part off J₀ removed.
         self.evaluate(
             &work.x0,
@@ -870,6 +890,15 @@ impl Island {
         }
         Ok(())
     }
+}
+
+/// How a projection ends (see [`Island::project`]).
+#[derive(Clone, Copy, PartialEq)]
+enum Restore {
+    /// The pre-kick speed after an Euler step of this length, eq. (9b).
+    Speed(f64),
+    /// The energy of the step's start after RK4, eq. (9c).
+    Energy,
 }
 
 /// Which state a solve of eq. (10) is at.
