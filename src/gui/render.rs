@@ -465,30 +465,28 @@ pub fn zigzag(a: Vec2, b: Vec2, turns: usize, width: f32) -> Vec<Vec2> {
     points
 }
 
-/// Draws the constraint force on each bead on a wire and on the selected
-/// bead (a rope's every bead would hide the rope), and the drag spring.
+/// Draws the constraint force on each bead on a wire (on a bead hanging
+/// from rods it lies along them and would hide them; the panel lists every
+/// rod's λ), and the drag spring.
 fn draw_forces(
     beads: Query<(
-        Entity,
         &Bead,
         Option<&BeadDiagnostics>,
         Option<&DragTarget>,
         Has<OnWire>,
     )>,
-    selected: Option<Res<crate::gui::drag::SelectedBead>>,
     params: Res<crate::SimParams>,
     view: Res<FramedView>,
     style: Res<SceneStyle>,
     mut gizmos: Gizmos,
 ) {
     let g = params.gravity.length().max(1e-3) as f32;
-    for (entity, bead, diagnostics, drag, on_wire) in &beads {
+    for (bead, diagnostics, drag, on_wire) in &beads {
         // Forces are drawn in units of the bead's weight.
         let per_newton = style.force_scale * view.size.y / (bead.mass() as f32 * g);
         let at = bead.position.as_vec2();
-        let shown = on_wire || selected.as_ref().is_some_and(|s| s.0 == Some(entity));
         let force = diagnostics
-            .filter(|_| shown)
+            .filter(|_| on_wire)
             .map_or(Vec2::ZERO, |d| d.constraint_force.as_vec2())
             * per_newton;
         if force.length() > 1e-4 * view.size.y {
