@@ -48,27 +48,37 @@ fn colour_near(image: &RgbImage, at: [f32; 2], radius: i32, colour: Rgb<u8>) -> 
     })
 }
 
-#[test]
-#[ignore = "needs the screenshot .ci/run makes under Xvfb"]
-fn screenshot_shows_the_wire_and_the_bead_where_simulated() {
-    let image = image::open(dir().join("shot.png"))
+/// The screenshot `name`.png with its report, of the same size.
+fn screenshot(name: &str) -> (RgbImage, FrameReport) {
+    let image = image::open(dir().join(format!("{name}.png")))
         .expect("screenshot")
         .to_rgb8();
-    let report = report("shot.ron");
+    let report = report(&format!("{name}.ron"));
     assert_eq!([image.width(), image.height()], report.window);
-    let style = wirebead::gui::SceneStyle::default();
-    let (wire_colour, bead_colour) = (rgb(style.wire), rgb(style.bead));
+    (image, report)
+}
 
-    // The bead's colour is at the bead's simulated position.
+/// Every bead of the report shows the bead colour at its simulated
+/// position.
+fn beads_drawn_where_simulated(image: &RgbImage, report: &FrameReport) {
+    let bead_colour = rgb(wirebead::gui::SceneStyle::default().bead);
     assert!(!report.beads.is_empty());
     for bead in &report.beads {
         let r = (0.5 * bead.radius_px).max(2.0) as i32;
         assert!(
-            colour_near(&image, bead.pixel, r, bead_colour),
+            colour_near(image, bead.pixel, r, bead_colour),
             "no bead colour at {:?}",
             bead.pixel
         );
     }
+}
+
+#[test]
+#[ignore = "needs the screenshot .ci/run makes under Xvfb"]
+fn screenshot_shows_the_wire_and_the_bead_where_simulated() {
+    let (image, report) = screenshot("shot");
+    let wire_colour = rgb(wirebead::gui::SceneStyle::default().wire);
+    beads_drawn_where_simulated(&image, &report);
 
     // The wire's stroke is where the simulated wire is, and not beside it.
     let mut on = 0;
@@ -149,22 +159,11 @@ fn editing_the_running_preset_reloads_it() {
 #[test]
 #[ignore = "needs the screenshot .ci/run makes under Xvfb"]
 fn screenshot_of_a_coupled_preset_shows_its_rod_between_its_beads() {
-    let image = image::open(dir().join("coupled.png"))
-        .expect("screenshot")
-        .to_rgb8();
-    let report = report("coupled.ron");
+    let (image, report) = screenshot("coupled");
     assert_eq!(report.preset.as_deref(), Some("Pendulum on a cart"));
-    let style = wirebead::gui::SceneStyle::default();
-    let (rod_colour, bead_colour) = (rgb(style.rod), rgb(style.bead));
+    let rod_colour = rgb(wirebead::gui::SceneStyle::default().rod);
     assert_eq!(report.beads.len(), 2);
-    for bead in &report.beads {
-        let r = (0.5 * bead.radius_px).max(2.0) as i32;
-        assert!(
-            colour_near(&image, bead.pixel, r, bead_colour),
-            "no bead colour at {:?}",
-            bead.pixel
-        );
-    }
+    beads_drawn_where_simulated(&image, &report);
     // The rod is drawn from bead to bead: its colour along the middle of
     // the segment, and not 20 px to its side.
     assert_eq!(report.rods.len(), 1);
