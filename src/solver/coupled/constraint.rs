@@ -185,7 +185,12 @@ impl SpringLink {
 
     /// The energy stored in the spring where the beads are at `x`.
     pub fn energy(&self, x: &[DVec2]) -> f64 {
-        let stretch = (x[self.a] - x[self.b]).length() - self.rest_length;
+        self.stored(x[self.a], x[self.b])
+    }
+
+    /// The energy stored in the spring with its ends at `a` and `b`.
+    pub(crate) fn stored(&self, a: DVec2, b: DVec2) -> f64 {
+        let stretch = (a - b).length() - self.rest_length;
         0.5 * self.stiffness * stretch * stretch
     }
 }

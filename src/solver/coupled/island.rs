@@ -317,8 +317,12 @@ impl Island {
                 kinetic + potential
             })
             .sum();
-        let x: Vec<DVec2> = states.iter().map(|s| s.position).collect();
-        beads + self.springs.iter().map(|s| s.energy(&x)).sum::<f64>()
+        let springs: f64 = self
+            .springs
+            .iter()
+            .map(|s| s.stored(states[s.a].position, states[s.b].position))
+            .sum();
+        beads + springs
     }
 
     /// One step of every bead of the island under `settings`: `states`

@@ -139,6 +139,26 @@ fn double_pendulum() -> (Island, Vec<BeadState>, Vec<LinearForce>) {
     (island, states, weights(&masses))
 }
 
+/// The double pendulum run `steps` steps under `method` at `dt`: the
+/// largest `|C|` and the largest energy change (J) over the run.
+fn double_pendulum_run(method: Method, dt: f64, steps: usize) -> (f64, f64) {
+    let (island, mut states, forces) = double_pendulum();
+    let e0 = island.energy(&states, G);
+    let mut worst = (0.0f64, 0.0f64);
+    run(
+        &island,
+        &mut states,
+        &forces,
+        &settings(method, dt),
+        steps,
+        |states, work| {
+            worst.0 = worst.0.max(max_drift(work, 1.0));
+            worst.1 = worst.1.max((island.energy(states, G) - e0).abs());
+        },
+    );
+    worst
+}
+
 #[test]
 fn double_pendulum_holds_its_rods_and_its_energy() {
     // Chaotic, so only the invariants are tested: the rods to the Newton
@@ -149,20 +169,7 @@ fn double_pendulum_holds_its_rods_and_its_energy() {
         (Method::Rattle, 1.0 / 240.0, 0.05),
         (Method::Rk4(Stabilization::Projection), 1.0 / 240.0, 0.05),
     ] {
-        let (island, mut states, forces) = double_pendulum();
-        let e0 = island.energy(&states, G);
-        let mut worst = (0.0f64, 0.0f64);
-        run(
-            &island,
-            &mut states,
-            &forces,
-            &settings(method, dt),
-            (10.0 / dt) as usize,
-            |states, work| {
-                worst.0 = worst.0.max(max_drift(work, 1.0));
-                worst.1 = worst.1.max((island.energy(states, G) - e0).abs());
-            },
-        );
+        let worst = double_pendulum_run(method, dt, (10.0 / dt) as usize);
         assert!(worst.0 <= 1e-12, "{method}: |C| reached {:e}", worst.0);
         assert!(
             worst.1 <= energy_tolerance,
@@ -611,22 +618,10 @@ fn euler_with_projection_adds_no_energy_to_an_island() {
     // The double pendulum at 1/240 s for 10 s: semi-implicit Euler with
     // projection keeps the energy within 5 % of m g L = 9.81 J (0.15 J
     // measured; 17 J without eq. (9b)).
-    let (island, mut states, forces) = double_pendulum();
-    let e0 = island.energy(&states, G);
-    let mut worst = (0.0f64, 0.0f64);
-    run(
-        &island,
-        &mut states,
-        &forces,
-        &settings(
-            Method::SemiImplicitEuler(Stabilization::Projection),
-            1.0 / 240.0,
-        ),
+    let worst = double_pendulum_run(
+        Method::SemiImplicitEuler(Stabilization::Projection),
+        1.0 / 240.0,
         2400,
-        |states, work| {
-            worst.0 = worst.0.max(max_drift(work, 1.0));
-            worst.1 = worst.1.max((island.energy(states, G) - e0).abs());
-        },
     );
     assert!(worst.0 <= 1e-12, "|C| reached {:e}", worst.0);
     assert!(worst.1 < 0.05 * 9.81, "energy moved {} J", worst.1);
@@ -673,17 +668,8 @@ fn double_pendulum_keeps_its_energy_to_1e_6_with_rk4_and_projection() {
     // 100 s at 1/240 s: within 1e-6 of m g l = 9.81 J. RK4 alone drifts by
     // 6.7e-6 of it here; eq. (9c) keeps the energy of the conservative
     // island at the start's.
-    let (island, mut states, forces) = double_pendulum();
-    let e0 = island.energy(&states, G);
-    let mut worst = 0.0f64;
-    run(
-        &island,
-        &mut states,
-        &forces,
-        &settings(Method::Rk4(Stabilization::Projection), 1.0 / 240.0),
-        24_000,
-        |states, _| worst = worst.max((island.energy(states, G) - e0).abs()),
-    );
+    let (_, worst) =
+        double_pendulum_run(Method::Rk4(Stabilization::Projection), 1.0 / 240.0, 24_000);
     assert!(worst < 1e-6 * 9.81, "energy moved {worst:e} J");
 }
 
