@@ -21,6 +21,7 @@
 mod circle;
 mod ellipse;
 mod line;
+mod motion;
 mod parabola;
 mod pose;
 mod shape;
@@ -32,6 +33,9 @@ pub use circle::Circle;
 pub(crate) use circle::circle_geometry;
 pub use ellipse::Ellipse;
 pub use line::Line;
+pub use motion::{
+    FixedTrack, MovingTrack, Oscillate, PoseHistory, PosePath, Spin, Track, Twist, WireMotion,
+};
 pub use parabola::Parabola;
 pub use pose::{Placed, Pose};
 pub use shape::{WireKind, WireShape};

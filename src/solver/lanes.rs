@@ -225,7 +225,7 @@ struct CircleStages<'a, T: Lane> {
 impl<T: Lane> Stages<T> for CircleStages<'_, T> {
     type Error = Infallible;
     #[inline(always)]
-    fn acceleration(&mut self, x: V2<T>, v: V2<T>) -> Result<V2<T>, Infallible> {
+    fn acceleration(&mut self, x: V2<T>, v: V2<T>, _at: f64) -> Result<V2<T>, Infallible> {
         let (solved, _, ok) = solve_on_circles(
             x,
             v,

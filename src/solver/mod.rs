@@ -41,7 +41,7 @@ pub use rk4::rk4;
 pub use settings::{Gains, StepSettings};
 pub use solve::{SolveError, Solved, lambda, solve};
 pub use state::{BeadState, LinearForce};
-pub use step::{Advance, StepOutput, constraint_state, step};
+pub use step::{Advance, StepOutput, constraint_state, constraint_state_on, step, step_on};
 
 /// What the solver's unit tests share.
 #[cfg(test)]

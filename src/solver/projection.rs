@@ -6,7 +6,7 @@ use bevy::math::DVec2;
 
 use super::solve::{SolveError, normal_length_squared};
 use super::state::BeadState;
-use crate::geometry::ImplicitCurve;
+use crate::geometry::{FixedTrack, ImplicitCurve, Track};
 
 /// Tolerance on `|C|` for the Newton solves (RATTLE, projection), in units
 /// of the wire's scale: a few ulps, which Newton's quadratic convergence
@@ -22,18 +22,19 @@ fn newton_done(residual: f64, scale: f64, last: bool) -> bool {
     residual <= NEWTON_TOLERANCE * scale || (last && residual <= NEWTON_ACCEPT * scale)
 }
 
-/// Newton's method on `s ↦ C(base + s dir)`: the root `s`.
-pub(crate) fn newton_along<C: ImplicitCurve + ?Sized>(
-    curve: &C,
+/// Newton's method on `s ↦ C(base + s dir, t)`: the root `s`.
+pub(crate) fn newton_along<T: Track + ?Sized>(
+    track: &T,
+    t: f64,
     base: DVec2,
     dir: DVec2,
 ) -> Result<f64, SolveError> {
-    let scale = curve.scale().max(f64::MIN_POSITIVE);
+    let scale = track.scale().max(f64::MIN_POSITIVE);
     let mut s = 0.0;
     let mut residual = f64::INFINITY;
     for i in 0..=NEWTON_MAX_ITERATIONS {
         let p = base + s * dir;
-        let g = curve.geometry(p);
+        let g = track.geometry(t, p);
         residual = g.c.abs();
         if newton_done(residual, scale, i == NEWTON_MAX_ITERATIONS) {
             return Ok(s);
@@ -60,12 +61,22 @@ pub fn project<C: ImplicitCurve + ?Sized>(
     curve: &C,
     state: BeadState,
 ) -> Result<BeadState, SolveError> {
-    let scale = curve.scale().max(f64::MIN_POSITIVE);
+    project_on(&FixedTrack(curve), 0.0, state)
+}
+
+/// [`project`] onto a wire that may move, at time `t`: the velocity keeps
+/// the wire's own normal velocity, so `Ċ = ∇C·(ẋ − w) = 0`.
+pub(crate) fn project_on<T: Track + ?Sized>(
+    track: &T,
+    t: f64,
+    state: BeadState,
+) -> Result<BeadState, SolveError> {
+    let scale = track.scale().max(f64::MIN_POSITIVE);
     let mut x = state.position;
     let mut converged = false;
     let mut residual = f64::INFINITY;
     for i in 0..=NEWTON_MAX_ITERATIONS {
-        let g = curve.geometry(x);
+        let g = track.geometry(t, x);
         residual = g.c.abs();
         if newton_done(residual, scale, i == NEWTON_MAX_ITERATIONS) {
             converged = true;
@@ -85,19 +96,39 @@ pub fn project<C: ImplicitCurve + ?Sized>(
     }
     Ok(BeadState {
         position: x,
-        velocity: tangential(curve, x, state.velocity)?,
+        velocity: tangential(track, t, x, state.velocity)?,
     })
 }
 
-/// `v` without its component along the normal at `x`.
-fn tangential<C: ImplicitCurve + ?Sized>(
-    curve: &C,
+/// The velocity of the wire's point at `x` at time `t` (zero on a fixed
+/// wire).
+#[inline(always)]
+fn wire_velocity<T: Track + ?Sized>(track: &T, t: f64, x: DVec2) -> DVec2 {
+    if T::MOVES {
+        track.twist(t).velocity_at(x)
+    } else {
+        DVec2::ZERO
+    }
+}
+
+/// `v` without the part of its normal component that the wire does not
+/// share: `∇C·(v − w) = 0` afterwards.
+fn tangential<T: Track + ?Sized>(
+    track: &T,
+    t: f64,
     x: DVec2,
     v: DVec2,
 ) -> Result<DVec2, SolveError> {
-    let n = curve.gradient(x);
+    let n = track.geometry(t, x).normal;
     let nn = normal_length_squared(n, x)?;
-    Ok(v - (n.dot(v) / nn) * n)
+    let w = wire_velocity(track, t, x);
+    Ok(v - (n.dot(v - w) / nn) * n)
+}
+
+/// `a` without its component along `n`.
+fn along_wire(n: DVec2, a: DVec2, x: DVec2) -> Result<DVec2, SolveError> {
+    let nn = normal_length_squared(n, x)?;
+    Ok(a - (n.dot(a) / nn) * n)
 }
 
 /// Eq. (9b): the factor that scales a projected velocity of kinetic
@@ -112,30 +143,39 @@ pub(crate) fn kinetic_scale(kinetic_target: f64, kinetic_now: f64) -> f64 {
     }
 }
 
-/// Eq. (9b) for one bead after an Euler step of length `h` from `start`:
-/// `projected`'s velocity scaled to the speed of `v₀ + h a_t`, the start
-/// velocity plus the step's kick without its normal part (`a_t` the
-/// applied acceleration's component along the wire at `x₀`), and its
-/// normal component, which the scale multiplies from rounding, removed
-/// again.
-pub(crate) fn restore_speed<C: ImplicitCurve + ?Sized>(
-    curve: &C,
+/// Eq. (9b) for one bead after an Euler step of length `h` from `start`
+/// at time `t`: `projected`'s velocity scaled to the speed of
+/// `v₀ + h a_t`, the start velocity plus the step's kick without its
+/// normal part (`a_t` the applied acceleration's component along the wire
+/// at `x₀`), and its normal component, which the scale multiplies from
+/// rounding, removed again. On a moving wire the same holds in the wire's
+/// frame: relative velocities, and the frame's acceleration `a_w` taken
+/// from the applied one.
+pub(crate) fn restore_speed<T: Track + ?Sized>(
+    track: &T,
+    t: f64,
     start: BeadState,
     projected: BeadState,
     force: &super::state::LinearForce,
     mass: f64,
     h: f64,
 ) -> Result<BeadState, SolveError> {
-    let x0 = start.position;
-    let tangential_kick = tangential(curve, x0, force.at(x0) / mass)?;
-    let target = (start.velocity + h * tangential_kick).length_squared();
-    let scale = kinetic_scale(target, projected.velocity.length_squared());
+    let (x0, x1, t1) = (start.position, projected.position, t + h);
+    let (w0, w1) = (wire_velocity(track, t, x0), wire_velocity(track, t1, x1));
+    let relative = start.velocity - w0;
+    let mut applied = force.at(x0) / mass;
+    if T::MOVES {
+        applied -= track.twist(t).acceleration_at(x0, relative);
+    }
+    let kick = along_wire(track.geometry(t, x0).normal, applied, x0)?;
+    let target = (relative + h * kick).length_squared();
+    let now = projected.velocity - w1;
+    let scale = kinetic_scale(target, now.length_squared());
     Ok(BeadState {
-        velocity: tangential(curve, projected.position, scale * projected.velocity)?,
+        velocity: tangential(track, t1, x1, w1 + scale * now)?,
         ..projected
     })
 }
-
 /// The largest relative change of speed eq. (9c) makes: a fourth-order
 /// step's energy error is far below it; a larger mismatch means a bead at
 /// a turning point or at rest, where the ratio of two near-zero kinetic
@@ -159,8 +199,9 @@ pub(crate) fn energy_scale(kinetic_target: f64, kinetic_now: f64) -> f64 {
 /// velocity scaled so that the energy is the start's, kinetic plus the
 /// potential of the linear force of eq. (5) (gravity and the drag spring),
 /// and its normal component removed again.
-pub(crate) fn restore_energy<C: ImplicitCurve + ?Sized>(
-    curve: &C,
+pub(crate) fn restore_energy<T: Track + ?Sized>(
+    track: &T,
+    t: f64,
     start: BeadState,
     projected: BeadState,
     force: &super::state::LinearForce,
@@ -170,7 +211,7 @@ pub(crate) fn restore_energy<C: ImplicitCurve + ?Sized>(
         - force.potential(projected.position);
     let scale = energy_scale(target, 0.5 * mass * projected.velocity.length_squared());
     Ok(BeadState {
-        velocity: tangential(curve, projected.position, scale * projected.velocity)?,
+        velocity: tangential(track, t, projected.position, scale * projected.velocity)?,
         ..projected
     })
 }

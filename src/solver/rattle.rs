@@ -4,7 +4,9 @@ use super::Advance;
 use super::projection::newton_along;
 use super::solve::{SolveError, normal_length_squared};
 use super::state::{BeadState, LinearForce};
-use crate::geometry::ImplicitCurve;
+use bevy::math::DVec2;
+
+use crate::geometry::{FixedTrack, ImplicitCurve, Track};
 
 /// One RATTLE step of length `h`: the position solve by Newton along
 /// `N₀`, then the velocity solve, linear in μ. λ reported is the mean of
@@ -16,21 +18,42 @@ pub fn rattle<C: ImplicitCurve + ?Sized>(
     mass: f64,
     h: f64,
 ) -> Result<Advance, SolveError> {
+    rattle_on(&FixedTrack(curve), 0.0, state, force, mass, h)
+}
+
+/// [`rattle`] on a wire that may move, the step starting at time `t`:
+/// the position solve meets `C(x₁, t + h) = 0`, the velocity solve
+/// `∇C·(v₁ − w(x₁)) = 0` at `t + h`, the wire's own velocity `w` taking
+/// the place of `−∂C/∂t`.
+pub(crate) fn rattle_on<T: Track + ?Sized>(
+    track: &T,
+    t: f64,
+    state: BeadState,
+    force: &LinearForce,
+    mass: f64,
+    h: f64,
+) -> Result<Advance, SolveError> {
     let BeadState {
         position: x0,
         velocity: v0,
     } = state;
-    let n0 = curve.gradient(x0);
+    let t1 = t + h;
+    let n0 = track.geometry(t, x0).normal;
     normal_length_squared(n0, x0)?;
     let free = x0 + h * v0 + (h * h / (2.0 * mass)) * force.at(x0);
-    let s = newton_along(curve, free, n0)?;
+    let s = newton_along(track, t1, free, n0)?;
     let x1 = free + s * n0;
     let lambda = 2.0 * mass * s / (h * h);
     let v_half = (x1 - x0) / h;
-    let n1 = curve.gradient(x1);
+    let n1 = track.geometry(t1, x1).normal;
     let nn1 = normal_length_squared(n1, x1)?;
     let w = v_half + (h / (2.0 * mass)) * force.at(x1);
-    let mu_scaled = -n1.dot(w) / nn1;
+    let wire = if T::MOVES {
+        track.twist(t1).velocity_at(x1)
+    } else {
+        DVec2::ZERO
+    };
+    let mu_scaled = -n1.dot(w - wire) / nn1;
     let v1 = w + mu_scaled * n1;
     let mu = 2.0 * mass * mu_scaled / h;
     Ok(Advance {

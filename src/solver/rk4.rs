@@ -2,9 +2,9 @@
 
 use super::Advance;
 use super::settings::Gains;
-use super::solve::{SolveError, Solved, solve};
+use super::solve::{SolveError, Solved, solve_on};
 use super::state::{BeadState, LinearForce};
-use crate::geometry::ImplicitCurve;
+use crate::geometry::{FixedTrack, ImplicitCurve, Track};
 use crate::lane::{Lane, V2};
 
 /// The acceleration at each later stage of eq. (7): eq. (4) solved afresh.
@@ -13,8 +13,9 @@ use crate::lane::{Lane, V2};
 pub(crate) trait Stages<T> {
     /// Why a stage cannot be solved.
     type Error;
-    /// The acceleration at `(x, v)`.
-    fn acceleration(&mut self, x: V2<T>, v: V2<T>) -> Result<V2<T>, Self::Error>;
+    /// The acceleration at `(x, v)`, a fraction `at` of the step after its
+    /// start (½, ½, then 1).
+    fn acceleration(&mut self, x: V2<T>, v: V2<T>, at: f64) -> Result<V2<T>, Self::Error>;
 }
 
 /// Eq. (7) on lanes: one step of length `h` from `(x, v)` with `a` the
@@ -30,11 +31,11 @@ pub(crate) fn rk4_lanes<T: Lane, S: Stages<T>>(
 ) -> Result<(V2<T>, V2<T>), S::Error> {
     let half = h.splat(0.5) * h;
     let v2 = v.plus(half, a);
-    let a2 = stages.acceleration(x.plus(half, v), v2)?;
+    let a2 = stages.acceleration(x.plus(half, v), v2, 0.5)?;
     let v3 = v.plus(half, a2);
-    let a3 = stages.acceleration(x.plus(half, v2), v3)?;
+    let a3 = stages.acceleration(x.plus(half, v2), v3, 0.5)?;
     let v4 = v.plus(h, a3);
-    let a4 = stages.acceleration(x.plus(h, v3), v4)?;
+    let a4 = stages.acceleration(x.plus(h, v3), v4, 1.0)?;
     let (two, sixth) = (h.splat(2.0), h / h.splat(6.0));
     Ok((
         x.plus(sixth, v + v2.scale(two) + v3.scale(two) + v4),
@@ -54,8 +55,27 @@ pub fn rk4<C: ImplicitCurve + ?Sized>(
     first: &Solved,
     h: f64,
 ) -> Result<Advance, SolveError> {
-    let mut stages = CurveStages {
-        curve,
+    rk4_on(&FixedTrack(curve), 0.0, state, force, mass, gains, first, h)
+}
+
+/// [`rk4`] on a wire that may move, the step starting at time `t`: each
+/// stage is solved at its own time.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn rk4_on<T: Track + ?Sized>(
+    track: &T,
+    t: f64,
+    state: BeadState,
+    force: &LinearForce,
+    mass: f64,
+    gains: Gains,
+    first: &Solved,
+    h: f64,
+) -> Result<Advance, SolveError> {
+    let mut stages = TrackStages {
+        track,
+        start: t,
+        h,
         force,
         mass,
         gains,
@@ -72,23 +92,26 @@ pub fn rk4<C: ImplicitCurve + ?Sized>(
     })
 }
 
-/// The stages of one bead on any curve: [`solve`] at each.
-struct CurveStages<'a, C: ?Sized> {
-    curve: &'a C,
+/// The stages of one bead on any wire: [`solve_on`] at each, at its time.
+struct TrackStages<'a, T: ?Sized> {
+    track: &'a T,
+    start: f64,
+    h: f64,
     force: &'a LinearForce,
     mass: f64,
     gains: Gains,
 }
 
-impl<C: ImplicitCurve + ?Sized> Stages<f64> for CurveStages<'_, C> {
+impl<T: Track + ?Sized> Stages<f64> for TrackStages<'_, T> {
     type Error = SolveError;
     #[inline(always)]
-    fn acceleration(&mut self, x: V2<f64>, v: V2<f64>) -> Result<V2<f64>, SolveError> {
+    fn acceleration(&mut self, x: V2<f64>, v: V2<f64>, at: f64) -> Result<V2<f64>, SolveError> {
         let stage = BeadState {
             position: x.into(),
             velocity: v.into(),
         };
-        solve(self.curve, stage, self.force, self.mass, self.gains)
+        let t = self.start + at * self.h;
+        solve_on(self.track, t, stage, self.force, self.mass, self.gains)
             .map(|solved| solved.acceleration.into())
     }
 }

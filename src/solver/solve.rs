@@ -5,7 +5,7 @@ use bevy::math::DVec2;
 
 use super::settings::Gains;
 use super::state::{BeadState, LinearForce};
-use crate::geometry::{Geometry, ImplicitCurve};
+use crate::geometry::{FixedTrack, Geometry, ImplicitCurve, Track};
 use crate::lane::{Lane, V2};
 
 /// Why a step could not be taken.
@@ -161,12 +161,45 @@ pub fn solve<C: ImplicitCurve + ?Sized>(
     mass: f64,
     gains: Gains,
 ) -> Result<Solved, SolveError> {
-    let g = curve.geometry(state.position);
-    let solved = constraint_force_at(&g, state, force.at(state.position), mass, gains)?;
+    solve_on(&FixedTrack(curve), 0.0, state, force, mass, gains)
+}
+
+/// Eq. (3) on a wire that may move, at time `t`: in the wire's frame the
+/// bead has the relative velocity `v_r = ẋ − w(x)` and feels
+/// `f − m a_w` (see [`Twist::acceleration_at`](crate::geometry::Twist::acceleration_at)),
+/// so eq. (3) is solved with those, and `a_w` is added back to the
+/// acceleration.
+#[inline(always)]
+pub(crate) fn solve_on<T: Track + ?Sized>(
+    track: &T,
+    t: f64,
+    state: BeadState,
+    force: &LinearForce,
+    mass: f64,
+    gains: Gains,
+) -> Result<Solved, SolveError> {
+    let g = track.geometry(t, state.position);
+    let f = force.at(state.position);
+    if !T::MOVES {
+        let solved = constraint_force_at(&g, state, f, mass, gains)?;
+        return Ok(Solved {
+            lambda: solved.lambda,
+            constraint_force: solved.lambda * g.normal,
+            acceleration: solved.acceleration.into(),
+        });
+    }
+    let twist = track.twist(t);
+    let relative = state.velocity - twist.velocity_at(state.position);
+    let frame = twist.acceleration_at(state.position, relative);
+    let seen = BeadState {
+        velocity: relative,
+        ..state
+    };
+    let solved = constraint_force_at(&g, seen, f - mass * frame, mass, gains)?;
     Ok(Solved {
         lambda: solved.lambda,
         constraint_force: solved.lambda * g.normal,
-        acceleration: solved.acceleration.into(),
+        acceleration: DVec2::from(solved.acceleration) + frame,
     })
 }
 

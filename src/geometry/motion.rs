@@ -1,0 +1,455 @@
+//! Wires that move: [`WireMotion`] (a prescribed motion), [`PoseHistory`]
+//! (a motion known only from the poses a game writes), [`PosePath`] (either,
+//! or none) and [`Twist`], a rigid motion's velocity and acceleration at one
+//! instant. [`Track`] is what the solver asks of a wire at a time `t`:
+//! [`FixedTrack`] for a wire that stays put, [`MovingTrack`] for one that
+//! follows a [`PosePath`].
+//!
+//! A wire placed by a moving pose has `C(x, t) = C_local(Rᵀ(t)(x − p(t)))`.
+//! Its points move rigidly: the point of the wire at `x` has the velocity
+//! `w(x) = ṗ + ω J(x − p)` (`J` the quarter turn), so `∂C/∂t = −∇C·w` and
+//! `Ċ = ∇C·(ẋ − w)`. Differentiating again, with `v_r = ẋ − w(x)` the
+//! bead's velocity relative to the wire,
+//!
+//! ```text
+//! C̈ = v_rᵀ H v_r + ∇C·(ẍ − a_w),   a_w = p̈ + ω̇ J r − ω² r + 2ω J v_r,   r = x − p
+//! ```
+//!
+//! `a_w` is the acceleration of the wire's point under the bead plus the
+//! Coriolis term: in the wire's frame the bead sees a fixed wire and the
+//! force `f − m a_w`. The solver uses exactly that.
+
+use std::f64::consts::TAU;
+
+use bevy::math::DVec2;
+use serde::{Deserialize, Serialize};
+
+use super::{Geometry, ImplicitCurve, Placed, Pose};
+use crate::validate::{ParamError, finite, finite_vector, positive};
+
+/// The quarter turn `J d = (−d.y, d.x)`.
+#[inline(always)]
+fn perp(d: DVec2) -> DVec2 {
+    DVec2::new(-d.y, d.x)
+}
+
+/// A rigid motion of the plane at one instant: the velocity and
+/// acceleration of a reference point and the angular velocity and
+/// acceleration about it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Twist {
+    /// The reference point (the wire's origin `p`).
+    pub origin: DVec2,
+    /// `ṗ`.
+    pub velocity: DVec2,
+    /// `ω`, counter-clockwise positive.
+    pub angular_velocity: f64,
+    /// `p̈`.
+    pub acceleration: DVec2,
+    /// `ω̇`.
+    pub angular_acceleration: f64,
+}
+
+impl Twist {
+    /// The velocity `w(x) = ṗ + ω J(x − p)` of the moving frame's point at `x`.
+    #[inline]
+    pub fn velocity_at(&self, x: DVec2) -> DVec2 {
+        self.velocity + self.angular_velocity * perp(x - self.origin)
+    }
+
+    /// `a_w = p̈ + ω̇ J r − ω² r + 2ω J v_r` (`r = x − p`): the acceleration
+    /// of the frame's point at `x` plus the Coriolis term for a body moving
+    /// at `relative_velocity` in the frame.
+    #[inline]
+    pub fn acceleration_at(&self, x: DVec2, relative_velocity: DVec2) -> DVec2 {
+        let r = x - self.origin;
+        let w = self.angular_velocity;
+        self.acceleration + self.angular_acceleration * perp(r) - w * w * r
+            + 2.0 * w * perp(relative_velocity)
+    }
+}
+
+/// A prescribed motion of a wire about its resting pose (scene field
+/// `motion`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum WireMotion {
+    /// The wire stays where it is placed.
+    #[default]
+    Fixed,
+    /// The wire's origin at `position + amplitude · sin(2π f t)`.
+    Oscillate(Oscillate),
+    /// The wire turns about its origin at a constant rate.
+    Spin(Spin),
+}
+
+/// See [`WireMotion::Oscillate`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Oscillate {
+    /// The displacement's amplitude (world units, both axes).
+    pub amplitude: DVec2,
+    /// The frequency in Hz.
+    pub frequency: f64,
+}
+
+/// See [`WireMotion::Spin`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Spin {
+    /// Radians per second, counter-clockwise positive.
+    pub angular_velocity: f64,
+}
+
+impl WireMotion {
+    /// Checks that every number is finite and a frequency positive.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        match self {
+            Self::Fixed => Ok(()),
+            Self::Oscillate(o) => {
+                finite_vector("oscillation amplitude", o.amplitude)?;
+                positive("oscillation frequency", o.frequency).map(drop)
+            }
+            Self::Spin(s) => finite("angular velocity", s.angular_velocity).map(drop),
+        }
+    }
+
+    /// Whether the wire moves at all.
+    pub fn moves(&self) -> bool {
+        match self {
+            Self::Fixed => false,
+            Self::Oscillate(o) => o.amplitude != DVec2::ZERO,
+            Self::Spin(s) => s.angular_velocity != 0.0,
+        }
+    }
+
+    /// The pose at time `t` of a wire resting at `base`, and its twist,
+    /// exact (no differencing).
+    pub fn at(&self, base: Pose, t: f64) -> (Pose, Twist) {
+        match self {
+            Self::Fixed => (base, Twist::default()),
+            Self::Oscillate(o) => {
+                let w = TAU * o.frequency;
+                let (s, c) = (w * t).sin_cos();
+                let origin = base.origin + o.amplitude * s;
+                let pose = Pose { origin, ..base };
+                let twist = Twist {
+                    origin,
+                    velocity: o.amplitude * (w * c),
+                    acceleration: o.amplitude * (-w * w * s),
+                    ..Twist::default()
+                };
+                (pose, twist)
+            }
+            Self::Spin(s) => {
+                let turn = DVec2::from_angle(s.angular_velocity * t);
+                let pose = Pose {
+                    origin: base.origin,
+                    rotation: turn.rotate(base.rotation),
+                };
+                let twist = Twist {
+                    origin: base.origin,
+                    angular_velocity: s.angular_velocity,
+                    ..Twist::default()
+                };
+                (pose, twist)
+            }
+        }
+    }
+}
+
+/// The poses a wire had at the ends of the last steps, as a game wrote
+/// them into its `Transform`: the motion between them is the quadratic
+/// through the last three, so within a step the pose is interpolated to
+/// third order in the step, the velocity to second and the acceleration
+/// to first. With two poses the motion is linear, with one it is at rest.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PoseHistory {
+    /// The time of the newest pose.
+    time: f64,
+    /// The time between poses.
+    step: f64,
+    /// Origins, oldest first.
+    origins: [DVec2; 3],
+    /// Angles (unwrapped), oldest first.
+    angles: [f64; 3],
+    /// How many of the three are real (1 to 3).
+    known: u8,
+}
+
+impl PoseHistory {
+    /// A wire at rest at `pose` at time `time`.
+    pub fn at_rest(time: f64, pose: Pose) -> Self {
+        let angle = pose.rotation.to_angle();
+        Self {
+            time,
+            step: 0.0,
+            origins: [pose.origin; 3],
+            angles: [angle; 3],
+            known: 1,
+        }
+    }
+
+    /// The newest pose and its time.
+    pub fn newest(&self) -> (f64, Pose) {
+        (self.time, Pose::new(self.origins[2], self.angles[2]))
+    }
+
+    /// Takes in the pose at `time`, one step `step` after the newest. A
+    /// history whose newest pose is older than `time − step` is restarted
+    /// from that pose held at `time − step` (the wire did not move in
+    /// between).
+    pub fn push(&mut self, time: f64, step: f64, pose: Pose) {
+        let consecutive = ((self.time + step) - time).abs() <= 1e-9 * step.max(time.abs())
+            && (self.known == 1 || (self.step - step).abs() <= 1e-12 * step);
+        if !consecutive {
+            let (_, last) = self.newest();
+            *self = Self::at_rest(time - step, last);
+        }
+        self.step = step;
+        let previous = self.angles[2];
+        // The angle taken nearest to the previous one: no jump of 2π.
+        let angle = previous
+            + (pose.rotation.to_angle() - previous + std::f64::consts::PI).rem_euclid(TAU)
+            - std::f64::consts::PI;
+        self.origins = [self.origins[1], self.origins[2], pose.origin];
+        self.angles = [self.angles[1], self.angles[2], angle];
+        self.time = time;
+        self.known = (self.known + 1).min(3);
+        if self.known < 3 {
+            // Extend back linearly: no curvature until three are known.
+            self.origins[0] = 2.0 * self.origins[1] - self.origins[2];
+            self.angles[0] = 2.0 * self.angles[1] - self.angles[2];
+        }
+    }
+
+    /// Whether the last three poses are one: the wire is at rest.
+    pub fn is_at_rest(&self) -> bool {
+        self.known == 1
+            || (self.origins.iter().all(|o| *o == self.origins[2])
+                && self.angles.iter().all(|a| *a == self.angles[2]))
+    }
+
+    /// The interpolated pose and twist at `t` (meant for the last step,
+    /// `time − step ≤ t ≤ time`).
+    pub fn at(&self, t: f64) -> (Pose, Twist) {
+        if self.is_at_rest() || self.step <= 0.0 {
+            let (_, pose) = self.newest();
+            return (
+                pose,
+                Twist {
+                    origin: pose.origin,
+                    ..Twist::default()
+                },
+            );
+        }
+        let h = self.step;
+        let s = (t - self.time) / h;
+        let [o0, o1, o2] = self.origins;
+        let [a0, a1, a2] = self.angles;
+        let (do1, do2) = (o2 - o1, o2 - 2.0 * o1 + o0);
+        let (da1, da2) = (a2 - a1, a2 - 2.0 * a1 + a0);
+        let curve = 0.5 * s * (s + 1.0);
+        let rate = s + 0.5;
+        let origin = o2 + s * do1 + curve * do2;
+        let angle = a2 + s * da1 + curve * da2;
+        (
+            Pose::new(origin, angle),
+            Twist {
+                origin,
+                velocity: (do1 + rate * do2) / h,
+                angular_velocity: (da1 + rate * da2) / h,
+                acceleration: do2 / (h * h),
+                angular_acceleration: da2 / (h * h),
+            },
+        )
+    }
+}
+
+/// Where a wire is over time: fixed, prescribed, or followed from the
+/// poses a game wrote.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PosePath {
+    /// At one pose.
+    Fixed(Pose),
+    /// `motion` about the resting pose `base`.
+    Prescribed {
+        /// The pose at `t = 0`.
+        base: Pose,
+        /// The motion.
+        motion: WireMotion,
+    },
+    /// Interpolated from the last poses.
+    Followed(PoseHistory),
+}
+
+impl PosePath {
+    /// The pose and twist at `t`.
+    #[inline]
+    pub fn at(&self, t: f64) -> (Pose, Twist) {
+        match self {
+            Self::Fixed(pose) => (
+                *pose,
+                Twist {
+                    origin: pose.origin,
+                    ..Twist::default()
+                },
+            ),
+            Self::Prescribed { base, motion } => motion.at(*base, t),
+            Self::Followed(history) => history.at(t),
+        }
+    }
+
+    /// The pose at `t`.
+    pub fn pose(&self, t: f64) -> Pose {
+        self.at(t).0
+    }
+
+    /// The pose if the wire does not move.
+    pub fn fixed(&self) -> Option<Pose> {
+        match self {
+            Self::Fixed(pose) => Some(*pose),
+            Self::Prescribed { base, motion } if !motion.moves() => Some(*base),
+            Self::Followed(history) if history.is_at_rest() => Some(history.newest().1),
+            _ => None,
+        }
+    }
+}
+
+/// A wire over time, as the solver asks for it: its geometry where a bead
+/// is at time `t`, and the velocity and acceleration of its points.
+pub trait Track {
+    /// Whether the wire may move. When false, `velocity_at` and
+    /// `acceleration_at` are zero and the solver skips them.
+    const MOVES: bool;
+    /// `C`, `∇C` and the Hessian at `x` at time `t`.
+    fn geometry(&self, t: f64, x: DVec2) -> Geometry;
+    /// A characteristic length (see [`ImplicitCurve::scale`]).
+    fn scale(&self) -> f64;
+    /// The wire's twist at time `t`.
+    fn twist(&self, t: f64) -> Twist;
+}
+
+/// A wire that stays put: the curve itself, in world coordinates.
+pub struct FixedTrack<'a, C: ImplicitCurve + ?Sized>(pub &'a C);
+
+impl<C: ImplicitCurve + ?Sized> Track for FixedTrack<'_, C> {
+    const MOVES: bool = false;
+    #[inline(always)]
+    fn geometry(&self, _t: f64, x: DVec2) -> Geometry {
+        self.0.geometry(x)
+    }
+    fn scale(&self) -> f64 {
+        self.0.scale()
+    }
+    fn twist(&self, _t: f64) -> Twist {
+        Twist::default()
+    }
+}
+
+/// A curve in its local frame carried along a [`PosePath`].
+pub struct MovingTrack<'a, C: ImplicitCurve + ?Sized> {
+    /// The curve in its local frame.
+    pub curve: &'a C,
+    /// Where its frame is over time.
+    pub path: &'a PosePath,
+}
+
+impl<C: ImplicitCurve + ?Sized> Track for MovingTrack<'_, C> {
+    const MOVES: bool = true;
+    #[inline]
+    fn geometry(&self, t: f64, x: DVec2) -> Geometry {
+        Placed {
+            curve: self.curve,
+            pose: self.path.pose(t),
+        }
+        .geometry(x)
+    }
+    fn scale(&self) -> f64 {
+        self.curve.scale()
+    }
+    fn twist(&self, t: f64) -> Twist {
+        self.path.at(t).1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    /// The prescribed motions' velocities and accelerations are the
+    /// derivatives of their poses (central differences).
+    #[test]
+    fn prescribed_twists_are_the_derivatives_of_the_poses() {
+        let base = Pose::new(DVec2::new(0.4, -0.2), 0.3);
+        let x = DVec2::new(1.1, 0.7);
+        let u = base.to_local(x);
+        for motion in [
+            WireMotion::Oscillate(Oscillate {
+                amplitude: DVec2::new(0.1, 0.3),
+                frequency: 1.7,
+            }),
+            WireMotion::Spin(Spin {
+                angular_velocity: 2.3,
+            }),
+        ] {
+            let t = 0.37;
+            let h = 1e-5;
+            // The world position of the frame's point with local coordinates u.
+            let point = |t: f64| motion.at(base, t).0.to_world(u);
+            let (pose, twist) = motion.at(base, t);
+            assert_relative_eq!(pose.to_world(u).x, point(t).x);
+            let fd_v = (point(t + h) - point(t - h)) / (2.0 * h);
+            let fd_a = (point(t + h) - 2.0 * point(t) + point(t - h)) / (h * h);
+            let x_t = point(t);
+            let v = twist.velocity_at(x_t);
+            let a = twist.acceleration_at(x_t, DVec2::ZERO);
+            assert_relative_eq!(v.x, fd_v.x, epsilon = 1e-8);
+            assert_relative_eq!(v.y, fd_v.y, epsilon = 1e-8);
+            assert_relative_eq!(a.x, fd_a.x, epsilon = 1e-4);
+            assert_relative_eq!(a.y, fd_a.y, epsilon = 1e-4);
+        }
+    }
+
+    /// A history of poses on a quadratic motion reproduces it exactly, and
+    /// on a sine to the orders its doc states.
+    #[test]
+    fn a_followed_history_interpolates_to_the_stated_orders() {
+        let motion = WireMotion::Oscillate(Oscillate {
+            amplitude: DVec2::new(0.0, 0.2),
+            frequency: 1.0,
+        });
+        let base = Pose::IDENTITY;
+        let errors = |h: f64| {
+            let mut history = PoseHistory::at_rest(0.0, base);
+            for k in 1..=10 {
+                let t = k as f64 * h;
+                history.push(t, h, motion.at(base, t).0);
+            }
+            let t = 9.5 * h;
+            let (pose, twist) = history.at(t);
+            let (exact_pose, exact) = motion.at(base, t);
+            (
+                (pose.origin - exact_pose.origin).length(),
+                (twist.velocity - exact.velocity).length(),
+                (twist.acceleration - exact.acceleration).length(),
+            )
+        };
+        let (p1, v1, a1) = errors(0.002);
+        let (p2, v2, a2) = errors(0.001);
+        assert!((p1 / p2).log2() > 2.8, "pose order {}", (p1 / p2).log2());
+        assert!(
+            (v1 / v2).log2() > 1.7,
+            "velocity order {}",
+            (v1 / v2).log2()
+        );
+        assert!(
+            (a1 / a2).log2() > 0.9,
+            "acceleration order {}",
+            (a1 / a2).log2()
+        );
+        // A spin across the ±π cut is followed without a jump.
+        let mut history = PoseHistory::at_rest(0.0, Pose::new(DVec2::ZERO, 3.1));
+        history.push(0.1, 0.1, Pose::new(DVec2::ZERO, 3.2));
+        history.push(0.2, 0.1, Pose::new(DVec2::ZERO, 3.3));
+        assert_relative_eq!(history.at(0.2).1.angular_velocity, 1.0, epsilon = 1e-9);
+    }
+}
