@@ -33,6 +33,7 @@
 //! | [`WireBeadPlugin`] | the simulation: components, parameters, the step in `FixedUpdate` |
 //! | [`WireBeadSystems`] | the sets: `Restart` in `PreUpdate`; `Prepare → Forces → Step → Writeback` in `FixedUpdate` |
 //! | [`Wire`], [`Bead`], [`OnWire`] | a wire placed by its `Transform`; a bead on it (or free, on none) |
+//! | [`PrescribedMotion`] | a wire that moves ([`WireMotion`]: oscillates or spins), its motion exact in the constraint force; a wire the game moves is followed |
 //! | [`Rod`], [`Pin`], [`Joint`], [`Spring`] | links between beads, each on an entity of its own; [`Constraint`] for a game's own joint |
 //! | [`Islands`], [`ConstraintDiagnostics`] | the beads links join, solved together (`J W Jᵀ λ = …`); each link's `C`, `Ċ`, λ |
 //! | [`SimParams`], [`PendingParams`], [`PendingBead`], [`PendingWire`] | applied and edited parameters; [`Restart`] applies the edits |
@@ -86,9 +87,10 @@ pub use controls::KeyboardControlsPlugin;
 pub use dynamics::{
     Bead, BeadDiagnostics, BeadDiverged, BeadParams, ConstraintDiagnostics, Diverged,
     DivergenceReason, DragTarget, Joint, MAX_TIMESTEP, MIN_TIMESTEP, OnWire, PendingBead,
-    PendingParams, PendingWire, Pin, Rod, SimParams, Spring, Wire, WireBeads, pose_of,
+    PendingParams, PendingWire, Pin, PrescribedMotion, Rod, SimParams, Spring, Wire, WireBeads,
+    pose_of,
 };
-pub use geometry::{ImplicitCurve, WireKind, WireShape};
+pub use geometry::{ImplicitCurve, Oscillate, Spin, WireKind, WireMotion, WireShape};
 pub use plugin::{
     IslandReport, Islands, ParallelStep, Restart, SimClock, WireBeadPlugin, WireBeadSystems,
 };
@@ -102,8 +104,9 @@ pub mod prelude {
         Bead, BeadDiagnostics, BeadDiverged, BeadParams, Constraint, ConstraintDiagnostics,
         Diverged, DragTarget, ImplicitCurve, Integrator, Islands, Joint, KeyboardControlsPlugin,
         LoadPreset, Method, OnWire, ParallelStep, ParamError, PendingBead, PendingParams, Pin,
-        Restart, Rod, ScenePreset, ScenePresetPlugin, SimClock, SimParams, Spring, Stabilization,
-        Wire, WireBeadPlugin, WireBeadSystems, WireBeads, WireKind, WireShape,
+        PrescribedMotion, Restart, Rod, ScenePreset, ScenePresetPlugin, SimClock, SimParams,
+        Spring, Stabilization, Wire, WireBeadPlugin, WireBeadSystems, WireBeads, WireKind,
+        WireMotion, WireShape,
     };
 }
 

@@ -31,9 +31,12 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::dynamics::{Bead, BeadParams, OnWire, PendingParams, Pin, Rod, SimParams, Spring, Wire};
-use crate::geometry::WireShape;
+use crate::dynamics::{
+    Bead, BeadParams, OnWire, PendingParams, Pin, PrescribedMotion, Rod, SimParams, Spring, Wire,
+};
+use crate::geometry::{Pose, Twist, WireMotion, WireShape};
 use crate::plugin::{Restart, WireBeadSystems};
+use crate::solver::BeadState;
 use crate::validate::{ParamError, finite, finite_vector, non_negative, positive};
 
 /// A bead of a scene file: its name (optional) and its parameters.
@@ -140,6 +143,12 @@ pub struct WirePreset {
     /// The wire's rotation, in degrees counter-clockwise.
     #[serde(default)]
     pub angle_degrees: f64,
+    /// How it moves about that pose: `Fixed` (the default),
+    /// `Oscillate((amplitude: (ax, ay), frequency: f))` or
+    /// `Spin((angular_velocity: w))`. Its beads' initial velocities are
+    /// relative to the wire's own at `t = 0`.
+    #[serde(default)]
+    pub motion: WireMotion,
     /// The beads on it.
     #[serde(default)]
     pub beads: Vec<BeadPreset>,
@@ -243,6 +252,7 @@ impl ScenePreset {
                 .map_err(|source| PresetError::Wire { index, source })?;
             finite_vector("wire position", wire.position)
                 .and_then(|_| finite("wire angle", wire.angle_degrees))
+                .and_then(|_| wire.motion.validate())
                 .map_err(|source| PresetError::Wire { index, source })?;
             for (bead, preset) in wire.beads.iter().enumerate() {
                 preset
@@ -379,14 +389,23 @@ impl ScenePreset {
         let names = self.bead_names();
         let mut beads = Vec::new();
         let mut spawn_bead =
-            |preset: &BeadPreset, wire: Option<Entity>, commands: &mut Commands| {
+            |preset: &BeadPreset, wire: Option<(Entity, Twist)>, commands: &mut Commands| {
                 let name = Name::new(names[beads.len()].clone());
-                let Ok(bead) = Bead::new(preset.params()) else {
+                let Ok(mut bead) = Bead::new(preset.params()) else {
                     beads.push(Entity::PLACEHOLDER);
                     return;
                 };
+                // The initial velocity is relative to the wire's own at
+                // t = 0, as a restart makes it.
+                if let Some((_, twist)) = wire {
+                    let state = bead.state();
+                    bead.advance_to(BeadState {
+                        velocity: state.velocity + twist.velocity_at(state.position),
+                        ..state
+                    });
+                }
                 let mut entity = commands.spawn((bead, name, FromPreset));
-                if let Some(wire) = wire {
+                if let Some((wire, _)) = wire {
                     entity.insert(OnWire(wire));
                 }
                 beads.push(entity.id());
@@ -395,11 +414,19 @@ impl ScenePreset {
             let transform =
                 Transform::from_xyz(wire.position.x as f32, wire.position.y as f32, 0.0)
                     .with_rotation(Quat::from_rotation_z(wire.angle_degrees.to_radians() as f32));
-            let wire_entity = Wire::new(wire.shape.clone())
-                .ok()
-                .map(|component| commands.spawn((component, transform, FromPreset)).id());
+            let wire_entity = Wire::new(wire.shape.clone()).ok().map(|component| {
+                let mut entity = commands.spawn((component, transform, FromPreset));
+                if let Ok(motion) = PrescribedMotion::new(wire.motion)
+                    && wire.motion.moves()
+                {
+                    entity.insert(motion);
+                }
+                entity.id()
+            });
+            let base = Pose::new(wire.position, wire.angle_degrees.to_radians());
+            let (_, twist) = wire.motion.at(base, 0.0);
             for preset in &wire.beads {
-                spawn_bead(preset, wire_entity, commands);
+                spawn_bead(preset, wire_entity.map(|e| (e, twist)), commands);
             }
         }
         for preset in &self.beads {

@@ -5,7 +5,9 @@ use std::sync::Arc;
 
 use bevy::prelude::*;
 
-use crate::geometry::{Circle, Ellipse, ImplicitCurve, Line, Parabola, Pose, Sine, WireShape};
+use crate::geometry::{
+    Circle, Ellipse, ImplicitCurve, Line, Parabola, Pose, PosePath, Sine, WireMotion, WireShape,
+};
 use crate::validate::ParamError;
 
 /// A wire: a shape placed in the plane by the entity's `Transform`
@@ -70,26 +72,57 @@ impl Wire {
     }
 }
 
-/// Where a wire sits for the current step: its `Transform` read once, in
-/// [`WireBeadSystems::Prepare`](crate::WireBeadSystems::Prepare), so the
-/// beads on it do not each convert it. Kept by the plugin.
+/// Moves a wire along a prescribed motion about the pose its `Transform`
+/// has when the motion first applies (its resting pose, to which a
+/// [`Restart`](crate::Restart) returns it). The plugin writes the wire's
+/// `Transform` each step, and the beads on it feel the motion exactly: its
+/// velocity and acceleration enter the constraint force (the `∂C/∂t`
+/// terms), with no differencing.
+///
+/// A wire without this component whose `Transform` the game writes is
+/// followed instead: see [`WireBeadSystems::Prepare`](crate::WireBeadSystems::Prepare).
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
-pub(crate) struct WirePose(Option<Pose>);
+pub struct PrescribedMotion(WireMotion);
+
+impl PrescribedMotion {
+    /// The motion, if its numbers are valid.
+    pub fn new(motion: WireMotion) -> Result<Self, ParamError> {
+        motion.validate()?;
+        Ok(Self(motion))
+    }
+
+    /// The motion.
+    pub fn motion(&self) -> WireMotion {
+        self.0
+    }
+}
+
+/// Where a wire is over time, kept by the plugin in
+/// [`WireBeadSystems::Prepare`](crate::WireBeadSystems::Prepare): fixed,
+/// prescribed, or followed from the poses the game writes; none if its
+/// `Transform` is not finite.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub(crate) struct WirePose(Option<PosePath>);
 
 impl Default for WirePose {
     fn default() -> Self {
-        Self(Some(Pose::IDENTITY))
+        Self(Some(PosePath::Fixed(Pose::IDENTITY)))
     }
 }
 
 impl WirePose {
-    /// The pose of `transform`, or none if it is not finite.
+    /// The wire held at `transform`, or none if it is not finite.
     pub(crate) fn from_transform(transform: &Transform) -> Self {
-        Self(pose_of(transform).ok())
+        Self(pose_of(transform).ok().map(PosePath::Fixed))
     }
 
-    /// The pose, or the error that the wire's transform is not finite.
-    pub(crate) fn get(&self) -> Result<Pose, ParamError> {
+    /// A wire on `path`.
+    pub(crate) fn on(path: PosePath) -> Self {
+        Self(Some(path))
+    }
+
+    /// The path, or the error that the wire's transform is not finite.
+    pub(crate) fn get(&self) -> Result<PosePath, ParamError> {
         self.0.ok_or(ParamError::NotFinite {
             name: "wire transform",
             value: f64::NAN,

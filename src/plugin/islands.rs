@@ -311,7 +311,7 @@ pub(crate) fn prepare_islands(
                     rows.push(IslandRow {
                         kind: RowKind::Wire {
                             shape: wire.shape().clone(),
-                            pose,
+                            pose: pose.pose(clock.time),
                         },
                         beads: vec![local],
                     });
@@ -416,9 +416,13 @@ pub(crate) fn step_islands(
             let Ok((wire, pose)) = wires.get(wire) else {
                 continue;
             };
-            if let Ok(pose) = pose.get() {
+            if let Ok(path) = pose.get() {
+                // A moving wire is placed where it is at the step's end;
+                // its velocity does not enter the island's solve yet.
                 let reshaped = wire.is_changed().then(|| wire.shape().clone());
-                cached.island.place_wire(row, reshaped, pose);
+                cached
+                    .island
+                    .place_wire(row, reshaped, path.pose(clock.time));
             }
         }
         for &(row, pin) in &cached.anchored {

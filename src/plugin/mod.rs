@@ -32,7 +32,7 @@ pub use schedule::WireBeadSystems;
 use forces::apply_drag;
 use islands::{any_island, islands_changed, prepare_islands, step_islands, topology_changed};
 use restart::{apply_restart, apply_timestep};
-use step::{prepare_step, step_beads};
+use step::{prepare_step, step_beads, wire_added};
 use writeback::write_transforms;
 
 use crate::dynamics::{
@@ -127,6 +127,7 @@ impl Plugin for WireBeadPlugin {
             .init_resource::<SimClock>()
             .init_resource::<LastStep>()
             .init_resource::<Islands>()
+            .add_observer(wire_added)
             .add_observer(topology_changed::<Add, Bead>)
             .add_observer(topology_changed::<Remove, Bead>)
             .add_observer(topology_changed::<Insert, OnWire>)

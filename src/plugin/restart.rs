@@ -5,12 +5,13 @@ use bevy::prelude::*;
 
 use super::islands::Islands;
 
+use super::step::{prescribed, set_pose};
 use crate::dynamics::{
-    Bead, BeadDiagnostics, Diverged, OnWire, PendingBead, PendingParams, PendingWire, SimParams,
-    Wire, pose_of,
+    Bead, BeadDiagnostics, Diverged, OnWire, PendingBead, PendingParams, PendingWire,
+    PrescribedMotion, SimParams, Wire, WirePose,
 };
-use crate::geometry::{ImplicitCurve, Placed};
-use crate::solver::constraint_state;
+use crate::geometry::{MovingTrack, Track};
+use crate::solver::{BeadState, constraint_state_on};
 
 /// Restarts the run: applies [`PendingParams`] and every [`PendingBead`],
 /// returns each bead to its initial state, clears divergence, and sets
@@ -34,8 +35,8 @@ pub struct SimClock {
 }
 
 /// The diagnostics of a bead's current state on `curve`, before any step.
-fn diagnose(curve: &dyn ImplicitCurve, bead: &Bead, gravity: bevy::math::DVec2) -> BeadDiagnostics {
-    let (c, c_dot) = constraint_state(curve, bead.state());
+fn diagnose<T: Track>(track: &T, bead: &Bead, gravity: bevy::math::DVec2) -> BeadDiagnostics {
+    let (c, c_dot) = constraint_state_on(track, 0.0, bead.state());
     let (kinetic, potential) = bead.state().energy(bead.mass(), gravity);
     BeadDiagnostics {
         c,
@@ -59,7 +60,14 @@ pub(crate) fn apply_restart(
     mut params: ResMut<SimParams>,
     mut time: ResMut<Time<Fixed>>,
     mut clock: ResMut<SimClock>,
-    mut wires: Query<(Entity, &mut Wire, &Transform, Option<&PendingWire>)>,
+    mut wires: Query<(
+        Entity,
+        &mut Wire,
+        &mut Transform,
+        &mut WirePose,
+        Option<&PendingWire>,
+        Option<&PrescribedMotion>,
+    )>,
     mut beads: Query<(
         Entity,
         &mut Bead,
@@ -75,10 +83,21 @@ pub(crate) fn apply_restart(
     }
     // Masses and wire shapes may change: the islands are built afresh.
     islands.mark_dirty();
-    for (entity, mut wire, _, edit) in &mut wires {
+    for (entity, mut wire, mut transform, mut pose, edit, motion) in &mut wires {
         if let Some(edit) = edit {
             *wire = edit.wire().clone();
             commands.entity(entity).remove::<PendingWire>();
+        }
+        // A wire on a prescribed motion goes back to its resting pose; one
+        // the game moved starts again at rest where it is.
+        match motion {
+            Some(motion) => {
+                *pose = prescribed(motion, &pose, &transform);
+                if let Ok(path) = pose.get() {
+                    set_pose(&mut transform, path.pose(0.0));
+                }
+            }
+            None => *pose = WirePose::from_transform(&transform),
         }
     }
     *params = pending.get().clone();
@@ -90,19 +109,27 @@ pub(crate) fn apply_restart(
         let bead_params = edit.map_or(*bead.params(), |p| *p.get());
         bead.reset(bead_params);
         commands.entity(entity).remove::<(Diverged, PendingBead)>();
-        let Some(mut diagnostics) = diagnostics else {
+        let wire = on_wire.and_then(|on| wires.get(on.0).ok());
+        let Some((_, wire, _, pose, ..)) = wire else {
+            if let Some(mut diagnostics) = diagnostics {
+                *diagnostics = BeadDiagnostics::default();
+            }
             continue;
         };
-        let wire = on_wire.and_then(|on| wires.get(on.0).ok());
-        *diagnostics = match wire.map(|(_, w, t, _)| (w, pose_of(t))) {
-            Some((wire, Ok(pose))) => {
-                let placed = Placed {
-                    curve: wire.shape().curve(),
-                    pose,
-                };
-                diagnose(&placed, &bead, params.gravity)
-            }
-            _ => BeadDiagnostics::default(),
-        };
+        let Ok(path) = pose.get() else { continue };
+        // The initial velocity is relative to the wire's own at t = 0.
+        let (_, twist) = path.at(0.0);
+        let state = bead.state();
+        bead.advance_to(BeadState {
+            velocity: state.velocity + twist.velocity_at(state.position),
+            ..state
+        });
+        if let Some(mut diagnostics) = diagnostics {
+            let track = MovingTrack {
+                curve: wire.shape().curve(),
+                path: &path,
+            };
+            *diagnostics = diagnose(&track, &bead, params.gravity);
+        }
     }
 }

@@ -19,6 +19,19 @@ pub enum WireBeadSystems {
     Restart,
     /// [`FixedUpdate`]: places each wire for the step (reads its `Transform`
     /// once) and advances the [`SimClock`](crate::SimClock).
+    ///
+    /// A wire with a [`PrescribedMotion`](crate::PrescribedMotion) gets its
+    /// `Transform` written here, at the pose for the step's end.
+    ///
+    /// A game that moves a wire itself writes its `Transform` before this
+    /// set, at the pose the wire has at the end of the coming step
+    /// (`SimClock::time + timestep`). The plugin keeps the poses of the last
+    /// three steps and takes the quadratic through them as the wire's
+    /// motion within the step: the pose is then right to third order in the
+    /// timestep, the wire's velocity to second and its acceleration to
+    /// first. A bead's trajectory follows the prescribed motion's to second
+    /// order (measured in the tests). A wire moved once, then left, is
+    /// taken to have moved at constant speed during that one step.
     Prepare,
     /// [`FixedUpdate`]: accumulates the external forces other than gravity:
     /// the drag spring, the game's own.

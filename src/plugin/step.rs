@@ -6,6 +6,7 @@
 use std::sync::{Mutex, PoisonError};
 
 use bevy::ecs::change_detection::ContiguousMut;
+use bevy::ecs::entity::EntityHashSet;
 use bevy::ecs::storage::SparseSet;
 use bevy::ecs::system::{SystemChangeTick, SystemParam};
 use bevy::prelude::*;
@@ -16,24 +17,104 @@ use super::parallel::ParallelStep;
 use super::restart::SimClock;
 use super::writeback::{LastStep, place};
 use crate::dynamics::{
-    Bead, BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason, OnWire, SimParams, Wire,
-    WirePose,
+    Bead, BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason, OnWire, PrescribedMotion,
+    SimParams, Wire, WirePose, pose_of,
 };
-use crate::geometry::{ImplicitCurve, Placed, Pose, WireShape};
+use crate::geometry::{
+    FixedTrack, MovingTrack, Placed, Pose, PoseHistory, PosePath, Track, WireShape,
+};
 use crate::solver::{self, StepOutput, StepSettings};
 
 /// Prepares the step: places every wire (reads each changed wire
-/// `Transform` once, so the beads do not) and advances the [`SimClock`].
+/// `Transform` once, so the beads do not; writes the `Transform` of a wire
+/// on a prescribed motion; takes in the pose of a wire the game moves) and
+/// advances the [`SimClock`].
 pub(crate) fn prepare_step(
     params: Res<SimParams>,
     mut clock: ResMut<SimClock>,
-    mut wires: Query<(&Transform, &mut WirePose), Changed<Transform>>,
+    mut driven: Query<(&PrescribedMotion, &mut Transform, &mut WirePose)>,
+    mut followed: Query<
+        (Entity, Ref<Transform>, &mut WirePose),
+        (With<Wire>, Without<PrescribedMotion>),
+    >,
+    mut moving: Local<EntityHashSet>,
 ) {
-    for (transform, mut pose) in &mut wires {
+    let (start, h) = (clock.time, params.timestep);
+    let end = start + h;
+    for (motion, mut transform, mut pose) in &mut driven {
+        let placed = prescribed(motion, &pose, &transform);
+        pose.set_if_neq(placed);
+        if let Ok(path) = placed.get() {
+            set_pose(&mut transform, path.pose(end));
+        }
+    }
+    let mut still_moving = EntityHashSet::default();
+    for (entity, transform, mut pose) in &mut followed {
+        if !transform.is_changed() && !moving.contains(&entity) {
+            continue;
+        }
+        let Ok(now) = pose_of(&transform) else {
+            pose.set_if_neq(WirePose::from_transform(&transform));
+            continue;
+        };
+        let mut history = match pose.get() {
+            Ok(PosePath::Fixed(at)) if at == now => continue,
+            Ok(PosePath::Fixed(at)) => PoseHistory::at_rest(f64::NEG_INFINITY, at),
+            Ok(PosePath::Followed(history)) => history,
+            Ok(path @ PosePath::Prescribed { .. }) => PoseHistory::at_rest(start, path.pose(start)),
+            Err(_) => PoseHistory::at_rest(start, now),
+        };
+        history.push(end, h, now);
+        let path = if history.is_at_rest() {
+            PosePath::Fixed(now)
+        } else {
+            still_moving.insert(entity);
+            PosePath::Followed(history)
+        };
+        pose.set_if_neq(WirePose::on(path));
+    }
+    *moving = still_moving;
+    clock.steps += 1;
+    clock.time = end;
+}
+
+/// Places a wire where its `Transform` puts it the moment it is added, so
+/// that a game moving it from its first step on moves it from there.
+pub(crate) fn wire_added(add: On<Add, Wire>, mut wires: Query<(&Transform, &mut WirePose)>) {
+    if let Ok((transform, mut pose)) = wires.get_mut(add.entity) {
         *pose = WirePose::from_transform(transform);
     }
-    clock.steps += 1;
-    clock.time += params.timestep;
+}
+
+/// A wire on `motion` about its resting pose: the one `pose` already
+/// holds, else its `Transform`'s (when the motion first applies).
+pub(crate) fn prescribed(
+    motion: &PrescribedMotion,
+    pose: &WirePose,
+    transform: &Transform,
+) -> WirePose {
+    let base = match pose.get() {
+        Ok(PosePath::Prescribed { base, .. }) => Ok(base),
+        _ => pose_of(transform),
+    };
+    match base {
+        Ok(base) => WirePose::on(PosePath::Prescribed {
+            base,
+            motion: motion.motion(),
+        }),
+        Err(_) => WirePose::from_transform(transform),
+    }
+}
+
+/// Writes an in-plane pose into a `Transform` (x, y and the rotation about
+/// z; z kept), converted to `f32` at this edge.
+pub(crate) fn set_pose(transform: &mut Transform, pose: Pose) {
+    let origin = pose.origin.as_vec2();
+    if origin.is_finite() && pose.rotation.is_finite() {
+        transform.translation.x = origin.x;
+        transform.translation.y = origin.y;
+        transform.rotation = Quat::from_rotation_z(pose.rotation.to_angle() as f32);
+    }
 }
 
 /// Divergences found inside a (possibly parallel) loop, reported after it.
@@ -98,7 +179,7 @@ macro_rules! with_curve {
 
 /// A wire's shape and pose for the step, or why beads cannot be stepped on
 /// it.
-type PlacedWire = Result<(WireShape, Pose), DivergenceReason>;
+type PlacedWire = Result<(WireShape, PosePath), DivergenceReason>;
 
 /// Every wire's shape and pose, kept by [`step_beads`] from change
 /// detection (a copy made when a wire changes, not each step), so a bead
@@ -128,8 +209,8 @@ impl WireTable {
         }
     }
 
-    /// The shape and pose of the wire a bead is on.
-    fn get(&self, on: &OnWire) -> Result<&(WireShape, Pose), DivergenceReason> {
+    /// The shape and path of the wire a bead is on.
+    fn get(&self, on: &OnWire) -> Result<&(WireShape, PosePath), DivergenceReason> {
         match self.0.get(on.0) {
             Some((entity, placed)) if *entity == on.0 => placed.as_ref().map_err(Clone::clone),
             _ => Err(DivergenceReason::InvalidWire(format!(
@@ -162,7 +243,8 @@ impl StepContext<'_> {
         for i in 0..run.beads.len() {
             let wire = self.wires.get(&run.on_wires[i]);
             if batched
-                && let Ok((WireShape::Circle(circle), pose)) = wire
+                && let Ok((WireShape::Circle(circle), path)) = wire
+                && let Some(pose) = path.fixed()
                 && pose.is_unrotated()
             {
                 let bead = &run.beads[i];
@@ -199,9 +281,14 @@ impl StepContext<'_> {
     fn step_one(&self, run: &mut BeadRun, i: usize) {
         let result = match self.wires.get(&run.on_wires[i]) {
             Err(reason) => Err(reason),
-            Ok((shape, pose)) => with_curve!(shape, curve => {
-                self.step_bead(&Placed { curve, pose: *pose }, &run.beads[i])
-            }),
+            Ok((shape, path)) => match path.fixed() {
+                Some(pose) => with_curve!(shape, curve => {
+                    self.step_bead(&FixedTrack(&Placed { curve, pose }), &run.beads[i])
+                }),
+                None => with_curve!(shape, curve => {
+                    self.step_bead(&MovingTrack { curve, path }, &run.beads[i])
+                }),
+            },
         };
         match result {
             Ok(out) => self.finish(run.outputs(i), out),
@@ -216,10 +303,11 @@ impl StepContext<'_> {
         }
     }
 
-    /// Eq. (3) and the integrator for one bead.
-    fn step_bead<C: ImplicitCurve + ?Sized>(
+    /// Eq. (3) and the integrator for one bead, the step starting at
+    /// `time − dt`.
+    fn step_bead<T: Track + ?Sized>(
         &self,
-        placed: &Placed<C>,
+        track: &T,
         bead: &Bead,
     ) -> Result<StepOutput, DivergenceReason> {
         let state = bead.state();
@@ -227,7 +315,8 @@ impl StepContext<'_> {
             return Err(DivergenceReason::NonFiniteState);
         }
         let force = bead.step_force(self.params.gravity);
-        solver::step(placed, state, &force, bead.mass(), &self.settings)
+        let start = self.time - self.settings.dt;
+        solver::step_on(track, start, state, &force, bead.mass(), &self.settings)
             .map_err(DivergenceReason::Solve)
     }
 

@@ -17,5 +17,6 @@ mod presets;
 mod readme;
 mod restart;
 mod scenes;
+mod tracks;
 #[cfg(feature = "gui")]
 mod window;

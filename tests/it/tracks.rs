@@ -1,0 +1,163 @@
+//! Tracks that move: prescribed motions and wires a game moves, through
+//! the plugin (`../shared` PHYSICS, moving wires; the Kapitza pendulum).
+
+use std::f64::consts::TAU;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use wirebead::prelude::*;
+use wirebead::{Oscillate, ScenePreset};
+
+use crate::common::{Recording, app, run_for};
+
+fn preset(file: &str) -> ScenePreset {
+    let path = format!("{}/assets/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
+    ScenePreset::from_ron(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Runs `preset` for `seconds` and returns the recorded samples of its
+/// first bead as `(t, position)`.
+fn run_scene(preset: &ScenePreset, seconds: f64) -> Vec<(f64, DVec2)> {
+    let mut app = app(preset.params.clone());
+    let beads = preset.spawn(&mut app.world_mut().commands());
+    app.world_mut().flush();
+    run_for(&mut app, seconds);
+    assert!(
+        app.world().get::<Diverged>(beads[0]).is_none(),
+        "{} diverged",
+        preset.name
+    );
+    app.world()
+        .resource::<Recording>()
+        .of(beads[0])
+        .iter()
+        .map(|s| (s.t, s.position))
+        .collect()
+}
+
+/// The largest angle from the top of the Kapitza circle over `seconds`,
+/// shaken at `frequency`, in degrees.
+fn kapitza_worst_angle(frequency: f64, seconds: f64) -> f64 {
+    let mut scene = preset("kapitza.scene.ron");
+    let WireMotion::Oscillate(shake) = scene.wires[0].motion else {
+        panic!("the Kapitza scene shakes its wire");
+    };
+    let shake = Oscillate { frequency, ..shake };
+    scene.wires[0].motion = WireMotion::Oscillate(shake);
+    let samples = run_scene(&scene, seconds);
+    samples
+        .iter()
+        .map(|&(t, x)| {
+            let centre = shake.amplitude * (TAU * frequency * t).sin();
+            let r = x - centre;
+            r.x.atan2(r.y).abs().to_degrees()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// A circle of radius 1 shaken vertically by 0.1 at 20 Hz keeps a bead
+/// released 10° from the top within 30° of it for 20 s
+/// (a²ω² = 158 > 2gl = 19.6); shaken at 3 Hz (a²ω² = 3.6) the bead falls.
+#[test]
+fn the_kapitza_pendulum_stands_when_shaken_fast_and_falls_when_slow() {
+    let fast = kapitza_worst_angle(20.0, 20.0);
+    assert!(
+        fast < 30.0,
+        "at 20 Hz the bead reached {fast:.1}° from the top"
+    );
+    let slow = kapitza_worst_angle(3.0, 5.0);
+    assert!(
+        slow > 90.0,
+        "at 3 Hz the bead only reached {slow:.1}° from the top"
+    );
+    eprintln!("Kapitza: 20 Hz worst {fast:.2}°, 3 Hz worst {slow:.1}°");
+}
+
+/// A bead from rest on a rod spinning at ω, with no gravity, slides out as
+/// `r₀ cosh ωt` (the spinning-rod scene: r₀ = 0.2, ω = 1, RATTLE at 2 ms).
+#[test]
+fn a_bead_on_the_spinning_rod_scene_slides_out_as_cosh() {
+    let samples = run_scene(&preset("spinning_rod.scene.ron"), 3.0);
+    let worst = samples
+        .iter()
+        .map(|&(t, x)| {
+            let exact = 0.2 * t.cosh();
+            (x.length() - exact).abs() / exact
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-5, "relative error in r reached {worst:e}");
+    eprintln!("spinning rod: worst relative error in r over 3 s {worst:e}");
+}
+
+/// The motion both runs of the comparison give the wire: its origin at
+/// `A sin(2π f t)`.
+const SHAKE: Oscillate = Oscillate {
+    amplitude: DVec2::new(0.3, 0.2),
+    frequency: 1.0,
+};
+
+/// Writes the shaken wire's `Transform` for the end of the coming step, as
+/// a game moving a platform would.
+fn shake_wire(
+    clock: Res<SimClock>,
+    params: Res<SimParams>,
+    mut wires: Query<&mut Transform, With<Wire>>,
+) {
+    let t = clock.time + params.timestep;
+    let origin = SHAKE.amplitude * (TAU * SHAKE.frequency * t).sin();
+    for mut transform in &mut wires {
+        transform.translation = Vec3::new(origin.x as f32, origin.y as f32, 0.0);
+    }
+}
+
+/// A pendulum on a circle shaken by `SHAKE` for 2 s at `dt`, the wire
+/// driven by a [`PrescribedMotion`] or moved by the game; the bead's last
+/// position.
+fn shaken_pendulum(dt: f64, by_game: bool) -> DVec2 {
+    let mut app = app(SimParams {
+        timestep: dt,
+        method: Method::Rattle,
+        ..default()
+    });
+    let wire = app
+        .world_mut()
+        .spawn((Wire::circle(1.0).unwrap(), Transform::default()))
+        .id();
+    if by_game {
+        app.add_systems(FixedUpdate, shake_wire.before(WireBeadSystems::Prepare));
+    } else {
+        let motion = PrescribedMotion::new(WireMotion::Oscillate(SHAKE)).unwrap();
+        app.world_mut().entity_mut(wire).insert(motion);
+    }
+    let start = DVec2::new(60f64.to_radians().sin(), -60f64.to_radians().cos());
+    // At rest relative to the wire, which starts at speed 2π f A.
+    let velocity = SHAKE.amplitude * TAU * SHAKE.frequency;
+    let bead = Bead::new(BeadParams {
+        mass: 1.0,
+        initial_position: start,
+        initial_velocity: velocity,
+    })
+    .unwrap();
+    let bead = app.world_mut().spawn((bead, OnWire(wire))).id();
+    run_for(&mut app, 2.0);
+    assert!(app.world().get::<Diverged>(bead).is_none());
+    app.world().get::<Bead>(bead).unwrap().position
+}
+
+/// A game writing a wire's `Transform` each step gives the trajectory of
+/// the same prescribed motion, to second order in the timestep (the
+/// pose history's quadratic, see `WireBeadSystems::Prepare`).
+#[test]
+fn a_wire_the_game_moves_gives_the_prescribed_motions_trajectory() {
+    let gap = |dt: f64| (shaken_pendulum(dt, true) - shaken_pendulum(dt, false)).length();
+    let (coarse, fine) = (gap(1.0 / 100.0), gap(1.0 / 200.0));
+    let order = (coarse / fine).log2();
+    eprintln!(
+        "game-moved vs prescribed after 2 s: {coarse:e} at 1/100 s, {fine:e} at 1/200 s, order {order:.2}"
+    );
+    assert!(
+        coarse < 1e-2,
+        "the trajectories part by {coarse:e} at 1/100 s"
+    );
+    assert!(order > 1.8, "observed order {order:.2}");
+}
