@@ -49,6 +49,8 @@ impl Default for PresetCatalog {
                     "Two beads and a spring on a track",
                     "scenes/spring_pair.scene.ron",
                 ),
+                ("Kapitza pendulum", "scenes/kapitza.scene.ron"),
+                ("Bead on a spinning rod", "scenes/spinning_rod.scene.ron"),
             ]
             .into_iter()
             .map(|(a, b)| (a.to_owned(), b.to_owned()))

@@ -417,12 +417,8 @@ pub(crate) fn step_islands(
                 continue;
             };
             if let Ok(path) = pose.get() {
-                // A moving wire is placed where it is at the step's end;
-                // its velocity does not enter the island's solve yet.
                 let reshaped = wire.is_changed().then(|| wire.shape().clone());
-                cached
-                    .island
-                    .place_wire(row, reshaped, path.pose(clock.time));
+                cached.island.move_wire(row, reshaped, path);
             }
         }
         for &(row, pin) in &cached.anchored {
@@ -431,7 +427,8 @@ pub(crate) fn step_islands(
                 cached.island.place_axis(row + 1, at.y);
             }
         }
-        if let Err(e) = cached.island.step(
+        if let Err(e) = cached.island.step_at(
+            clock.time - settings.dt,
             &mut cached.states,
             &cached.forces,
             &settings,

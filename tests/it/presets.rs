@@ -21,6 +21,8 @@ pub(crate) const SHIPPED: &[&str] = &[
     "rope.scene.ron",
     "ring.scene.ron",
     "spring_pair.scene.ron",
+    "kapitza.scene.ron",
+    "spinning_rod.scene.ron",
 ];
 
 /// The shipped presets that join beads.

@@ -5,7 +5,7 @@ use bevy::math::DVec2;
 
 use super::constraint::{RowKind, SpringLink};
 use super::normal::{Factored, NormalMatrix};
-use crate::geometry::{Pose, WireShape};
+use crate::geometry::{ImplicitCurve, Placed, Pose, PosePath, WireShape};
 use crate::solver::method::Method;
 use crate::solver::projection::{
     NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE, energy_scale, kinetic_scale,
@@ -110,6 +110,8 @@ pub struct Island {
     entry_bead: Vec<usize>,
     springs: Vec<SpringLink>,
     normal: NormalMatrix,
+    /// The path of each wire row that moves (see [`Island::move_wire`]).
+    paths: Vec<Option<PosePath>>,
 }
 
 /// The buffers one island's step works in, kept between steps so a step
@@ -128,6 +130,11 @@ pub struct IslandWork {
     first_gradient: Vec<DVec2>,
     c: Vec<f64>,
     curvature: Vec<f64>,
+    /// Each row's `−∂C/∂t` (the moving wire's `∇C·w`; zero for the rest):
+    /// `Ċ = J v − bias`.
+    bias: Vec<f64>,
+    /// The time the rows are evaluated at.
+    time: f64,
     rhs: Vec<f64>,
     lambda: Vec<f64>,
     values: Vec<f64>,
@@ -262,6 +269,7 @@ impl Island {
         }
         let normal =
             NormalMatrix::new(&row_start, &entry_bead, beads).ok_or(IslandError::OutOfMemory)?;
+        let paths = vec![None; kinds.len()];
         Ok(Self {
             inverse_mass,
             rows: kinds,
@@ -269,6 +277,7 @@ impl Island {
             entry_bead,
             springs,
             normal,
+            paths,
         })
     }
 
@@ -282,10 +291,36 @@ impl Island {
         }) = self.rows.get_mut(row)
         {
             *placed = pose;
+            self.paths[row] = None;
             if let Some(shape) = shape {
                 *placed_shape = shape;
             }
         }
+    }
+
+    /// Puts the wire of row `row` on `path`, a wire that moves during the
+    /// step: its rows are evaluated where the wire is at each stage's
+    /// time, with the terms of eq. (13) (the step's times come from
+    /// [`Island::step_at`]). `shape` as for [`Island::place_wire`].
+    pub fn move_wire(&mut self, row: usize, shape: Option<WireShape>, path: PosePath) {
+        if let Some(pose) = path.fixed() {
+            return self.place_wire(row, shape, pose);
+        }
+        if let Some(RowKind::Wire {
+            shape: placed_shape,
+            ..
+        }) = self.rows.get_mut(row)
+        {
+            self.paths[row] = Some(path);
+            if let Some(shape) = shape {
+                *placed_shape = shape;
+            }
+        }
+    }
+
+    /// Whether a row's wire moves.
+    fn moves(&self) -> bool {
+        self.paths.iter().any(Option::is_some)
     }
 
     /// Moves the line of the axis row `row` (one of a pin's rows) to
@@ -343,9 +378,24 @@ impl Island {
         settings: &StepSettings,
         work: &mut IslandWork,
     ) -> Result<(), SolveError> {
+        self.step_at(0.0, states, forces, settings, work)
+    }
+
+    /// [`Island::step`] for a step that starts at time `time`: the time
+    /// at which wires on a path (see [`Island::move_wire`]) are placed.
+    pub fn step_at(
+        &self,
+        time: f64,
+        states: &mut [BeadState],
+        forces: &[LinearForce],
+        settings: &StepSettings,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
         work.substeps = 0;
-        match self.advance(states, forces, settings, work) {
-            Err(SolveError::NoConvergence { .. }) => self.halve(states, forces, settings, work, 1),
+        match self.advance(time, states, forces, settings, work) {
+            Err(SolveError::NoConvergence { .. }) => {
+                self.halve(time, states, forces, settings, work, 1)
+            }
             other => other,
         }
     }
@@ -354,6 +404,7 @@ impl Island {
     /// where its Newton solve fails, `depth` halvings deep.
     fn halve(
         &self,
+        time: f64,
         states: &mut [BeadState],
         forces: &[LinearForce],
         settings: &StepSettings,
@@ -365,10 +416,11 @@ impl Island {
             ..*settings
         };
         let mut trial = states.to_vec();
-        for _ in 0..2 {
-            match self.advance(&mut trial, forces, &half, work) {
+        for k in 0..2 {
+            let start = time + f64::from(k) * half.dt;
+            match self.advance(start, &mut trial, forces, &half, work) {
                 Err(SolveError::NoConvergence { .. }) if depth < MAX_HALVINGS => {
-                    self.halve(&mut trial, forces, &half, work, depth + 1)?;
+                    self.halve(start, &mut trial, forces, &half, work, depth + 1)?;
                 }
                 other => other?,
             }
@@ -380,6 +432,7 @@ impl Island {
     /// One step of length `settings.dt`, with no halving.
     fn advance(
         &self,
+        time: f64,
         states: &mut [BeadState],
         forces: &[LinearForce],
         settings: &StepSettings,
@@ -402,6 +455,7 @@ impl Island {
         work.v0.extend(states.iter().map(|s| s.velocity));
         let h = settings.dt;
         let gains = settings.gains();
+        work.time = time;
         match settings.method {
             Method::Rattle => self.rattle(forces, h, work)?,
             Method::ExplicitEuler(_) | Method::SemiImplicitEuler(_) => {
@@ -420,6 +474,7 @@ impl Island {
         if work.x.iter().chain(&work.v).any(|p| !p.is_finite()) {
             return Err(SolveError::NonFinite);
         }
+        work.time = time + h;
         self.evaluate_at_new(work);
         for r in 0..self.rows() {
             let bound = settings.drift_bound * self.rows[r].scale();
@@ -429,7 +484,10 @@ impl Island {
             }
         }
         if settings.method.projects() {
-            let restore = if settings.method.is_euler() {
+            let restore = if self.moves() {
+                // A moving wire does work: there is no energy or speed to keep.
+                Restore::Nothing
+            } else if settings.method.is_euler() {
                 Restore::Speed(settings.dt)
             } else {
                 Restore::Energy
@@ -440,7 +498,7 @@ impl Island {
         work.bead_forces.resize(n, DVec2::ZERO);
         for (r, report) in work.reports.iter_mut().enumerate() {
             report.c = work.c[r];
-            report.c_dot = self.rate(r, &work.gradient, &work.v);
+            report.c_dot = self.rate(r, &work.gradient, &work.v, &work.bias);
             let entries = self.row_start[r]..self.row_start[r + 1];
             for (&bead, g) in self.entry_bead[entries.clone()]
                 .iter()
@@ -457,21 +515,42 @@ impl Island {
         Ok(())
     }
 
-    /// Evaluates every row at `(x, v)`: gradients, `C`, `J̇q̇`.
-    fn evaluate(
-        &self,
-        x: &[DVec2],
-        v: &[DVec2],
-        gradient: &mut Vec<DVec2>,
-        c: &mut Vec<f64>,
-        curvature: &mut Vec<f64>,
-        scratch: &mut Vec<DVec2>,
-    ) {
+    /// Evaluates every row at `(x, v)` at `work.time`: gradients, `C`,
+    /// `J̇q̇` and the bias `−∂C/∂t`, into `out`.
+    fn evaluate(&self, x: &[DVec2], v: &[DVec2], time: f64, out: Rows<'_>) {
+        let Rows {
+            gradient,
+            c,
+            curvature,
+            bias,
+            scratch,
+        } = out;
         gradient.resize(self.entry_bead.len(), DVec2::ZERO);
         c.resize(self.rows(), 0.0);
         curvature.resize(self.rows(), 0.0);
+        bias.clear();
+        bias.resize(self.rows(), 0.0);
         for (r, kind) in self.rows.iter().enumerate() {
             let range = self.row_start[r]..self.row_start[r + 1];
+            if let (Some(path), RowKind::Wire { shape, .. }) = (&self.paths[r], kind) {
+                // Eq. (13): the wire where it is at `time`, seen from its frame.
+                let bead = self.entry_bead[range.start];
+                let (p, u) = (x[bead], v[bead]);
+                let (pose, twist) = path.at(time);
+                let g = Placed {
+                    curve: shape.curve(),
+                    pose,
+                }
+                .geometry(p);
+                let w = twist.velocity_at(p);
+                let relative = u - w;
+                gradient[range.start] = g.normal;
+                c[r] = g.c;
+                curvature[r] = relative.dot(g.hessian * relative)
+                    - g.normal.dot(twist.acceleration_at(p, relative));
+                bias[r] = g.normal.dot(w);
+                continue;
+            }
             let (value, bend) = kind.evaluate(
                 &self.entry_bead[range.clone()],
                 x,
@@ -490,18 +569,45 @@ impl Island {
         self.evaluate(
             &work.x,
             &work.v,
-            &mut work.gradient,
-            &mut work.c,
-            &mut work.curvature,
-            &mut work.scratch,
+            work.time,
+            Rows {
+                gradient: &mut work.gradient,
+                c: &mut work.c,
+                curvature: &mut work.curvature,
+                bias: &mut work.bias,
+                scratch: &mut work.scratch,
+            },
         );
     }
 
-    /// `Ċ_r = Σ g·v` over row `r`'s entries.
-    fn rate(&self, r: usize, gradient: &[DVec2], v: &[DVec2]) -> f64 {
+    /// Evaluates the rows at the step's start `work.x0`, `work.v0` into
+    /// `work.first_gradient` (and `work.c`, `work.curvature`, `work.bias`).
+    fn evaluate_at_start(&self, work: &mut IslandWork, time: f64) {
+        self.evaluate(
+            &work.x0,
+            &work.v0,
+            time,
+            Rows {
+                gradient: &mut work.first_gradient,
+                c: &mut work.c,
+                curvature: &mut work.curvature,
+                bias: &mut work.bias,
+                scratch: &mut work.scratch,
+            },
+        );
+    }
+
+    /// `Σ g·v` over row `r`'s entries (`J v` of one row).
+    fn along(&self, r: usize, gradient: &[DVec2], v: &[DVec2]) -> f64 {
         (self.row_start[r]..self.row_start[r + 1])
             .map(|e| gradient[e].dot(v[self.entry_bead[e]]))
             .sum()
+    }
+
+    /// `Ċ_r = Σ g·v − bias` over row `r`'s entries: the rate relative to
+    /// a moving wire.
+    fn rate(&self, r: usize, gradient: &[DVec2], v: &[DVec2], bias: &[f64]) -> f64 {
+        self.along(r, gradient, v) - bias[r]
     }
 
     /// The applied forces at `(x, v)`: each bead's external force, plus
@@ -573,7 +679,7 @@ impl Island {
                     work.gradient[e].dot(self.inverse_mass[bead] * work.force[bead])
                 })
                 .sum();
-            let c_dot = self.rate(r, &work.gradient, v);
+            let c_dot = self.rate(r, &work.gradient, v, &work.bias);
             work.lambda
                 .push(-work.curvature[r] - pushed - gains.alpha * work.c[r] - gains.beta * c_dot);
         }
@@ -611,6 +717,7 @@ impl Island {
         self.accelerate(forces, gains, work, Stage::Start)?;
         self.keep_lambda(work);
         let n = self.beads();
+        let start = work.time;
         work.x_sum.clone_from(&work.v0);
         work.v_sum.clone_from(&work.acceleration);
         for (weight, advance) in [(2.0, 0.5 * h), (2.0, 0.5 * h), (1.0, h)] {
@@ -621,6 +728,7 @@ impl Island {
                 work.x[i] = work.x0[i] + advance * dx;
                 work.v[i] = work.v0[i] + advance * dv;
             }
+            work.time = start + advance;
             self.accelerate(forces, gains, work, Stage::Later)?;
             for i in 0..n {
                 work.x_sum[i] += weight * work.v[i];
@@ -752,7 +860,8 @@ impl Island {
         self.factor(&work.gradient, &work.x, &mut work.factored)?;
         work.rhs.clear();
         for r in 0..self.rows() {
-            work.rhs.push(-self.rate(r, &work.gradient, &work.v));
+            work.rhs
+                .push(-self.rate(r, &work.gradient, &work.v, &work.bias));
         }
         self.normal.solve(&mut work.factored, &mut work.rhs);
         self.push(&work.gradient, &work.rhs, &mut work.v);
@@ -785,6 +894,7 @@ impl Island {
         };
         let now = kinetic(&work.v);
         let h = match restore {
+            Restore::Nothing => return Ok(()),
             Restore::Speed(h) => h,
             Restore::Energy => {
                 if self.springs.iter().any(|s| s.damping != 0.0) {
@@ -803,14 +913,7 @@ impl Island {
             }
         };
         // The applied kick W Q at the start, its part off J₀ removed.
-        self.evaluate(
-            &work.x0,
-            &work.v0,
-            &mut work.first_gradient,
-            &mut work.c,
-            &mut work.curvature,
-            &mut work.scratch,
-        );
+        self.evaluate_at_start(work, work.time - h);
         self.applied(forces, &work.x0, &work.v0, &mut work.force);
         for (f, w) in work.force.iter_mut().zip(&self.inverse_mass) {
             *f *= *w;
@@ -820,7 +923,7 @@ impl Island {
             work.rhs.clear();
             for r in 0..self.rows() {
                 work.rhs
-                    .push(-self.rate(r, &work.first_gradient, &work.force));
+                    .push(-self.along(r, &work.first_gradient, &work.force));
             }
             self.normal.solve(&mut work.factored, &mut work.rhs);
             self.push(&work.first_gradient, &work.rhs, &mut work.force);
@@ -850,18 +953,10 @@ impl Island {
         work: &mut IslandWork,
     ) -> Result<(), SolveError> {
         let n = self.beads();
-        self.evaluate(
-            &work.x0,
-            &work.v0,
-            &mut work.gradient,
-            &mut work.c,
-            &mut work.curvature,
-            &mut work.scratch,
-        );
+        self.evaluate_at_start(work, work.time);
         if self.rows() > 0 {
-            self.factor(&work.gradient, &work.x0, &mut work.factored)?;
+            self.factor(&work.first_gradient, &work.x0, &mut work.factored)?;
         }
-        work.first_gradient.clone_from(&work.gradient);
         self.applied(forces, &work.x0, &work.v0, &mut work.force);
         work.x.clear();
         work.v.clear();
@@ -871,6 +966,7 @@ impl Island {
                 .push(work.x0[i] + h * work.v0[i] + (0.5 * h * h * w) * work.force[i]);
             work.v.push(work.v0[i]);
         }
+        work.time += h;
         self.newton(work, Direction::First)?;
         let to_lambda = 2.0 / (h * h);
         work.reports.clear();
@@ -896,9 +992,20 @@ impl Island {
     }
 }
 
+/// Where [`Island::evaluate`] writes.
+struct Rows<'a> {
+    gradient: &'a mut Vec<DVec2>,
+    c: &'a mut Vec<f64>,
+    curvature: &'a mut Vec<f64>,
+    bias: &'a mut Vec<f64>,
+    scratch: &'a mut Vec<DVec2>,
+}
+
 /// How a projection ends (see [`Island::project`]).
 #[derive(Clone, Copy, PartialEq)]
 enum Restore {
+    /// As projected: an island on a moving wire, which does work on it.
+    Nothing,
     /// The pre-kick speed after an Euler step of this length, eq. (9b).
     Speed(f64),
     /// The energy of the step's start after RK4, eq. (9c).
