@@ -26,6 +26,7 @@ mod parabola;
 mod pose;
 mod shape;
 mod sine;
+mod surface;
 
 use bevy::math::{DMat2, DVec2};
 
@@ -34,12 +35,14 @@ pub(crate) use circle::circle_geometry;
 pub use ellipse::Ellipse;
 pub use line::Line;
 pub use motion::{
-    FixedTrack, MovingTrack, Oscillate, PoseHistory, PosePath, Spin, Track, Twist, WireMotion,
+    FixedTrack, MovingTrack, Oscillate, PoseHistory, PosePath, Rough, Spin, Track, Twist,
+    WireMotion,
 };
 pub use parabola::Parabola;
 pub use pose::{Placed, Pose};
 pub use shape::{WireKind, WireShape};
 pub use sine::Sine;
+pub use surface::{Friction, Side, Surface};
 
 /// The value, gradient and Hessian of a constraint at one point.
 #[derive(Clone, Copy, Debug, PartialEq)]

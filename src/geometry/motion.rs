@@ -24,7 +24,7 @@ use std::f64::consts::TAU;
 use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
 
-use super::{Geometry, ImplicitCurve, Placed, Pose};
+use super::{Geometry, ImplicitCurve, Placed, Pose, Surface};
 use crate::validate::{ParamError, finite, finite_vector, positive};
 
 /// The quarter turn `J d = (−d.y, d.x)`.
@@ -325,6 +325,50 @@ pub trait Track {
     fn scale(&self) -> f64;
     /// The wire's twist at time `t`.
     fn twist(&self, t: f64) -> Twist;
+    /// Where the point of the wire that is at `x` at time `from` is at time
+    /// `to` (a bead held still on the wire is carried there).
+    fn carry(&self, x: DVec2, from: f64, to: f64) -> DVec2;
+    /// Friction and damping along the wire, if it has any, and the
+    /// direction the bead slid in at the step's start (see [`Rough`]).
+    #[inline(always)]
+    fn surface(&self) -> Option<(&Surface, DVec2)> {
+        None
+    }
+}
+
+/// A wire with friction or damping along it: `track` with `surface`, for
+/// one step of a bead that slid in the direction `sliding` at the step's
+/// start (zero if it was at rest). Kinetic friction keeps opposing that
+/// direction through the step, so that a bead friction stops within a step
+/// reverses rather than chatters, and the step is cut where it stops.
+pub struct Rough<'a, T: Track + ?Sized> {
+    /// The wire.
+    pub track: &'a T,
+    /// What resists sliding on it.
+    pub surface: &'a Surface,
+    /// The bead's velocity along the wire (relative to it) at the step's
+    /// start.
+    pub sliding: DVec2,
+}
+
+impl<T: Track + ?Sized> Track for Rough<'_, T> {
+    const MOVES: bool = T::MOVES;
+    #[inline(always)]
+    fn geometry(&self, t: f64, x: DVec2) -> Geometry {
+        self.track.geometry(t, x)
+    }
+    fn scale(&self) -> f64 {
+        self.track.scale()
+    }
+    fn twist(&self, t: f64) -> Twist {
+        self.track.twist(t)
+    }
+    fn carry(&self, x: DVec2, from: f64, to: f64) -> DVec2 {
+        self.track.carry(x, from, to)
+    }
+    fn surface(&self) -> Option<(&Surface, DVec2)> {
+        Some((self.surface, self.sliding))
+    }
 }
 
 /// A wire that stays put: the curve itself, in world coordinates.
@@ -341,6 +385,9 @@ impl<C: ImplicitCurve + ?Sized> Track for FixedTrack<'_, C> {
     }
     fn twist(&self, _t: f64) -> Twist {
         Twist::default()
+    }
+    fn carry(&self, x: DVec2, _from: f64, _to: f64) -> DVec2 {
+        x
     }
 }
 
@@ -367,6 +414,11 @@ impl<C: ImplicitCurve + ?Sized> Track for MovingTrack<'_, C> {
     }
     fn twist(&self, t: f64) -> Twist {
         self.path.at(t).1
+    }
+    fn carry(&self, x: DVec2, from: f64, to: f64) -> DVec2 {
+        self.path
+            .pose(to)
+            .to_world(self.path.pose(from).to_local(x))
     }
 }
 

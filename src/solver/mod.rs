@@ -9,6 +9,7 @@
 //! | `solve` | λ of eq. (3) in closed form |
 //! | `euler`, `rk4`, `rattle`, `projection` | the integrators and post-stabilization, eqs. (6)–(9) |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
+//! | `contact` | [`step_surface`]: one-sided wires, landings and friction, eq. (14) |
 //! | `lanes` | [`step_on_circles`]: [`LANES`] beads on circles at once, bit for bit [`step`] |
 //! | `coupled` | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (10)–(12) |
 //!
@@ -16,6 +17,7 @@
 //!
 #![doc = include_str!("../../docs/method.md")]
 
+mod contact;
 mod coupled;
 mod euler;
 mod lanes;
@@ -28,6 +30,7 @@ mod solve;
 mod state;
 mod step;
 
+pub use contact::{Contact, ContactEvent, SurfaceStep, free_step, step_surface};
 pub use coupled::{
     Constraint, Island, IslandError, IslandRow, IslandWork, MAX_HALVINGS, REDUNDANT_PIVOT, RowKind,
     RowReport, SpringLink, islands,

@@ -4,7 +4,8 @@
 
 use bevy::math::DVec2;
 
-use super::solve::{SolveError, normal_length_squared};
+use super::settings::Gains;
+use super::solve::{SolveError, normal_length_squared, resistance, solve_on};
 use super::state::BeadState;
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
 
@@ -167,7 +168,14 @@ pub(crate) fn restore_speed<T: Track + ?Sized>(
     if T::MOVES {
         applied -= track.twist(t).acceleration_at(x0, relative);
     }
-    let kick = along_wire(track.geometry(t, x0).normal, applied, x0)?;
+    let normal = track.geometry(t, x0).normal;
+    if let Some((surface, sliding)) = track.surface() {
+        // Friction and damping are part of the kick: the speed they take
+        // away stays away.
+        let lambda = solve_on(track, t, start, force, mass, Gains::NONE)?.lambda;
+        applied += resistance(surface, sliding, normal, relative, mass * applied, lambda) / mass;
+    }
+    let kick = along_wire(normal, applied, x0)?;
     let target = (relative + h * kick).length_squared();
     let now = projected.velocity - w1;
     let scale = kinetic_scale(target, now.length_squared());

@@ -2,7 +2,8 @@
 
 use super::Advance;
 use super::projection::newton_along;
-use super::solve::{SolveError, normal_length_squared};
+use super::settings::Gains;
+use super::solve::{SolveError, normal_length_squared, resistance, solve_on};
 use super::state::{BeadState, LinearForce};
 use bevy::math::DVec2;
 
@@ -40,14 +41,26 @@ pub(crate) fn rattle_on<T: Track + ?Sized>(
     let t1 = t + h;
     let n0 = track.geometry(t, x0).normal;
     normal_length_squared(n0, x0)?;
-    let free = x0 + h * v0 + (h * h / (2.0 * mass)) * force.at(x0);
+    // Friction and damping along the wire, held at their start value
+    // through the step (eq. 14).
+    let resisted = match track.surface() {
+        Some((surface, sliding)) => {
+            let twist = track.twist(t);
+            let relative = v0 - twist.velocity_at(x0);
+            let applied = force.at(x0) - mass * twist.acceleration_at(x0, relative);
+            let lambda = solve_on(track, t, state, force, mass, Gains::NONE)?.lambda;
+            resistance(surface, sliding, n0, relative, applied, lambda)
+        }
+        None => DVec2::ZERO,
+    };
+    let free = x0 + h * v0 + (h * h / (2.0 * mass)) * (force.at(x0) + resisted);
     let s = newton_along(track, t1, free, n0)?;
     let x1 = free + s * n0;
     let lambda = 2.0 * mass * s / (h * h);
     let v_half = (x1 - x0) / h;
     let n1 = track.geometry(t1, x1).normal;
     let nn1 = normal_length_squared(n1, x1)?;
-    let w = v_half + (h / (2.0 * mass)) * force.at(x1);
+    let w = v_half + (h / (2.0 * mass)) * (force.at(x1) + resisted);
     let wire = if T::MOVES {
         track.twist(t1).velocity_at(x1)
     } else {

@@ -5,7 +5,7 @@ use bevy::math::DVec2;
 
 use super::settings::Gains;
 use super::state::{BeadState, LinearForce};
-use crate::geometry::{FixedTrack, Geometry, ImplicitCurve, Track};
+use crate::geometry::{FixedTrack, Geometry, ImplicitCurve, Surface, Track};
 use crate::lane::{Lane, V2};
 
 /// Why a step could not be taken.
@@ -180,7 +180,7 @@ pub(crate) fn solve_on<T: Track + ?Sized>(
 ) -> Result<Solved, SolveError> {
     let g = track.geometry(t, state.position);
     let f = force.at(state.position);
-    if !T::MOVES {
+    if !T::MOVES && track.surface().is_none() {
         let solved = constraint_force_at(&g, state, f, mass, gains)?;
         return Ok(Solved {
             lambda: solved.lambda,
@@ -195,12 +195,53 @@ pub(crate) fn solve_on<T: Track + ?Sized>(
         velocity: relative,
         ..state
     };
-    let solved = constraint_force_at(&g, seen, f - mass * frame, mass, gains)?;
+    let applied = f - mass * frame;
+    let solved = constraint_force_at(&g, seen, applied, mass, gains)?;
+    let mut acceleration = DVec2::from(solved.acceleration) + frame;
+    if let Some((surface, sliding)) = track.surface() {
+        acceleration +=
+            resistance(surface, sliding, g.normal, relative, applied, solved.lambda) / mass;
+    }
     Ok(Solved {
         lambda: solved.lambda,
         constraint_force: solved.lambda * g.normal,
-        acceleration: DVec2::from(solved.acceleration) + frame,
+        acceleration,
     })
+}
+
+/// Eq. (14): the force along the wire that friction and damping put on a
+/// bead whose velocity relative to the wire is `relative`, pressed on it
+/// with `|λ ∇C|`, under the applied force `applied` (in the wire's frame),
+/// in a step that started sliding along `sliding`. Sliding, kinetic
+/// friction `μk |λ∇C|` opposes the start's direction of sliding (taken
+/// along the wire where the bead is) and damping the sliding itself; from
+/// rest (`sliding` zero), static friction cancels the force along the wire
+/// up to `μs |λ∇C|`, and past it kinetic friction opposes that force.
+pub(crate) fn resistance(
+    surface: &Surface,
+    sliding: DVec2,
+    normal: DVec2,
+    relative: DVec2,
+    applied: DVec2,
+    lambda: f64,
+) -> DVec2 {
+    let nn = normal.length_squared();
+    let along = |a: DVec2| a - normal * (normal.dot(a) / nn);
+    let press = lambda.abs() * nn.sqrt();
+    let kinetic = surface.friction.kinetic_coefficient * press;
+    let damping = -surface.damping * along(relative);
+    let direction = along(sliding);
+    let speed = direction.length();
+    if speed > 0.0 {
+        return damping - (kinetic / speed) * direction;
+    }
+    let pull = along(applied);
+    let strength = pull.length();
+    if strength <= surface.friction.static_coefficient * press {
+        -pull
+    } else {
+        -(kinetic / strength) * pull
+    }
 }
 
 #[cfg(test)]

@@ -102,7 +102,9 @@ pub fn step_on<T: Track + ?Sized>(
         let projected = project_on(track, t1, advance.state)?;
         let projected = if settings.method.is_euler() {
             restore_speed(track, t, state, projected, force, mass, h)?
-        } else if T::MOVES {
+        } else if T::MOVES || track.surface().is_some_and(|(s, _)| s.resists()) {
+            // Eq. (9c) keeps a conservative system's energy: a moving wire
+            // does work, friction and damping take it away.
             projected
         } else {
             restore_energy(track, t1, state, projected, force, mass)?
