@@ -33,6 +33,7 @@
 //! | [`WireBeadPlugin`] | the simulation: components, parameters, the step in `FixedUpdate` |
 //! | [`WireBeadSystems`] | the sets: `Restart` in `PreUpdate`; `Prepare → Forces → Step → Writeback` in `FixedUpdate` |
 //! | [`Wire`], [`Bead`], [`OnWire`] | a wire placed by its `Transform`; a bead on it (or free, on none) |
+//! | [`Surface`], [`WireContact`], [`ContactChanged`] | one-sided wires a bead leaves and lands on, restitution, friction; each bead's contact and the message when it changes |
 //! | [`PrescribedMotion`] | a wire that moves ([`WireMotion`]: oscillates or spins), its motion exact in the constraint force; a wire the game moves is followed |
 //! | [`Rod`], [`Pin`], [`Joint`], [`Spring`] | links between beads, each on an entity of its own; [`Constraint`] for a game's own joint |
 //! | [`Islands`], [`ConstraintDiagnostics`] | the beads links join, solved together (`J W Jᵀ λ = …`); each link's `C`, `Ċ`, λ |
@@ -85,12 +86,14 @@ mod validate;
 
 pub use controls::KeyboardControlsPlugin;
 pub use dynamics::{
-    Bead, BeadDiagnostics, BeadDiverged, BeadParams, ConstraintDiagnostics, Diverged,
-    DivergenceReason, DragTarget, Joint, MAX_TIMESTEP, MIN_TIMESTEP, OnWire, PendingBead,
+    Bead, BeadDiagnostics, BeadDiverged, BeadParams, ConstraintDiagnostics, ContactChanged,
+    Diverged, DivergenceReason, DragTarget, Joint, MAX_TIMESTEP, MIN_TIMESTEP, OnWire, PendingBead,
     PendingParams, PendingWire, Pin, PrescribedMotion, Rod, SimParams, Spring, Wire, WireBeads,
-    pose_of,
+    WireContact, pose_of,
 };
-pub use geometry::{ImplicitCurve, Oscillate, Spin, WireKind, WireMotion, WireShape};
+pub use geometry::{
+    Friction, ImplicitCurve, Oscillate, Side, Spin, Surface, WireKind, WireMotion, WireShape,
+};
 pub use plugin::{
     IslandReport, Islands, ParallelStep, Restart, SimClock, WireBeadPlugin, WireBeadSystems,
 };
@@ -102,11 +105,11 @@ pub use validate::ParamError;
 pub mod prelude {
     pub use crate::{
         Bead, BeadDiagnostics, BeadDiverged, BeadParams, Constraint, ConstraintDiagnostics,
-        Diverged, DragTarget, ImplicitCurve, Integrator, Islands, Joint, KeyboardControlsPlugin,
-        LoadPreset, Method, OnWire, ParallelStep, ParamError, PendingBead, PendingParams, Pin,
-        PrescribedMotion, Restart, Rod, ScenePreset, ScenePresetPlugin, SimClock, SimParams,
-        Spring, Stabilization, Wire, WireBeadPlugin, WireBeadSystems, WireBeads, WireKind,
-        WireMotion, WireShape,
+        ContactChanged, Diverged, DragTarget, Friction, ImplicitCurve, Integrator, Islands, Joint,
+        KeyboardControlsPlugin, LoadPreset, Method, OnWire, ParallelStep, ParamError, PendingBead,
+        PendingParams, Pin, PrescribedMotion, Restart, Rod, ScenePreset, ScenePresetPlugin, Side,
+        SimClock, SimParams, Spring, Stabilization, Surface, Wire, WireBeadPlugin, WireBeadSystems,
+        WireBeads, WireContact, WireKind, WireMotion, WireShape,
     };
 }
 

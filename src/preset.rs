@@ -34,7 +34,7 @@ use serde::{Deserialize, Serialize};
 use crate::dynamics::{
     Bead, BeadParams, OnWire, PendingParams, Pin, PrescribedMotion, Rod, SimParams, Spring, Wire,
 };
-use crate::geometry::{Pose, Twist, WireMotion, WireShape};
+use crate::geometry::{Friction, Pose, Side, Surface, Twist, WireMotion, WireShape};
 use crate::plugin::{Restart, WireBeadSystems};
 use crate::solver::BeadState;
 use crate::validate::{ParamError, finite, finite_vector, non_negative, positive};
@@ -149,9 +149,36 @@ pub struct WirePreset {
     /// relative to the wire's own at `t = 0`.
     #[serde(default)]
     pub motion: WireMotion,
+    /// Which way it pushes: `Both` (the default), `Positive` or `Negative`
+    /// (see [`Side`]).
+    #[serde(default)]
+    pub side: Side,
+    /// On a one-sided wire, the share of the normal speed a landing bead
+    /// bounces off with (0, the default: it stays on).
+    #[serde(default)]
+    pub restitution: f64,
+    /// Coulomb friction along it, `(static: μs, kinetic: μk)`; none by
+    /// default.
+    #[serde(default)]
+    pub friction: Friction,
+    /// Viscous damping along it, N·s/m; none by default.
+    #[serde(default)]
+    pub damping: f64,
     /// The beads on it.
     #[serde(default)]
     pub beads: Vec<BeadPreset>,
+}
+
+impl WirePreset {
+    /// Its side, restitution, friction and damping.
+    pub fn surface(&self) -> Surface {
+        Surface {
+            side: self.side,
+            restitution: self.restitution,
+            friction: self.friction,
+            damping: self.damping,
+        }
+    }
 }
 
 /// A whole scene: parameters, wires and beads.
@@ -253,6 +280,7 @@ impl ScenePreset {
             finite_vector("wire position", wire.position)
                 .and_then(|_| finite("wire angle", wire.angle_degrees))
                 .and_then(|_| wire.motion.validate())
+                .and_then(|_| wire.surface().validate())
                 .map_err(|source| PresetError::Wire { index, source })?;
             for (bead, preset) in wire.beads.iter().enumerate() {
                 preset
@@ -414,7 +442,8 @@ impl ScenePreset {
             let transform =
                 Transform::from_xyz(wire.position.x as f32, wire.position.y as f32, 0.0)
                     .with_rotation(Quat::from_rotation_z(wire.angle_degrees.to_radians() as f32));
-            let wire_entity = Wire::new(wire.shape.clone()).ok().map(|component| {
+            let made = Wire::new(wire.shape.clone()).and_then(|w| w.with_surface(wire.surface()));
+            let wire_entity = made.ok().map(|component| {
                 let mut entity = commands.spawn((component, transform, FromPreset));
                 if let Ok(motion) = PrescribedMotion::new(wire.motion)
                     && wire.motion.moves()

@@ -8,11 +8,11 @@ use std::time::Instant;
 
 use bevy::math::DVec2;
 use bevy::prelude::{Entity, FixedUpdate, IntoScheduleConfigs, Query, Res, ResMut, Resource};
-use wirebead::geometry::{ImplicitCurve, Placed, Pose, WireShape};
+use wirebead::geometry::{ImplicitCurve, Placed, Pose, WireMotion, WireShape};
 use wirebead::headless::{Headless, run_steps};
 use wirebead::{
     Bead, Diverged, Method, ParamError, SceneLink, ScenePreset, SimClock, SimParams,
-    WireBeadPlugin, WireBeadSystems,
+    WireBeadPlugin, WireBeadSystems, WireContact,
 };
 
 use crate::AnalysisResult;
@@ -26,7 +26,8 @@ pub fn load_scene(path: &Path) -> AnalysisResult<ScenePreset> {
 /// One constraint to measure, with beads as indices in the file's order.
 #[derive(Clone, Debug)]
 enum Check {
-    Wire(usize, WireShape, Pose),
+    /// A bead on a wire resting at the pose, moving by the motion.
+    Wire(usize, WireShape, Pose, WireMotion),
     Rod(usize, usize, f64),
     Pin(usize, DVec2),
 }
@@ -48,7 +49,7 @@ impl Measure {
         for wire in &preset.wires {
             let pose = Pose::new(wire.position, wire.angle_degrees.to_radians());
             for _ in &wire.beads {
-                checks.push(Check::Wire(bead, wire.shape.clone(), pose));
+                checks.push(Check::Wire(bead, wire.shape.clone(), pose, wire.motion));
                 bead += 1;
             }
         }
@@ -70,14 +71,16 @@ impl Measure {
         })
     }
 
-    /// The largest `|C|` of every constraint, wires included.
-    fn max_abs_c(&self, x: &[DVec2]) -> f64 {
+    /// The largest `|C|` at time `t` of every constraint, wires included
+    /// (a bead in flight off its wire left out).
+    fn max_abs_c(&self, t: f64, x: &[DVec2], on: &[bool]) -> f64 {
         self.checks
             .iter()
             .map(|check| match check {
-                Check::Wire(b, shape, pose) => Placed {
+                Check::Wire(b, _, _, _) if !on[*b] => 0.0,
+                Check::Wire(b, shape, pose, motion) => Placed {
                     curve: shape.curve(),
-                    pose: *pose,
+                    pose: motion.at(*pose, t).0,
                 }
                 .value(x[*b])
                 .abs(),
@@ -117,6 +120,9 @@ pub struct SceneRow {
     pub positions: Vec<DVec2>,
     /// Every bead's velocity.
     pub velocities: Vec<DVec2>,
+    /// Whether each bead is held on its wire (false in flight off a
+    /// one-sided wire, and for a bead on no wire).
+    pub on: Vec<bool>,
     /// Kinetic plus gravitational energy of all beads.
     pub energy: f64,
     /// The energy stored in the springs (not a CSV column; `compare` adds
@@ -146,17 +152,19 @@ struct Recorder {
 }
 
 impl Recorder {
-    fn record(&mut self, t: f64, beads: &Query<(&Bead, Option<&Diverged>)>) {
+    fn record(&mut self, t: f64, beads: &Query<BeadRecord>) {
         if self.stopped {
             return;
         }
         let mut x = Vec::with_capacity(self.beads.len());
         let mut v = Vec::with_capacity(self.beads.len());
+        let mut on = Vec::with_capacity(self.beads.len());
         for &entity in &self.beads {
             match beads.get(entity) {
-                Ok((bead, None)) => {
+                Ok((bead, contact, None)) => {
                     x.push(bead.position);
                     v.push(bead.velocity);
+                    on.push(contact.is_some_and(WireContact::is_on));
                 }
                 _ => {
                     self.stopped = true;
@@ -168,18 +176,22 @@ impl Recorder {
             t,
             energy: self.measure.energy(&x, &v),
             spring_energy: self.measure.spring_energy(&x),
-            max_abs_c: self.measure.max_abs_c(&x),
+            max_abs_c: self.measure.max_abs_c(t, &x, &on),
             positions: x,
             velocities: v,
+            on,
         });
     }
 }
 
-fn record_scene(
-    clock: Res<SimClock>,
-    beads: Query<(&Bead, Option<&Diverged>)>,
-    mut recorder: ResMut<Recorder>,
-) {
+/// What the recorder reads of a bead.
+type BeadRecord = (
+    &'static Bead,
+    Option<&'static WireContact>,
+    Option<&'static Diverged>,
+);
+
+fn record_scene(clock: Res<SimClock>, beads: Query<BeadRecord>, mut recorder: ResMut<Recorder>) {
     recorder.record(clock.time, &beads);
 }
 
@@ -240,21 +252,23 @@ pub fn simulate_scene(
     })
 }
 
-/// Writes a scene run as CSV: `t`, then `<name>.x,<name>.y,<name>.vx,<name>.vy`
-/// for each bead in the file's order, then `energy,max_abs_c`.
+/// Writes a scene run as CSV: `t`, then
+/// `<name>.x,<name>.y,<name>.vx,<name>.vy,<name>.on` for each bead in the
+/// file's order (`on` 1 while held on its wire, 0 in flight off a one-sided
+/// wire or on no wire), then `energy,max_abs_c`.
 pub fn write_scene_csv(path: &Path, run: &SceneRun) -> AnalysisResult<()> {
     let mut writer =
         csv::Writer::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut header = vec!["t".to_owned()];
     for name in &run.names {
-        header.extend(["x", "y", "vx", "vy"].map(|c| format!("{name}.{c}")));
+        header.extend(["x", "y", "vx", "vy", "on"].map(|c| format!("{name}.{c}")));
     }
     header.extend(["energy".to_owned(), "max_abs_c".to_owned()]);
     writer.write_record(&header)?;
     for row in &run.rows {
         let mut record = vec![row.t];
-        for (x, v) in row.positions.iter().zip(&row.velocities) {
-            record.extend([x.x, x.y, v.x, v.y]);
+        for ((x, v), on) in row.positions.iter().zip(&row.velocities).zip(&row.on) {
+            record.extend([x.x, x.y, v.x, v.y, f64::from(u8::from(*on))]);
         }
         record.extend([row.energy, row.max_abs_c]);
         writer.write_record(record.iter().map(|v| format!("{v:e}")))?;

@@ -152,15 +152,17 @@ fn simulate_scene_writes_a_column_set_per_named_bead() {
     let (header, rows) = read_csv(&path);
     assert_eq!(
         header.join(","),
-        "t,cart.x,cart.y,cart.vx,cart.vy,bob.x,bob.y,bob.vx,bob.vy,energy,max_abs_c"
+        "t,cart.x,cart.y,cart.vx,cart.vy,cart.on,bob.x,bob.y,bob.vx,bob.vy,bob.on,energy,max_abs_c"
     );
     assert_eq!(rows.len(), 61, "t = 0 and 60 steps");
-    assert_eq!(rows[0][5..7], [0.75f64.sqrt(), -0.5]);
+    assert_eq!(rows[0][6..8], [0.75f64.sqrt(), -0.5]);
     for row in &rows {
         // RATTLE: the rod and the rail to rounding; no horizontal momentum.
-        assert!(row[10] <= 1e-12, "max |C| = {:e}", row[10]);
-        assert!((2.0 * row[3] + row[7]).abs() < 1e-12);
-        assert!((row[9] - rows[0][9]).abs() < 1e-2, "energy {}", row[9]);
+        assert!(row[12] <= 1e-12, "max |C| = {:e}", row[12]);
+        assert!((2.0 * row[3] + row[8]).abs() < 1e-12);
+        assert!((row[11] - rows[0][11]).abs() < 1e-2, "energy {}", row[11]);
+        // The cart is on its rail; the bob is on no wire.
+        assert_eq!((row[5], row[10]), (1.0, 0.0));
     }
 }
 

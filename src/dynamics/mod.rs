@@ -15,4 +15,6 @@ pub use diagnostics::{BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason}
 pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
 pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, PendingParams, SimParams};
 pub(crate) use wire::WirePose;
-pub use wire::{OnWire, PendingWire, PrescribedMotion, Wire, WireBeads, pose_of};
+pub use wire::{
+    ContactChanged, OnWire, PendingWire, PrescribedMotion, Wire, WireBeads, WireContact, pose_of,
+};

@@ -6,8 +6,10 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 use crate::geometry::{
-    Circle, Ellipse, ImplicitCurve, Line, Parabola, Pose, PosePath, Sine, WireMotion, WireShape,
+    Circle, Ellipse, ImplicitCurve, Line, Parabola, Pose, PosePath, Sine, Surface, WireMotion,
+    WireShape,
 };
+use crate::solver::{Contact, ContactEvent};
 use crate::validate::ParamError;
 
 /// A wire: a shape placed in the plane by the entity's `Transform`
@@ -20,13 +22,38 @@ use crate::validate::ParamError;
 #[require(Transform, WirePose)]
 pub struct Wire {
     shape: WireShape,
+    surface: Surface,
 }
 
 impl Wire {
     /// A wire of any shape, if its dimensions are valid.
     pub fn new(shape: WireShape) -> Result<Self, ParamError> {
         shape.validate()?;
-        Ok(Self { shape })
+        Ok(Self {
+            shape,
+            surface: Surface::PLAIN,
+        })
+    }
+
+    /// The wire with `surface`: one-sided, bouncy, rough or damped (see
+    /// [`Surface`]), if its numbers are valid.
+    pub fn with_surface(self, surface: Surface) -> Result<Self, ParamError> {
+        surface.validate()?;
+        Ok(Self { surface, ..self })
+    }
+
+    /// What the wire does besides holding its beads.
+    pub fn surface(&self) -> &Surface {
+        &self.surface
+    }
+
+    /// The wire with `shape` in place of its own, its surface kept (the
+    /// shape was validated when `shape` was made a [`PendingWire`]).
+    pub(crate) fn reshaped(&self, shape: &WireShape) -> Self {
+        Self {
+            shape: shape.clone(),
+            surface: self.surface,
+        }
     }
 
     /// A circle of the given radius about the entity's origin.
@@ -43,6 +70,7 @@ impl Wire {
     pub fn line() -> Self {
         Self {
             shape: WireShape::Line(Line),
+            surface: Surface::PLAIN,
         }
     }
 
@@ -63,6 +91,7 @@ impl Wire {
     pub fn custom(curve: impl ImplicitCurve + Send + Sync + 'static) -> Self {
         Self {
             shape: WireShape::Custom(Arc::new(curve)),
+            surface: Surface::PLAIN,
         }
     }
 
@@ -162,7 +191,36 @@ impl PendingWire {
 /// wire despawns its beads.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
 #[relationship(relationship_target = WireBeads)]
+#[require(WireContact)]
 pub struct OnWire(pub Entity);
+
+/// Whether a bead is held on its wire or flying off a one-sided one (see
+/// [`Surface`]), kept by the plugin; a [`Restart`](crate::Restart) puts
+/// every bead back on its wire.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WireContact(pub(crate) Contact);
+
+impl WireContact {
+    /// On the wire.
+    pub fn is_on(&self) -> bool {
+        self.0 == Contact::OnWire
+    }
+
+    /// The contact.
+    pub fn get(&self) -> Contact {
+        self.0
+    }
+}
+
+/// Sent when a bead leaves its one-sided wire or lands on it (also
+/// logged, one line).
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct ContactChanged {
+    /// The bead.
+    pub bead: Entity,
+    /// What happened, when and where.
+    pub event: ContactEvent,
+}
 
 /// The beads on a wire, kept by Bevy from their [`OnWire`].
 #[derive(Component, Debug, Default)]

@@ -307,6 +307,12 @@ pub(crate) fn prepare_islands(
             let Some(on_wire) = on_wire else { continue };
             match wires.get(on_wire.0).map(|(w, p)| (w, p.get())) {
                 Ok((wire, Ok(pose))) => {
+                    if !wire.surface().is_plain() {
+                        warn!(
+                            "wirebead: bead {entity} is joined to other beads, and in an island its wire {} holds it two-sided and without friction (its side, restitution, friction and damping apply to lone beads only)",
+                            on_wire.0
+                        );
+                    }
                     wire_rows.push((local, rows.len(), on_wire.0));
                     rows.push(IslandRow {
                         kind: RowKind::Wire {

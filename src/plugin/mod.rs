@@ -36,8 +36,8 @@ use step::{prepare_step, step_beads, wire_added};
 use writeback::write_transforms;
 
 use crate::dynamics::{
-    Bead, BeadDiagnostics, BeadDiverged, ConstraintDiagnostics, DragTarget, Joint, OnWire,
-    PendingBead, PendingParams, Pin, Rod, SimParams, Spring, Wire,
+    Bead, BeadDiagnostics, BeadDiverged, ConstraintDiagnostics, ContactChanged, DragTarget, Joint,
+    OnWire, PendingBead, PendingParams, Pin, Rod, SimParams, Spring, Wire,
 };
 use bevy::ecs::lifecycle::{Add, Insert, Remove};
 use writeback::LastStep;
@@ -144,6 +144,7 @@ impl Plugin for WireBeadPlugin {
             .add_observer(topology_changed::<Remove, Joint>)
             .add_message::<Restart>()
             .add_message::<BeadDiverged>()
+            .add_message::<ContactChanged>()
             .register_type::<Bead>()
             .register_type::<BeadDiagnostics>()
             .register_type::<DragTarget>()

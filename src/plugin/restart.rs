@@ -8,7 +8,7 @@ use super::islands::Islands;
 use super::step::{prescribed, set_pose};
 use crate::dynamics::{
     Bead, BeadDiagnostics, Diverged, OnWire, PendingBead, PendingParams, PendingWire,
-    PrescribedMotion, SimParams, Wire, WirePose,
+    PrescribedMotion, SimParams, Wire, WireContact, WirePose,
 };
 use crate::geometry::{MovingTrack, Track};
 use crate::solver::{BeadState, constraint_state_on};
@@ -72,6 +72,7 @@ pub(crate) fn apply_restart(
         Entity,
         &mut Bead,
         Option<&mut BeadDiagnostics>,
+        Option<&mut WireContact>,
         Option<&OnWire>,
         Option<&PendingBead>,
     )>,
@@ -85,7 +86,7 @@ pub(crate) fn apply_restart(
     islands.mark_dirty();
     for (entity, mut wire, mut transform, mut pose, edit, motion) in &mut wires {
         if let Some(edit) = edit {
-            *wire = edit.wire().clone();
+            *wire = wire.reshaped(edit.shape());
             commands.entity(entity).remove::<PendingWire>();
         }
         // A wire on a prescribed motion goes back to its resting pose; one
@@ -105,9 +106,12 @@ pub(crate) fn apply_restart(
     let overstep = time.overstep();
     time.discard_overstep(overstep);
     *clock = SimClock::default();
-    for (entity, mut bead, diagnostics, on_wire, edit) in &mut beads {
+    for (entity, mut bead, diagnostics, contact, on_wire, edit) in &mut beads {
         let bead_params = edit.map_or(*bead.params(), |p| *p.get());
         bead.reset(bead_params);
+        if let Some(mut contact) = contact {
+            contact.set_if_neq(WireContact::default());
+        }
         commands.entity(entity).remove::<(Diverged, PendingBead)>();
         let wire = on_wire.and_then(|on| wires.get(on.0).ok());
         let Some((_, wire, _, pose, ..)) = wire else {

@@ -17,13 +17,13 @@ use super::parallel::ParallelStep;
 use super::restart::SimClock;
 use super::writeback::{LastStep, place};
 use crate::dynamics::{
-    Bead, BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason, OnWire, PrescribedMotion,
-    SimParams, Wire, WirePose, pose_of,
+    Bead, BeadDiagnostics, BeadDiverged, ContactChanged, Diverged, DivergenceReason, OnWire,
+    PrescribedMotion, SimParams, Wire, WireContact, WirePose, pose_of,
 };
 use crate::geometry::{
-    FixedTrack, MovingTrack, Placed, Pose, PoseHistory, PosePath, Track, WireShape,
+    FixedTrack, MovingTrack, Placed, Pose, PoseHistory, PosePath, Surface, Track, WireShape,
 };
-use crate::solver::{self, StepOutput, StepSettings};
+use crate::solver::{self, Contact, ContactEvent, StepOutput, StepSettings};
 
 /// Prepares the step: places every wire (reads each changed wire
 /// `Transform` once, so the beads do not; writes the `Transform` of a wire
@@ -177,9 +177,15 @@ macro_rules! with_curve {
     };
 }
 
-/// A wire's shape and pose for the step, or why beads cannot be stepped on
-/// it.
-type PlacedWire = Result<(WireShape, PosePath), DivergenceReason>;
+/// A wire as the step needs it: its shape, path and surface.
+pub(crate) struct TableWire {
+    shape: WireShape,
+    path: PosePath,
+    surface: Surface,
+}
+
+/// A wire for the step, or why beads cannot be stepped on it.
+type PlacedWire = Result<TableWire, DivergenceReason>;
 
 /// Every wire's shape and pose, kept by [`step_beads`] from change
 /// detection (a copy made when a wire changes, not each step), so a bead
@@ -203,14 +209,18 @@ impl WireTable {
         for (entity, wire, pose) in changed {
             let placed = pose
                 .get()
-                .map(|pose| (wire.shape().clone(), pose))
+                .map(|path| TableWire {
+                    shape: wire.shape().clone(),
+                    path,
+                    surface: *wire.surface(),
+                })
                 .map_err(|e| DivergenceReason::InvalidWire(e.to_string()));
             self.0.insert(entity, (entity, placed));
         }
     }
 
-    /// The shape and path of the wire a bead is on.
-    fn get(&self, on: &OnWire) -> Result<&(WireShape, PosePath), DivergenceReason> {
+    /// The wire a bead is on.
+    fn get(&self, on: &OnWire) -> Result<&TableWire, DivergenceReason> {
         match self.0.get(on.0) {
             Some((entity, placed)) if *entity == on.0 => placed.as_ref().map_err(Clone::clone),
             _ => Err(DivergenceReason::InvalidWire(format!(
@@ -227,6 +237,7 @@ struct StepContext<'a> {
     settings: StepSettings,
     wires: &'a WireTable,
     found: &'a FoundDivergences,
+    events: &'a FoundEvents,
     time: f64,
 }
 
@@ -243,7 +254,12 @@ impl StepContext<'_> {
         for i in 0..run.beads.len() {
             let wire = self.wires.get(&run.on_wires[i]);
             if batched
-                && let Ok((WireShape::Circle(circle), path)) = wire
+                && let Ok(TableWire {
+                    shape: WireShape::Circle(circle),
+                    path,
+                    surface,
+                }) = wire
+                && surface.is_plain()
                 && let Some(pose) = path.fixed()
                 && pose.is_unrotated()
             {
@@ -279,14 +295,19 @@ impl StepContext<'_> {
 
     /// Bead `i` of `run` through [`solver::step`]; a failure is recorded.
     fn step_one(&self, run: &mut BeadRun, i: usize) {
+        let contact = run.contacts.as_deref_mut().map(|c| &mut c[i]);
+        let bead = &run.beads[i];
         let result = match self.wires.get(&run.on_wires[i]) {
             Err(reason) => Err(reason),
-            Ok((shape, path)) => match path.fixed() {
+            Ok(wire) if !wire.surface.is_plain() => {
+                self.step_on_surface(wire, bead, run.entities[i], contact)
+            }
+            Ok(TableWire { shape, path, .. }) => match path.fixed() {
                 Some(pose) => with_curve!(shape, curve => {
-                    self.step_bead(&FixedTrack(&Placed { curve, pose }), &run.beads[i])
+                    self.step_bead(&FixedTrack(&Placed { curve, pose }), bead)
                 }),
                 None => with_curve!(shape, curve => {
-                    self.step_bead(&MovingTrack { curve, path }, &run.beads[i])
+                    self.step_bead(&MovingTrack { curve, path }, bead)
                 }),
             },
         };
@@ -318,6 +339,61 @@ impl StepContext<'_> {
         let start = self.time - self.settings.dt;
         solver::step_on(track, start, state, &force, bead.mass(), &self.settings)
             .map_err(DivergenceReason::Solve)
+    }
+
+    /// One bead on a wire with a surface (one-sided, rough or damped):
+    /// [`solver::step_surface`] from its contact, which it updates; a
+    /// change of contact is recorded.
+    fn step_on_surface(
+        &self,
+        wire: &TableWire,
+        bead: &Bead,
+        entity: Entity,
+        contact: Option<&mut WireContact>,
+    ) -> Result<StepOutput, DivergenceReason> {
+        let state = bead.state();
+        if !state.is_finite() {
+            return Err(DivergenceReason::NonFiniteState);
+        }
+        let force = bead.step_force(self.params.gravity);
+        let start = self.time - self.settings.dt;
+        let from = contact.as_deref().map_or(Contact::OnWire, WireContact::get);
+        let TableWire {
+            shape,
+            path,
+            surface,
+        } = wire;
+        let curve = shape.curve();
+        let stepped = match path.fixed() {
+            Some(pose) => solver::step_surface(
+                &FixedTrack(&Placed { curve, pose }),
+                start,
+                state,
+                &force,
+                bead.mass(),
+                &self.settings,
+                surface,
+                from,
+            ),
+            None => solver::step_surface(
+                &MovingTrack { curve, path },
+                start,
+                state,
+                &force,
+                bead.mass(),
+                &self.settings,
+                surface,
+                from,
+            ),
+        }
+        .map_err(DivergenceReason::Solve)?;
+        if let Some(contact) = contact {
+            contact.0 = stepped.contact;
+        }
+        if let Some(event) = stepped.event {
+            self.events.push(entity, event);
+        }
+        Ok(stepped.output)
     }
 
     /// Stores a step's result: the new state (which consumes the force),
@@ -355,6 +431,7 @@ struct BeadRun<'w> {
     on_wires: &'w [OnWire],
     diagnostics: Option<&'w mut [BeadDiagnostics]>,
     transforms: Option<&'w mut [Transform]>,
+    contacts: Option<&'w mut [WireContact]>,
 }
 
 /// What one bead's step writes.
@@ -382,6 +459,7 @@ type BeadTable<'w> = (
     &'w [OnWire],
     Option<ContiguousMut<'w, BeadDiagnostics>>,
     Option<ContiguousMut<'w, Transform>>,
+    Option<ContiguousMut<'w, WireContact>>,
 );
 
 /// An optional column cut into runs of `n`; `None` for every run if absent
@@ -396,11 +474,28 @@ fn column_runs<'w, T>(
         .chain(std::iter::repeat_with(|| None))
 }
 
+/// The contact column cut into runs of `n`, not marked changed: a step
+/// marks the few beads whose contact changed itself.
+fn contact_runs<'w>(
+    column: Option<ContiguousMut<'w, WireContact>>,
+    n: usize,
+) -> impl Iterator<Item = Option<&'w mut [WireContact]>> {
+    column
+        .into_iter()
+        .flat_map(move |c| {
+            ContiguousMut::bypass_change_detection_split(c)
+                .0
+                .chunks_mut(n)
+                .map(Some)
+        })
+        .chain(std::iter::repeat_with(|| None))
+}
+
 /// Cuts one table's beads into runs: one for a single thread, else about a
 /// quarter of each thread's share, so a slow thread does not hold the
 /// others up. Marks the beads, diagnostics and transforms changed.
 fn split_table<'w>(
-    (entities, beads, on_wires, diagnostics, transforms): BeadTable<'w>,
+    (entities, beads, on_wires, diagnostics, transforms, contacts): BeadTable<'w>,
     threads: usize,
 ) -> Vec<BeadRun<'w>> {
     let runs = if threads > 1 { 4 * threads } else { 1 };
@@ -412,13 +507,15 @@ fn split_table<'w>(
         .zip(on_wires.chunks(n))
         .zip(column_runs(diagnostics, n))
         .zip(column_runs(transforms, n))
+        .zip(contact_runs(contacts, n))
         .map(
-            |((((entities, beads), on_wires), diagnostics), transforms)| BeadRun {
+            |(((((entities, beads), on_wires), diagnostics), transforms), contacts)| BeadRun {
                 entities,
                 beads,
                 on_wires,
                 diagnostics,
                 transforms,
+                contacts,
             },
         )
         .collect()
@@ -443,10 +540,13 @@ pub(crate) fn step_beads(
             &OnWire,
             Option<&mut BeadDiagnostics>,
             Option<&mut Transform>,
+            Option<&mut WireContact>,
         ),
         (Without<Diverged>, Without<InIsland>),
     >,
     mut found: Local<FoundDivergences>,
+    mut events: Local<FoundEvents>,
+    mut changes: MessageWriter<ContactChanged>,
     mut stepped: ResMut<LastStep>,
     ticks: SystemChangeTick,
     mut divergences: Divergences,
@@ -458,6 +558,7 @@ pub(crate) fn step_beads(
         settings: params.step_settings(),
         wires: &wires,
         found: &found,
+        events: &events,
         time: clock.time,
     };
     let count = beads.iter().size_hint().1.unwrap_or(usize::MAX);
@@ -484,5 +585,51 @@ pub(crate) fn step_beads(
         }
     };
     found.report(&mut divergences);
+    for (bead, event) in events.take() {
+        if let Ok((.., Some(mut contact))) = beads.get_mut(bead) {
+            contact.set_changed();
+        }
+        info!("wirebead: bead {bead} {}", describe_event(&event));
+        changes.write(ContactChanged { bead, event });
+    }
     stepped.0 = ticks.this_run();
+}
+
+/// A change of contact in words, for the log.
+fn describe_event(event: &ContactEvent) -> String {
+    match *event {
+        ContactEvent::Left { time, position } => format!(
+            "left its wire at t = {time:.4} s at ({:.3}, {:.3}), where the wire would have had to pull",
+            position.x, position.y
+        ),
+        ContactEvent::Landed {
+            time,
+            position,
+            normal_speed,
+            bounced,
+        } => format!(
+            "landed on its wire at t = {time:.4} s at ({:.3}, {:.3}) at {normal_speed:.3} m/s across it and {}",
+            position.x,
+            position.y,
+            if bounced { "bounced off" } else { "stayed on" }
+        ),
+    }
+}
+
+/// Changes of contact found inside a (possibly parallel) loop, sent after
+/// it.
+#[derive(Default)]
+pub(crate) struct FoundEvents(Mutex<Vec<(Entity, ContactEvent)>>);
+
+impl FoundEvents {
+    fn push(&self, bead: Entity, event: ContactEvent) {
+        self.0
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .push((bead, event));
+    }
+
+    fn take(&mut self) -> Vec<(Entity, ContactEvent)> {
+        std::mem::take(self.0.get_mut().unwrap_or_else(PoisonError::into_inner))
+    }
 }

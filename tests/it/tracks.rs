@@ -161,3 +161,63 @@ fn a_wire_the_game_moves_gives_the_prescribed_motions_trajectory() {
     );
     assert!(order > 1.8, "observed order {order:.2}");
 }
+
+/// Every contact change, as the plugin sends them.
+#[derive(Resource, Default)]
+struct Changes(Vec<ContactChanged>);
+
+fn collect_changes(mut messages: MessageReader<ContactChanged>, mut changes: ResMut<Changes>) {
+    changes.0.extend(messages.read().copied());
+}
+
+/// Through the plugin: a bead inside a one-sided loop, leaving the bottom
+/// with `v0² = 3gr`, leaves at `4r/3` (a `ContactChanged` message and its
+/// `WireContact`), flies, and lands on the loop again.
+#[test]
+fn a_bead_leaves_a_one_sided_loop_and_lands_on_it_again() {
+    let mut app = app(SimParams {
+        timestep: 1e-3,
+        method: Method::Rattle,
+        ..default()
+    });
+    app.init_resource::<Changes>()
+        .add_systems(FixedUpdate, collect_changes.after(WireBeadSystems::Step));
+    let surface = Surface {
+        side: Side::Negative,
+        ..Surface::PLAIN
+    };
+    let wire = Wire::circle(1.0).unwrap().with_surface(surface).unwrap();
+    let wire = app.world_mut().spawn(wire).id();
+    let g = 9.81f64;
+    let bead = Bead::new(BeadParams {
+        mass: 1.0,
+        initial_position: DVec2::new(0.0, -1.0),
+        initial_velocity: DVec2::new((3.0 * g).sqrt(), 0.0),
+    })
+    .unwrap();
+    let bead = app.world_mut().spawn((bead, OnWire(wire))).id();
+    let mut in_flight = false;
+    for _ in 0..2000 {
+        crate::common::run_steps(&mut app, 1);
+        in_flight |= !app.world().get::<WireContact>(bead).unwrap().is_on();
+    }
+    assert!(in_flight, "the WireContact never showed the flight");
+    let changes = &app.world().resource::<Changes>().0;
+    let [left, landed, ..] = changes.as_slice() else {
+        panic!("expected a departure and a landing, got {changes:?}");
+    };
+    let wirebead::solver::ContactEvent::Left { position, .. } = left.event else {
+        panic!("first {left:?}");
+    };
+    let height = position.y + 1.0;
+    assert!(
+        (height - 4.0 / 3.0).abs() < 1e-3,
+        "left {height} r above the bottom"
+    );
+    assert!(matches!(
+        landed.event,
+        wirebead::solver::ContactEvent::Landed { bounced: false, .. }
+    ));
+    assert!(app.world().get::<Diverged>(bead).is_none());
+    eprintln!("plugin loop-the-loop: left {height:.6} r above the bottom, then {landed:?}");
+}
