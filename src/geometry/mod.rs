@@ -19,6 +19,7 @@
 //! This module knows nothing of the ECS: plain values and `bevy_math` only.
 
 mod circle;
+mod cycloid;
 mod ellipse;
 mod line;
 mod motion;
@@ -26,12 +27,15 @@ mod parabola;
 mod pose;
 mod shape;
 mod sine;
+mod spline;
 mod surface;
+mod traced;
 
 use bevy::math::{DMat2, DVec2};
 
 pub use circle::Circle;
 pub(crate) use circle::circle_geometry;
+pub use cycloid::{Cycloid, CycloidArch};
 pub use ellipse::Ellipse;
 pub use line::Line;
 pub use motion::{
@@ -42,7 +46,9 @@ pub use parabola::Parabola;
 pub use pose::{Placed, Pose};
 pub use shape::{WireKind, WireShape};
 pub use sine::Sine;
+pub use spline::{CubicPath, Spline, SplineKind, SplineSpec};
 pub use surface::{Friction, Side, Surface};
+pub use traced::{Parametric, Traced};
 
 /// The value, gradient and Hessian of a constraint at one point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,6 +78,17 @@ pub trait ImplicitCurve {
     /// relative to it and solver tolerances scale with it.
     fn scale(&self) -> f64 {
         1.0
+    }
+    /// Whether the curve ends (an open spline or cycloid): a lone bead
+    /// that passes an end leaves the wire.
+    fn has_ends(&self) -> bool {
+        false
+    }
+    /// How far past an end of an open curve the point of the curve nearest
+    /// `p` lies, along the end's tangent (zero or less: on the curve;
+    /// −∞ for a curve with no end).
+    fn past_end(&self, _p: DVec2) -> f64 {
+        f64::NEG_INFINITY
     }
     /// All three at once; override when they share work.
     fn geometry(&self, p: DVec2) -> Geometry {

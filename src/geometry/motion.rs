@@ -325,6 +325,11 @@ pub trait Track {
     fn scale(&self) -> f64;
     /// The wire's twist at time `t`.
     fn twist(&self, t: f64) -> Twist;
+    /// Whether the wire ends (see [`ImplicitCurve::has_ends`]).
+    fn has_ends(&self) -> bool;
+    /// How far past an end the point nearest `x` is at time `t` (see
+    /// [`ImplicitCurve::past_end`]).
+    fn past_end(&self, t: f64, x: DVec2) -> f64;
     /// Where the point of the wire that is at `x` at time `from` is at time
     /// `to` (a bead held still on the wire is carried there).
     fn carry(&self, x: DVec2, from: f64, to: f64) -> DVec2;
@@ -366,6 +371,12 @@ impl<T: Track + ?Sized> Track for Rough<'_, T> {
     fn carry(&self, x: DVec2, from: f64, to: f64) -> DVec2 {
         self.track.carry(x, from, to)
     }
+    fn has_ends(&self) -> bool {
+        self.track.has_ends()
+    }
+    fn past_end(&self, t: f64, x: DVec2) -> f64 {
+        self.track.past_end(t, x)
+    }
     fn surface(&self) -> Option<(&Surface, DVec2)> {
         Some((self.surface, self.sliding))
     }
@@ -388,6 +399,12 @@ impl<C: ImplicitCurve + ?Sized> Track for FixedTrack<'_, C> {
     }
     fn carry(&self, x: DVec2, _from: f64, _to: f64) -> DVec2 {
         x
+    }
+    fn has_ends(&self) -> bool {
+        self.0.has_ends()
+    }
+    fn past_end(&self, _t: f64, x: DVec2) -> f64 {
+        self.0.past_end(x)
     }
 }
 
@@ -419,6 +436,12 @@ impl<C: ImplicitCurve + ?Sized> Track for MovingTrack<'_, C> {
         self.path
             .pose(to)
             .to_world(self.path.pose(from).to_local(x))
+    }
+    fn has_ends(&self) -> bool {
+        self.curve.has_ends()
+    }
+    fn past_end(&self, t: f64, x: DVec2) -> f64 {
+        self.curve.past_end(self.path.pose(t).to_local(x))
     }
 }
 

@@ -115,6 +115,12 @@ impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Placed<'_, C> {
     fn scale(&self) -> f64 {
         self.curve.scale()
     }
+    fn has_ends(&self) -> bool {
+        self.curve.has_ends()
+    }
+    fn past_end(&self, p: DVec2) -> f64 {
+        self.curve.past_end(self.pose.to_local(p))
+    }
     #[inline(always)]
     fn geometry(&self, p: DVec2) -> Geometry {
         if self.pose.is_unrotated() {

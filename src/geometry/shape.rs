@@ -9,7 +9,7 @@ use std::sync::Arc;
 use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
 
-use super::{Circle, Ellipse, ImplicitCurve, Line, Parabola, Sine};
+use super::{Circle, Cycloid, Ellipse, ImplicitCurve, Line, Parabola, Sine, Spline};
 use crate::validate::{ParamError, finite, positive};
 
 /// One of the built-in shapes, or a curve of the game's own.
@@ -25,6 +25,10 @@ pub enum WireShape {
     Parabola(Parabola),
     /// See [`Sine`].
     Sine(Sine),
+    /// See [`Cycloid`].
+    Cycloid(Cycloid),
+    /// See [`Spline`]: a Bevy cubic curve.
+    Spline(Spline),
     /// A game's own curve. Not serializable.
     #[serde(skip)]
     Custom(Arc<dyn ImplicitCurve + Send + Sync>),
@@ -38,6 +42,8 @@ impl fmt::Debug for WireShape {
             Self::Line(s) => s.fmt(f),
             Self::Parabola(s) => s.fmt(f),
             Self::Sine(s) => s.fmt(f),
+            Self::Cycloid(s) => s.fmt(f),
+            Self::Spline(s) => s.fmt(f),
             Self::Custom(_) => f.write_str("Custom(..)"),
         }
     }
@@ -68,6 +74,9 @@ impl WireShape {
                 finite("amplitude", s.amplitude)?;
                 positive("wavelength", s.wavelength).map(drop)
             }
+            Self::Cycloid(c) => positive("cycloid radius", c.radius()).map(drop),
+            // Checked when it was made.
+            Self::Spline(_) => Ok(()),
         }
     }
 
@@ -79,6 +88,8 @@ impl WireShape {
             Self::Line(s) => s,
             Self::Parabola(s) => s,
             Self::Sine(s) => s,
+            Self::Cycloid(s) => s,
+            Self::Spline(s) => s,
             Self::Custom(s) => s.as_ref(),
         }
     }
@@ -91,7 +102,8 @@ impl WireShape {
             Self::Circle(c) => DVec2::new(0.0, -c.radius),
             Self::Ellipse(e) => DVec2::new(0.0, -e.b),
             Self::Sine(s) => DVec2::new(-0.25 * s.wavelength, -s.amplitude),
-            Self::Line(_) | Self::Parabola(_) | Self::Custom(_) => DVec2::ZERO,
+            Self::Spline(s) => s.lowest(),
+            Self::Line(_) | Self::Parabola(_) | Self::Cycloid(_) | Self::Custom(_) => DVec2::ZERO,
         }
     }
 
@@ -103,14 +115,18 @@ impl WireShape {
             Self::Line(_) => Some(WireKind::Line),
             Self::Parabola(_) => Some(WireKind::Parabola),
             Self::Sine(_) => Some(WireKind::Sine),
-            Self::Custom(_) => None,
+            Self::Cycloid(_) => Some(WireKind::Cycloid),
+            Self::Spline(_) | Self::Custom(_) => None,
         }
     }
 
     /// A short lowercase name: `circle`, `ellipse`, `line`, `parabola`,
-    /// `sine` or `custom`.
+    /// `sine`, `cycloid`, `spline` or `custom`.
     pub fn name(&self) -> &'static str {
-        self.kind().map_or("custom", WireKind::name)
+        match self {
+            Self::Spline(_) => "spline",
+            _ => self.kind().map_or("custom", WireKind::name),
+        }
     }
 }
 
@@ -130,16 +146,19 @@ pub enum WireKind {
     Parabola,
     /// `y = 0.3 size sin(2πx / (2 size))`.
     Sine,
+    /// A cycloid of generating radius `size` (see [`Cycloid`]).
+    Cycloid,
 }
 
 impl WireKind {
     /// Every kind, in the order a menu shows them.
-    pub const ALL: [WireKind; 5] = [
+    pub const ALL: [WireKind; 6] = [
         WireKind::Circle,
         WireKind::Ellipse,
         WireKind::Line,
         WireKind::Parabola,
         WireKind::Sine,
+        WireKind::Cycloid,
     ];
 
     /// The lowercase name used on the command line and in the panel.
@@ -150,6 +169,7 @@ impl WireKind {
             Self::Line => "line",
             Self::Parabola => "parabola",
             Self::Sine => "sine",
+            Self::Cycloid => "cycloid",
         }
     }
 
@@ -169,6 +189,7 @@ impl WireKind {
                 amplitude: 0.3 * size,
                 wavelength: 2.0 * size,
             }),
+            Self::Cycloid => WireShape::Cycloid(Cycloid::new(size)),
         }
     }
 }

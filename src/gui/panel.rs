@@ -16,6 +16,7 @@ use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 use egui_plot::{Line, Plot, PlotPoints};
 
 use crate::controls::{ControlKeys, StepRequests};
+use crate::geometry::Cycloid;
 use crate::gui::drag::SelectedBead;
 use crate::gui::render::SceneStyle;
 use crate::preset::{ActivePreset, LoadPreset};
@@ -523,7 +524,14 @@ fn wire_editor(ui: &mut egui::Ui, shape: &WireShape) -> Option<WireShape> {
                 number(ui, "amplitude", &mut s.amplitude, 0.01);
                 number(ui, "wavelength", &mut s.wavelength, 0.01);
             }
-            WireShape::Line(_) | WireShape::Custom(_) => {}
+            WireShape::Cycloid(c) => {
+                let mut radius = c.radius();
+                number(ui, "radius", &mut radius, 0.01);
+                if radius != c.radius() {
+                    *c = Cycloid::new(radius);
+                }
+            }
+            WireShape::Line(_) | WireShape::Spline(_) | WireShape::Custom(_) => {}
         }
     });
     (format!("{edited:?}") != format!("{shape:?}")).then_some(edited)

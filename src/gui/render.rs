@@ -202,6 +202,8 @@ pub fn wire_points(shape: &WireShape, pose: &Pose, half_span: Option<f64>) -> Ve
                 DVec2::new(e.a * a.cos(), e.b * a.sin())
             })
             .collect(),
+        WireShape::Cycloid(c) => c.polyline().collect(),
+        WireShape::Spline(s) => s.polyline().collect(),
         open => {
             let scale = open.curve().scale();
             let span = half_span.unwrap_or(match open {

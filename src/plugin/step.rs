@@ -169,6 +169,8 @@ macro_rules! with_curve {
             WireShape::Line($curve) => $body,
             WireShape::Parabola($curve) => $body,
             WireShape::Sine($curve) => $body,
+            WireShape::Cycloid($curve) => $body,
+            WireShape::Spline($curve) => $body,
             WireShape::Custom(custom) => {
                 let $curve = custom.as_ref();
                 $body
@@ -299,7 +301,7 @@ impl StepContext<'_> {
         let bead = &run.beads[i];
         let result = match self.wires.get(&run.on_wires[i]) {
             Err(reason) => Err(reason),
-            Ok(wire) if !wire.surface.is_plain() => {
+            Ok(wire) if !wire.surface.is_plain() || wire.shape.curve().has_ends() => {
                 self.step_on_surface(wire, bead, run.entities[i], contact)
             }
             Ok(TableWire { shape, path, .. }) => match path.fixed() {

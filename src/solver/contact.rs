@@ -95,7 +95,7 @@ pub fn step_surface<T: Track + ?Sized>(
     surface: &Surface,
     contact: Contact,
 ) -> Result<SurfaceStep, SolveError> {
-    if surface.is_plain() {
+    if surface.is_plain() && !track.has_ends() {
         return Ok(SurfaceStep {
             output: step_on(track, t, state, force, mass, settings)?,
             contact: Contact::OnWire,
@@ -176,6 +176,10 @@ impl<T: Track + ?Sized> Walk<'_, T> {
     ) -> Result<SurfaceStep, SolveError> {
         let side = self.surface.side.sign();
         let cut = events < MAX_EVENTS;
+        let ends = self.track.has_ends();
+        if ends && cut && self.track.past_end(t, state.position) > 0.0 {
+            return self.off_the_end(t, h, state, events);
+        }
         let start = if side != 0.0 {
             side * self.lambda(t, state)?
         } else {
@@ -195,6 +199,16 @@ impl<T: Track + ?Sized> Walk<'_, T> {
             return self.held(t, h, state);
         }
         let out = self.slide(t, h, state, sliding)?;
+        if ends && cut && self.track.past_end(t + h, out.state.position) > 0.0 {
+            // It passed an end within the step: cut there.
+            let before = -self.track.past_end(t, state.position);
+            let tau = self.locate(h, before, |tau| {
+                let part = self.slide(t, tau, state, sliding)?;
+                Ok(-self.track.past_end(t + tau, part.state.position))
+            })?;
+            let at = self.slide(t, tau, state, sliding)?;
+            return self.off_the_end(t + tau, h - tau, at.state, events);
+        }
         if side != 0.0 && cut && side * self.lambda(t + h, out.state)? < 0.0 {
             let tau = self.locate(h, start, |tau| {
                 let part = self.slide(t, tau, state, sliding)?;
@@ -230,6 +244,22 @@ impl<T: Track + ?Sized> Walk<'_, T> {
             contact: Contact::OnWire,
             event: None,
         })
+    }
+
+    /// A bead at an end of its wire: it leaves, flying on from `state`.
+    fn off_the_end(
+        &self,
+        t: f64,
+        h: f64,
+        state: BeadState,
+        events: u32,
+    ) -> Result<SurfaceStep, SolveError> {
+        let mut flown = self.in_flight(t, h, state, events + 1)?;
+        flown.event = flown.event.or(Some(ContactEvent::Left {
+            time: t,
+            position: state.position,
+        }));
+        Ok(flown)
     }
 
     /// Whether a bead at rest on the wire stays so: the force along the
@@ -281,7 +311,11 @@ impl<T: Track + ?Sized> Walk<'_, T> {
             return Err(SolveError::NonFinite);
         }
         let c = self.track.geometry(t + h, flown.position).c;
-        if side == 0.0 || side * c > 0.0 || events >= MAX_EVENTS {
+        if side == 0.0
+            || side * c > 0.0
+            || events >= MAX_EVENTS
+            || self.track.past_end(t + h, flown.position) > 0.0
+        {
             let (_, _, across) = self.split(t + h, flown)?;
             let normal = self.track.geometry(t + h, flown.position).normal;
             return Ok(SurfaceStep {

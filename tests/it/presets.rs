@@ -23,6 +23,7 @@ pub(crate) const SHIPPED: &[&str] = &[
     "spring_pair.scene.ron",
     "kapitza.scene.ron",
     "spinning_rod.scene.ron",
+    "tautochrone.scene.ron",
 ];
 
 /// The shipped presets that join beads.

@@ -221,3 +221,148 @@ fn a_bead_leaves_a_one_sided_loop_and_lands_on_it_again() {
     assert!(app.world().get::<Diverged>(bead).is_none());
     eprintln!("plugin loop-the-loop: left {height:.6} r above the bottom, then {landed:?}");
 }
+
+/// The tautochrone scene: three beads released from rest at heights 1.5,
+/// 1 and 0.5 on a cycloid of generating radius 1 each reach the bottom
+/// after `π sqrt(r/g)`, within 1e-4 of it, with every accurate method.
+#[test]
+fn tautochrone_beads_reach_the_bottom_together() {
+    let scene = preset("tautochrone.scene.ron");
+    let expected = std::f64::consts::PI * (1.0 / 9.81f64).sqrt();
+    for method in [
+        Method::Rattle,
+        Method::Rk4(Stabilization::None),
+        Method::Rk4(Stabilization::Projection),
+    ] {
+        let mut scene = scene.clone();
+        scene.params.method = method;
+        let mut app = app(scene.params.clone());
+        let beads = scene.spawn(&mut app.world_mut().commands());
+        app.world_mut().flush();
+        run_for(&mut app, 1.2);
+        let recording = app.world().resource::<Recording>();
+        for &bead in &beads {
+            let samples = recording.of(bead);
+            // The first time x reaches 0, interpolated within the step.
+            let arrival = samples
+                .windows(2)
+                .find(|w| w[0].position.x < 0.0 && w[1].position.x >= 0.0)
+                .map(|w| {
+                    let (a, b) = (w[0].position.x, w[1].position.x);
+                    w[0].t + (w[1].t - w[0].t) * (-a / (b - a))
+                })
+                .expect("reaches the bottom");
+            let error = (arrival - expected).abs() / expected;
+            eprintln!("{method}: arrived at {arrival:.6} s (relative error {error:e})");
+            assert!(
+                error < 1e-4,
+                "{method}: arrived at {arrival}, not {expected}"
+            );
+        }
+    }
+}
+
+/// `y = x²` on `[-2, 2]` as a Bevy Hermite curve: points every 0.25 with
+/// the tangents of `u ↦ (x + u/4, (x + u/4)²)`, so its `f32` coefficients
+/// are exact and the spline is the parabola itself.
+fn parabola_spline() -> wirebead::geometry::Spline {
+    use bevy::math::cubic_splines::{CubicGenerator, CubicHermite};
+    let xs: Vec<f32> = (-8..=8).map(|i| i as f32 * 0.25).collect();
+    let points = xs.iter().map(|&x| Vec2::new(x, x * x));
+    let tangents = xs.iter().map(|&x| Vec2::new(0.25, 0.5 * x));
+    let curve = CubicHermite::new(points, tangents).to_curve().unwrap();
+    wirebead::geometry::Spline::from_curve(&curve)
+}
+
+/// A bead on a spline wire made from a Bevy `CubicCurve` stays on it to
+/// 1e-9, and moves as on the implicit wire of the same shape: on the
+/// parabola `y = x²`, RATTLE's trajectories on the two agree to 1e-9 and
+/// both keep the energy to the same bound.
+#[test]
+fn a_bead_on_a_bevy_spline_moves_as_on_the_implicit_wire_of_its_shape() {
+    use wirebead::geometry::{ImplicitCurve, Parabola};
+    use wirebead::solver::{BeadState, LinearForce, StepSettings, step};
+    let spline = parabola_spline();
+    let parabola = Parabola { focal_length: 0.25 };
+    let settings = StepSettings {
+        dt: 1.0 / 240.0,
+        method: Method::Rattle,
+        alpha: 0.0,
+        beta: 0.0,
+        drift_bound: 1.0,
+    };
+    let gravity = LinearForce::constant(DVec2::new(0.0, -9.81));
+    let start = BeadState {
+        position: DVec2::new(-1.5, 2.25),
+        velocity: DVec2::ZERO,
+    };
+    let energy = |s: &BeadState| 0.5 * s.velocity.length_squared() + 9.81 * s.position.y;
+    let (mut on_spline, mut on_parabola) = (start, start);
+    let (mut apart, mut off, mut drift_spline, mut drift_parabola) =
+        (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for _ in 0..2400 {
+        on_spline = step(&spline, on_spline, &gravity, 1.0, &settings)
+            .unwrap()
+            .state;
+        on_parabola = step(&parabola, on_parabola, &gravity, 1.0, &settings)
+            .unwrap()
+            .state;
+        apart = apart.max((on_spline.position - on_parabola.position).length());
+        let x = on_spline.position;
+        off = off.max((x.y - x.x * x.x).abs()).max(spline.value(x).abs());
+        drift_spline = drift_spline.max((energy(&on_spline) - energy(&start)).abs());
+        drift_parabola = drift_parabola.max((energy(&on_parabola) - energy(&start)).abs());
+    }
+    eprintln!(
+        "spline parabola: {apart:e} apart over 10 s, {off:e} off the curve, energy error {drift_spline:e} (implicit {drift_parabola:e})"
+    );
+    assert!(off < 1e-9, "the bead left the spline by {off:e}");
+    assert!(apart < 1e-9, "the trajectories part by {apart:e}");
+    assert!(
+        (drift_spline - drift_parabola).abs() <= 1e-9 + 0.01 * drift_parabola,
+        "energy errors {drift_spline:e} on the spline, {drift_parabola:e} on the parabola"
+    );
+}
+
+/// A bead sliding off the open end of a spline leaves the wire there (a
+/// `ContactChanged` at the end point) and falls freely.
+#[test]
+fn a_bead_sliding_off_an_open_spline_falls_freely_from_its_end() {
+    let mut app = app(SimParams {
+        timestep: 1.0 / 240.0,
+        method: Method::Rattle,
+        ..default()
+    });
+    app.init_resource::<Changes>()
+        .add_systems(FixedUpdate, collect_changes.after(WireBeadSystems::Step));
+    let spline = parabola_spline();
+    let end = DVec2::new(2.0, 4.0);
+    let wire = Wire::new(wirebead::WireShape::Spline(spline)).unwrap();
+    let wire = app.world_mut().spawn(wire).id();
+    let bead = Bead::new(BeadParams {
+        mass: 1.0,
+        initial_position: DVec2::new(-1.0, 1.0),
+        initial_velocity: DVec2::new(6.0, -12.0),
+    })
+    .unwrap();
+    let bead = app.world_mut().spawn((bead, OnWire(wire))).id();
+    crate::common::run_steps(&mut app, 240);
+    let changes = &app.world().resource::<Changes>().0;
+    let Some(wirebead::solver::ContactEvent::Left { position, .. }) =
+        changes.first().map(|c| c.event)
+    else {
+        panic!("expected a departure, got {changes:?}");
+    };
+    assert!(
+        (position - end).length() < 1e-9,
+        "left at {position:?}, not the end {end:?}"
+    );
+    assert!(!app.world().get::<WireContact>(bead).unwrap().is_on());
+    let samples = app.world().resource::<Recording>().of(bead);
+    let last = &samples[samples.len() - 3..];
+    let a = (last[2].velocity - last[1].velocity) / (last[2].t - last[1].t);
+    assert!(
+        (a - DVec2::new(0.0, -9.81)).length() < 1e-9,
+        "acceleration {a:?}"
+    );
+}

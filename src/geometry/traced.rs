@@ -1,0 +1,275 @@
+//! Curves given by a parametrization `γ(s)`, made wires by their signed
+//! distance: [`Parametric`], [`Traced`].
+//!
+//! `C(x) = n̂(s*)·(x − γ(s*))`, with `s*` the parameter of the point of the
+//! curve nearest `x` and `n̂` the unit normal to the left of the direction
+//! of travel. Then `∇C = n̂(s*)` exactly (a unit vector: `C` reads as a
+//! distance), and with the signed curvature `κ`,
+//!
+//! ```text
+//! H = −κ / (1 − κ C) · t̂ t̂ᵀ
+//! ```
+//!
+//! `C` vanishes exactly on the curve, so every method holds a bead on it as
+//! it holds one on a circle: to rounding for RATTLE and projection. The
+//! nearest point is found by Newton's method on `(γ(s) − x)·γ′(s) = 0`
+//! from the nearest of a polyline of samples, kept inside the samples'
+//! bracket, to the last bit. The form is singular where `1 − κ C` vanishes
+//! (at a centre of curvature, far off the curve) and where `γ′` does (a
+//! cusp): there the normal is reported as zero, a singular point.
+//!
+//! An open curve goes on past its ends along its end tangents, so `C` stays
+//! smooth; [`ImplicitCurve::past_end`] says how far past an end the nearest
+//! point lies, and a lone bead that passes an end leaves the wire there
+//! (see [`crate::solver::step_surface`]). A closed curve has no end.
+
+use bevy::math::{DMat2, DVec2};
+
+use super::{Geometry, ImplicitCurve};
+
+/// A curve `γ(s)` over a parameter interval.
+pub trait Parametric {
+    /// The parameter's interval `[start, end]`.
+    fn domain(&self) -> (f64, f64);
+    /// Whether `γ(end) = γ(start)` and the curve goes on round.
+    fn closed(&self) -> bool;
+    /// `γ(s)`, `γ′(s)` and `γ″(s)`.
+    fn eval(&self, s: f64) -> [DVec2; 3];
+}
+
+/// How many samples per unit of parameter the polyline takes.
+const SAMPLES_PER_UNIT: f64 = 24.0;
+
+/// A [`Parametric`] curve as a wire, by its signed distance.
+#[derive(Clone, Debug)]
+pub struct Traced<P> {
+    path: P,
+    /// `(s, γ(s))` along the curve.
+    samples: Vec<(f64, DVec2)>,
+    scale: f64,
+}
+
+/// The point of a curve nearest some `x`.
+#[derive(Clone, Copy, Debug)]
+struct Nearest {
+    /// `γ(s*)`, `γ′(s*)`, `γ″(s*)` (or, past an end, the end's point and
+    /// tangent and no curvature).
+    at: [DVec2; 3],
+    /// How far past an end along its tangent line the nearest point of the
+    /// extended curve lies; zero or less on the curve.
+    past: f64,
+}
+
+impl<P: Parametric> Traced<P> {
+    /// The curve `path` as a wire, with a polyline of samples to start the
+    /// nearest-point search from.
+    pub fn new(path: P) -> Self {
+        let (start, end) = path.domain();
+        let n = (((end - start) * SAMPLES_PER_UNIT).ceil() as usize).clamp(16, 1 << 16);
+        let samples: Vec<(f64, DVec2)> = (0..=n)
+            .map(|i| {
+                let s = start + (end - start) * i as f64 / n as f64;
+                (s, path.eval(s)[0])
+            })
+            .collect();
+        let length: f64 = samples.windows(2).map(|w| (w[1].1 - w[0].1).length()).sum();
+        let scale = (length / (end - start).max(1.0)).max(f64::MIN_POSITIVE);
+        Self {
+            path,
+            samples,
+            scale,
+        }
+    }
+
+    /// The parametrized curve.
+    pub fn path(&self) -> &P {
+        &self.path
+    }
+
+    /// The sample points, in order (for drawing).
+    pub fn polyline(&self) -> impl Iterator<Item = DVec2> + '_ {
+        self.samples.iter().map(|(_, p)| *p)
+    }
+
+    /// The nearest point of the curve (extended past its ends) to `x`.
+    fn nearest(&self, x: DVec2) -> Nearest {
+        let (start, end) = self.path.domain();
+        let closest = self
+            .samples
+            .iter()
+            .enumerate()
+            .min_by(|a, b| {
+                (a.1.1 - x)
+                    .length_squared()
+                    .total_cmp(&(b.1.1 - x).length_squared())
+            })
+            .map_or(0, |(i, _)| i);
+        let last = self.samples.len() - 1;
+        let closed = self.path.closed();
+        let period = end - start;
+        let (mut lo, mut hi) = (
+            self.samples[closest.saturating_sub(1)].0,
+            self.samples[(closest + 1).min(last)].0,
+        );
+        if closed && closest == 0 {
+            lo = self.samples[last - 1].0 - period;
+        }
+        if closed && closest == last {
+            hi = self.samples[1].0 + period;
+        }
+        let mut s = self.samples[closest].0;
+        let f = |s: f64| {
+            let [p, d1, d2] = self.path.eval(wrap(s, start, period, closed));
+            ((p - x).dot(d1), d1.length_squared() + (p - x).dot(d2))
+        };
+        for _ in 0..60 {
+            let (value, slope) = f(s);
+            if value == 0.0 {
+                break;
+            }
+            if value > 0.0 {
+                hi = s;
+            } else {
+                lo = s;
+            }
+            let mut next = s - value / slope;
+            if !(next > lo && next < hi) {
+                next = 0.5 * (lo + hi);
+            }
+            if next == s || hi - lo <= 4.0 * f64::EPSILON * s.abs().max(1.0) {
+                s = next;
+                break;
+            }
+            s = next;
+        }
+        if !closed {
+            // Past an end: the nearest point of the end's tangent line.
+            for (bound, sign) in [(start, -1.0), (end, 1.0)] {
+                let [p, d1, _] = self.path.eval(bound);
+                let along = (x - p).dot(d1) / d1.length_squared().max(f64::MIN_POSITIVE);
+                if sign * along > 0.0 && (s - bound).abs() <= 1e-9 * period.max(1.0) {
+                    return Nearest {
+                        at: [p, d1, DVec2::ZERO],
+                        past: sign * along * d1.length(),
+                    };
+                }
+            }
+        }
+        let at = self.path.eval(wrap(s, start, period, closed));
+        let past = if closed {
+            f64::NEG_INFINITY
+        } else {
+            -((s - start).min(end - s))
+        };
+        Nearest { at, past }
+    }
+}
+
+/// `s` brought into `[start, start + period)` on a closed curve.
+fn wrap(s: f64, start: f64, period: f64, closed: bool) -> f64 {
+    if closed {
+        start + (s - start).rem_euclid(period)
+    } else {
+        s
+    }
+}
+
+impl<P: Parametric> ImplicitCurve for Traced<P> {
+    fn value(&self, p: DVec2) -> f64 {
+        self.geometry(p).c
+    }
+    fn gradient(&self, p: DVec2) -> DVec2 {
+        self.geometry(p).normal
+    }
+    fn hessian(&self, p: DVec2) -> DMat2 {
+        self.geometry(p).hessian
+    }
+    fn scale(&self) -> f64 {
+        self.scale
+    }
+    fn geometry(&self, p: DVec2) -> Geometry {
+        let Nearest {
+            at: [point, d1, d2],
+            ..
+        } = self.nearest(p);
+        let speed = d1.length();
+        let tangent = d1 / speed;
+        let normal = DVec2::new(-tangent.y, tangent.x);
+        let c = normal.dot(p - point);
+        let curvature = d1.perp_dot(d2) / (speed * speed * speed);
+        let stretch = 1.0 - curvature * c;
+        if !(speed > 1e-12 * self.scale && stretch > 1e-9 && normal.is_finite()) {
+            // A cusp, or a centre of curvature: no normal to push along.
+            return Geometry {
+                c,
+                normal: DVec2::ZERO,
+                hessian: DMat2::ZERO,
+            };
+        }
+        let k = -curvature / stretch;
+        Geometry {
+            c,
+            normal,
+            hessian: DMat2::from_cols(tangent * (k * tangent.x), tangent * (k * tangent.y)),
+        }
+    }
+    fn has_ends(&self) -> bool {
+        !self.path.closed()
+    }
+    fn past_end(&self, p: DVec2) -> f64 {
+        self.nearest(p).past
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    /// The unit circle, counter-clockwise: inside is positive.
+    struct Round;
+
+    impl Parametric for Round {
+        fn domain(&self) -> (f64, f64) {
+            (0.0, std::f64::consts::TAU)
+        }
+        fn closed(&self) -> bool {
+            true
+        }
+        fn eval(&self, s: f64) -> [DVec2; 3] {
+            let (sin, cos) = s.sin_cos();
+            [
+                DVec2::new(cos, sin),
+                DVec2::new(-sin, cos),
+                DVec2::new(-cos, -sin),
+            ]
+        }
+    }
+
+    /// A traced circle is the circle's signed distance `1 − |x|`, with its
+    /// gradient and Hessian, to rounding.
+    #[test]
+    fn a_traced_circle_is_its_signed_distance() {
+        let traced = Traced::new(Round);
+        for p in [
+            DVec2::new(0.3, 0.5),
+            DVec2::new(-1.2, 0.1),
+            DVec2::new(0.05, -1.01),
+            DVec2::new(1.0, -1e-9),
+        ] {
+            let g = traced.geometry(p);
+            let r = p.length();
+            assert_relative_eq!(g.c, 1.0 - r, epsilon = 1e-14);
+            assert_relative_eq!(g.normal.x, -p.x / r, epsilon = 1e-13);
+            assert_relative_eq!(g.normal.y, -p.y / r, epsilon = 1e-13);
+            let t = DVec2::new(-p.y, p.x) / r;
+            let h = -DMat2::from_cols(t * t.x, t * t.y) / r;
+            for (a, b) in [(g.hessian.x_axis, h.x_axis), (g.hessian.y_axis, h.y_axis)] {
+                assert_relative_eq!(a.x, b.x, epsilon = 1e-12);
+                assert_relative_eq!(a.y, b.y, epsilon = 1e-12);
+            }
+        }
+        // The centre is every point's centre of curvature: singular.
+        assert_eq!(traced.geometry(DVec2::ZERO).normal, DVec2::ZERO);
+    }
+}
