@@ -28,8 +28,9 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Run one simulation and write a CSV (`t,x,y,vx,vy,c,c_dot,lambda,energy`);
-    /// with `--scene`, any scene file (`t`, then `<bead>.x,<bead>.y,<bead>.vx,<bead>.vy`
-    /// for each bead, then `energy,max_abs_c`).
+    /// with `--scene`, any scene file (`t`, then
+    /// `<bead>.x,<bead>.y,<bead>.vx,<bead>.vy,<bead>.on` for each bead, `on` 1
+    /// while held on its wire, then `energy,max_abs_c`).
     Simulate(SimulateArgs),
     /// Reproduce the assignment's three studies: trajectory, drift and energy PNGs,
     /// the CSV behind each, and summary.md.

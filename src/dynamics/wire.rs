@@ -195,20 +195,42 @@ impl PendingWire {
 pub struct OnWire(pub Entity);
 
 /// Whether a bead is held on its wire or flying off a one-sided one (see
-/// [`Surface`]), kept by the plugin; a [`Restart`](crate::Restart) puts
-/// every bead back on its wire.
-#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct WireContact(pub(crate) Contact);
+/// [`Surface`]), and, on a spline or cycloid, where along the curve it
+/// was last (so a curve that crosses itself keeps the bead on its branch).
+/// Kept by the plugin; a [`Restart`](crate::Restart) puts every bead back
+/// on its wire.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct WireContact {
+    pub(crate) contact: Contact,
+    /// The curve parameter at the end of the last step; NaN if unknown.
+    pub(crate) along: f32,
+}
+
+impl Default for WireContact {
+    fn default() -> Self {
+        Self {
+            contact: Contact::OnWire,
+            along: f32::NAN,
+        }
+    }
+}
 
 impl WireContact {
     /// On the wire.
     pub fn is_on(&self) -> bool {
-        self.0 == Contact::OnWire
+        self.contact == Contact::OnWire
     }
 
     /// The contact.
     pub fn get(&self) -> Contact {
-        self.0
+        self.contact
+    }
+
+    /// On a spline or cycloid, its parameter where the bead was after the
+    /// last step (a spline's segment `i` spans `[i, i + 1]`); NaN before
+    /// the first step and on other wires.
+    pub fn along(&self) -> f64 {
+        f64::from(self.along)
     }
 }
 

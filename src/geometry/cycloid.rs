@@ -130,4 +130,13 @@ impl ImplicitCurve for Cycloid {
     fn past_end(&self, p: DVec2) -> f64 {
         self.traced.past_end(p)
     }
+    fn parameter(&self, p: DVec2, hint: f64) -> f64 {
+        self.traced.parameter(p, hint)
+    }
+    fn geometry_near(&self, p: DVec2, hint: f64) -> Geometry {
+        self.traced.geometry_near(p, hint)
+    }
+    fn past_end_near(&self, p: DVec2, hint: f64) -> f64 {
+        self.traced.past_end_near(p, hint)
+    }
 }

@@ -48,7 +48,7 @@ pub use shape::{WireKind, WireShape};
 pub use sine::Sine;
 pub use spline::{CubicPath, Spline, SplineKind, SplineSpec};
 pub use surface::{Friction, Side, Surface};
-pub use traced::{Parametric, Traced};
+pub use traced::{HINT_WINDOW, Parametric, Traced};
 
 /// The value, gradient and Hessian of a constraint at one point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,6 +90,23 @@ pub trait ImplicitCurve {
     fn past_end(&self, _p: DVec2) -> f64 {
         f64::NEG_INFINITY
     }
+    /// The curve's own parameter at the point nearest `p`, searched near
+    /// `hint` (NaN: anywhere); NaN for a curve with no parameter. A
+    /// parametric curve that crosses itself uses it to stay on the branch a
+    /// bead is on (see [`Near`]).
+    fn parameter(&self, _p: DVec2, _hint: f64) -> f64 {
+        f64::NAN
+    }
+    /// [`ImplicitCurve::geometry`] with the nearest point searched near the
+    /// parameter `hint`.
+    fn geometry_near(&self, p: DVec2, _hint: f64) -> Geometry {
+        self.geometry(p)
+    }
+    /// [`ImplicitCurve::past_end`] with the nearest point searched near the
+    /// parameter `hint`.
+    fn past_end_near(&self, p: DVec2, _hint: f64) -> f64 {
+        self.past_end(p)
+    }
     /// All three at once; override when they share work.
     fn geometry(&self, p: DVec2) -> Geometry {
         Geometry {
@@ -97,6 +114,42 @@ pub trait ImplicitCurve {
             normal: self.gradient(p),
             hessian: self.hessian(p),
         }
+    }
+}
+
+/// A curve whose nearest points are searched near one parameter: the
+/// branch of a self-crossing spline a bead is on, for one step.
+pub struct Near<'a, C: ImplicitCurve + ?Sized> {
+    /// The curve.
+    pub curve: &'a C,
+    /// The parameter near which to look.
+    pub hint: f64,
+}
+
+impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Near<'_, C> {
+    fn value(&self, p: DVec2) -> f64 {
+        self.geometry(p).c
+    }
+    fn gradient(&self, p: DVec2) -> DVec2 {
+        self.geometry(p).normal
+    }
+    fn hessian(&self, p: DVec2) -> DMat2 {
+        self.geometry(p).hessian
+    }
+    fn scale(&self) -> f64 {
+        self.curve.scale()
+    }
+    fn has_ends(&self) -> bool {
+        self.curve.has_ends()
+    }
+    fn past_end(&self, p: DVec2) -> f64 {
+        self.curve.past_end_near(p, self.hint)
+    }
+    fn parameter(&self, p: DVec2, hint: f64) -> f64 {
+        self.curve.parameter(p, hint)
+    }
+    fn geometry(&self, p: DVec2) -> Geometry {
+        self.curve.geometry_near(p, self.hint)
     }
 }
 

@@ -107,6 +107,12 @@ impl WireShape {
         }
     }
 
+    /// Whether it is a parametric curve made a wire by its signed distance
+    /// (a cycloid or a spline; see [`Traced`](super::Traced)).
+    pub fn is_traced(&self) -> bool {
+        matches!(self, Self::Cycloid(_) | Self::Spline(_))
+    }
+
     /// The built-in kind of this shape; `None` for a custom curve.
     pub fn kind(&self) -> Option<WireKind> {
         match self {

@@ -2,10 +2,7 @@
 
 use std::sync::Arc;
 
-use bevy::math::cubic_splines::{
-    CubicBSpline, CubicCardinalSpline, CubicCurve, CubicGenerator, CubicHermite,
-    CyclicCubicGenerator,
-};
+use bevy::math::cubic_splines::CubicCurve;
 use bevy::math::{DMat2, DVec2, Vec2};
 use serde::{Deserialize, Serialize};
 
@@ -50,7 +47,8 @@ pub struct SplineSpec {
 /// positive to the left of the direction the points run in (above a track
 /// drawn left to right, inside a closed loop drawn counter-clockwise). An
 /// open spline ends at its first and last points, a closed one goes round.
-/// The curve's coefficients are Bevy's (`f32`), held in `f64`.
+/// A scene's spline is computed as Bevy computes it, in `f64`; a game's
+/// `CubicCurve` keeps its `f32` coefficients, held in `f64`.
 #[derive(Clone, Serialize, Deserialize)]
 #[serde(try_from = "SplineSpec", into = "SplineSpec")]
 pub struct Spline {
@@ -88,41 +86,91 @@ fn refuse(what: &'static str) -> ParamError {
     ParamError::Incompatible(what)
 }
 
+/// Bevy's characteristic matrix of the cubic Hermite spline.
+const HERMITE: [[f64; 4]; 4] = [
+    [1., 0., 0., 0.],
+    [0., 1., 0., 0.],
+    [-3., -2., 3., -1.],
+    [2., 1., -2., 1.],
+];
+
+/// Six times Bevy's characteristic matrix of the uniform B-spline.
+const B_SPLINE: [[f64; 4]; 4] = [
+    [1.0, 4.0, 1.0, 0.0],
+    [-3.0, 0.0, 3.0, 0.0],
+    [3.0, -6.0, 3.0, 0.0],
+    [-1.0, 3.0, -3.0, 1.0],
+];
+
+/// A segment's coefficients: the characteristic matrix times the points.
+fn coefficients(p: [DVec2; 4], matrix: [[f64; 4]; 4]) -> [DVec2; 4] {
+    matrix.map(|row| p[0] * row[0] + p[1] * row[1] + p[2] * row[2] + p[3] * row[3])
+}
+
+/// Bevy's cardinal spline of tension `s` through `points`: open, with the
+/// ends mirrored (`P₋₁ = 2P₀ − P₁`); closed, with its segments in the
+/// order `to_curve_cyclic` gives them (the first from the first point to
+/// the second).
+fn cardinal(s: f64, points: &[DVec2], closed: bool) -> Result<Vec<[DVec2; 4]>, ParamError> {
+    let n = points.len();
+    if n < 2 {
+        return Err(refuse("a cardinal spline needs two points at least"));
+    }
+    let matrix = [
+        [0., 1., 0., 0.],
+        [-s, 0., s, 0.],
+        [2. * s, s - 3., 3. - 2. * s, -s],
+        [-s, 2. - s, s - 2., s],
+    ];
+    if closed {
+        let at = |i: usize| points[i % n];
+        let first = coefficients([points[n - 1], points[0], at(1), at(2)], matrix);
+        let later =
+            (0..n - 1).map(|i| coefficients([at(i), at(i + 1), at(i + 2), at(i + 3)], matrix));
+        return Ok(std::iter::once(first).chain(later).collect());
+    }
+    let mut extended = Vec::with_capacity(n + 2);
+    extended.push(points[0] * 2.0 - points[1]);
+    extended.extend_from_slice(points);
+    extended.push(points[n - 1] * 2.0 - points[n - 2]);
+    Ok(extended
+        .windows(4)
+        .map(|w| coefficients([w[0], w[1], w[2], w[3]], matrix))
+        .collect())
+}
+
 impl Spline {
-    /// The spline `spec` describes, if its points make a curve.
+    /// The spline `spec` describes, if its points make a curve: Bevy's
+    /// generator of that kind (`CubicCardinalSpline`, `CubicBSpline`,
+    /// `CubicHermite`, with `to_curve` or, closed, `to_curve_cyclic`),
+    /// computed in `f64` with the same characteristic matrices, end
+    /// mirroring and segment order, so a scene's points lie on the wire
+    /// exactly.
     pub fn new(spec: SplineSpec) -> Result<Self, ParamError> {
-        if spec.points.iter().any(|p| !p.is_finite()) {
+        let points = &spec.points;
+        if points.iter().any(|p| !p.is_finite()) {
             return Err(refuse("a spline's points must be finite"));
         }
-        let points: Vec<Vec2> = spec.points.iter().map(|p| p.as_vec2()).collect();
-        let too_few = |_| {
-            refuse(
-                "a spline needs more points (a cubic spline needs at least two, a B-spline four)",
-            )
-        };
-        let curve = match &spec.kind {
-            SplineKind::CatmullRom | SplineKind::Cardinal(_) => {
-                let tension = match spec.kind {
-                    SplineKind::Cardinal(t) => t as f32,
-                    _ => 0.5,
-                };
+        let segments = match &spec.kind {
+            SplineKind::CatmullRom => cardinal(0.5, points, spec.closed)?,
+            SplineKind::Cardinal(tension) => {
                 if !tension.is_finite() {
                     return Err(refuse("a cardinal spline's tension must be finite"));
                 }
-                let spline = CubicCardinalSpline::new(tension, points);
-                if spec.closed {
-                    spline.to_curve_cyclic().map_err(too_few)?
-                } else {
-                    spline.to_curve().map_err(too_few)?
-                }
+                cardinal(*tension, points, spec.closed)?
             }
             SplineKind::BSpline => {
-                let spline = CubicBSpline::new(points);
-                if spec.closed {
-                    spline.to_curve_cyclic().map_err(too_few)?
-                } else {
-                    spline.to_curve().map_err(too_few)?
+                let matrix = B_SPLINE.map(|row| row.map(|c| c / 6.0));
+                let n = points.len();
+                if (spec.closed && n < 2) || (!spec.closed && n < 4) {
+                    return Err(refuse(
+                        "a B-spline needs four points at least (two when closed)",
+                    ));
                 }
+                let count = if spec.closed { n } else { n - 3 };
+                (0..count)
+                    .map(|i| coefficients(std::array::from_fn(|k| points[(i + k) % n]), matrix))
+                    .collect()
             }
             SplineKind::Hermite(tangents) => {
                 if tangents.len() != points.len() || tangents.iter().any(|t| !t.is_finite()) {
@@ -130,12 +178,17 @@ impl Spline {
                         "a Hermite spline needs one finite tangent for each point",
                     ));
                 }
-                let spline = CubicHermite::new(points, tangents.iter().map(|t| t.as_vec2()));
-                if spec.closed {
-                    spline.to_curve_cyclic().map_err(too_few)?
-                } else {
-                    spline.to_curve().map_err(too_few)?
+                let n = points.len();
+                if n < 2 {
+                    return Err(refuse("a Hermite spline needs two points at least"));
                 }
+                let count = if spec.closed { n } else { n - 1 };
+                (0..count)
+                    .map(|i| {
+                        let j = (i + 1) % n;
+                        coefficients([points[i], tangents[i], points[j], tangents[j]], HERMITE)
+                    })
+                    .collect()
             }
             SplineKind::Segments(segments) => {
                 if segments.is_empty() || segments.iter().flatten().any(|c| !c.is_finite()) {
@@ -143,14 +196,11 @@ impl Spline {
                         "a spline's segments must be finite, and one at least",
                     ));
                 }
-                return Ok(Self::from_segments(segments.clone(), spec.closed));
+                segments.clone()
             }
         };
-        let mut made = Self::from_curve(&curve);
-        made.spec = SplineSpec {
-            closed: spec.closed,
-            ..spec
-        };
+        let mut made = Self::from_segments(segments, spec.closed);
+        made.spec = spec;
         Ok(made)
     }
 
@@ -192,6 +242,11 @@ impl Spline {
     /// What it was made from.
     pub fn spec(&self) -> &SplineSpec {
         &self.spec
+    }
+
+    /// Its segments' coefficients, as [`SplineKind::Segments`].
+    pub fn traced_segments(&self) -> SplineKind {
+        SplineKind::Segments(self.traced.path().segments.clone())
     }
 
     /// Points along the curve, for drawing.
@@ -260,5 +315,108 @@ impl ImplicitCurve for Spline {
     }
     fn past_end(&self, p: DVec2) -> f64 {
         self.traced.past_end(p)
+    }
+    fn parameter(&self, p: DVec2, hint: f64) -> f64 {
+        self.traced.parameter(p, hint)
+    }
+    fn geometry_near(&self, p: DVec2, hint: f64) -> Geometry {
+        self.traced.geometry_near(p, hint)
+    }
+    fn past_end_near(&self, p: DVec2, hint: f64) -> f64 {
+        self.traced.past_end_near(p, hint)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bevy::math::cubic_splines::{
+        CubicBSpline, CubicCardinalSpline, CubicGenerator, CubicHermite, CyclicCubicGenerator,
+    };
+
+    /// Every kind, open and closed, has the coefficients Bevy's own
+    /// generator gives (in `f32`), and a scene's points lie on the curve.
+    #[test]
+    fn splines_match_bevys_generators() {
+        let points: Vec<DVec2> = [(0.0, 0.0), (1.0, 2.0), (3.0, 1.5), (4.0, -1.0), (6.0, 0.5)]
+            .map(|(x, y)| DVec2::new(x, y))
+            .to_vec();
+        let tangents: Vec<DVec2> = points.iter().map(|p| DVec2::new(1.0, -p.y)).collect();
+        let f32s = |v: &[DVec2]| v.iter().map(|p| p.as_vec2()).collect::<Vec<_>>();
+        for closed in [false, true] {
+            let bevy = |curve: CubicCurve<Vec2>| -> Vec<[DVec2; 4]> {
+                curve
+                    .segments()
+                    .iter()
+                    .map(|s| s.coeff.map(|c| c.as_dvec2()))
+                    .collect()
+            };
+            let cardinal = CubicCardinalSpline::new(0.3, f32s(&points));
+            let catmull = CubicCardinalSpline::new_catmull_rom(f32s(&points));
+            let b = CubicBSpline::new(f32s(&points));
+            let hermite = CubicHermite::new(f32s(&points), f32s(&tangents));
+            let cases = [
+                (
+                    SplineKind::Cardinal(0.3),
+                    if closed {
+                        cardinal.to_curve_cyclic()
+                    } else {
+                        cardinal.to_curve()
+                    }
+                    .unwrap(),
+                ),
+                (
+                    SplineKind::CatmullRom,
+                    if closed {
+                        catmull.to_curve_cyclic()
+                    } else {
+                        catmull.to_curve()
+                    }
+                    .unwrap(),
+                ),
+                (
+                    SplineKind::BSpline,
+                    if closed {
+                        b.to_curve_cyclic()
+                    } else {
+                        b.to_curve()
+                    }
+                    .unwrap(),
+                ),
+                (
+                    SplineKind::Hermite(tangents.clone()),
+                    if closed {
+                        hermite.to_curve_cyclic()
+                    } else {
+                        hermite.to_curve()
+                    }
+                    .unwrap(),
+                ),
+            ];
+            for (kind, curve) in cases {
+                let ours = Spline::new(SplineSpec {
+                    kind: kind.clone(),
+                    points: points.clone(),
+                    closed,
+                })
+                .unwrap();
+                let SplineKind::Segments(mine) = &ours.traced_segments() else {
+                    unreachable!()
+                };
+                let theirs = bevy(curve);
+                assert_eq!(mine.len(), theirs.len(), "{kind:?} closed {closed}");
+                for (a, b) in mine.iter().flatten().zip(theirs.iter().flatten()) {
+                    assert!(
+                        (*a - *b).length() < 1e-5,
+                        "{kind:?} closed {closed}: {a} vs {b}"
+                    );
+                }
+                if !matches!(kind, SplineKind::BSpline) {
+                    for p in &points[1..points.len() - 1] {
+                        assert!(ours.value(*p).abs() < 1e-12, "{kind:?}: {p} off the curve");
+                    }
+                }
+            }
+        }
     }
 }

@@ -40,18 +40,25 @@ pub trait Parametric {
 /// How many samples per unit of parameter the polyline takes.
 const SAMPLES_PER_UNIT: f64 = 24.0;
 
+/// How far in parameter from a hint the nearest-point search looks.
+pub const HINT_WINDOW: f64 = 0.75;
+
 /// A [`Parametric`] curve as a wire, by its signed distance.
 #[derive(Clone, Debug)]
 pub struct Traced<P> {
     path: P,
     /// `(s, γ(s))` along the curve.
     samples: Vec<(f64, DVec2)>,
+    /// The longest distance between neighbouring samples.
+    spacing: f64,
     scale: f64,
 }
 
 /// The point of a curve nearest some `x`.
 #[derive(Clone, Copy, Debug)]
 struct Nearest {
+    /// `s*`.
+    s: f64,
     /// `γ(s*)`, `γ′(s*)`, `γ″(s*)` (or, past an end, the end's point and
     /// tangent and no curvature).
     at: [DVec2; 3],
@@ -72,11 +79,14 @@ impl<P: Parametric> Traced<P> {
                 (s, path.eval(s)[0])
             })
             .collect();
-        let length: f64 = samples.windows(2).map(|w| (w[1].1 - w[0].1).length()).sum();
+        let gaps = || samples.windows(2).map(|w| (w[1].1 - w[0].1).length());
+        let length: f64 = gaps().sum();
+        let spacing = gaps().fold(0.0, f64::max);
         let scale = (length / (end - start).max(1.0)).max(f64::MIN_POSITIVE);
         Self {
             path,
             samples,
+            spacing,
             scale,
         }
     }
@@ -91,19 +101,84 @@ impl<P: Parametric> Traced<P> {
         self.samples.iter().map(|(_, p)| *p)
     }
 
-    /// The nearest point of the curve (extended past its ends) to `x`.
-    fn nearest(&self, x: DVec2) -> Nearest {
+    /// The sample nearest `x` among those within [`HINT_WINDOW`] of the
+    /// parameter `hint` (on a curve that crosses itself, the branch the
+    /// bead is on); none if the hint is not finite or the window's nearest
+    /// sample is at its edge (the bead went farther: the whole curve is
+    /// searched).
+    fn windowed_sample(&self, x: DVec2, hint: f64) -> Option<usize> {
+        let last = self.samples.len() - 1;
+        let distance = |i: usize| (self.samples[i].1 - x).length_squared();
+        if !hint.is_finite() {
+            return None;
+        }
         let (start, end) = self.path.domain();
-        let closest = self
+        let per_unit = last as f64 / (end - start);
+        let centre = ((hint - start) * per_unit).round() as i64;
+        let reach = (HINT_WINDOW * per_unit).ceil() as i64;
+        let closed = self.path.closed();
+        let index = |k: i64| {
+            if closed {
+                Some(k.rem_euclid(last as i64) as usize)
+            } else {
+                usize::try_from(k).ok().filter(|&i| i <= last)
+            }
+        };
+        let best = (centre - reach..=centre + reach)
+            .filter_map(|k| index(k).map(|i| (k, i)))
+            .min_by(|a, b| distance(a.1).total_cmp(&distance(b.1)));
+        match best {
+            Some((k, i)) if (k - centre).abs() < reach || i == 0 || i == last => Some(i),
+            _ => None,
+        }
+    }
+
+    /// The nearest point to `x`: from the hint's window if it has one,
+    /// else refined from every sample that is a local minimum of the
+    /// distance within one sample spacing of the nearest (near a crossing,
+    /// both branches), the nearest of those.
+    fn nearest(&self, x: DVec2, hint: f64) -> Nearest {
+        if let Some(i) = self.windowed_sample(x, hint) {
+            return self.refine(x, i);
+        }
+        let distance: Vec<f64> = self
             .samples
             .iter()
-            .enumerate()
-            .min_by(|a, b| {
-                (a.1.1 - x)
-                    .length_squared()
-                    .total_cmp(&(b.1.1 - x).length_squared())
-            })
-            .map_or(0, |(i, _)| i);
+            .map(|(_, p)| (*p - x).length())
+            .collect();
+        let best = distance.iter().copied().fold(f64::INFINITY, f64::min);
+        let last = distance.len() - 1;
+        let closed = self.path.closed();
+        let minimum = |i: usize| {
+            let before = match (i, closed) {
+                (0, true) => distance[last - 1],
+                (0, false) => f64::INFINITY,
+                _ => distance[i - 1],
+            };
+            let after = match (i == last, closed) {
+                (true, true) => distance[1],
+                (true, false) => f64::INFINITY,
+                _ => distance[i + 1],
+            };
+            distance[i] <= before && distance[i] <= after
+        };
+        (0..=last)
+            .filter(|&i| distance[i] <= best + self.spacing && minimum(i))
+            .map(|i| self.refine(x, i))
+            .min_by(|a, b| (a.at[0] - x).length().total_cmp(&(b.at[0] - x).length()))
+            .unwrap_or_else(|| self.refine(x, 0))
+    }
+
+    /// The curve's parameter at the point nearest `x`, searched near
+    /// `hint` (see [`Traced::windowed_sample`]).
+    pub fn parameter(&self, x: DVec2, hint: f64) -> f64 {
+        self.nearest(x, hint).s
+    }
+
+    /// The nearest point of the curve (extended past its ends) to `x`,
+    /// refined by Newton's method from sample `closest`.
+    fn refine(&self, x: DVec2, closest: usize) -> Nearest {
+        let (start, end) = self.path.domain();
         let last = self.samples.len() - 1;
         let closed = self.path.closed();
         let period = end - start;
@@ -149,19 +224,21 @@ impl<P: Parametric> Traced<P> {
                 let along = (x - p).dot(d1) / d1.length_squared().max(f64::MIN_POSITIVE);
                 if sign * along > 0.0 && (s - bound).abs() <= 1e-9 * period.max(1.0) {
                     return Nearest {
+                        s: bound,
                         at: [p, d1, DVec2::ZERO],
                         past: sign * along * d1.length(),
                     };
                 }
             }
         }
-        let at = self.path.eval(wrap(s, start, period, closed));
+        let s = wrap(s, start, period, closed);
+        let at = self.path.eval(s);
         let past = if closed {
             f64::NEG_INFINITY
         } else {
             -((s - start).min(end - s))
         };
-        Nearest { at, past }
+        Nearest { s, at, past }
     }
 }
 
@@ -188,10 +265,13 @@ impl<P: Parametric> ImplicitCurve for Traced<P> {
         self.scale
     }
     fn geometry(&self, p: DVec2) -> Geometry {
+        self.geometry_near(p, f64::NAN)
+    }
+    fn geometry_near(&self, p: DVec2, hint: f64) -> Geometry {
         let Nearest {
             at: [point, d1, d2],
             ..
-        } = self.nearest(p);
+        } = self.nearest(p, hint);
         let speed = d1.length();
         let tangent = d1 / speed;
         let normal = DVec2::new(-tangent.y, tangent.x);
@@ -217,7 +297,13 @@ impl<P: Parametric> ImplicitCurve for Traced<P> {
         !self.path.closed()
     }
     fn past_end(&self, p: DVec2) -> f64 {
-        self.nearest(p).past
+        self.past_end_near(p, f64::NAN)
+    }
+    fn past_end_near(&self, p: DVec2, hint: f64) -> f64 {
+        self.nearest(p, hint).past
+    }
+    fn parameter(&self, p: DVec2, hint: f64) -> f64 {
+        Traced::parameter(self, p, hint)
     }
 }
 

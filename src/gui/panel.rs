@@ -25,6 +25,7 @@ use crate::{
     OnWire, ParamError, PendingBead, PendingParams, PendingWire, Pin, Restart, Rod, SimClock,
     SimParams, Stabilization, Wire, WireBeadSystems, WireKind, WireShape, pose_of,
 };
+use crate::{PrescribedMotion, Side, Surface, WireContact, WireMotion};
 
 /// The presets the panel offers: `(label, asset path)`.
 #[derive(Resource, Clone, Debug)]
@@ -52,6 +53,8 @@ impl Default for PresetCatalog {
                 ),
                 ("Kapitza pendulum", "scenes/kapitza.scene.ron"),
                 ("Bead on a spinning rod", "scenes/spinning_rod.scene.ron"),
+                ("Tautochrone race", "scenes/tautochrone.scene.ron"),
+                ("Roller coaster", "scenes/roller_coaster.scene.ron"),
             ]
             .into_iter()
             .map(|(a, b)| (a.to_owned(), b.to_owned()))
@@ -236,8 +239,10 @@ pub struct PanelView<'w, 's> {
             &'static Wire,
             &'static Transform,
             Option<&'static PendingWire>,
+            Option<&'static PrescribedMotion>,
         ),
     >,
+    contacts: Query<'w, 's, &'static WireContact>,
     rods: Query<'w, 's, (&'static Rod, &'static ConstraintDiagnostics)>,
     pins: Query<'w, 's, (&'static Pin, &'static ConstraintDiagnostics)>,
     names: Query<'w, 's, &'static Name>,
@@ -403,7 +408,7 @@ fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) ->
     });
     let mut outcome = None;
     if let Some(on_wire) = on_wire
-        && let Ok((wire, transform, pending_wire)) = view.wires.get(on_wire.0)
+        && let Ok((wire, transform, pending_wire, motion)) = view.wires.get(on_wire.0)
     {
         let shape = pending_wire.map_or_else(|| wire.shape().clone(), |p| p.shape().clone());
         if let Some(edited) = wire_editor(ui, &shape) {
@@ -414,6 +419,13 @@ fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) ->
                 draft.initial_position = pose.to_world(edited.bottom());
             }));
         }
+        let contact = view.contacts.get(entity).ok();
+        track_lines(
+            ui,
+            wire.surface(),
+            motion.map(PrescribedMotion::motion),
+            contact,
+        );
     }
     if draft != before {
         outcome = Some(PendingBead::new(draft).map(|edit| {
@@ -491,6 +503,56 @@ impl PanelView<'_, '_> {
         self.names
             .get(bead)
             .map_or_else(|_| bead.to_string(), |n| n.as_str().to_owned())
+    }
+}
+
+/// What the wire does besides holding the bead, in words: its motion, its
+/// side, restitution, friction and damping, and whether the bead is on it.
+fn track_lines(
+    ui: &mut egui::Ui,
+    surface: &Surface,
+    motion: Option<WireMotion>,
+    contact: Option<&WireContact>,
+) {
+    let moving = match motion {
+        Some(WireMotion::Oscillate(o)) => Some(format!(
+            "oscillates by ({:.2}, {:.2}) at {:.2} Hz",
+            o.amplitude.x, o.amplitude.y, o.frequency
+        )),
+        Some(WireMotion::Spin(s)) => Some(format!("spins at {:.2} rad/s", s.angular_velocity)),
+        _ => None,
+    };
+    let mut lines: Vec<String> = moving.into_iter().collect();
+    if surface.side != Side::Both {
+        lines.push(format!(
+            "pushes one way ({} side), restitution {:.2}",
+            surface.side.name(),
+            surface.restitution
+        ));
+    }
+    if surface.friction.is_some() {
+        lines.push(format!(
+            "friction μs {:.2}, μk {:.2}",
+            surface.friction.static_coefficient, surface.friction.kinetic_coefficient
+        ));
+    }
+    if surface.damping > 0.0 {
+        lines.push(format!("damping {:.2} N·s/m", surface.damping));
+    }
+    if let Some(contact) = contact
+        && (surface.side != Side::Both || !contact.is_on())
+    {
+        lines.push(
+            if contact.is_on() {
+                "on its wire"
+            } else {
+                "in flight"
+            }
+            .to_owned(),
+        );
+    }
+    for line in lines {
+        ui.label(line);
     }
 }
 

@@ -12,7 +12,7 @@ use bevy::prelude::*;
 use crate::geometry::{ImplicitCurve, Placed, Pose, WireShape};
 use crate::{
     Bead, BeadDiagnostics, DragTarget, OnWire, Pin, Restart, Rod, Spring, Wire, WireBeadSystems,
-    pose_of,
+    WireContact, pose_of,
 };
 
 /// Colours and sizes of the scene.
@@ -28,6 +28,8 @@ pub struct SceneStyle {
     pub diverged: Color,
     /// Trails (faded toward the background with age).
     pub trail: Color,
+    /// A bead in flight off its one-sided wire, and its trail there.
+    pub flight: Color,
     /// The constraint force arrow.
     pub constraint_force: Color,
     /// The drag spring.
@@ -58,6 +60,7 @@ impl Default for SceneStyle {
             bead: Color::srgb(1.0, 0.55, 0.10),
             diverged: Color::srgb(0.9, 0.1, 0.1),
             trail: Color::srgb(1.0, 0.85, 0.3),
+            flight: Color::srgb(0.95, 0.35, 1.0),
             constraint_force: Color::srgb(0.4, 1.0, 0.4),
             drag: Color::srgb(1.0, 0.3, 0.8),
             rod: Color::srgb(0.92, 0.92, 0.92),
@@ -79,9 +82,10 @@ pub struct SceneCamera;
 #[derive(Component, Clone, Copy, Debug, Default)]
 pub struct BeadVisual;
 
-/// A bead's recent positions, newest last.
+/// A bead's recent positions, newest last, each with whether the bead was
+/// in flight off its wire there.
 #[derive(Component, Clone, Debug, Default)]
-pub struct Trail(pub VecDeque<Vec2>);
+pub struct Trail(pub VecDeque<(Vec2, bool)>);
 
 /// The world rectangle the camera frames (center, size), updated each frame.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
@@ -158,11 +162,12 @@ pub fn add_bead_visuals(
 pub fn record_trails(
     params: Res<crate::SimParams>,
     style: Res<SceneStyle>,
-    mut beads: Query<(&Bead, &mut Trail)>,
+    mut beads: Query<(&Bead, &mut Trail, Option<&WireContact>)>,
 ) {
     let keep = (style.trail_seconds / params.timestep).ceil() as usize;
-    for (bead, mut trail) in &mut beads {
-        trail.0.push_back(bead.position.as_vec2());
+    for (bead, mut trail, contact) in &mut beads {
+        let flying = contact.is_some_and(|c| !c.is_on());
+        trail.0.push_back((bead.position.as_vec2(), flying));
         while trail.0.len() > keep.max(2) {
             trail.0.pop_front();
         }
@@ -304,6 +309,7 @@ fn size_and_colour_beads(
             &mut Transform,
             &MeshMaterial2d<ColorMaterial>,
             Has<crate::Diverged>,
+            Option<&WireContact>,
         ),
         With<Bead>,
     >,
@@ -317,14 +323,20 @@ fn size_and_colour_beads(
             *limit = limit.min(0.4 * rod.length() as f32);
         }
     }
-    for (entity, mut transform, material, diverged) in &mut beads {
+    for (entity, mut transform, material, diverged, contact) in &mut beads {
         let r = shortest
             .get(&entity)
             .map_or(radius, |&limit| radius.min(limit));
         transform.scale = Vec3::splat(r);
         transform.translation.z = 1.0;
         if let Some(mut m) = materials.get_mut(&material.0) {
-            let colour = if diverged { style.diverged } else { style.bead };
+            let colour = if diverged {
+                style.diverged
+            } else if contact.is_some_and(|c| !c.is_on()) {
+                style.flight
+            } else {
+                style.bead
+            };
             if m.color != colour {
                 m.color = colour;
             }
@@ -360,8 +372,43 @@ pub fn draw_wires(
                     (view.size.length() as f64) + (pose.origin - view.center.as_dvec2()).length();
                 let points = wire_points(shape, &pose, Some(span));
                 gizmos.linestrip_2d(points.iter().map(|p| p.as_vec2()), style.wire);
+                let side = wire.surface().side.sign();
+                if side != 0.0 {
+                    let placed = Placed {
+                        curve: shape.curve(),
+                        pose,
+                    };
+                    hatch(&mut gizmos, &placed, &points, side, &view, style.wire);
+                }
             }
         }
+    }
+}
+
+/// Marks the closed side of a one-sided wire: short slanted strokes on the
+/// side it does not push toward (like the hatching of a wall in a
+/// drawing), so the open side is the clear one.
+fn hatch(
+    gizmos: &mut Gizmos,
+    curve: &dyn ImplicitCurve,
+    points: &[DVec2],
+    side: f64,
+    view: &FramedView,
+    colour: Color,
+) {
+    let length = 0.018 * f64::from(view.size.y);
+    let mut travelled = 0.0;
+    for pair in points.windows(2) {
+        travelled += (pair[1] - pair[0]).length();
+        if travelled < 1.5 * length {
+            continue;
+        }
+        travelled = 0.0;
+        let p = pair[1];
+        let normal = curve.gradient(p).normalize_or_zero();
+        let along = DVec2::new(-normal.y, normal.x);
+        let end = p - side * length * normal + 0.5 * length * along;
+        gizmos.line_2d(p.as_vec2(), end.as_vec2(), colour.with_alpha(0.6));
     }
 }
 
@@ -404,16 +451,15 @@ pub fn implicit_segments(
     segments
 }
 
+/// Draws each trail fading with age, in the flight colour where the bead
+/// was off its wire.
 fn draw_trails(beads: Query<&Trail>, style: Res<SceneStyle>, mut gizmos: Gizmos) {
     for trail in &beads {
         let n = trail.0.len().max(1) as f32;
-        gizmos.linestrip_gradient_2d(
-            trail
-                .0
-                .iter()
-                .enumerate()
-                .map(|(i, p)| (*p, style.trail.with_alpha((i as f32 + 1.0) / n))),
-        );
+        gizmos.linestrip_gradient_2d(trail.0.iter().enumerate().map(|(i, (p, flying))| {
+            let colour = if *flying { style.flight } else { style.trail };
+            (*p, colour.with_alpha((i as f32 + 1.0) / n))
+        }));
     }
 }
 

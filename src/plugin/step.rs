@@ -21,7 +21,7 @@ use crate::dynamics::{
     PrescribedMotion, SimParams, Wire, WireContact, WirePose, pose_of,
 };
 use crate::geometry::{
-    FixedTrack, MovingTrack, Placed, Pose, PoseHistory, PosePath, Surface, Track, WireShape,
+    FixedTrack, MovingTrack, Near, Placed, Pose, PoseHistory, PosePath, Surface, Track, WireShape,
 };
 use crate::solver::{self, Contact, ContactEvent, StepOutput, StepSettings};
 
@@ -301,7 +301,7 @@ impl StepContext<'_> {
         let bead = &run.beads[i];
         let result = match self.wires.get(&run.on_wires[i]) {
             Err(reason) => Err(reason),
-            Ok(wire) if !wire.surface.is_plain() || wire.shape.curve().has_ends() => {
+            Ok(wire) if !wire.surface.is_plain() || wire.shape.is_traced() => {
                 self.step_on_surface(wire, bead, run.entities[i], contact)
             }
             Ok(TableWire { shape, path, .. }) => match path.fixed() {
@@ -360,12 +360,16 @@ impl StepContext<'_> {
         let force = bead.step_force(self.params.gravity);
         let start = self.time - self.settings.dt;
         let from = contact.as_deref().map_or(Contact::OnWire, WireContact::get);
+        let hint = contact.as_deref().map_or(f64::NAN, WireContact::along);
         let TableWire {
             shape,
             path,
             surface,
         } = wire;
-        let curve = shape.curve();
+        let curve = &Near {
+            curve: shape.curve(),
+            hint,
+        };
         let stepped = match path.fixed() {
             Some(pose) => solver::step_surface(
                 &FixedTrack(&Placed { curve, pose }),
@@ -390,7 +394,9 @@ impl StepContext<'_> {
         }
         .map_err(DivergenceReason::Solve)?;
         if let Some(contact) = contact {
-            contact.0 = stepped.contact;
+            contact.contact = stepped.contact;
+            let local = path.pose(self.time).to_local(stepped.output.state.position);
+            contact.along = shape.curve().parameter(local, hint) as f32;
         }
         if let Some(event) = stepped.event {
             self.events.push(entity, event);

@@ -24,6 +24,7 @@ pub(crate) const SHIPPED: &[&str] = &[
     "kapitza.scene.ron",
     "spinning_rod.scene.ron",
     "tautochrone.scene.ron",
+    "roller_coaster.scene.ron",
 ];
 
 /// The shipped presets that join beads.

@@ -366,3 +366,64 @@ fn a_bead_sliding_off_an_open_spline_falls_freely_from_its_end() {
         "acceleration {a:?}"
     );
 }
+
+/// A bead rides a Catmull–Rom loop that crosses itself: through the
+/// crossing it keeps to its branch (its parameter only grows), goes round
+/// the loop and leaves on the far side, on the curve to 1e-9 throughout.
+#[test]
+fn a_bead_rides_a_self_crossing_spline_loop_on_its_branch() {
+    use wirebead::geometry::{Spline, SplineKind, SplineSpec};
+    let points = [
+        (-4.0, 0.0),
+        (-2.0, 0.0),
+        (0.0, 0.0),
+        (1.2, 1.1),
+        (0.0, 2.2),
+        (-1.2, 1.1),
+        (0.0, 0.0),
+        (2.0, 0.0),
+        (4.0, 0.0),
+    ];
+    let spline = Spline::new(SplineSpec {
+        kind: SplineKind::CatmullRom,
+        points: points.iter().map(|&(x, y)| DVec2::new(x, y)).collect(),
+        closed: false,
+    })
+    .unwrap();
+    let segments = (points.len() - 3) as f64;
+    let start = spline.point(0.1);
+    let ahead = (spline.point(0.1001) - start).normalize();
+    let mut app = app(SimParams {
+        timestep: 1.0 / 240.0,
+        method: Method::Rattle,
+        gravity: DVec2::ZERO,
+        ..default()
+    });
+    let wire = Wire::new(wirebead::WireShape::Spline(spline)).unwrap();
+    let wire = app.world_mut().spawn(wire).id();
+    let bead = Bead::new(BeadParams {
+        mass: 1.0,
+        initial_position: start,
+        initial_velocity: 3.0 * ahead,
+    })
+    .unwrap();
+    let bead = app.world_mut().spawn((bead, OnWire(wire))).id();
+    let (mut last, mut top, mut worst) = (0.0f64, f64::MIN, 0.0f64);
+    for _ in 0..2000 {
+        crate::common::run_steps(&mut app, 1);
+        let along = app.world().get::<WireContact>(bead).unwrap().along();
+        let y = app.world().get::<Bead>(bead).unwrap().position.y;
+        let c = crate::common::diagnostics(&app, bead).c.abs();
+        if along >= segments - 0.05 {
+            break;
+        }
+        assert!(along >= last - 1e-6, "went back from {last} to {along}");
+        (last, top, worst) = (along, top.max(y), worst.max(c));
+    }
+    eprintln!(
+        "self-crossing loop: reached parameter {last:.3} of {segments}, top {top:.3}, |C| {worst:e}"
+    );
+    assert!(last > segments - 0.2, "stopped at parameter {last}");
+    assert!(top > 2.0, "never went round the loop (highest {top})");
+    assert!(worst < 1e-9, "|C| reached {worst:e}");
+}
