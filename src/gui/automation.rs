@@ -11,9 +11,10 @@ use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
 use serde::{Deserialize, Serialize};
 
-use crate::gui::render::{FramedView, SceneCamera, wire_points};
+use crate::geometry::Placed;
+use crate::gui::render::{FramedView, SceneCamera, hatch_length, hatch_point, wire_points};
 use crate::preset::ActivePreset;
-use crate::{Bead, Diverged, DragTarget, Pin, Rod, Wire, pose_of};
+use crate::{Bead, Diverged, DragTarget, Pin, Rod, Wire, WireContact, pose_of};
 
 /// Where one bead is.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -26,6 +27,9 @@ pub struct BeadReport {
     pub radius_px: f32,
     /// Why it diverged, if it did.
     pub diverged: Option<String>,
+    /// Whether it is in flight off a one-sided wire.
+    #[serde(default)]
+    pub in_flight: bool,
 }
 
 /// Where one wire is drawn.
@@ -36,6 +40,13 @@ pub struct WireReport {
     /// Points on the simulated wire, in physical pixels (only those inside
     /// the window).
     pub pixels: Vec<[f32; 2]>,
+    /// On a one-sided wire, the middle of the hatch stroke each point would
+    /// have on the wire's closed side, in physical pixels.
+    #[serde(default)]
+    pub closed_side: Vec<[f32; 2]>,
+    /// The same points mirrored to the open side, where no stroke is drawn.
+    #[serde(default)]
+    pub open_side: Vec<[f32; 2]>,
 }
 
 /// What a mouse drag did.
@@ -134,6 +145,7 @@ struct ReportView<'w, 's> {
             Option<&'static DragTarget>,
             Option<&'static Diverged>,
             &'static Transform,
+            Option<&'static WireContact>,
         ),
     >,
     wires: Query<'w, 's, (&'static Wire, &'static Transform)>,
@@ -168,29 +180,51 @@ impl ReportView<'_, '_> {
             beads: self
                 .beads
                 .iter()
-                .filter_map(|(bead, _, diverged, transform)| {
+                .filter_map(|(bead, _, diverged, transform, contact)| {
                     Some(BeadReport {
                         world: bead.position.to_array(),
                         pixel: to_pixel(bead.position)?,
                         radius_px: transform.scale.x / self.view.size.y.max(1e-9) * size[1] as f32,
                         diverged: diverged.map(|d| d.reason.to_string()),
+                        in_flight: contact.is_some_and(|c| !c.is_on()),
                     })
                 })
                 .collect(),
             wires: self
                 .wires
                 .iter()
-                .map(|(wire, transform)| WireReport {
-                    shape: wire.shape().name().to_owned(),
-                    pixels: wire_points(
-                        wire.shape(),
-                        &pose_of(transform).unwrap_or_default(),
-                        None,
-                    )
-                    .into_iter()
-                    .filter_map(to_pixel)
-                    .filter(in_window)
-                    .collect(),
+                .map(|(wire, transform)| {
+                    let pose = pose_of(transform).unwrap_or_default();
+                    let points = wire_points(wire.shape(), &pose, None);
+                    let side = wire.surface().side.sign();
+                    let placed = Placed {
+                        curve: wire.shape().curve(),
+                        pose,
+                    };
+                    let length = hatch_length(&self.view);
+                    // The middle of a stroke, on either side.
+                    let probes = |side: f64| -> Vec<[f32; 2]> {
+                        if side == 0.0 {
+                            return Vec::new();
+                        }
+                        points
+                            .iter()
+                            .map(|&p| 0.5 * (p + hatch_point(&placed, p, side, length)))
+                            .filter_map(to_pixel)
+                            .filter(in_window)
+                            .collect()
+                    };
+                    WireReport {
+                        shape: wire.shape().name().to_owned(),
+                        pixels: points
+                            .iter()
+                            .copied()
+                            .filter_map(to_pixel)
+                            .filter(in_window)
+                            .collect(),
+                        closed_side: probes(side),
+                        open_side: probes(-side),
+                    }
                 })
                 .collect(),
             rods: self

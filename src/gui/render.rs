@@ -396,7 +396,7 @@ fn hatch(
     view: &FramedView,
     colour: Color,
 ) {
-    let length = 0.018 * f64::from(view.size.y);
+    let length = hatch_length(view);
     let mut travelled = 0.0;
     for pair in points.windows(2) {
         travelled += (pair[1] - pair[0]).length();
@@ -405,11 +405,23 @@ fn hatch(
         }
         travelled = 0.0;
         let p = pair[1];
-        let normal = curve.gradient(p).normalize_or_zero();
-        let along = DVec2::new(-normal.y, normal.x);
-        let end = p - side * length * normal + 0.5 * length * along;
+        let end = hatch_point(curve, p, side, length);
         gizmos.line_2d(p.as_vec2(), end.as_vec2(), colour.with_alpha(0.6));
     }
+}
+
+/// The length of a hatch stroke in world units, for the framed view.
+pub fn hatch_length(view: &FramedView) -> f64 {
+    0.018 * f64::from(view.size.y)
+}
+
+/// The far end of the hatch stroke from `p` on a wire that pushes toward
+/// `side` (a stroke of `length` toward the other side, slanted along the
+/// wire): a negative `side` gives the mirror stroke, on the open side.
+pub fn hatch_point(curve: &dyn ImplicitCurve, p: DVec2, side: f64, length: f64) -> DVec2 {
+    let normal = curve.gradient(p).normalize_or_zero();
+    let along = DVec2::new(-normal.y, normal.x);
+    p - side * length * normal + 0.5 * length * along
 }
 
 /// The zero set of `curve` inside the rectangle `lo..hi`, as line segments:

@@ -58,17 +58,23 @@ fn screenshot(name: &str) -> (RgbImage, FrameReport) {
     (image, report)
 }
 
-/// Every bead of the report shows the bead colour at its simulated
-/// position.
+/// Every bead of the report shows its colour (the bead colour, or the
+/// flight colour while it is off its wire) at its simulated position.
 fn beads_drawn_where_simulated(image: &RgbImage, report: &FrameReport) {
-    let bead_colour = rgb(wirebead::gui::SceneStyle::default().bead);
+    let style = wirebead::gui::SceneStyle::default();
     assert!(!report.beads.is_empty());
     for bead in &report.beads {
+        let colour = rgb(if bead.in_flight {
+            style.flight
+        } else {
+            style.bead
+        });
         let r = (0.5 * bead.radius_px).max(2.0) as i32;
         assert!(
-            colour_near(image, bead.pixel, r, bead_colour),
-            "no bead colour at {:?}",
-            bead.pixel
+            colour_near(image, bead.pixel, r, colour),
+            "no bead colour at {:?} (in flight: {})",
+            bead.pixel,
+            bead.in_flight
         );
     }
 }
@@ -189,5 +195,49 @@ fn screenshot_of_a_coupled_preset_shows_its_rod_between_its_beads() {
     assert!(
         beside <= 2,
         "rod colour 20 px beside the rod at {beside} points"
+    );
+}
+
+#[test]
+#[ignore = "needs the screenshot .ci/run makes under Xvfb"]
+fn screenshot_of_the_roller_coaster_hatches_the_closed_side_of_its_track() {
+    let (image, report) = screenshot("coaster");
+    assert_eq!(report.preset.as_deref(), Some("Roller coaster"));
+    beads_drawn_where_simulated(&image, &report);
+    let wire_colour = rgb(wirebead::gui::SceneStyle::default().wire);
+    let [track] = report.wires.as_slice() else {
+        panic!("one track expected, got {}", report.wires.len());
+    };
+    assert_eq!(track.shape, "spline");
+    // Away from the bead, the middle of a hatch stroke shows the wire's
+    // colour on the closed side far more often than on the open side.
+    let clear = |p: &[f32; 2]| {
+        report.beads.iter().all(|b| {
+            ((p[0] - b.pixel[0]).powi(2) + (p[1] - b.pixel[1]).powi(2)).sqrt() > 3.0 * b.radius_px
+        })
+    };
+    let share = |probes: &[[f32; 2]]| {
+        let probes: Vec<_> = probes.iter().filter(|p| clear(p)).collect();
+        let hits = probes
+            .iter()
+            .filter(|p| colour_near(&image, **p, 2, wire_colour))
+            .count();
+        (hits as f64 / probes.len().max(1) as f64, probes.len())
+    };
+    let (closed, n_closed) = share(&track.closed_side);
+    let (open, n_open) = share(&track.open_side);
+    eprintln!(
+        "hatching: {closed:.2} of {n_closed} closed-side probes, {open:.2} of {n_open} open-side"
+    );
+    assert!(n_closed > 100 && n_open > 100, "too few probes in view");
+    assert!(
+        closed > 0.15,
+        "hatching at only {:.0}% of the closed side",
+        100.0 * closed
+    );
+    assert!(
+        open < closed / 3.0,
+        "wire colour on the open side at {:.0}%",
+        100.0 * open
     );
 }
