@@ -217,7 +217,7 @@ fn screenshot_of_the_roller_coaster_hatches_the_closed_side_of_its_track() {
         })
     };
     let share = |probes: &[[f32; 2]]| {
-        let probes: Vec<_> = probes.iter().filter(|p| clear(p)).collect();
+        let probes: Vec<[f32; 2]> = probes.iter().copied().filter(|p| clear(p)).collect();
         let hits = probes
             .iter()
             .filter(|p| colour_near(&image, **p, 2, wire_colour))
