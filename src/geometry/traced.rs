@@ -170,7 +170,7 @@ impl<P: Parametric> Traced<P> {
     }
 
     /// The curve's parameter at the point nearest `x`, searched near
-    /// `hint` (see [`Traced::windowed_sample`]).
+    /// `hint` (within [`HINT_WINDOW`] of it, else anywhere).
     pub fn parameter(&self, x: DVec2, hint: f64) -> f64 {
         self.nearest(x, hint).s
     }
