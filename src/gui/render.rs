@@ -22,6 +22,8 @@ pub struct SceneStyle {
     pub background: Color,
     /// Wire strokes.
     pub wire: Color,
+    /// The hatching on the closed side of a one-sided wire.
+    pub hatch: Color,
     /// Beads.
     pub bead: Color,
     /// A diverged bead.
@@ -57,6 +59,7 @@ impl Default for SceneStyle {
         Self {
             background: Color::srgb(0.07, 0.08, 0.10),
             wire: Color::srgb(0.35, 0.80, 1.0),
+            hatch: Color::srgb(0.24, 0.52, 0.66),
             bead: Color::srgb(1.0, 0.55, 0.10),
             diverged: Color::srgb(0.9, 0.1, 0.1),
             trail: Color::srgb(1.0, 0.85, 0.3),
@@ -378,7 +381,7 @@ pub fn draw_wires(
                         curve: shape.curve(),
                         pose,
                     };
-                    hatch(&mut gizmos, &placed, &points, side, &view, style.wire);
+                    hatch(&mut gizmos, &placed, &points, side, &view, style.hatch);
                 }
             }
         }
@@ -406,7 +409,7 @@ fn hatch(
         travelled = 0.0;
         let p = pair[1];
         let end = hatch_point(curve, p, side, length);
-        gizmos.line_2d(p.as_vec2(), end.as_vec2(), colour.with_alpha(0.6));
+        gizmos.line_2d(p.as_vec2(), end.as_vec2(), colour);
     }
 }
 

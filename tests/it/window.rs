@@ -204,12 +204,12 @@ fn screenshot_of_the_roller_coaster_hatches_the_closed_side_of_its_track() {
     let (image, report) = screenshot("coaster");
     assert_eq!(report.preset.as_deref(), Some("Roller coaster"));
     beads_drawn_where_simulated(&image, &report);
-    let wire_colour = rgb(wirebead::gui::SceneStyle::default().wire);
+    let hatch_colour = rgb(wirebead::gui::SceneStyle::default().hatch);
     let [track] = report.wires.as_slice() else {
         panic!("one track expected, got {}", report.wires.len());
     };
     assert_eq!(track.shape, "spline");
-    // Away from the bead, the middle of a hatch stroke shows the wire's
+    // Away from the bead, the middle of a hatch stroke shows the hatching's
     // colour on the closed side far more often than on the open side.
     let clear = |p: &[f32; 2]| {
         report.beads.iter().all(|b| {
@@ -220,7 +220,7 @@ fn screenshot_of_the_roller_coaster_hatches_the_closed_side_of_its_track() {
         let probes: Vec<[f32; 2]> = probes.iter().copied().filter(|p| clear(p)).collect();
         let hits = probes
             .iter()
-            .filter(|p| colour_near(&image, **p, 2, wire_colour))
+            .filter(|p| colour_near(&image, **p, 2, hatch_colour))
             .count();
         (hits as f64 / probes.len().max(1) as f64, probes.len())
     };
