@@ -11,14 +11,14 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::restart::SimClock;
-use super::step::Divergences;
+use super::step::{Divergences, describe_event};
 use super::writeback::place;
 use crate::dynamics::{
-    Bead, BeadDiagnostics, ConstraintDiagnostics, Diverged, DivergenceReason, Joint, OnWire, Pin,
-    Rod, SimParams, Spring, Wire, WirePose,
+    Bead, BeadDiagnostics, ConstraintDiagnostics, ContactChanged, Diverged, DivergenceReason,
+    Joint, OnWire, Pin, Rod, SimParams, Spring, Wire, WireContact, WirePose,
 };
 use crate::solver::{
-    self, BeadState, Island, IslandRow, IslandWork, LinearForce, RowKind, SpringLink,
+    self, BeadState, Contact, Island, IslandRow, IslandWork, LinearForce, RowKind, SpringLink,
 };
 
 /// Marks a bead stepped in an island (joined to another bead or a point,
@@ -298,6 +298,7 @@ pub(crate) fn prepare_islands(
         let mut rows = Vec::new();
         let mut wire_rows = Vec::new();
         let mut invalid = None;
+        let mut sides = Vec::new();
         for (local, &entity) in entities.iter().enumerate() {
             let Ok((_, bead, on_wire, _)) = beads.get(entity) else {
                 invalid = Some(format!("entity {entity} is no longer a bead"));
@@ -307,12 +308,13 @@ pub(crate) fn prepare_islands(
             let Some(on_wire) = on_wire else { continue };
             match wires.get(on_wire.0).map(|(w, p)| (w, p.get())) {
                 Ok((wire, Ok(pose))) => {
-                    if !wire.surface().is_plain() {
+                    if wire.surface().resists() {
                         warn!(
-                            "wirebead: bead {entity} is joined to other beads, and in an island its wire {} holds it two-sided and without friction (its side, restitution, friction and damping apply to lone beads only)",
+                            "wirebead: bead {entity} is joined to other beads, and in an island its wire {} holds it without friction or damping (they apply to lone beads only)",
                             on_wire.0
                         );
                     }
+                    sides.push((rows.len(), *wire.surface()));
                     wire_rows.push((local, rows.len(), on_wire.0));
                     rows.push(IslandRow {
                         kind: RowKind::Wire {
@@ -349,6 +351,12 @@ pub(crate) fn prepare_islands(
             None => Island::new(&masses, rows, springs)
                 .map_err(|e| DivergenceReason::InvalidConstraint(e.to_string())),
         };
+        let built = built.map(|mut island| {
+            for (row, surface) in sides {
+                island.set_side(row, surface.side, surface.restitution);
+            }
+            island
+        });
         match built {
             Ok(island) => islands.cached.push(CachedIsland {
                 report: IslandReport {
@@ -397,9 +405,11 @@ pub(crate) fn step_islands(
             &mut Bead,
             Option<&mut BeadDiagnostics>,
             Option<&mut Transform>,
+            Option<&mut WireContact>,
         ),
         (With<InIsland>, Without<Diverged>),
     >,
+    mut changes: MessageWriter<ContactChanged>,
     wires: Query<(Ref<Wire>, &WirePose)>,
     pins: Query<&Pin>,
     transforms: Query<&Transform, Without<InIsland>>,
@@ -447,8 +457,25 @@ pub(crate) fn step_islands(
         }
         let rows = cached.work.rows();
         let pushed = cached.work.constraint_forces();
+        for &(_, local, event) in cached.work.events() {
+            let bead = cached.report.beads[local];
+            info!("wirebead: bead {bead} {}", describe_event(&event));
+            changes.write(ContactChanged { bead, event });
+        }
+        for &(local, row, _) in &cached.wire_rows {
+            if let Ok((.., Some(mut contact))) = beads.get_mut(cached.report.beads[local]) {
+                let held = if cached.work.holds(row) {
+                    Contact::OnWire
+                } else {
+                    Contact::InFlight
+                };
+                if contact.contact != held {
+                    contact.contact = held;
+                }
+            }
+        }
         for (i, &entity) in cached.report.beads.iter().enumerate() {
-            let Ok((mut bead, bead_diagnostics, transform)) = beads.get_mut(entity) else {
+            let Ok((mut bead, bead_diagnostics, transform, _)) = beads.get_mut(entity) else {
                 continue;
             };
             let state = cached.states[i];

@@ -604,7 +604,7 @@ pub(crate) fn step_beads(
 }
 
 /// A change of contact in words, for the log.
-fn describe_event(event: &ContactEvent) -> String {
+pub(crate) fn describe_event(event: &ContactEvent) -> String {
     match *event {
         ContactEvent::Left { time, position } => format!(
             "left its wire at t = {time:.4} s at ({:.3}, {:.3}), where the wire would have had to pull",

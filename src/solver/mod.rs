@@ -32,8 +32,8 @@ mod step;
 
 pub use contact::{Contact, ContactEvent, SurfaceStep, free_step, step_surface};
 pub use coupled::{
-    Constraint, Island, IslandError, IslandRow, IslandWork, MAX_HALVINGS, REDUNDANT_PIVOT, RowKind,
-    RowReport, SpringLink, islands,
+    Constraint, Island, IslandError, IslandRow, IslandWork, MAX_HALVINGS, OFF_THE_WIRE,
+    REDUNDANT_PIVOT, RowKind, RowReport, SpringLink, islands,
 };
 pub use euler::{explicit_euler, semi_implicit_euler};
 pub use lanes::{CircleLanes, CircleSteps, LANES, is_batched, step_on_circles};

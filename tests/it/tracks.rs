@@ -427,3 +427,74 @@ fn a_bead_rides_a_self_crossing_spline_loop_on_its_branch() {
     assert!(top > 2.0, "never went round the loop (highest {top})");
     assert!(worst < 1e-9, "|C| reached {worst:e}");
 }
+
+/// A cart of two beads joined by a rod on the roller coaster's one-sided
+/// track: solved as an island, it goes round the self-crossing loop, flies
+/// off the hill (both wheels leave) and lands again, the rod held to 1e-9
+/// and each wheel on the track to 1e-9 while it is held.
+#[test]
+fn a_two_bead_cart_rides_the_roller_coaster_and_flies_off_its_hill() {
+    use wirebead::geometry::WireShape;
+    use wirebead::preset::{BeadPreset, ConstraintPreset, RodPreset};
+    let mut scene = preset("roller_coaster.scene.ron");
+    let WireShape::Spline(track) = scene.wires[0].shape.clone() else {
+        panic!("the roller coaster runs on a spline");
+    };
+    let (back, front) = (track.point(0.0), track.point(0.25));
+    let length = (front - back).length();
+    scene.wires[0].beads = vec![
+        BeadPreset {
+            name: "back".into(),
+            mass: 1.0,
+            initial_position: back,
+            ..default()
+        },
+        BeadPreset {
+            name: "front".into(),
+            mass: 1.0,
+            initial_position: front,
+            ..default()
+        },
+    ];
+    scene.constraints = vec![ConstraintPreset::Rod(RodPreset {
+        a: "back".into(),
+        b: "front".into(),
+        length,
+    })];
+    let mut app = app(scene.params.clone());
+    app.init_resource::<Changes>()
+        .add_systems(FixedUpdate, collect_changes.after(WireBeadSystems::Step));
+    let beads = scene.spawn(&mut app.world_mut().commands());
+    app.world_mut().flush();
+    let (mut stretch, mut off, mut top) = (0.0f64, 0.0f64, f64::MIN);
+    for _ in 0..4000 {
+        crate::common::run_steps(&mut app, 1);
+        let at = |b: Entity| app.world().get::<Bead>(b).unwrap().position;
+        stretch = stretch.max(((at(beads[0]) - at(beads[1])).length() - length).abs());
+        for &b in &beads {
+            assert!(app.world().get::<Diverged>(b).is_none());
+            if app.world().get::<WireContact>(b).unwrap().is_on() {
+                off = off.max(crate::common::diagnostics(&app, b).c.abs());
+            }
+            if at(b).x.abs() < 2.0 {
+                top = top.max(at(b).y);
+            }
+        }
+    }
+    let changes = &app.world().resource::<Changes>().0;
+    let left = changes
+        .iter()
+        .filter(|c| matches!(c.event, wirebead::solver::ContactEvent::Left { .. }))
+        .count();
+    let landed = changes.len() - left;
+    eprintln!(
+        "two-bead cart: {left} departures, {landed} landings, rod {stretch:e}, track {off:e}, loop top {top:.2}"
+    );
+    assert!(left >= 2 && landed >= 2, "{changes:?}");
+    assert!(stretch < 1e-9, "the rod stretched by {stretch:e}");
+    assert!(off < 1e-9, "a held wheel was {off:e} off the track");
+    assert!(
+        top > 3.5,
+        "the cart never went round the loop (highest {top})"
+    );
+}

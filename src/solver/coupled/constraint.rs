@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use bevy::math::DVec2;
 
-use crate::geometry::{ImplicitCurve, Placed, Pose, WireShape};
+use crate::geometry::{ImplicitCurve, Near, Placed, Pose, WireShape};
 
 /// A constraint of a game's own among one or more beads: `C(x₁, …, xₖ) = 0`.
 ///
@@ -99,7 +99,8 @@ impl RowKind {
 
     /// `C`, its gradient (into `gradient`, one entry per bead of `beads`)
     /// and `J̇q̇`, where the island's beads are at `x` with velocities `v`.
-    /// `scratch` gathers a custom constraint's beads.
+    /// `scratch` gathers a custom constraint's beads; `hint` is a wire's
+    /// curve parameter where its bead was (see [`ImplicitCurve::parameter`]).
     #[inline]
     pub(crate) fn evaluate(
         &self,
@@ -108,12 +109,16 @@ impl RowKind {
         v: &[DVec2],
         gradient: &mut [DVec2],
         scratch: &mut Vec<DVec2>,
+        hint: f64,
     ) -> (f64, f64) {
         match self {
             Self::Wire { shape, pose } => {
                 let (p, u) = (x[beads[0]], v[beads[0]]);
                 let g = Placed {
-                    curve: shape.curve(),
+                    curve: &Near {
+                        curve: shape.curve(),
+                        hint,
+                    },
                     pose: *pose,
                 }
                 .geometry(p);

@@ -5,7 +5,8 @@ use bevy::math::DVec2;
 
 use super::constraint::{RowKind, SpringLink};
 use super::normal::{Factored, NormalMatrix};
-use crate::geometry::{ImplicitCurve, Placed, Pose, PosePath, WireShape};
+use crate::geometry::{ImplicitCurve, Near, Placed, Pose, PosePath, Side, WireShape};
+use crate::solver::contact::ContactEvent;
 use crate::solver::method::Method;
 use crate::solver::projection::{
     NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE, energy_scale, kinetic_scale,
@@ -13,6 +14,10 @@ use crate::solver::projection::{
 use crate::solver::settings::{Gains, StepSettings};
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
+
+/// How far off a one-sided wire, on the side it pushes toward, a bead must
+/// start (in units of the wire's scale) to start in flight.
+pub const OFF_THE_WIRE: f64 = 1e-9;
 
 /// How many times a step may be halved when its Newton solve finds no
 /// root: at most 2⁶ = 64 substeps.
@@ -112,6 +117,9 @@ pub struct Island {
     normal: NormalMatrix,
     /// The path of each wire row that moves (see [`Island::move_wire`]).
     paths: Vec<Option<PosePath>>,
+    /// Each row's side (+1, −1, or 0 for a two-sided row) and restitution
+    /// (see [`Island::set_side`]).
+    sides: Vec<(f64, f64)>,
 }
 
 /// The buffers one island's step works in, kept between steps so a step
@@ -135,6 +143,13 @@ pub struct IslandWork {
     bias: Vec<f64>,
     /// The time the rows are evaluated at.
     time: f64,
+    /// The rows set aside: one-sided wires their beads have left.
+    inactive: Vec<bool>,
+    /// Each wire row's curve parameter where its bead was after the last
+    /// step (NaN: unknown), so a self-crossing track keeps it on its branch.
+    hints: Vec<f64>,
+    /// What the last step did to one-sided rows: (row, bead, event).
+    events: Vec<(usize, usize, ContactEvent)>,
     rhs: Vec<f64>,
     lambda: Vec<f64>,
     values: Vec<f64>,
@@ -166,6 +181,18 @@ impl IslandWork {
     /// How many rows the last factorization dropped as redundant.
     pub fn redundant(&self) -> usize {
         self.factored.redundant
+    }
+
+    /// Whether row `row` holds its bead: false for a one-sided wire the
+    /// bead has left (see [`Island::set_side`]).
+    pub fn holds(&self, row: usize) -> bool {
+        !self.inactive.get(row).copied().unwrap_or(false)
+    }
+
+    /// The beads that left or landed on a one-sided row in the last step:
+    /// `(row, bead, event)`.
+    pub fn events(&self) -> &[(usize, usize, ContactEvent)] {
+        &self.events
     }
 }
 
@@ -270,6 +297,7 @@ impl Island {
         let normal =
             NormalMatrix::new(&row_start, &entry_bead, beads).ok_or(IslandError::OutOfMemory)?;
         let paths = vec![None; kinds.len()];
+        let sides = vec![(0.0, 0.0); kinds.len()];
         Ok(Self {
             inverse_mass,
             rows: kinds,
@@ -278,6 +306,7 @@ impl Island {
             springs,
             normal,
             paths,
+            sides,
         })
     }
 
@@ -316,6 +345,28 @@ impl Island {
                 *placed_shape = shape;
             }
         }
+    }
+
+    /// Makes the wire of row `row` one-sided (see
+    /// [`Side`](crate::geometry::Side)) with restitution `restitution`:
+    /// where λ takes the sign the wire cannot push with at a step's start,
+    /// the row is set aside and its bead flies with the rest of the island;
+    /// where the bead crosses the wire again by a step's end, it lands
+    /// there (the island projected onto it, the bead's normal velocity
+    /// reversed and scaled by the restitution, the row kept aside if it
+    /// bounced). Events fall on step boundaries here, so their timing is
+    /// first order in the step (a lone bead's are located within the step).
+    pub fn set_side(&mut self, row: usize, side: Side, restitution: f64) {
+        if let (Some(RowKind::Wire { .. }), Some(slot)) =
+            (self.rows.get(row), self.sides.get_mut(row))
+        {
+            *slot = (side.sign(), restitution.clamp(0.0, 1.0));
+        }
+    }
+
+    /// Whether a row is one-sided.
+    fn one_sided(&self) -> bool {
+        self.sides.iter().any(|(side, _)| *side != 0.0)
     }
 
     /// Whether a row's wire moves.
@@ -391,13 +442,180 @@ impl Island {
         settings: &StepSettings,
         work: &mut IslandWork,
     ) -> Result<(), SolveError> {
+        work.events.clear();
+        if work.inactive.len() != self.rows() {
+            // A fresh island: a bead that starts off a one-sided wire, on
+            // the side it pushes toward, starts in flight.
+            let x: Vec<DVec2> = states.iter().map(|s| s.position).collect();
+            work.inactive = (0..self.rows())
+                .map(|r| {
+                    let (side, _) = self.sides[r];
+                    side != 0.0
+                        && x.len() == self.beads()
+                        && side * self.wire_row(r, &x, time).0 > OFF_THE_WIRE * self.rows[r].scale()
+                })
+                .collect();
+        }
+        let one_sided = self.one_sided();
+        if one_sided {
+            self.leave(time, states, forces, work)?;
+        }
         work.substeps = 0;
         match self.advance(time, states, forces, settings, work) {
             Err(SolveError::NoConvergence { .. }) => {
-                self.halve(time, states, forces, settings, work, 1)
+                self.halve(time, states, forces, settings, work, 1)?
             }
-            other => other,
+            other => other?,
         }
+        if one_sided {
+            self.land(time + settings.dt, states, forces, settings.dt, work)?;
+        }
+        self.follow(time + settings.dt, states, work);
+        Ok(())
+    }
+
+    /// Keeps each wire row's curve parameter where its bead is now (at
+    /// `time`), and reports each set-aside row's own `C` and `Ċ`.
+    fn follow(&self, time: f64, states: &[BeadState], work: &mut IslandWork) {
+        work.hints.resize(self.rows(), f64::NAN);
+        for (r, kind) in self.rows.iter().enumerate() {
+            let RowKind::Wire { shape, pose } = kind else {
+                continue;
+            };
+            let Some(state) = states.get(self.entry_bead[self.row_start[r]]) else {
+                continue;
+            };
+            let (pose, twist) = match &self.paths[r] {
+                Some(path) => path.at(time),
+                None => (*pose, Default::default()),
+            };
+            let local = pose.to_local(state.position);
+            work.hints[r] = shape.curve().parameter(local, work.hints[r]);
+            if work.inactive.get(r) == Some(&true)
+                && let Some(report) = work.reports.get_mut(r)
+            {
+                let g = Placed {
+                    curve: shape.curve(),
+                    pose,
+                }
+                .geometry(state.position);
+                report.c = g.c;
+                report.c_dot = g
+                    .normal
+                    .dot(state.velocity - twist.velocity_at(state.position));
+            }
+        }
+    }
+
+    /// Sets aside every one-sided row whose λ (eq. 10 with no
+    /// stabilization) at the step's start has the sign its wire cannot
+    /// push with.
+    fn leave(
+        &self,
+        time: f64,
+        states: &[BeadState],
+        forces: &[LinearForce],
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        if states.len() != self.beads() || forces.len() != self.beads() {
+            return Ok(()); // `advance` reports it
+        }
+        work.x0.clear();
+        work.x0.extend(states.iter().map(|s| s.position));
+        work.v0.clear();
+        work.v0.extend(states.iter().map(|s| s.velocity));
+        work.time = time;
+        self.accelerate(forces, Gains::NONE, work, Stage::Start)?;
+        for r in 0..self.rows() {
+            let (side, _) = self.sides[r];
+            if side != 0.0 && !work.inactive[r] && side * work.lambda[r] < 0.0 {
+                work.inactive[r] = true;
+                let bead = self.entry_bead[self.row_start[r]];
+                let position = states[bead].position;
+                work.events
+                    .push((r, bead, ContactEvent::Left { time, position }));
+            }
+        }
+        Ok(())
+    }
+
+    /// Lands every bead whose set-aside one-sided row it crossed during the
+    /// step: the island projected onto its rows with that one back, the
+    /// bead's velocity across the wire reversed and scaled by the
+    /// restitution.
+    fn land(
+        &self,
+        time: f64,
+        states: &mut [BeadState],
+        forces: &[LinearForce],
+        h: f64,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        work.time = time;
+        for r in 0..self.rows() {
+            let (side, restitution) = self.sides[r];
+            if side == 0.0 || !work.inactive[r] {
+                continue;
+            }
+            let bead = self.entry_bead[self.row_start[r]];
+            let x: Vec<DVec2> = states.iter().map(|s| s.position).collect();
+            let v: Vec<DVec2> = states.iter().map(|s| s.velocity).collect();
+            let (c, normal, wire) = self.wire_row(r, &x, time);
+            if side * c > 0.0 {
+                continue;
+            }
+            // Back on: onto every held row, then the velocities.
+            work.inactive[r] = false;
+            work.x.clone_from(&x);
+            work.v.clone_from(&v);
+            self.newton(work, Direction::Current)?;
+            self.evaluate_at_new(work);
+            let nn = normal.length_squared().max(f64::MIN_POSITIVE);
+            let across = normal.dot(v[bead] - wire);
+            let normal_speed = across.abs() / nn.sqrt();
+            let push =
+                (normal.dot(forces[bead].at(x[bead])) * self.inverse_mass[bead]).abs() / nn.sqrt();
+            let bounced = restitution > 0.0 && restitution * normal_speed > push * h;
+            if bounced {
+                work.bias[r] -= restitution * across;
+            }
+            self.project_velocity(work)?;
+            for (state, (x, v)) in states.iter_mut().zip(work.x.iter().zip(&work.v)) {
+                state.position = *x;
+                state.velocity = *v;
+            }
+            work.inactive[r] = bounced;
+            work.events.push((
+                r,
+                bead,
+                ContactEvent::Landed {
+                    time,
+                    position: states[bead].position,
+                    normal_speed,
+                    bounced,
+                },
+            ));
+        }
+        Ok(())
+    }
+
+    /// `C`, `∇C` and the wire's velocity of wire row `r` at `(x, v)` at
+    /// `time`, whether the row is held or not.
+    fn wire_row(&self, r: usize, x: &[DVec2], time: f64) -> (f64, DVec2, DVec2) {
+        let RowKind::Wire { shape, pose } = &self.rows[r] else {
+            return (0.0, DVec2::ZERO, DVec2::ZERO);
+        };
+        let bead = self.entry_bead[self.row_start[r]];
+        let (pose, twist) = match &self.paths[r] {
+            Some(path) => path.at(time),
+            None => (*pose, Default::default()),
+        };
+        let g = Placed {
+            curve: shape.curve(),
+            pose,
+        }
+        .geometry(x[bead]);
+        (g.c, g.normal, twist.velocity_at(x[bead]))
     }
 
     /// Two steps of half the length of `settings.dt`, each halved again
@@ -517,7 +735,9 @@ impl Island {
 
     /// Evaluates every row at `(x, v)` at `work.time`: gradients, `C`,
     /// `J̇q̇` and the bias `−∂C/∂t`, into `out`.
-    fn evaluate(&self, x: &[DVec2], v: &[DVec2], time: f64, out: Rows<'_>) {
+    fn evaluate(&self, x: &[DVec2], v: &[DVec2], time: f64, held: Held<'_>, out: Rows<'_>) {
+        let Held { inactive, hints } = held;
+        let hint = |r: usize| hints.get(r).copied().unwrap_or(f64::NAN);
         let Rows {
             gradient,
             c,
@@ -532,13 +752,22 @@ impl Island {
         bias.resize(self.rows(), 0.0);
         for (r, kind) in self.rows.iter().enumerate() {
             let range = self.row_start[r]..self.row_start[r + 1];
+            if inactive.get(r) == Some(&true) {
+                // Set aside: no force, no error.
+                gradient[range].fill(DVec2::ZERO);
+                (c[r], curvature[r], bias[r]) = (0.0, 0.0, 0.0);
+                continue;
+            }
             if let (Some(path), RowKind::Wire { shape, .. }) = (&self.paths[r], kind) {
                 // Eq. (13): the wire where it is at `time`, seen from its frame.
                 let bead = self.entry_bead[range.start];
                 let (p, u) = (x[bead], v[bead]);
                 let (pose, twist) = path.at(time);
                 let g = Placed {
-                    curve: shape.curve(),
+                    curve: &Near {
+                        curve: shape.curve(),
+                        hint: hint(r),
+                    },
                     pose,
                 }
                 .geometry(p);
@@ -557,6 +786,7 @@ impl Island {
                 v,
                 &mut gradient[range],
                 scratch,
+                hint(r),
             );
             c[r] = value;
             curvature[r] = bend;
@@ -570,6 +800,10 @@ impl Island {
             &work.x,
             &work.v,
             work.time,
+            Held {
+                inactive: &work.inactive,
+                hints: &work.hints,
+            },
             Rows {
                 gradient: &mut work.gradient,
                 c: &mut work.c,
@@ -587,6 +821,10 @@ impl Island {
             &work.x0,
             &work.v0,
             time,
+            Held {
+                inactive: &work.inactive,
+                hints: &work.hints,
+            },
             Rows {
                 gradient: &mut work.first_gradient,
                 c: &mut work.c,
@@ -641,10 +879,11 @@ impl Island {
         &self,
         gradient: &[DVec2],
         x: &[DVec2],
+        inactive: &[bool],
         factored: &mut Factored,
     ) -> Result<(), SolveError> {
         self.normal
-            .factor(&self.inverse_mass, gradient, factored)
+            .factor(&self.inverse_mass, gradient, inactive, factored)
             .map_err(|r| {
                 let p = x[self.entry_bead[self.row_start[r]]];
                 SolveError::Singular { x: p.x, y: p.y }
@@ -669,7 +908,7 @@ impl Island {
         let (x, v) = (&work.x, &work.v);
         self.applied(forces, x, v, &mut work.force);
         if self.rows() > 0 {
-            self.factor(&work.gradient, x, &mut work.factored)?;
+            self.factor(&work.gradient, x, &work.inactive, &mut work.factored)?;
         }
         work.lambda.clear();
         for r in 0..self.rows() {
@@ -796,7 +1035,7 @@ impl Island {
             let along = match direction {
                 Direction::First => &work.first_gradient,
                 Direction::Current => {
-                    self.factor(&work.gradient, &work.x, &mut work.factored)?;
+                    self.factor(&work.gradient, &work.x, &work.inactive, &mut work.factored)?;
                     &work.gradient
                 }
             };
@@ -837,6 +1076,9 @@ impl Island {
             return Ok(());
         }
         for r in 0..self.rows() {
+            if work.inactive.get(r) == Some(&true) {
+                continue;
+            }
             let turn: f64 = (self.row_start[r]..self.row_start[r + 1])
                 .map(|e| work.gradient[e].dot(work.first_gradient[e]))
                 .sum();
@@ -857,7 +1099,7 @@ impl Island {
         if self.rows() == 0 {
             return Ok(());
         }
-        self.factor(&work.gradient, &work.x, &mut work.factored)?;
+        self.factor(&work.gradient, &work.x, &work.inactive, &mut work.factored)?;
         work.rhs.clear();
         for r in 0..self.rows() {
             work.rhs
@@ -919,7 +1161,12 @@ impl Island {
             *f *= *w;
         }
         if self.rows() > 0 {
-            self.factor(&work.first_gradient, &work.x0, &mut work.factored)?;
+            self.factor(
+                &work.first_gradient,
+                &work.x0,
+                &work.inactive,
+                &mut work.factored,
+            )?;
             work.rhs.clear();
             for r in 0..self.rows() {
                 work.rhs
@@ -955,7 +1202,12 @@ impl Island {
         let n = self.beads();
         self.evaluate_at_start(work, work.time);
         if self.rows() > 0 {
-            self.factor(&work.first_gradient, &work.x0, &mut work.factored)?;
+            self.factor(
+                &work.first_gradient,
+                &work.x0,
+                &work.inactive,
+                &mut work.factored,
+            )?;
         }
         self.applied(forces, &work.x0, &work.v0, &mut work.force);
         work.x.clear();
@@ -990,6 +1242,13 @@ impl Island {
         }
         Ok(())
     }
+}
+
+/// Which rows [`Island::evaluate`] holds, and where along their curves
+/// the wire rows' beads were.
+struct Held<'a> {
+    inactive: &'a [bool],
+    hints: &'a [f64],
 }
 
 /// Where [`Island::evaluate`] writes.

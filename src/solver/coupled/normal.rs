@@ -264,6 +264,7 @@ impl NormalMatrix {
         &self,
         inverse_mass: &[f64],
         gradient: &[DVec2],
+        inactive: &[bool],
         f: &mut Factored,
     ) -> Result<(), usize> {
         let nnz = self.term_start.len() - 1;
@@ -276,6 +277,14 @@ impl NormalMatrix {
         }));
         f.scale.clear();
         for (r, &k) in self.diagonal.iter().enumerate() {
+            if inactive.get(r) == Some(&true) {
+                // A row set aside (a one-sided wire the bead has left): its
+                // gradient is zero, so it meets no other row; a unit
+                // diagonal gives it λ = 0.
+                f.values[k] = 1.0;
+                f.scale.push(1.0);
+                continue;
+            }
             let d = f.values[k];
             if !(d.is_finite() && d > 1e-300) {
                 return Err(r);
