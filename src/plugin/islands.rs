@@ -308,13 +308,7 @@ pub(crate) fn prepare_islands(
             let Some(on_wire) = on_wire else { continue };
             match wires.get(on_wire.0).map(|(w, p)| (w, p.get())) {
                 Ok((wire, Ok(pose))) => {
-                    if wire.surface().resists() {
-                        warn!(
-                            "wirebead: bead {entity} is joined to other beads, and in an island its wire {} holds it without friction or damping (they apply to lone beads only)",
-                            on_wire.0
-                        );
-                    }
-                    sides.push((rows.len(), *wire.surface()));
+                    sides.push((rows.len(), local, *wire.surface()));
                     wire_rows.push((local, rows.len(), on_wire.0));
                     rows.push(IslandRow {
                         kind: RowKind::Wire {
@@ -345,6 +339,21 @@ pub(crate) fn prepare_islands(
                 rows.push(row);
             }
         }
+        // A rough wire's bead gets a row to hold it still while static
+        // friction can (set aside while it slides).
+        let mut sticks = Vec::new();
+        for &(row, local, surface) in &sides {
+            if surface.friction.is_some() {
+                sticks.push((row, rows.len()));
+                rows.push(IslandRow {
+                    kind: RowKind::Axis {
+                        axis: DVec2::X,
+                        offset: 0.0,
+                    },
+                    beads: vec![local],
+                });
+            }
+        }
         let row_count = rows.len();
         let built = match invalid {
             Some(why) => Err(DivergenceReason::InvalidWire(why)),
@@ -352,8 +361,12 @@ pub(crate) fn prepare_islands(
                 .map_err(|e| DivergenceReason::InvalidConstraint(e.to_string())),
         };
         let built = built.map(|mut island| {
-            for (row, surface) in sides {
+            for (row, _, surface) in sides {
                 island.set_side(row, surface.side, surface.restitution);
+                if surface.resists() {
+                    let stick = sticks.iter().find(|s| s.0 == row).map(|s| s.1);
+                    island.set_rough(row, surface.friction, surface.damping, stick);
+                }
             }
             island
         });

@@ -498,3 +498,41 @@ fn a_two_bead_cart_rides_the_roller_coaster_and_flies_off_its_hill() {
         "the cart never went round the loop (highest {top})"
     );
 }
+
+/// A scene's rough wire through the plugin: a lone bead and a two-bead
+/// cart (an island), each sent at 3 m/s along a line with
+/// `friction: (static: 0.5, kinetic: 0.3)`, stop after `v0² / (2 μk g)`.
+#[test]
+fn a_scene_with_a_rough_wire_stops_lone_beads_and_carts_at_the_coulomb_distance() {
+    let scene = ScenePreset::from_ron(
+        "(name: \"rough\", params: (integrator: Rattle, timestep: 0.004),
+          wires: [
+            (shape: Line(()), friction: (static: 0.5, kinetic: 0.3),
+             beads: [(name: \"lone\", mass: 1.0, initial_velocity: (3.0, 0.0))]),
+            (shape: Line(()), position: (0.0, -5.0), friction: (static: 0.5, kinetic: 0.3),
+             beads: [(name: \"front\", mass: 1.0, initial_position: (0.5, -5.0), initial_velocity: (3.0, 0.0)),
+                     (name: \"back\", mass: 2.0, initial_position: (0.0, -5.0), initial_velocity: (3.0, 0.0))]),
+          ],
+          constraints: [Rod((a: \"front\", b: \"back\", length: 0.5))])",
+    )
+    .unwrap();
+    let mut app = app(scene.params.clone());
+    let beads = scene.spawn(&mut app.world_mut().commands());
+    app.world_mut().flush();
+    run_for(&mut app, 3.0);
+    let expected = 9.0 / (2.0 * 0.3 * 9.81);
+    for (bead, start) in [(beads[0], 0.0), (beads[2], 0.0)] {
+        let b = app.world().get::<Bead>(bead).unwrap();
+        let error = ((b.position.x - start) - expected).abs() / expected;
+        eprintln!(
+            "rough scene: stopped after {:.6} m (relative error {error:.2e})",
+            b.position.x
+        );
+        assert!(
+            error < 1e-3,
+            "stopped after {}, not {expected}",
+            b.position.x
+        );
+        assert!(b.velocity.length() < 1e-9);
+    }
+}

@@ -5,7 +5,7 @@ use bevy::math::DVec2;
 
 use super::constraint::{RowKind, SpringLink};
 use super::normal::{Factored, NormalMatrix};
-use crate::geometry::{ImplicitCurve, Near, Placed, Pose, PosePath, Side, WireShape};
+use crate::geometry::{Friction, ImplicitCurve, Near, Placed, Pose, PosePath, Side, WireShape};
 use crate::solver::contact::ContactEvent;
 use crate::solver::method::Method;
 use crate::solver::projection::{
@@ -120,6 +120,18 @@ pub struct Island {
     /// Each row's side (+1, −1, or 0 for a two-sided row) and restitution
     /// (see [`Island::set_side`]).
     sides: Vec<(f64, f64)>,
+    /// Each wire row's friction, if it has any (see [`Island::set_rough`]).
+    rough: Vec<Option<RoughRow>>,
+}
+
+/// Friction and damping along one wire row, and the row that holds its bead
+/// still while static friction does.
+#[derive(Clone, Copy, Debug)]
+struct RoughRow {
+    friction: Friction,
+    damping: f64,
+    /// An axis row, set aside while the bead slides.
+    stick: Option<usize>,
 }
 
 /// The buffers one island's step works in, kept between steps so a step
@@ -148,6 +160,8 @@ pub struct IslandWork {
     /// Each wire row's curve parameter where its bead was after the last
     /// step (NaN: unknown), so a self-crossing track keeps it on its branch.
     hints: Vec<f64>,
+    /// Where each stick row holds its bead: the line `axis·x = offset`.
+    sticks: Vec<Option<(DVec2, f64)>>,
     /// What the last step did to one-sided rows: (row, bead, event).
     events: Vec<(usize, usize, ContactEvent)>,
     rhs: Vec<f64>,
@@ -298,6 +312,7 @@ impl Island {
             NormalMatrix::new(&row_start, &entry_bead, beads).ok_or(IslandError::OutOfMemory)?;
         let paths = vec![None; kinds.len()];
         let sides = vec![(0.0, 0.0); kinds.len()];
+        let rough = vec![None; kinds.len()];
         Ok(Self {
             inverse_mass,
             rows: kinds,
@@ -307,6 +322,7 @@ impl Island {
             normal,
             paths,
             sides,
+            rough,
         })
     }
 
@@ -362,6 +378,45 @@ impl Island {
         {
             *slot = (side.sign(), restitution.clamp(0.0, 1.0));
         }
+    }
+
+    /// Gives the wire of row `row` Coulomb friction and viscous damping
+    /// along it, eq. (14b). `stick` names an axis row of the same bead
+    /// (`RowKind::Axis`, any axis) the island uses to hold the bead still
+    /// while static friction can: it is set aside while the bead slides,
+    /// placed across the wire where the bead stops, and set aside again
+    /// when the force it needs passes `μs |λ∇C|`. Kinetic friction and
+    /// damping act as forces held at their value at the step's start. A
+    /// bead on a moving wire does not stick in an island (it slides).
+    pub fn set_rough(
+        &mut self,
+        row: usize,
+        friction: Friction,
+        damping: f64,
+        stick: Option<usize>,
+    ) {
+        let stick = stick.filter(|&s| {
+            matches!(self.rows.get(s), Some(RowKind::Axis { .. }))
+                && self.entry_bead.get(self.row_start[s])
+                    == self.entry_bead.get(self.row_start[row])
+        });
+        if let (Some(RowKind::Wire { .. }), Some(slot)) =
+            (self.rows.get(row), self.rough.get_mut(row))
+        {
+            *slot = Some(RoughRow {
+                friction,
+                damping: damping.max(0.0),
+                stick,
+            });
+        }
+    }
+
+    /// Whether a row is a stick row of a rough wire.
+    fn is_stick(&self, row: usize) -> bool {
+        self.rough
+            .iter()
+            .flatten()
+            .any(|rough| rough.stick == Some(row))
     }
 
     /// Whether a row is one-sided.
@@ -445,21 +500,48 @@ impl Island {
         work.events.clear();
         if work.inactive.len() != self.rows() {
             // A fresh island: a bead that starts off a one-sided wire, on
-            // the side it pushes toward, starts in flight.
+            // the side it pushes toward, starts in flight; stick rows start
+            // set aside (a bead slides until friction stops it).
             let x: Vec<DVec2> = states.iter().map(|s| s.position).collect();
             work.inactive = (0..self.rows())
                 .map(|r| {
                     let (side, _) = self.sides[r];
-                    side != 0.0
-                        && x.len() == self.beads()
-                        && side * self.wire_row(r, &x, time).0 > OFF_THE_WIRE * self.rows[r].scale()
+                    self.is_stick(r)
+                        || (side != 0.0
+                            && x.len() == self.beads()
+                            && side * self.wire_row(r, &x, time).0
+                                > OFF_THE_WIRE * self.rows[r].scale())
                 })
                 .collect();
+            // A bead at rest on a rough wire starts held by static friction.
+            for (r, rough) in self.rough.iter().enumerate() {
+                let Some(RoughRow { stick: Some(s), .. }) = rough else {
+                    continue;
+                };
+                let bead = self.entry_bead[self.row_start[r]];
+                if work.inactive[r] || self.paths[r].is_some() || x.len() != self.beads() {
+                    continue;
+                }
+                let (_, normal, wire) = self.wire_row(r, &x, time);
+                if states[bead].velocity == wire {
+                    let axis = DVec2::new(-normal.y, normal.x).normalize_or_zero();
+                    self.place_stick(*s, axis, axis.dot(x[bead]), work);
+                }
+            }
         }
         let one_sided = self.one_sided();
-        if one_sided {
+        let rough = self.rough.iter().any(Option::is_some);
+        if one_sided || rough {
             self.leave(time, states, forces, work)?;
         }
+        let mut resisted = Vec::new();
+        let slides = if rough && states.len() == self.beads() && forces.len() == self.beads() {
+            resisted.extend_from_slice(forces);
+            self.resist(time, states, &mut resisted, work)
+        } else {
+            Vec::new()
+        };
+        let forces = if rough { &resisted[..] } else { forces };
         work.substeps = 0;
         match self.advance(time, states, forces, settings, work) {
             Err(SolveError::NoConvergence { .. }) => {
@@ -470,8 +552,128 @@ impl Island {
         if one_sided {
             self.land(time + settings.dt, states, forces, settings.dt, work)?;
         }
+        if rough {
+            self.stop(time + settings.dt, states, &slides, work)?;
+        }
         self.follow(time + settings.dt, states, work);
         Ok(())
+    }
+
+    /// Eq. (14b) on the island at the step's start (λ from
+    /// [`Island::leave`]): releases every stick row whose force passes
+    /// static friction, and adds kinetic friction and damping to the force
+    /// on each sliding bead. Returns each rough row's bead and its sliding
+    /// velocity at the start.
+    fn resist(
+        &self,
+        time: f64,
+        states: &[BeadState],
+        forces: &mut [LinearForce],
+        work: &mut IslandWork,
+    ) -> Vec<(usize, usize, DVec2)> {
+        let x: Vec<DVec2> = states.iter().map(|s| s.position).collect();
+        let mut slides = Vec::new();
+        for (r, rough) in self.rough.iter().enumerate() {
+            let Some(rough) = rough else { continue };
+            let bead = self.entry_bead[self.row_start[r]];
+            if work.inactive[r] {
+                // In flight: nothing to rub against, nothing to stick to.
+                if let Some(s) = rough.stick {
+                    work.inactive[s] = true;
+                }
+                continue;
+            }
+            let (_, normal, wire) = self.wire_row(r, &x, time);
+            let nn = normal.length_squared();
+            if nn.is_nan() || nn <= 0.0 {
+                continue;
+            }
+            let press = work.lambda[r].abs() * nn.sqrt();
+            let relative = states[bead].velocity - wire;
+            let sliding = relative - normal * (normal.dot(relative) / nn);
+            let mut direction = sliding;
+            if let Some(s) = rough.stick
+                && !work.inactive[s]
+            {
+                let hold = work.lambda[s];
+                if hold.abs() <= rough.friction.static_coefficient * press {
+                    continue; // held still
+                }
+                // It gives way: it slides toward the pull, against λ's push.
+                work.inactive[s] = true;
+                if let RowKind::Axis { axis, .. } = self.rows[s] {
+                    direction = -hold * axis;
+                }
+            }
+            let speed = direction.length();
+            if speed > 0.0 {
+                forces[bead].force -=
+                    (rough.friction.kinetic_coefficient * press / speed) * direction;
+            }
+            forces[bead].force -= rough.damping * sliding;
+            slides.push((r, bead, sliding));
+        }
+        slides
+    }
+
+    /// Where friction stopped a sliding bead during the step (its sliding
+    /// velocity reversed), puts its stick row across the wire there and
+    /// projects the island's velocities onto the rows with it: the bead
+    /// stays put while static friction can hold it.
+    fn stop(
+        &self,
+        time: f64,
+        states: &mut [BeadState],
+        slides: &[(usize, usize, DVec2)],
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        let x: Vec<DVec2> = states.iter().map(|s| s.position).collect();
+        let mut stopped = false;
+        for &(r, bead, before) in slides {
+            let Some(RoughRow {
+                stick: Some(s),
+                friction,
+                ..
+            }) = self.rough[r]
+            else {
+                continue;
+            };
+            if work.inactive[r] || self.paths[r].is_some() || !friction.is_some() {
+                continue;
+            }
+            let (_, normal, wire) = self.wire_row(r, &x, time);
+            let nn = normal.length_squared();
+            let relative = states[bead].velocity - wire;
+            let sliding = relative - normal * (normal.dot(relative) / nn);
+            if before != DVec2::ZERO && sliding.dot(before) >= 0.0 {
+                continue;
+            }
+            if before == DVec2::ZERO && sliding == DVec2::ZERO {
+                continue;
+            }
+            let axis = DVec2::new(-normal.y, normal.x).normalize_or_zero();
+            self.place_stick(s, axis, axis.dot(x[bead]), work);
+            stopped = true;
+        }
+        if stopped {
+            work.time = time;
+            work.x.clone_from(&x);
+            work.v.clear();
+            work.v.extend(states.iter().map(|s| s.velocity));
+            self.evaluate_at_new(work);
+            self.project_velocity(work)?;
+            for (state, v) in states.iter_mut().zip(&work.v) {
+                state.velocity = *v;
+            }
+        }
+        Ok(())
+    }
+
+    /// Takes stick row `s` back, as the line `axis·x = offset`.
+    fn place_stick(&self, s: usize, axis: DVec2, offset: f64, work: &mut IslandWork) {
+        work.inactive[s] = false;
+        work.sticks.resize(self.rows(), None);
+        work.sticks[s] = Some((axis, offset));
     }
 
     /// Keeps each wire row's curve parameter where its bead is now (at
@@ -702,11 +904,16 @@ impl Island {
             }
         }
         if settings.method.projects() {
+            let rough = self.rough.iter().any(Option::is_some);
             let restore = if self.moves() {
                 // A moving wire does work: there is no energy or speed to keep.
                 Restore::Nothing
             } else if settings.method.is_euler() {
+                // Friction is in the kick (the forces it is given).
                 Restore::Speed(settings.dt)
+            } else if rough {
+                // Friction takes energy away: none to keep.
+                Restore::Nothing
             } else {
                 Restore::Energy
             };
@@ -736,7 +943,11 @@ impl Island {
     /// Evaluates every row at `(x, v)` at `work.time`: gradients, `C`,
     /// `J̇q̇` and the bias `−∂C/∂t`, into `out`.
     fn evaluate(&self, x: &[DVec2], v: &[DVec2], time: f64, held: Held<'_>, out: Rows<'_>) {
-        let Held { inactive, hints } = held;
+        let Held {
+            inactive,
+            hints,
+            sticks,
+        } = held;
         let hint = |r: usize| hints.get(r).copied().unwrap_or(f64::NAN);
         let Rows {
             gradient,
@@ -756,6 +967,13 @@ impl Island {
                 // Set aside: no force, no error.
                 gradient[range].fill(DVec2::ZERO);
                 (c[r], curvature[r], bias[r]) = (0.0, 0.0, 0.0);
+                continue;
+            }
+            if let Some(Some((axis, offset))) = sticks.get(r) {
+                // A stick row, placed where its bead stopped.
+                let bead = self.entry_bead[range.start];
+                gradient[range.start] = *axis;
+                (c[r], curvature[r], bias[r]) = (axis.dot(x[bead]) - offset, 0.0, 0.0);
                 continue;
             }
             if let (Some(path), RowKind::Wire { shape, .. }) = (&self.paths[r], kind) {
@@ -803,6 +1021,7 @@ impl Island {
             Held {
                 inactive: &work.inactive,
                 hints: &work.hints,
+                sticks: &work.sticks,
             },
             Rows {
                 gradient: &mut work.gradient,
@@ -824,6 +1043,7 @@ impl Island {
             Held {
                 inactive: &work.inactive,
                 hints: &work.hints,
+                sticks: &work.sticks,
             },
             Rows {
                 gradient: &mut work.first_gradient,
@@ -1249,6 +1469,7 @@ impl Island {
 struct Held<'a> {
     inactive: &'a [bool],
     hints: &'a [f64],
+    sticks: &'a [Option<(DVec2, f64)>],
 }
 
 /// Where [`Island::evaluate`] writes.

@@ -1000,3 +1000,98 @@ fn a_two_bead_cart_too_fast_for_a_one_sided_hump_flies_off_it() {
         "the centre of mass fell at g off by {worst:e}"
     );
 }
+
+/// A cart of two beads joined by a rod, both on a rough line tilted by
+/// `degrees`, the rough rows with their stick rows.
+fn rough_cart(degrees: f64, friction: crate::geometry::Friction) -> Island {
+    let line = WireShape::Line(Line);
+    let pose = Pose::new(DVec2::ZERO, degrees.to_radians());
+    let stick = |bead| IslandRow {
+        kind: RowKind::Axis {
+            axis: DVec2::X,
+            offset: 0.0,
+        },
+        beads: vec![bead],
+    };
+    let mut island = Island::new(
+        &[1.0, 2.0],
+        vec![
+            wire(0, line.clone(), pose),
+            wire(1, line.clone(), pose),
+            rod(0, 1, 0.5),
+            stick(0),
+            stick(1),
+        ],
+        vec![],
+    )
+    .unwrap();
+    island.set_rough(0, friction, 0.0, Some(3));
+    island.set_rough(1, friction, 0.0, Some(4));
+    island
+}
+
+/// Friction in an island: a two-bead cart sent at 3 m/s along a rough
+/// horizontal line (μk = 0.3) stops after `v0² / (2 μk g)` and stays; from
+/// rest on a slope gentler than `atan μs` it stays exactly where it is,
+/// on a steeper one it slides.
+#[test]
+fn a_two_bead_cart_on_a_rough_line_stops_at_the_coulomb_distance_and_sticks() {
+    use crate::geometry::Friction;
+    let friction = Friction::new(0.5, 0.3).unwrap();
+    let forces = weights(&[1.0, 2.0]);
+    let h = 1.0 / 240.0;
+    for method in [Method::Rattle, Method::Rk4(Stabilization::Projection)] {
+        let s = settings(method, h);
+        let island = rough_cart(0.0, friction);
+        let v0 = 3.0;
+        let mut states: Vec<BeadState> = [0.5, 0.0]
+            .map(|x| BeadState {
+                position: DVec2::new(x, 0.0),
+                velocity: DVec2::new(v0, 0.0),
+            })
+            .to_vec();
+        let mut work = IslandWork::default();
+        for k in 0..720 {
+            island
+                .step_at(k as f64 * h, &mut states, &forces, &s, &mut work)
+                .unwrap();
+        }
+        let expected = v0 * v0 / (2.0 * 0.3 * 9.81);
+        let travelled = states[1].position.x;
+        let error = (travelled - expected).abs() / expected;
+        eprintln!("{method}: the cart stopped after {travelled:.6} m (relative error {error:.2e})");
+        assert!(
+            error < 1e-3,
+            "{method}: stopped after {travelled}, not {expected}"
+        );
+        assert!(
+            states.iter().all(|s| s.velocity.length() < 1e-9),
+            "{states:?}"
+        );
+    }
+    let limit = 0.5f64.atan().to_degrees();
+    for (degrees, slides) in [(limit - 2.0, false), (limit + 2.0, true)] {
+        let island = rough_cart(degrees, friction);
+        let a = degrees.to_radians();
+        let start: Vec<BeadState> = [0.5, 0.0]
+            .map(|d| BeadState {
+                position: d * DVec2::new(a.cos(), a.sin()),
+                velocity: DVec2::ZERO,
+            })
+            .to_vec();
+        let mut states = start.clone();
+        let mut work = IslandWork::default();
+        let s = settings(Method::Rattle, h);
+        for k in 0..240 {
+            island
+                .step_at(k as f64 * h, &mut states, &forces, &s, &mut work)
+                .unwrap();
+        }
+        let moved = (states[1].position - start[1].position).length();
+        if slides {
+            assert!(moved > 0.1, "at {degrees:.1}° the cart stuck");
+        } else {
+            assert!(moved < 1e-12, "at {degrees:.1}° the cart crept {moved:e}");
+        }
+    }
+}
