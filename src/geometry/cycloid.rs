@@ -3,10 +3,11 @@
 use std::f64::consts::{PI, TAU};
 use std::sync::Arc;
 
-use bevy::math::{DMat2, DVec2};
+use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
 
-use super::{Geometry, ImplicitCurve, Parametric, Traced};
+use super::traced::traced_curve;
+use super::{Parametric, Traced};
 
 /// One arch of a cycloid hanging cusps up, vertex at the local origin:
 /// `x = r(φ − sin φ) − πr`, `y = r(1 + cos φ)`, `φ ∈ [0, 2π]`, `r` the
@@ -108,35 +109,4 @@ impl Parametric for CycloidArch {
     }
 }
 
-impl ImplicitCurve for Cycloid {
-    fn value(&self, p: DVec2) -> f64 {
-        self.traced.value(p)
-    }
-    fn gradient(&self, p: DVec2) -> DVec2 {
-        self.traced.gradient(p)
-    }
-    fn hessian(&self, p: DVec2) -> DMat2 {
-        self.traced.hessian(p)
-    }
-    fn scale(&self) -> f64 {
-        self.radius
-    }
-    fn geometry(&self, p: DVec2) -> Geometry {
-        self.traced.geometry(p)
-    }
-    fn has_ends(&self) -> bool {
-        true
-    }
-    fn past_end(&self, p: DVec2) -> f64 {
-        self.traced.past_end(p)
-    }
-    fn parameter(&self, p: DVec2, hint: f64) -> f64 {
-        self.traced.parameter(p, hint)
-    }
-    fn geometry_near(&self, p: DVec2, hint: f64) -> Geometry {
-        self.traced.geometry_near(p, hint)
-    }
-    fn past_end_near(&self, p: DVec2, hint: f64) -> f64 {
-        self.traced.past_end_near(p, hint)
-    }
-}
+traced_curve!(Cycloid, |this| this.radius);

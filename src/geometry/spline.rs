@@ -3,10 +3,11 @@
 use std::sync::Arc;
 
 use bevy::math::cubic_splines::CubicCurve;
-use bevy::math::{DMat2, DVec2, Vec2};
+use bevy::math::{DVec2, Vec2};
 use serde::{Deserialize, Serialize};
 
-use super::{Geometry, ImplicitCurve, Parametric, Traced};
+use super::traced::traced_curve;
+use super::{Parametric, Traced};
 use crate::validate::ParamError;
 
 /// How a spline's points make its curve (Bevy's generators of
@@ -294,42 +295,12 @@ impl Parametric for CubicPath {
     }
 }
 
-impl ImplicitCurve for Spline {
-    fn value(&self, p: DVec2) -> f64 {
-        self.traced.value(p)
-    }
-    fn gradient(&self, p: DVec2) -> DVec2 {
-        self.traced.gradient(p)
-    }
-    fn hessian(&self, p: DVec2) -> DMat2 {
-        self.traced.hessian(p)
-    }
-    fn scale(&self) -> f64 {
-        self.traced.scale()
-    }
-    fn geometry(&self, p: DVec2) -> Geometry {
-        self.traced.geometry(p)
-    }
-    fn has_ends(&self) -> bool {
-        self.traced.has_ends()
-    }
-    fn past_end(&self, p: DVec2) -> f64 {
-        self.traced.past_end(p)
-    }
-    fn parameter(&self, p: DVec2, hint: f64) -> f64 {
-        self.traced.parameter(p, hint)
-    }
-    fn geometry_near(&self, p: DVec2, hint: f64) -> Geometry {
-        self.traced.geometry_near(p, hint)
-    }
-    fn past_end_near(&self, p: DVec2, hint: f64) -> f64 {
-        self.traced.past_end_near(p, hint)
-    }
-}
+traced_curve!(Spline, |this| this.traced.scale());
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::ImplicitCurve;
     use bevy::math::cubic_splines::{
         CubicBSpline, CubicCardinalSpline, CubicGenerator, CubicHermite, CyclicCubicGenerator,
     };

@@ -23,7 +23,9 @@ use crate::dynamics::{
 use crate::geometry::{
     FixedTrack, MovingTrack, Near, Placed, Pose, PoseHistory, PosePath, Surface, Track, WireShape,
 };
-use crate::solver::{self, Contact, ContactEvent, StepOutput, StepSettings};
+use crate::solver::{
+    self, BeadState, Contact, ContactEvent, LinearForce, StepOutput, StepSettings,
+};
 
 /// Prepares the step: places every wire (reads each changed wire
 /// `Transform` once, so the beads do not; writes the `Transform` of a wire
@@ -333,14 +335,36 @@ impl StepContext<'_> {
         track: &T,
         bead: &Bead,
     ) -> Result<StepOutput, DivergenceReason> {
+        let (state, force, start) = self.start(bead)?;
+        solver::step_on(track, start, state, &force, bead.mass(), &self.settings)
+            .map_err(DivergenceReason::Solve)
+    }
+
+    /// [`solver::step_surface`] for one bead on `track`.
+    fn surface_step<T: Track + ?Sized>(
+        &self,
+        track: &T,
+        bead: &Bead,
+        surface: &Surface,
+        contact: Contact,
+    ) -> Result<solver::SurfaceStep, DivergenceReason> {
+        let (state, force, start) = self.start(bead)?;
+        let (mass, settings) = (bead.mass(), &self.settings);
+        solver::step_surface(
+            track, start, state, &force, mass, settings, surface, contact,
+        )
+        .map_err(DivergenceReason::Solve)
+    }
+
+    /// A bead's state (checked finite), the force on it and the time the
+    /// step starts.
+    fn start(&self, bead: &Bead) -> Result<(BeadState, LinearForce, f64), DivergenceReason> {
         let state = bead.state();
         if !state.is_finite() {
             return Err(DivergenceReason::NonFiniteState);
         }
         let force = bead.step_force(self.params.gravity);
-        let start = self.time - self.settings.dt;
-        solver::step_on(track, start, state, &force, bead.mass(), &self.settings)
-            .map_err(DivergenceReason::Solve)
+        Ok((state, force, self.time - self.settings.dt))
     }
 
     /// One bead on a wire with a surface (one-sided, rough or damped):
@@ -353,12 +377,6 @@ impl StepContext<'_> {
         entity: Entity,
         contact: Option<&mut WireContact>,
     ) -> Result<StepOutput, DivergenceReason> {
-        let state = bead.state();
-        if !state.is_finite() {
-            return Err(DivergenceReason::NonFiniteState);
-        }
-        let force = bead.step_force(self.params.gravity);
-        let start = self.time - self.settings.dt;
         let from = contact.as_deref().map_or(Contact::OnWire, WireContact::get);
         let hint = contact.as_deref().map_or(f64::NAN, WireContact::along);
         let TableWire {
@@ -371,28 +389,11 @@ impl StepContext<'_> {
             hint,
         };
         let stepped = match path.fixed() {
-            Some(pose) => solver::step_surface(
-                &FixedTrack(&Placed { curve, pose }),
-                start,
-                state,
-                &force,
-                bead.mass(),
-                &self.settings,
-                surface,
-                from,
-            ),
-            None => solver::step_surface(
-                &MovingTrack { curve, path },
-                start,
-                state,
-                &force,
-                bead.mass(),
-                &self.settings,
-                surface,
-                from,
-            ),
-        }
-        .map_err(DivergenceReason::Solve)?;
+            Some(pose) => {
+                self.surface_step(&FixedTrack(&Placed { curve, pose }), bead, surface, from)
+            }
+            None => self.surface_step(&MovingTrack { curve, path }, bead, surface, from),
+        }?;
         if let Some(contact) = contact {
             contact.contact = stepped.contact;
             let local = path.pose(self.time).to_local(stepped.output.state.position);

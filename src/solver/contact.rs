@@ -177,21 +177,16 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         let side = self.surface.side.sign();
         let cut = events < MAX_EVENTS;
         let ends = self.track.has_ends();
-        if ends && cut && self.track.past_end(t, state.position) > 0.0 {
-            return self.off_the_end(t, h, state, events);
+        // How far on the wire the bead is: negative past an end; λ's sign
+        // the wire can push with.
+        let on_the_curve = |t: f64, x: BeadState| -self.track.past_end(t, x.position);
+        let pushing = |t: f64, x: BeadState| Ok::<f64, SolveError>(side * self.lambda(t, x)?);
+        if cut && ends && on_the_curve(t, state) < 0.0 {
+            return self.leave(t, h, state, events);
         }
-        let start = if side != 0.0 {
-            side * self.lambda(t, state)?
-        } else {
-            0.0
-        };
-        if side != 0.0 && cut && start < 0.0 {
-            let mut flown = self.in_flight(t, h, state, events + 1)?;
-            flown.event = flown.event.or(Some(ContactEvent::Left {
-                time: t,
-                position: state.position,
-            }));
-            return Ok(flown);
+        let start = if side != 0.0 { pushing(t, state)? } else { 0.0 };
+        if cut && side != 0.0 && start < 0.0 {
+            return self.leave(t, h, state, events);
         }
         let friction = self.surface.friction.is_some();
         let (_, sliding, _) = self.split(t, state)?;
@@ -199,45 +194,31 @@ impl<T: Track + ?Sized> Walk<'_, T> {
             return self.held(t, h, state);
         }
         let out = self.slide(t, h, state, sliding)?;
-        if ends && cut && self.track.past_end(t + h, out.state.position) > 0.0 {
-            // It passed an end within the step: cut there.
-            let before = -self.track.past_end(t, state.position);
-            let tau = self.locate(h, before, |tau| {
-                let part = self.slide(t, tau, state, sliding)?;
-                Ok(-self.track.past_end(t + tau, part.state.position))
+        let end = t + h;
+        if cut && ends && on_the_curve(end, out.state) < 0.0 {
+            // It passed an end within the step: it leaves there.
+            let at = self.cut(t, h, state, sliding, on_the_curve(t, state), |tau, x| {
+                Ok(on_the_curve(t + tau, x))
             })?;
-            let at = self.slide(t, tau, state, sliding)?;
-            return self.off_the_end(t + tau, h - tau, at.state, events);
+            return self.leave(at.0, t + h - at.0, at.1, events);
         }
-        if side != 0.0 && cut && side * self.lambda(t + h, out.state)? < 0.0 {
-            let tau = self.locate(h, start, |tau| {
-                let part = self.slide(t, tau, state, sliding)?;
-                Ok(side * self.lambda(t + tau, part.state)?)
-            })?;
-            let at = self.slide(t, tau, state, sliding)?;
-            let mut flown = self.in_flight(t + tau, h - tau, at.state, events + 1)?;
-            flown.event = flown.event.or(Some(ContactEvent::Left {
-                time: t + tau,
-                position: at.state.position,
-            }));
-            return Ok(flown);
+        if cut && side != 0.0 && pushing(end, out.state)? < 0.0 {
+            // The wire would have to pull within the step: it leaves there.
+            let at = self.cut(t, h, state, sliding, start, |tau, x| pushing(t + tau, x))?;
+            return self.leave(at.0, t + h - at.0, at.1, events);
         }
-        if friction && cut {
-            let (_, after, _) = self.split(t + h, out.state)?;
-            if sliding.dot(after) < 0.0 {
-                // Friction stopped the bead within the step: cut there.
-                let tau = self.locate(h, sliding.length_squared(), |tau| {
-                    let part = self.slide(t, tau, state, sliding)?;
-                    Ok(self.split(t + tau, part.state)?.1.dot(sliding))
+        if cut && friction && sliding.dot(self.split(end, out.state)?.1) < 0.0 {
+            // Friction stopped the bead within the step: it stops there.
+            let (when, at) =
+                self.cut(t, h, state, sliding, sliding.length_squared(), |tau, x| {
+                    Ok(self.split(t + tau, x)?.1.dot(sliding))
                 })?;
-                let at = self.slide(t, tau, state, sliding)?;
-                let (wire, _, across) = self.split(t + tau, at.state)?;
-                let stopped = BeadState {
-                    velocity: wire + across,
-                    ..at.state
-                };
-                return self.on_wire(t + tau, h - tau, stopped, events + 1);
-            }
+            let (wire, _, across) = self.split(when, at)?;
+            let stopped = BeadState {
+                velocity: wire + across,
+                ..at
+            };
+            return self.on_wire(when, t + h - when, stopped, events + 1);
         }
         Ok(SurfaceStep {
             output: out,
@@ -246,8 +227,27 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         })
     }
 
-    /// A bead at an end of its wire: it leaves, flying on from `state`.
-    fn off_the_end(
+    /// Where within a part of length `h` from `state` at `t` (sliding
+    /// along `sliding`) the measure `g` (`g0` at the start, positive; not
+    /// positive at the end) reaches zero: the time and the state there.
+    fn cut(
+        &self,
+        t: f64,
+        h: f64,
+        state: BeadState,
+        sliding: DVec2,
+        g0: f64,
+        g: impl Fn(f64, BeadState) -> Result<f64, SolveError>,
+    ) -> Result<(f64, BeadState), SolveError> {
+        let tau = self.locate(h, g0, |tau| {
+            g(tau, self.slide(t, tau, state, sliding)?.state)
+        })?;
+        Ok((t + tau, self.slide(t, tau, state, sliding)?.state))
+    }
+
+    /// The bead leaves its wire at `t` from `state` (an end, or where the
+    /// wire would have to pull), flying on for `h`.
+    fn leave(
         &self,
         t: f64,
         h: f64,

@@ -1014,31 +1014,26 @@ impl Island {
     /// Evaluates the rows at the current state `work.x`, `work.v` (where
     /// the step ended, or the stage or Newton iterate being worked on).
     fn evaluate_at_new(&self, work: &mut IslandWork) {
-        self.evaluate(
-            &work.x,
-            &work.v,
-            work.time,
-            Held {
-                inactive: &work.inactive,
-                hints: &work.hints,
-                sticks: &work.sticks,
-            },
-            Rows {
-                gradient: &mut work.gradient,
-                c: &mut work.c,
-                curvature: &mut work.curvature,
-                bias: &mut work.bias,
-                scratch: &mut work.scratch,
-            },
-        );
+        self.evaluate_work(work, false, work.time);
     }
 
     /// Evaluates the rows at the step's start `work.x0`, `work.v0` into
     /// `work.first_gradient` (and `work.c`, `work.curvature`, `work.bias`).
     fn evaluate_at_start(&self, work: &mut IslandWork, time: f64) {
+        self.evaluate_work(work, true, time);
+    }
+
+    /// [`Island::evaluate`] on the work's state: the start's into
+    /// `work.first_gradient`, or the current one into `work.gradient`.
+    fn evaluate_work(&self, work: &mut IslandWork, at_start: bool, time: f64) {
+        let (x, v, gradient) = if at_start {
+            (&work.x0, &work.v0, &mut work.first_gradient)
+        } else {
+            (&work.x, &work.v, &mut work.gradient)
+        };
         self.evaluate(
-            &work.x0,
-            &work.v0,
+            x,
+            v,
             time,
             Held {
                 inactive: &work.inactive,
@@ -1046,7 +1041,7 @@ impl Island {
                 sticks: &work.sticks,
             },
             Rows {
-                gradient: &mut work.first_gradient,
+                gradient,
                 c: &mut work.c,
                 curvature: &mut work.curvature,
                 bias: &mut work.bias,
