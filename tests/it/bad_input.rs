@@ -222,3 +222,122 @@ fn nan_written_into_a_bead_is_reported_not_propagated() {
     );
     assert_eq!(*app.world().get::<Transform>(bead_entity).unwrap(), before);
 }
+
+/// Tracks refuse bad numbers in words: a motion, a surface, a spline, and
+/// the same in a scene file (which names the wire).
+#[test]
+fn bad_tracks_are_refused_in_words() {
+    use wirebead::geometry::{Spline, SplineKind, SplineSpec};
+    use wirebead::{Friction, Oscillate, PrescribedMotion, Surface, WireMotion};
+    let shake = |amplitude, frequency| {
+        PrescribedMotion::new(WireMotion::Oscillate(Oscillate {
+            amplitude,
+            frequency,
+        }))
+        .unwrap_err()
+        .to_string()
+    };
+    assert_eq!(
+        shake(DVec2::new(f64::NAN, 0.0), 1.0),
+        "oscillation amplitude must be finite, got (NaN, 0)"
+    );
+    assert_eq!(
+        shake(DVec2::Y, 0.0),
+        "oscillation frequency must be positive and finite, got 0"
+    );
+    let surface = |surface: Surface| Wire::line().with_surface(surface).unwrap_err().to_string();
+    assert_eq!(
+        surface(Surface {
+            restitution: 1.5,
+            ..Surface::PLAIN
+        }),
+        "restitution must be between 0 and 1, got 1.5"
+    );
+    assert_eq!(
+        Friction::new(0.2, 0.5).unwrap_err().to_string(),
+        "kinetic friction must not exceed static friction"
+    );
+    assert_eq!(
+        surface(Surface {
+            damping: -1.0,
+            ..Surface::PLAIN
+        }),
+        "damping along the wire must be zero or more and finite, got -1"
+    );
+    let spline = |points: Vec<DVec2>| {
+        Spline::new(SplineSpec {
+            kind: SplineKind::CatmullRom,
+            points,
+            closed: false,
+        })
+        .unwrap_err()
+        .to_string()
+    };
+    assert_eq!(
+        spline(vec![DVec2::ZERO]),
+        "a cardinal spline needs two points at least"
+    );
+    assert_eq!(
+        spline(vec![DVec2::ZERO, DVec2::new(f64::NAN, 1.0)]),
+        "a spline's points must be finite"
+    );
+    let scene = |wire: &str| {
+        ScenePreset::from_ron(&format!("(name: \"t\", wires: [({wire}, beads: [()])])"))
+            .unwrap_err()
+            .to_string()
+    };
+    assert_eq!(
+        scene("shape: Line(()), friction: (static: -1.0, kinetic: 0.0)"),
+        "wire 0: static friction must be zero or more and finite, got -1"
+    );
+    assert_eq!(
+        scene("shape: Line(()), motion: Spin((angular_velocity: inf))"),
+        "wire 0: angular velocity must be finite, got inf"
+    );
+    assert!(
+        scene("shape: Spline((points: [(0.0, 0.0)]))")
+            .contains("a cardinal spline needs two points at least"),
+        "{}",
+        scene("shape: Spline((points: [(0.0, 0.0)]))")
+    );
+}
+
+/// A bead put exactly on a cycloid's cusp (where the curve has no
+/// tangent) is reported at a singular point; the bead beside it runs on.
+#[test]
+fn a_bead_on_a_cycloids_cusp_is_reported_as_singular() {
+    use wirebead::geometry::Cycloid;
+    let mut app = app(SimParams::default());
+    let wire = spawn_wire(
+        &mut app,
+        Wire::new(wirebead::WireShape::Cycloid(Cycloid::new(1.0))).unwrap(),
+        Transform::default(),
+    );
+    let cusp = spawn_bead(
+        &mut app,
+        wire,
+        BeadParams {
+            initial_position: DVec2::new(std::f64::consts::PI, 2.0),
+            ..default()
+        },
+    );
+    let fine = spawn_bead(
+        &mut app,
+        wire,
+        BeadParams {
+            initial_position: Cycloid::new(1.0).point(2.0),
+            ..default()
+        },
+    );
+    run_steps(&mut app, 30);
+    let diverged = app.world().get::<Diverged>(cusp).expect("reported");
+    assert!(
+        diverged
+            .reason
+            .to_string()
+            .starts_with("the bead is at a singular point of its wire"),
+        "{}",
+        diverged.reason
+    );
+    assert!(app.world().get::<Diverged>(fine).is_none());
+}
