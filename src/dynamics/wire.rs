@@ -22,7 +22,8 @@ use crate::validate::ParamError;
 #[require(Transform, WirePose)]
 pub struct Wire {
     shape: WireShape,
-    surface: Surface,
+    /// None for a plain wire: most wires are, and stay small.
+    surface: Option<Box<Surface>>,
 }
 
 impl Wire {
@@ -31,7 +32,7 @@ impl Wire {
         shape.validate()?;
         Ok(Self {
             shape,
-            surface: Surface::PLAIN,
+            surface: None,
         })
     }
 
@@ -39,12 +40,13 @@ impl Wire {
     /// [`Surface`]), if its numbers are valid.
     pub fn with_surface(self, surface: Surface) -> Result<Self, ParamError> {
         surface.validate()?;
+        let surface = (surface != Surface::PLAIN).then(|| Box::new(surface));
         Ok(Self { surface, ..self })
     }
 
     /// What the wire does besides holding its beads.
     pub fn surface(&self) -> &Surface {
-        &self.surface
+        self.surface.as_deref().unwrap_or(&Surface::PLAIN)
     }
 
     /// The wire with `shape` in place of its own, its surface kept (the
@@ -52,7 +54,7 @@ impl Wire {
     pub(crate) fn reshaped(&self, shape: &WireShape) -> Self {
         Self {
             shape: shape.clone(),
-            surface: self.surface,
+            surface: self.surface.clone(),
         }
     }
 
@@ -70,7 +72,7 @@ impl Wire {
     pub fn line() -> Self {
         Self {
             shape: WireShape::Line(Line),
-            surface: Surface::PLAIN,
+            surface: None,
         }
     }
 
@@ -91,7 +93,7 @@ impl Wire {
     pub fn custom(curve: impl ImplicitCurve + Send + Sync + 'static) -> Self {
         Self {
             shape: WireShape::Custom(Arc::new(curve)),
-            surface: Surface::PLAIN,
+            surface: None,
         }
     }
 

@@ -79,9 +79,14 @@ impl Cycloid {
         .eval(phi)[0]
     }
 
+    /// The arch as a wire.
+    fn traced(&self) -> &Traced<CycloidArch> {
+        &self.traced
+    }
+
     /// Points along the arch, for drawing.
     pub fn polyline(&self) -> impl Iterator<Item = DVec2> + '_ {
-        self.traced.polyline()
+        self.traced().polyline()
     }
 }
 

@@ -52,26 +52,30 @@ pub struct SplineSpec {
 /// `CubicCurve` keeps its `f32` coefficients, held in `f64`.
 #[derive(Clone, Serialize, Deserialize)]
 #[serde(try_from = "SplineSpec", into = "SplineSpec")]
-pub struct Spline {
+pub struct Spline(Arc<SplineInner>);
+
+/// What a [`Spline`] shares between its clones: kept behind one pointer so
+/// that a [`WireShape`](super::WireShape) stays small.
+struct SplineInner {
     spec: SplineSpec,
-    traced: Arc<Traced<CubicPath>>,
+    traced: Traced<CubicPath>,
 }
 
 impl std::fmt::Debug for Spline {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.spec.fmt(f)
+        self.0.spec.fmt(f)
     }
 }
 
 impl PartialEq for Spline {
     fn eq(&self, other: &Self) -> bool {
-        self.spec == other.spec
+        self.0.spec == other.0.spec
     }
 }
 
 impl From<Spline> for SplineSpec {
     fn from(spline: Spline) -> Self {
-        spline.spec
+        spline.0.spec.clone()
     }
 }
 
@@ -200,9 +204,7 @@ impl Spline {
                 segments.clone()
             }
         };
-        let mut made = Self::from_segments(segments, spec.closed);
-        made.spec = spec;
-        Ok(made)
+        Ok(Self::from_segments(segments, spec.closed, Some(spec)))
     }
 
     /// A wire along a game's own curve (its segments' coefficients, kept
@@ -222,42 +224,50 @@ impl Spline {
             .map(|s| (s[1] + s[2] + s[3]).length())
             .sum::<f64>();
         let closed = (end - start).length() <= 1e-6 * size.max(f64::MIN_POSITIVE);
-        Self::from_segments(segments, closed)
+        Self::from_segments(segments, closed, None)
     }
 
-    fn from_segments(segments: Vec<[DVec2; 4]>, closed: bool) -> Self {
+    /// A spline of these segments, described by `spec` (by the segments
+    /// themselves if none).
+    fn from_segments(segments: Vec<[DVec2; 4]>, closed: bool, spec: Option<SplineSpec>) -> Self {
         let path = CubicPath {
             segments: segments.clone(),
             closed,
         };
-        Self {
-            spec: SplineSpec {
-                kind: SplineKind::Segments(segments),
-                points: Vec::new(),
-                closed,
-            },
-            traced: Arc::new(Traced::new(path)),
-        }
+        let spec = spec.unwrap_or(SplineSpec {
+            kind: SplineKind::Segments(segments),
+            points: Vec::new(),
+            closed,
+        });
+        Self(Arc::new(SplineInner {
+            spec,
+            traced: Traced::new(path),
+        }))
     }
 
     /// What it was made from.
     pub fn spec(&self) -> &SplineSpec {
-        &self.spec
+        &self.0.spec
+    }
+
+    /// The curve as a wire.
+    fn traced(&self) -> &Traced<CubicPath> {
+        &self.0.traced
     }
 
     /// Its segments' coefficients, as [`SplineKind::Segments`].
     pub fn traced_segments(&self) -> SplineKind {
-        SplineKind::Segments(self.traced.path().segments.clone())
+        SplineKind::Segments(self.traced().path().segments.clone())
     }
 
     /// Points along the curve, for drawing.
     pub fn polyline(&self) -> impl Iterator<Item = DVec2> + '_ {
-        self.traced.polyline()
+        self.traced().polyline()
     }
 
     /// The curve's point at parameter `s` (segment `floor(s)`).
     pub fn point(&self, s: f64) -> DVec2 {
-        self.traced.path().eval(s)[0]
+        self.traced().path().eval(s)[0]
     }
 
     /// Its lowest sampled point.
@@ -295,7 +305,7 @@ impl Parametric for CubicPath {
     }
 }
 
-traced_curve!(Spline, |this| this.traced.scale());
+traced_curve!(Spline, |this| this.traced().scale());
 
 #[cfg(test)]
 mod tests {

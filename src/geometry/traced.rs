@@ -242,41 +242,41 @@ impl<P: Parametric> Traced<P> {
     }
 }
 
-/// Implements [`ImplicitCurve`] for a shape that holds its [`Traced`]
-/// curve in the field `traced`, with `scale` its characteristic length.
+/// Implements [`ImplicitCurve`] for a shape whose method `traced()` gives
+/// its [`Traced`] curve, with `scale` its characteristic length.
 macro_rules! traced_curve {
     ($shape:ty, |$this:ident| $scale:expr) => {
         impl $crate::geometry::ImplicitCurve for $shape {
             fn value(&self, p: DVec2) -> f64 {
-                self.traced.value(p)
+                self.traced().value(p)
             }
             fn gradient(&self, p: DVec2) -> DVec2 {
-                self.traced.gradient(p)
+                self.traced().gradient(p)
             }
             fn hessian(&self, p: DVec2) -> bevy::math::DMat2 {
-                self.traced.hessian(p)
+                self.traced().hessian(p)
             }
             fn scale(&self) -> f64 {
                 let $this = self;
                 $scale
             }
             fn geometry(&self, p: DVec2) -> $crate::geometry::Geometry {
-                self.traced.geometry(p)
+                self.traced().geometry(p)
             }
             fn has_ends(&self) -> bool {
-                self.traced.has_ends()
+                self.traced().has_ends()
             }
             fn past_end(&self, p: DVec2) -> f64 {
-                self.traced.past_end(p)
+                self.traced().past_end(p)
             }
             fn parameter(&self, p: DVec2, hint: f64) -> f64 {
-                self.traced.parameter(p, hint)
+                self.traced().parameter(p, hint)
             }
             fn geometry_near(&self, p: DVec2, hint: f64) -> $crate::geometry::Geometry {
-                self.traced.geometry_near(p, hint)
+                self.traced().geometry_near(p, hint)
             }
             fn past_end_near(&self, p: DVec2, hint: f64) -> f64 {
-                self.traced.past_end_near(p, hint)
+                self.traced().past_end_near(p, hint)
             }
         }
     };

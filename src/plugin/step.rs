@@ -181,11 +181,45 @@ macro_rules! with_curve {
     };
 }
 
-/// A wire as the step needs it: its shape, path and surface.
+/// A wire as the step needs it: its shape and, for most wires, where it
+/// stays; a moving wire's path and a one-sided, rough or damped wire's
+/// surface behind one pointer, so the table stays small for the rest.
 pub(crate) struct TableWire {
     shape: WireShape,
-    path: PosePath,
-    surface: Surface,
+    /// Where a plain wire that stays put is (when `track` is none).
+    pose: Pose,
+    /// The path and surface of the others.
+    track: Option<Box<(PosePath, Surface)>>,
+}
+
+impl TableWire {
+    fn new(shape: WireShape, path: PosePath, surface: Surface) -> Self {
+        match path.fixed() {
+            Some(pose) if surface.is_plain() => Self {
+                shape,
+                pose,
+                track: None,
+            },
+            _ => Self {
+                shape,
+                pose: Pose::IDENTITY,
+                track: Some(Box::new((path, surface))),
+            },
+        }
+    }
+
+    /// The path (a fixed one for a wire that stays put).
+    fn path(&self) -> PosePath {
+        match &self.track {
+            Some(track) => track.0,
+            None => PosePath::Fixed(self.pose),
+        }
+    }
+
+    /// The surface.
+    fn surface(&self) -> &Surface {
+        self.track.as_deref().map_or(&Surface::PLAIN, |t| &t.1)
+    }
 }
 
 /// A wire for the step, or why beads cannot be stepped on it.
@@ -213,11 +247,7 @@ impl WireTable {
         for (entity, wire, pose) in changed {
             let placed = pose
                 .get()
-                .map(|path| TableWire {
-                    shape: wire.shape().clone(),
-                    path,
-                    surface: *wire.surface(),
-                })
+                .map(|path| TableWire::new(wire.shape().clone(), path, *wire.surface()))
                 .map_err(|e| DivergenceReason::InvalidWire(e.to_string()));
             self.0.insert(entity, (entity, placed));
         }
@@ -260,11 +290,9 @@ impl StepContext<'_> {
             if batched
                 && let Ok(TableWire {
                     shape: WireShape::Circle(circle),
-                    path,
-                    surface,
+                    pose,
+                    track: None,
                 }) = wire
-                && surface.is_plain()
-                && let Some(pose) = path.fixed()
                 && pose.is_unrotated()
             {
                 let bead = &run.beads[i];
@@ -303,17 +331,22 @@ impl StepContext<'_> {
         let bead = &run.beads[i];
         let result = match self.wires.get(&run.on_wires[i]) {
             Err(reason) => Err(reason),
-            Ok(wire) if !wire.surface.is_plain() || wire.shape.is_traced() => {
+            Ok(wire) if !wire.surface().is_plain() || wire.shape.is_traced() => {
                 self.step_on_surface(wire, bead, run.entities[i], contact)
             }
-            Ok(TableWire { shape, path, .. }) => match path.fixed() {
-                Some(pose) => with_curve!(shape, curve => {
-                    self.step_bead(&FixedTrack(&Placed { curve, pose }), bead)
-                }),
-                None => with_curve!(shape, curve => {
+            Ok(TableWire {
+                shape,
+                pose,
+                track: None,
+            }) => with_curve!(shape, curve => {
+                self.step_bead(&FixedTrack(&Placed { curve, pose: *pose }), bead)
+            }),
+            Ok(wire) => {
+                let path = &wire.path();
+                with_curve!(&wire.shape, curve => {
                     self.step_bead(&MovingTrack { curve, path }, bead)
-                }),
-            },
+                })
+            }
         };
         match result {
             Ok(out) => self.finish(run.outputs(i), out),
@@ -379,11 +412,7 @@ impl StepContext<'_> {
     ) -> Result<StepOutput, DivergenceReason> {
         let from = contact.as_deref().map_or(Contact::OnWire, WireContact::get);
         let hint = contact.as_deref().map_or(f64::NAN, WireContact::along);
-        let TableWire {
-            shape,
-            path,
-            surface,
-        } = wire;
+        let (shape, path, surface) = (&wire.shape, &wire.path(), wire.surface());
         let curve = &Near {
             curve: shape.curve(),
             hint,
