@@ -1,21 +1,29 @@
-//! The coupled solve's cost on a chain: `cargo bench --bench chain`.
+//! The coupled solve's cost: `cargo bench --bench chain`.
 //!
-//! `chain`: a rope of N rods hanging from a pin (N + 1 beads of 1 kg, the
-//! first held by the pin's two rows, links of 0.1 m, |g| = 10), released
-//! horizontal, stepped by RATTLE at 1/60 s through the pure `Island` (no
-//! ECS). Each iteration runs the first `STEPS` steps from the release, so
-//! every sample does the same work; throughput is rod-steps. Before the
-//! timing, one run prints the largest relative stretch `max |C| / L`, the
-//! most substeps a step took, and the energy change.
+//! - `islands`: N pendulums on carts through the plugin (single-threaded),
+//!   each a cart of 2 kg on its own horizontal rail and a 1 kg bob on a rod
+//!   of 1 m released 30° from the vertical, RATTLE at 1/60 s: N islands of
+//!   two beads. Throughput is bead-steps.
+//! - `chain`: a rope of N rods hanging from a pin (N + 1 beads of 1 kg,
+//!   the first held by the pin's two rows, links of 0.1 m, |g| = 10),
+//!   released horizontal, stepped by RATTLE at 1/60 s through the pure
+//!   `Island` (no ECS). Each iteration runs the first `STEPS` steps from
+//!   the release, so every sample does the same work; throughput is
+//!   rod-steps. Before the timing, one run prints the largest relative
+//!   stretch `max |C| / L`, the most substeps a step took, and the energy
+//!   change.
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use bevy::math::DVec2;
+use bevy::prelude::*;
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use wirebead::headless::Headless;
 use wirebead::solver::{
     BeadState, Island, IslandRow, IslandWork, LinearForce, Method, RowKind, StepSettings,
 };
+use wirebead::{Bead, OnWire, ParallelStep, Rod, SimParams, Wire, WireBeadPlugin};
 
 /// The link length.
 const LINK: f64 = 0.1;
@@ -116,5 +124,49 @@ fn chain(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, chain);
+/// `n` pendulums on carts, each on its own rail 3 m below the last.
+fn carts(n: usize) -> App {
+    let params = SimParams {
+        method: Method::Rattle,
+        ..SimParams::default()
+    };
+    let plugin = WireBeadPlugin::new(params).expect("valid parameters");
+    let mut app = Headless::new(plugin)
+        .single_threaded()
+        .parallel(ParallelStep::OFF)
+        .build();
+    let world = app.world_mut();
+    let swing = DVec2::new(30f64.to_radians().sin(), -30f64.to_radians().cos());
+    for i in 0..n {
+        let y = -3.0 * i as f64;
+        let rail = world
+            .spawn((Wire::line(), Transform::from_xyz(0.0, y as f32, 0.0)))
+            .id();
+        let cart = Bead::at_rest(2.0, DVec2::new(0.0, y)).expect("valid cart");
+        let cart = world.spawn((cart, OnWire(rail))).id();
+        let bob = Bead::at_rest(1.0, DVec2::new(0.0, y) + swing).expect("valid bob");
+        let bob = world.spawn(bob).id();
+        world.spawn(Rod::new(cart, bob, 1.0).expect("valid rod"));
+    }
+    // The first step builds the islands.
+    app.world_mut().run_schedule(FixedUpdate);
+    app
+}
+
+fn islands(c: &mut Criterion) {
+    let mut group = c.benchmark_group("islands");
+    for n in [100, 1_000, 10_000] {
+        group.throughput(Throughput::Elements(2 * n as u64));
+        group.sample_size(10);
+        group.warm_up_time(Duration::from_millis(500));
+        group.measurement_time(Duration::from_secs(5));
+        let mut app = carts(n);
+        group.bench_function(BenchmarkId::new("cart-rattle-1/60", n), |b| {
+            b.iter(|| app.world_mut().run_schedule(FixedUpdate));
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, islands, chain);
 criterion_main!(benches);
