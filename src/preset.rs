@@ -36,7 +36,6 @@ use crate::dynamics::{
 };
 use crate::geometry::{Friction, Pose, Side, Surface, Twist, WireMotion, WireShape};
 use crate::plugin::{Restart, WireBeadSystems};
-use crate::solver::BeadState;
 use crate::validate::{ParamError, finite, finite_vector, non_negative, positive};
 
 /// A bead of a scene file: its name (optional) and its parameters.
@@ -425,12 +424,8 @@ impl ScenePreset {
                 };
                 // The initial velocity is relative to the wire's own at
                 // t = 0, as a restart makes it.
-                if let Some((_, twist)) = wire {
-                    let state = bead.state();
-                    bead.advance_to(BeadState {
-                        velocity: state.velocity + twist.velocity_at(state.position),
-                        ..state
-                    });
+                if let Some((_, twist)) = &wire {
+                    bead.ride(twist);
                 }
                 let mut entity = commands.spawn((bead, name, FromPreset));
                 if let Some((wire, _)) = wire {

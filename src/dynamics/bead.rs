@@ -5,6 +5,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::geometry::Twist;
 use crate::solver::{BeadState, LinearForce};
 use crate::validate::{ParamError, finite_vector, positive};
 
@@ -149,6 +150,12 @@ impl Bead {
         self.velocity = state.velocity;
         self.force = DVec2::ZERO;
         self.force_stiffness = 0.0;
+    }
+
+    /// Adds the velocity of a moving wire's point where the bead is (its
+    /// initial velocity is relative to its wire at t = 0).
+    pub(crate) fn ride(&mut self, twist: &Twist) {
+        self.velocity += twist.velocity_at(self.position);
     }
 
     /// Applies `params` and returns the bead to its initial state.

@@ -11,7 +11,7 @@ use crate::dynamics::{
     PrescribedMotion, SimParams, Wire, WireContact, WirePose,
 };
 use crate::geometry::{MovingTrack, Track};
-use crate::solver::{BeadState, constraint_state_on};
+use crate::solver::constraint_state_on;
 
 /// Restarts the run: applies [`PendingParams`] and every [`PendingBead`],
 /// returns each bead to its initial state, clears divergence, and sets
@@ -122,12 +122,7 @@ pub(crate) fn apply_restart(
         };
         let Ok(path) = pose.get() else { continue };
         // The initial velocity is relative to the wire's own at t = 0.
-        let (_, twist) = path.at(0.0);
-        let state = bead.state();
-        bead.advance_to(BeadState {
-            velocity: state.velocity + twist.velocity_at(state.position),
-            ..state
-        });
+        bead.ride(&path.at(0.0).1);
         if let Some(mut diagnostics) = diagnostics {
             let track = MovingTrack {
                 curve: wire.shape().curve(),

@@ -15,7 +15,7 @@ use super::method::Method;
 use super::projection::project_on;
 use super::rk4::{Stages, rk4_lanes};
 use super::settings::{Gains, StepSettings};
-use super::solve::{SolveError, normal_length_squared, solve_on};
+use super::solve::{SolveError, Solved, normal_length_squared, solve_on};
 use super::state::{BeadState, LinearForce};
 use super::step::{StepOutput, step_on};
 use crate::geometry::{Rough, Surface, Track};
@@ -190,8 +190,11 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         }
         let friction = self.surface.friction.is_some();
         let (_, sliding, _) = self.split(t, state)?;
-        if friction && sliding == DVec2::ZERO && self.sticks(t, state)? {
-            return self.held(t, h, state);
+        if friction
+            && sliding == DVec2::ZERO
+            && let Some(solved) = self.sticks(t, state)?
+        {
+            return self.held(t, h, state, solved);
         }
         let out = self.slide(t, h, state, sliding)?;
         let end = t + h;
@@ -262,24 +265,31 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         Ok(flown)
     }
 
-    /// Whether a bead at rest on the wire stays so: the force along the
-    /// wire within static friction.
-    fn sticks(&self, t: f64, state: BeadState) -> Result<bool, SolveError> {
+    /// The constraint force on a bead at rest on the wire if it stays so
+    /// (the force along the wire within static friction); none if it
+    /// slides.
+    fn sticks(&self, t: f64, state: BeadState) -> Result<Option<Solved>, SolveError> {
         let solved = solve_on(self.track, t, state, self.force, self.mass, Gains::NONE)?;
-        let (wire, _, _) = self.split(t, state)?;
-        let frame = (self.track.twist(t)).acceleration_at(state.position, state.velocity - wire);
+        let twist = self.track.twist(t);
+        let relative = state.velocity - twist.velocity_at(state.position);
+        let frame = twist.acceleration_at(state.position, relative);
         let normal = self.track.geometry(t, state.position).normal;
         let nn = normal.length_squared();
         let applied = self.force.at(state.position) - self.mass * frame;
         let pull = applied - normal * (normal.dot(applied) / nn);
         let press = solved.lambda.abs() * nn.sqrt();
-        Ok(pull.length() <= self.surface.friction.static_coefficient * press)
+        Ok((pull.length() <= self.surface.friction.static_coefficient * press).then_some(solved))
     }
 
     /// A part of length `h` in which static friction holds the bead still
     /// on the wire (carried with it if it moves).
-    fn held(&self, t: f64, h: f64, state: BeadState) -> Result<SurfaceStep, SolveError> {
-        let solved = solve_on(self.track, t, state, self.force, self.mass, Gains::NONE)?;
+    fn held(
+        &self,
+        t: f64,
+        h: f64,
+        state: BeadState,
+        solved: Solved,
+    ) -> Result<SurfaceStep, SolveError> {
         let position = self.track.carry(state.position, t, t + h);
         let velocity = self.track.twist(t + h).velocity_at(position);
         let end = BeadState { position, velocity };

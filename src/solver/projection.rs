@@ -184,6 +184,7 @@ pub(crate) fn restore_speed<T: Track + ?Sized>(
         ..projected
     })
 }
+
 /// The largest relative change of speed eq. (9c) makes: a fourth-order
 /// step's energy error is far below it; a larger mismatch means a bead at
 /// a turning point or at rest, where the ratio of two near-zero kinetic

@@ -5,7 +5,9 @@ use bevy::math::DVec2;
 
 use super::constraint::{RowKind, SpringLink};
 use super::normal::{Factored, NormalMatrix};
-use crate::geometry::{Friction, ImplicitCurve, Near, Placed, Pose, PosePath, Side, WireShape};
+use crate::geometry::{
+    Friction, ImplicitCurve, Near, Placed, Pose, PosePath, Side, Twist, WireShape,
+};
 use crate::solver::contact::ContactEvent;
 use crate::solver::method::Method;
 use crate::solver::projection::{
@@ -502,14 +504,14 @@ impl Island {
             // A fresh island: a bead that starts off a one-sided wire, on
             // the side it pushes toward, starts in flight; stick rows start
             // set aside (a bead slides until friction stops it).
-            let x: Vec<DVec2> = states.iter().map(|s| s.position).collect();
+            let whole = states.len() == self.beads();
             work.inactive = (0..self.rows())
                 .map(|r| {
                     let (side, _) = self.sides[r];
                     self.is_stick(r)
                         || (side != 0.0
-                            && x.len() == self.beads()
-                            && side * self.wire_row(r, &x, time).0
+                            && whole
+                            && side * self.wire_row(r, states, time).c
                                 > OFF_THE_WIRE * self.rows[r].scale())
                 })
                 .collect();
@@ -519,13 +521,13 @@ impl Island {
                     continue;
                 };
                 let bead = self.entry_bead[self.row_start[r]];
-                if work.inactive[r] || self.paths[r].is_some() || x.len() != self.beads() {
+                if work.inactive[r] || self.paths[r].is_some() || !whole {
                     continue;
                 }
-                let (_, normal, wire) = self.wire_row(r, &x, time);
-                if states[bead].velocity == wire {
-                    let axis = DVec2::new(-normal.y, normal.x).normalize_or_zero();
-                    self.place_stick(*s, axis, axis.dot(x[bead]), work);
+                let row = self.wire_row(r, states, time);
+                if states[bead].velocity == row.wire {
+                    let axis = row.tangent();
+                    self.place_stick(*s, axis, axis.dot(states[bead].position), work);
                 }
             }
         }
@@ -571,7 +573,6 @@ impl Island {
         forces: &mut [LinearForce],
         work: &mut IslandWork,
     ) -> Vec<(usize, usize, DVec2)> {
-        let x: Vec<DVec2> = states.iter().map(|s| s.position).collect();
         let mut slides = Vec::new();
         for (r, rough) in self.rough.iter().enumerate() {
             let Some(rough) = rough else { continue };
@@ -583,14 +584,13 @@ impl Island {
                 }
                 continue;
             }
-            let (_, normal, wire) = self.wire_row(r, &x, time);
-            let nn = normal.length_squared();
+            let row = self.wire_row(r, states, time);
+            let nn = row.normal.length_squared();
             if nn.is_nan() || nn <= 0.0 {
                 continue;
             }
             let press = work.lambda[r].abs() * nn.sqrt();
-            let relative = states[bead].velocity - wire;
-            let sliding = relative - normal * (normal.dot(relative) / nn);
+            let sliding = row.sliding(states[bead].velocity);
             let mut direction = sliding;
             if let Some(s) = rough.stick
                 && !work.inactive[s]
@@ -627,7 +627,6 @@ impl Island {
         slides: &[(usize, usize, DVec2)],
         work: &mut IslandWork,
     ) -> Result<(), SolveError> {
-        let x: Vec<DVec2> = states.iter().map(|s| s.position).collect();
         let mut stopped = false;
         for &(r, bead, before) in slides {
             let Some(RoughRow {
@@ -641,23 +640,22 @@ impl Island {
             if work.inactive[r] || self.paths[r].is_some() || !friction.is_some() {
                 continue;
             }
-            let (_, normal, wire) = self.wire_row(r, &x, time);
-            let nn = normal.length_squared();
-            let relative = states[bead].velocity - wire;
-            let sliding = relative - normal * (normal.dot(relative) / nn);
+            let row = self.wire_row(r, states, time);
+            let sliding = row.sliding(states[bead].velocity);
             if before != DVec2::ZERO && sliding.dot(before) >= 0.0 {
                 continue;
             }
             if before == DVec2::ZERO && sliding == DVec2::ZERO {
                 continue;
             }
-            let axis = DVec2::new(-normal.y, normal.x).normalize_or_zero();
-            self.place_stick(s, axis, axis.dot(x[bead]), work);
+            let axis = row.tangent();
+            self.place_stick(s, axis, axis.dot(states[bead].position), work);
             stopped = true;
         }
         if stopped {
             work.time = time;
-            work.x.clone_from(&x);
+            work.x.clear();
+            work.x.extend(states.iter().map(|s| s.position));
             work.v.clear();
             work.v.extend(states.iter().map(|s| s.velocity));
             self.evaluate_at_new(work);
@@ -680,31 +678,21 @@ impl Island {
     /// `time`), and reports each set-aside row's own `C` and `Ċ`.
     fn follow(&self, time: f64, states: &[BeadState], work: &mut IslandWork) {
         work.hints.resize(self.rows(), f64::NAN);
-        for (r, kind) in self.rows.iter().enumerate() {
-            let RowKind::Wire { shape, pose } = kind else {
+        for r in 0..self.rows() {
+            let (Some((shape, pose, _)), Some(state)) = (
+                self.wire_at(r, time),
+                states.get(self.entry_bead[self.row_start[r]]),
+            ) else {
                 continue;
-            };
-            let Some(state) = states.get(self.entry_bead[self.row_start[r]]) else {
-                continue;
-            };
-            let (pose, twist) = match &self.paths[r] {
-                Some(path) => path.at(time),
-                None => (*pose, Default::default()),
             };
             let local = pose.to_local(state.position);
             work.hints[r] = shape.curve().parameter(local, work.hints[r]);
             if work.inactive.get(r) == Some(&true)
                 && let Some(report) = work.reports.get_mut(r)
             {
-                let g = Placed {
-                    curve: shape.curve(),
-                    pose,
-                }
-                .geometry(state.position);
-                report.c = g.c;
-                report.c_dot = g
-                    .normal
-                    .dot(state.velocity - twist.velocity_at(state.position));
+                let row = self.wire_row(r, states, time);
+                report.c = row.c;
+                report.c_dot = row.normal.dot(state.velocity - row.wire);
             }
         }
     }
@@ -760,23 +748,24 @@ impl Island {
                 continue;
             }
             let bead = self.entry_bead[self.row_start[r]];
-            let x: Vec<DVec2> = states.iter().map(|s| s.position).collect();
-            let v: Vec<DVec2> = states.iter().map(|s| s.velocity).collect();
-            let (c, normal, wire) = self.wire_row(r, &x, time);
+            let RowAt { c, normal, wire } = self.wire_row(r, states, time);
             if side * c > 0.0 {
                 continue;
             }
             // Back on: onto every held row, then the velocities.
+            let BeadState { position, velocity } = states[bead];
             work.inactive[r] = false;
-            work.x.clone_from(&x);
-            work.v.clone_from(&v);
+            work.x.clear();
+            work.x.extend(states.iter().map(|s| s.position));
+            work.v.clear();
+            work.v.extend(states.iter().map(|s| s.velocity));
             self.newton(work, Direction::Current)?;
             self.evaluate_at_new(work);
             let nn = normal.length_squared().max(f64::MIN_POSITIVE);
-            let across = normal.dot(v[bead] - wire);
+            let across = normal.dot(velocity - wire);
             let normal_speed = across.abs() / nn.sqrt();
             let push =
-                (normal.dot(forces[bead].at(x[bead])) * self.inverse_mass[bead]).abs() / nn.sqrt();
+                (normal.dot(forces[bead].at(position)) * self.inverse_mass[bead]).abs() / nn.sqrt();
             let bounced = restitution > 0.0 && restitution * normal_speed > push * h;
             if bounced {
                 work.bias[r] -= restitution * across;
@@ -801,23 +790,38 @@ impl Island {
         Ok(())
     }
 
-    /// `C`, `∇C` and the wire's velocity of wire row `r` at `(x, v)` at
-    /// `time`, whether the row is held or not.
-    fn wire_row(&self, r: usize, x: &[DVec2], time: f64) -> (f64, DVec2, DVec2) {
-        let RowKind::Wire { shape, pose } = &self.rows[r] else {
-            return (0.0, DVec2::ZERO, DVec2::ZERO);
-        };
-        let bead = self.entry_bead[self.row_start[r]];
-        let (pose, twist) = match &self.paths[r] {
-            Some(path) => path.at(time),
-            None => (*pose, Default::default()),
+    /// Wire row `r` where its bead is in `states` at `time`, whether the
+    /// row is held or not (zero for a row of another kind).
+    fn wire_row(&self, r: usize, states: &[BeadState], time: f64) -> RowAt {
+        let (Some((shape, pose, twist)), Some(state)) = (
+            self.wire_at(r, time),
+            states.get(self.entry_bead[self.row_start[r]]),
+        ) else {
+            return RowAt::default();
         };
         let g = Placed {
             curve: shape.curve(),
             pose,
         }
-        .geometry(x[bead]);
-        (g.c, g.normal, twist.velocity_at(x[bead]))
+        .geometry(state.position);
+        RowAt {
+            c: g.c,
+            normal: g.normal,
+            wire: twist.velocity_at(state.position),
+        }
+    }
+
+    /// The shape of wire row `r` and where its wire is at `time`, with its
+    /// twist; none for a row of another kind.
+    fn wire_at(&self, r: usize, time: f64) -> Option<(&WireShape, Pose, Twist)> {
+        let RowKind::Wire { shape, pose } = &self.rows[r] else {
+            return None;
+        };
+        let (pose, twist) = match &self.paths[r] {
+            Some(path) => path.at(time),
+            None => (*pose, Twist::default()),
+        };
+        Some((shape, pose, twist))
     }
 
     /// Two steps of half the length of `settings.dt`, each halved again
@@ -1456,6 +1460,29 @@ impl Island {
             report.lambda += 0.5 * to_mu * nu;
         }
         Ok(())
+    }
+}
+
+/// A wire row where its bead is: `C`, `∇C`, and the velocity of the
+/// wire's point there.
+#[derive(Clone, Copy, Default)]
+struct RowAt {
+    c: f64,
+    normal: DVec2,
+    wire: DVec2,
+}
+
+impl RowAt {
+    /// The part of `velocity`, relative to the wire, along it.
+    fn sliding(&self, velocity: DVec2) -> DVec2 {
+        let relative = velocity - self.wire;
+        let nn = self.normal.length_squared();
+        relative - self.normal * (self.normal.dot(relative) / nn)
+    }
+
+    /// The unit direction along the wire: a stick row's axis.
+    fn tangent(&self) -> DVec2 {
+        DVec2::new(-self.normal.y, self.normal.x).normalize_or_zero()
     }
 }
 
