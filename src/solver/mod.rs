@@ -32,7 +32,7 @@ mod step;
 
 pub use contact::{Contact, ContactEvent, SurfaceStep, free_step, step_surface};
 pub use coupled::{
-    Constraint, Island, IslandError, IslandRow, IslandWork, MAX_HALVINGS, OFF_THE_WIRE,
+    CALM_STEPS, Constraint, Island, IslandError, IslandRow, IslandWork, MAX_HALVINGS, OFF_THE_WIRE,
     REDUNDANT_PIVOT, RowKind, RowReport, SpringLink, islands,
 };
 pub use euler::{explicit_euler, semi_implicit_euler};

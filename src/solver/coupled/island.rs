@@ -4,7 +4,7 @@
 use bevy::math::DVec2;
 
 use super::constraint::{RowKind, SpringLink};
-use super::normal::{Factored, NormalMatrix};
+use super::normal::{Factored, LuWork, NormalMatrix};
 use crate::geometry::{
     Friction, ImplicitCurve, Near, Placed, Pose, PosePath, Side, Twist, WireShape,
 };
@@ -24,6 +24,10 @@ pub const OFF_THE_WIRE: f64 = 1e-9;
 /// How many times a step may be halved when its Newton solve finds no
 /// root: at most 2⁶ = 64 substeps.
 pub const MAX_HALVINGS: u32 = 6;
+
+/// After this many steps in a row that needed no more halvings than they
+/// started with, a step tries one halving fewer.
+pub const CALM_STEPS: u32 = 8;
 
 /// Why an island cannot be built: a constraint or spring that names a bead
 /// it cannot join.
@@ -168,12 +172,19 @@ pub struct IslandWork {
     events: Vec<(usize, usize, ContactEvent)>,
     rhs: Vec<f64>,
     lambda: Vec<f64>,
-    values: Vec<f64>,
+    lu: LuWork,
     scratch: Vec<DVec2>,
     factored: Factored,
     reports: Vec<RowReport>,
     bead_forces: Vec<DVec2>,
     substeps: u32,
+    /// How many halvings deep the last step's substeps went; the next
+    /// step starts there (see [`Island::step`]).
+    level: u32,
+    /// Steps in a row that went no deeper than they started.
+    calm: u32,
+    /// The states at the start of a step, restored if it fails.
+    start: Vec<BeadState>,
 }
 
 impl IslandWork {
@@ -476,9 +487,13 @@ impl Island {
     ///
     /// Where a Newton solve (RATTLE's positions, projection) finds no
     /// root, as when a rope's free end whips round faster than a step can
-    /// follow, the step is taken again as two halves, each halved again
-    /// if need be, down to 2^[`MAX_HALVINGS`] substeps;
-    /// [`IslandWork::substeps`] says how many the last step took.
+    /// follow, that part of the step and the rest of it are taken in
+    /// substeps of half the length, halved again if need be, down to
+    /// 2^[`MAX_HALVINGS`] substeps. The next step starts as finely as this
+    /// one ended, and tries one halving fewer after [`CALM_STEPS`] steps
+    /// that needed no more, so a long rope does not fail its way down to
+    /// the same level every step; [`IslandWork::substeps`] says how many
+    /// the last step took.
     pub fn step(
         &self,
         states: &mut [BeadState],
@@ -544,13 +559,7 @@ impl Island {
             Vec::new()
         };
         let forces = if rough { &resisted[..] } else { forces };
-        work.substeps = 0;
-        match self.advance(time, states, forces, settings, work) {
-            Err(SolveError::NoConvergence { .. }) => {
-                self.halve(time, states, forces, settings, work, 1)?
-            }
-            other => other?,
-        }
+        self.substeps(time, states, forces, settings, work)?;
         if one_sided {
             self.land(time + settings.dt, states, forces, settings.dt, work)?;
         }
@@ -824,32 +833,54 @@ impl Island {
         Some((shape, pose, twist))
     }
 
-    /// Two steps of half the length of `settings.dt`, each halved again
-    /// where its Newton solve fails, `depth` halvings deep.
-    fn halve(
+    /// The step of length `settings.dt` as `2^level` equal substeps, from
+    /// the level the last step ended at (one level fewer after
+    /// [`CALM_STEPS`] steps that needed no more). Where a substep's Newton
+    /// solve finds no root, it and the rest of the step are taken at half
+    /// the length, down to 2^[`MAX_HALVINGS`] substeps. On an error the
+    /// states are left as they were.
+    fn substeps(
         &self,
         time: f64,
         states: &mut [BeadState],
         forces: &[LinearForce],
         settings: &StepSettings,
         work: &mut IslandWork,
-        depth: u32,
     ) -> Result<(), SolveError> {
-        let half = StepSettings {
-            dt: 0.5 * settings.dt,
-            ..*settings
+        let was = work.level.min(MAX_HALVINGS);
+        let mut level = if work.calm >= CALM_STEPS {
+            was.saturating_sub(1)
+        } else {
+            was
         };
-        let mut trial = states.to_vec();
-        for k in 0..2 {
-            let start = time + f64::from(k) * half.dt;
-            match self.advance(start, &mut trial, forces, &half, work) {
-                Err(SolveError::NoConvergence { .. }) if depth < MAX_HALVINGS => {
-                    self.halve(start, &mut trial, forces, &half, work, depth + 1)?;
+        let first = level;
+        work.substeps = 0;
+        work.start.clear();
+        work.start.extend_from_slice(states);
+        // Progress through the step in its finest substeps.
+        let finest = 1u64 << MAX_HALVINGS;
+        let mut done = 0u64;
+        while done < finest {
+            let fraction = (done as f64) / (finest as f64);
+            let piece = StepSettings {
+                dt: settings.dt / f64::from(1u32 << level),
+                ..*settings
+            };
+            match self.advance(time + fraction * settings.dt, states, forces, &piece, work) {
+                Ok(()) => done += finest >> level,
+                Err(SolveError::NoConvergence { .. }) if level < MAX_HALVINGS => level += 1,
+                Err(error) => {
+                    states.copy_from_slice(&work.start);
+                    return Err(error);
                 }
-                other => other?,
             }
         }
-        states.copy_from_slice(&trial);
+        work.calm = if level == first && first == was {
+            work.calm + 1
+        } else {
+            0
+        };
+        work.level = level;
         Ok(())
     }
 
@@ -1218,6 +1249,7 @@ impl Island {
         work.lambda.resize(rows, 0.0);
         let mut exact = direction == Direction::First && rows == 1;
         let mut previous = f64::INFINITY;
+        let mut rising = 0;
         let mut i = 0;
         loop {
             self.evaluate_at_new(work);
@@ -1247,6 +1279,19 @@ impl Island {
                     residual: worst,
                 });
             }
+            if exact && direction == Direction::First && worst >= previous {
+                // Exact Newton steps converge fast near a root; two that do
+                // not shrink C mean there is none near: halve the step.
+                rising += 1;
+                if rising == 2 {
+                    return Err(SolveError::NoConvergence {
+                        iterations: i,
+                        residual: worst,
+                    });
+                }
+            } else {
+                rising = 0;
+            }
             exact |= direction == Direction::First && worst > 0.25 * previous;
             previous = worst;
             work.rhs.clear();
@@ -1263,7 +1308,7 @@ impl Island {
                     &self.inverse_mass,
                     &work.gradient,
                     along,
-                    &mut work.values,
+                    &mut work.lu,
                     &mut work.rhs,
                 );
             if !solved_exactly {

@@ -23,11 +23,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use bevy::math::DVec2;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::cholesky::{
     LdltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::linalg::lu::{NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
@@ -80,6 +79,15 @@ struct Unsymmetric {
     /// it is that entry's mirror below the diagonal.
     source: Vec<(usize, bool)>,
     symbolic: SymbolicLu<usize>,
+}
+
+/// The numeric LU of `J₁ W J₀ᵀ` and its scratch memory, kept between
+/// solves so that a Newton iteration allocates nothing.
+#[derive(Default)]
+pub(crate) struct LuWork {
+    values: Vec<f64>,
+    numeric: NumericLu<usize, f64>,
+    scratch: Scratch,
 }
 
 /// A factored `A`, kept between solves within a step.
@@ -210,7 +218,7 @@ impl NormalMatrix {
                     None,
                     full_row_idx,
                 );
-                let symbolic = SymbolicLu::try_new(pattern.as_ref()).ok()?;
+                let symbolic = factorize_symbolic_lu(pattern.as_ref(), Default::default()).ok()?;
                 Some(Unsymmetric {
                     pattern,
                     source,
@@ -228,14 +236,14 @@ impl NormalMatrix {
         inverse_mass: &[f64],
         now: &[DVec2],
         first: &[DVec2],
-        values: &mut Vec<f64>,
+        lu: &mut LuWork,
         rhs: &mut [f64],
     ) -> bool {
         let Some(u) = self.unsymmetric() else {
             return false;
         };
-        values.clear();
-        values.extend(u.source.iter().map(|&(k, mirror)| {
+        lu.values.clear();
+        lu.values.extend(u.source.iter().map(|&(k, mirror)| {
             self.terms[self.term_start[k]..self.term_start[k + 1]]
                 .iter()
                 .map(|t| {
@@ -248,11 +256,34 @@ impl NormalMatrix {
                 })
                 .sum::<f64>()
         }));
-        let matrix = SparseColMatRef::new(u.pattern.as_ref(), values);
-        let Ok(lu) = Lu::try_new_with_symbolic(u.symbolic.clone(), matrix) else {
+        if lu.scratch.owner != self.id {
+            lu.scratch.memory = None;
+            lu.scratch.owner = self.id;
+        }
+        let memory = lu.scratch.memory.get_or_insert_with(|| {
+            MemBuffer::new(
+                u.symbolic
+                    .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
+                    .or(u.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
+            )
+        });
+        let stack = MemStack::new(memory);
+        let matrix = SparseColMatRef::new(u.pattern.as_ref(), &lu.values);
+        let Ok(factored) = u.symbolic.factorize_numeric_lu(
+            &mut lu.numeric,
+            matrix,
+            Par::Seq,
+            stack,
+            Default::default(),
+        ) else {
             return false;
         };
-        lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, self.n, 1));
+        factored.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(rhs, self.n, 1),
+            Par::Seq,
+            stack,
+        );
         rhs.iter().all(|x| x.is_finite())
     }
 
