@@ -10,8 +10,10 @@
 //!   `Island` (no ECS). Each iteration runs the first `STEPS` steps from
 //!   the release, so every sample does the same work; throughput is
 //!   rod-steps. Before the timing, one run prints the largest relative
-//!   stretch `max |C| / L`, the most substeps a step took, and the energy
-//!   change.
+//!   stretch `max |C| / L` beside its rounding floor (an ulp of the
+//!   largest coordinate over `L`: a rope of N links reaches N·L from the
+//!   pin, so the floor grows as N), the substeps the steps took, and the
+//!   energy change.
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -64,26 +66,50 @@ fn settings() -> StepSettings {
     }
 }
 
-/// `STEPS` steps from `states`; the largest relative stretch and the most
-/// substeps, or the step that failed and why.
+/// What a run of `STEPS` steps measured.
+struct Measured {
+    /// The largest relative stretch `max |C| / L`.
+    stretch: f64,
+    /// The rounding floor of that stretch: one ulp of the largest
+    /// coordinate, over `L`.
+    floor: f64,
+    /// The most substeps a step took, and their total.
+    most: u32,
+    total: u32,
+}
+
+/// `STEPS` steps from `states` with a fresh work (so every iteration
+/// starts from whole steps), or the step that failed and why.
 fn run(
     island: &Island,
     states: &mut [BeadState],
     forces: &[LinearForce],
-    work: &mut IslandWork,
-) -> Result<(f64, u32), String> {
+) -> Result<Measured, String> {
     let s = settings();
-    let (mut stretch, mut substeps) = (0.0f64, 0);
+    let mut work = IslandWork::default();
+    let mut m = Measured {
+        stretch: 0.0,
+        floor: 0.0,
+        most: 0,
+        total: 0,
+    };
     for k in 0..STEPS {
         island
-            .step(states, forces, &s, work)
+            .step(states, forces, &s, &mut work)
             .map_err(|e| format!("step {k}: {e}"))?;
-        substeps = substeps.max(work.substeps());
+        m.most = m.most.max(work.substeps());
+        m.total += work.substeps();
         for w in states.windows(2) {
-            stretch = stretch.max(((w[1].position - w[0].position).length() - LINK).abs() / LINK);
+            let stretch = ((w[1].position - w[0].position).length() - LINK).abs() / LINK;
+            m.stretch = m.stretch.max(stretch);
         }
+        let far = states
+            .iter()
+            .map(|s| s.position.abs().max_element())
+            .fold(0.0, f64::max);
+        m.floor = m.floor.max(f64::EPSILON * far / LINK);
     }
-    Ok((stretch, substeps))
+    Ok(m)
 }
 
 fn energy(states: &[BeadState]) -> f64 {
@@ -101,11 +127,14 @@ fn chain(c: &mut Criterion) {
         group.warm_up_time(Duration::from_millis(500));
         group.measurement_time(Duration::from_secs(if n >= 10_000 { 20 } else { 5 }));
         let (island, start, forces) = rope(n);
-        let mut work = IslandWork::default();
         let mut states = start.clone();
-        match run(&island, &mut states, &forces, &mut work) {
-            Ok((stretch, substeps)) => eprintln!(
-                "chain/{n}: max |C|/L {stretch:.1e}, at most {substeps} substeps, energy change {:.3e} J over {STEPS} steps",
+        match run(&island, &mut states, &forces) {
+            Ok(m) => eprintln!(
+                "chain/{n}: max |C|/L {:.1e} (rounding floor {:.1e}), substeps {} in {STEPS} steps (at most {}), energy change {:.3e} J",
+                m.stretch,
+                m.floor,
+                m.total,
+                m.most,
                 energy(&states) - energy(&start)
             ),
             Err(why) => {
@@ -116,7 +145,7 @@ fn chain(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("rattle-1/60", n), |b| {
             b.iter_batched_ref(
                 || start.clone(),
-                |states| black_box(run(&island, states, &forces, &mut work)),
+                |states| black_box(run(&island, states, &forces)),
                 BatchSize::LargeInput,
             );
         });

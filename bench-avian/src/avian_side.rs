@@ -1,4 +1,5 @@
-//! avian2d on the bead-on-a-circle job.
+//! avian2d on the bead-on-a-circle job, and the app every job's avian side
+//! is built in ([`physics_app`], [`warm_up`], [`timed_step`]).
 //!
 //! Each pendulum is a dynamic body (mass 1, no collider) held by a
 //! [`DistanceJoint`] with `min = max = 0.8` and zero compliance to a static
@@ -12,7 +13,9 @@
 //! - Substeps: avian's default, `SubstepCount(6)`
 //!   (`src/dynamics/solver/schedule.rs`, `impl Default for SubstepCount`),
 //!   left untouched: avian is compared as shipped. The joint is solved by the
-//!   XPBD joint solver (`xpbd_joints` feature) once per substep.
+//!   XPBD joint solver (`xpbd_joints` feature) once per substep. The rope
+//!   and carts jobs also run at larger counts, set by inserting the
+//!   [`SubstepCount`] resource after the plugins.
 //! - No damping: `LinearDamping`/`AngularDamping` are read as `Option`s and
 //!   default to `0.0` when absent (`src/dynamics/integrator/mod.rs`,
 //!   `pre_process_velocity_increments`), `JointDamping` only acts on joints
@@ -92,8 +95,10 @@ fn bead_state(app: &App, bead: Entity, anchor: DVec2) -> (DVec2, DVec2) {
     (position - anchor, velocity)
 }
 
-/// Builds a headless app with avian2d and `n` pendulums, ready for
-/// [`App::update`]. Returns the app and the first pendulum's bead.
+/// A headless app with avian2d and no bodies yet, ready for spawning and
+/// then [`warm_up`]: gravity `gravity`, `substeps` substeps per step
+/// (`None`: avian's default, 6), transform sync off (see the module docs),
+/// and exactly one physics step of `step` per [`App::update`].
 ///
 /// # Stepping: exactly one physics step of `step` per `App::update`
 ///
@@ -116,11 +121,16 @@ fn bead_state(app: &App, bead: Entity, anchor: DVec2) -> (DVec2, DVec2) {
 ///   `src/dynamics/solver/schedule.rs`).
 /// - The very first update takes no step: `Time<Real>::update_with_duration`
 ///   only records its first instant, so the first delta is zero
-///   (`bevy_time-0.19.1/src/real.rs`). That update is used as a warm-up here;
+///   (`bevy_time-0.19.1/src/real.rs`). [`warm_up`] spends that update;
 ///   avian's own integrator test does the same.
 ///
-/// [`run_avian`] checks every update against `Time<Physics>`.
-fn build_app(n: usize, step: Duration, threads: Option<usize>) -> (App, Entity) {
+/// [`timed_step`] checks every later update against `Time<Physics>`.
+pub fn physics_app(
+    step: Duration,
+    threads: Option<usize>,
+    gravity: DVec2,
+    substeps: Option<u32>,
+) -> App {
     let mut app = App::new();
 
     // Bevy's task pools are process-wide and created once: a later
@@ -151,7 +161,11 @@ fn build_app(n: usize, step: Duration, threads: Option<usize>) -> (App, Entity) 
     });
     app.add_plugins((minimal, PhysicsPlugins::default()));
 
-    app.insert_resource(Gravity(DVec2::new(0.0, -GRAVITY)));
+    app.insert_resource(Gravity(gravity));
+    if let Some(k) = substeps {
+        // Replaces the default that `SolverSchedulePlugin` `init_resource`d.
+        app.insert_resource(SubstepCount(k));
+    }
     app.insert_resource(Time::<Fixed>::from_duration(step));
     app.insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
     {
@@ -166,6 +180,58 @@ fn build_app(n: usize, step: Duration, threads: Option<usize>) -> (App, Entity) 
     }
     app.finish();
     app.cleanup();
+    app
+}
+
+/// avian2d's default number of substeps per step (`impl Default for
+/// SubstepCount`, `src/dynamics/solver/schedule.rs`): 6.
+pub fn default_substeps() -> u32 {
+    SubstepCount::default().0
+}
+
+/// The first update of an app from [`physics_app`], after the bodies are
+/// spawned: runs the startup schedules and takes no physics step.
+///
+/// # Panics
+///
+/// If that update did step the physics.
+pub fn warm_up(app: &mut App) {
+    app.update();
+    assert_eq!(
+        app.world().resource::<Time<Physics>>().elapsed(),
+        Duration::ZERO,
+        "the warm-up update must not step the physics"
+    );
+}
+
+/// Update `k` (counted from 1) of an app from [`physics_app`]: one physics
+/// step of `step`. Returns the wall seconds of the `App::update` call alone.
+///
+/// # Panics
+///
+/// If the update did not advance the physics clock by one step.
+pub fn timed_step(app: &mut App, step: Duration, k: usize) -> f64 {
+    let before = app.world().resource::<Time<Physics>>().elapsed();
+    let start = Instant::now();
+    app.update();
+    let seconds = start.elapsed().as_secs_f64();
+
+    // One update, one physics step: the physics clock moved by one
+    // timestep (give or take the nanosecond rounding avian's
+    // relative-speed scaling may add), not zero and not two.
+    let advanced = app.world().resource::<Time<Physics>>().elapsed() - before;
+    assert!(
+        advanced > step / 2 && advanced < step * 3 / 2,
+        "update {k} advanced the physics clock by {advanced:?}, expected one step of {step:?}"
+    );
+    seconds
+}
+
+/// Builds a headless app with avian2d and `n` pendulums ([`physics_app`]
+/// at avian's default substeps), warmed up. Returns the app and the first
+/// pendulum's bead.
+fn build_app(n: usize, step: Duration, threads: Option<usize>) -> (App, Entity) {
+    let mut app = physics_app(step, threads, DVec2::new(0.0, -GRAVITY), None);
 
     let mut first = None;
     for i in 0..n {
@@ -198,12 +264,7 @@ fn build_app(n: usize, step: Duration, threads: Option<usize>) -> (App, Entity) 
     }
 
     // Warm-up: runs the startup schedules; takes no physics step (see above).
-    app.update();
-    assert_eq!(
-        app.world().resource::<Time<Physics>>().elapsed(),
-        Duration::ZERO,
-        "the warm-up update must not step the physics"
-    );
+    warm_up(&mut app);
 
     (app, first.expect("at least one pendulum"))
 }
@@ -264,19 +325,7 @@ pub fn run_avian(n: usize, dt: f64, steps: usize, threads: Option<usize>) -> Avi
     let mut wall_seconds = 0.0;
 
     for k in 1..=steps {
-        let before = app.world().resource::<Time<Physics>>().elapsed();
-        let start = Instant::now();
-        app.update();
-        wall_seconds += start.elapsed().as_secs_f64();
-
-        // One update, one physics step: the physics clock moved by one
-        // timestep (give or take the nanosecond rounding avian's
-        // relative-speed scaling may add), not zero and not two.
-        let advanced = app.world().resource::<Time<Physics>>().elapsed() - before;
-        assert!(
-            advanced > step / 2 && advanced < step * 3 / 2,
-            "update {k} advanced the physics clock by {advanced:?}, expected one step of {step:?}"
-        );
+        wall_seconds += timed_step(&mut app, step, k);
         sim_time += f64::from(substeps) * app.world().resource::<Time<Substeps>>().delta_secs_f64();
 
         for (bead, position) in beads.iter(app.world()) {

@@ -1,34 +1,81 @@
-//! wirebead against avian2d on one job: a bead on a circle of radius 0.8
-//! under |g| = 10, released from rest at 90°, dt = 1/60, 10 s.
+//! wirebead against avian2d on three jobs, one per subcommand:
 //!
 //! ```text
 //! cargo run --release -p wirebead-vs-avian
+//! cargo run --release -p wirebead-vs-avian -- circle [--steps 600] [--many 10000]
+//! cargo run --release -p wirebead-vs-avian -- rope [--steps 600] [--sizes 10,100,1000] [--substeps 20,50,100,200]
+//! cargo run --release -p wirebead-vs-avian -- carts [--steps 600] [--sizes 1000,10000] [--substeps 50] [--rail prismatic|locked]
 //! ```
 //!
-//! Prints a markdown table: energy change, max radial error and period
-//! error of each of our methods and of avian2d (a
-//! body on a `DistanceJoint` to a static anchor), and the wall time per
-//! bead-step at N = 1 and N = 10,000 pendulums.
+//! - `circle` (the default, also without a subcommand): a bead on a circle
+//!   of radius 0.8 under |g| = 10, released from rest at 90°, dt = 1/60,
+//!   10 s. Prints a markdown table: energy change, max radial error and
+//!   period error of each of our methods and of avian2d (a body on a
+//!   `DistanceJoint` to a static anchor), and the wall time per bead-step
+//!   at N = 1 and N = 10,000 pendulums.
+//! - `rope`: a rope of N rods of 0.1 m hanging from a pin, released
+//!   horizontal, our pure `Island` with RATTLE against avian2d's
+//!   `DistanceJoint`s at its default 6 substeps and at more (see
+//!   [`rope`]). Prints ns per rod-step, max relative stretch and energy
+//!   change per run, and the time ratios avian2d / ours.
+//! - `carts`: N pendulums on carts, our plugin against avian2d (a
+//!   `PrismaticJoint` or `LockedAxes` rail and a `DistanceJoint` rod) at
+//!   6 and 50 substeps (see [`carts`]). Prints ns per bead-step, rod and
+//!   rail errors and pendulum 0's energy change per run, and the time
+//!   ratios avian2d / ours.
+//!
+//! Every job uses Bevy's process-wide task pools with a compute thread per
+//! core, on both sides.
 
 #![warn(missing_docs)]
 
 mod avian_side;
+mod carts;
+mod rope;
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use clap::Parser;
+use clap::{Args, Parser, Subcommand};
 use wirebead::headless::Headless;
 use wirebead::prelude::*;
 use wirebead::reference::{pendulum_period, period_from_crossings};
 
+/// The circle's radius, metres.
 const RADIUS: f64 = 0.8;
+/// Magnitude of gravity, m/s², pointing along -y.
 const GRAVITY: f64 = 10.0;
 
+/// The command line: a job, or the circle job's options alone.
 #[derive(Parser, Debug)]
-#[command(about = "wirebead against avian2d on a bead on a circle")]
-struct Args {
+#[command(
+    about = "wirebead against avian2d: a bead on a circle, a hanging rope, pendulums on carts",
+    args_conflicts_with_subcommands = true
+)]
+struct Cli {
+    /// The job to run; the circle job if none is named.
+    #[command(subcommand)]
+    job: Option<Job>,
+    /// The circle job's options, when no job is named.
+    #[command(flatten)]
+    circle: CircleArgs,
+}
+
+/// The jobs.
+#[derive(Subcommand, Debug)]
+enum Job {
+    /// A bead on a circle, released from rest at 90° (the default job).
+    Circle(CircleArgs),
+    /// A rope of N rods hanging from a pin, released horizontal.
+    Rope(rope::RopeArgs),
+    /// N pendulums on carts, each cart on its own horizontal rail.
+    Carts(carts::CartsArgs),
+}
+
+/// Options of the circle job.
+#[derive(Args, Debug)]
+struct CircleArgs {
     /// Steps of 1/60 s to simulate.
     #[arg(long, default_value_t = 600)]
     steps: usize,
@@ -39,11 +86,17 @@ struct Args {
 
 /// What one run measured.
 struct Row {
+    /// The table's first column.
     name: String,
+    /// Energy per unit mass at the end minus at the release, J/kg.
     energy_change: f64,
+    /// Worst `| |x - centre| - r |` over the run, metres.
     max_radial_error: f64,
+    /// Relative period error, if a period was seen.
     period_error: Option<f64>,
+    /// Wall ns per bead-step at N = 1.
     ns_one: f64,
+    /// Wall ns per bead-step at N = `--many`.
     ns_many: f64,
 }
 
@@ -114,10 +167,21 @@ fn run_ours(n: usize, method: Method, dt: f64, steps: usize) -> (f64, f64, Optio
     )
 }
 
+/// Parses the command line and runs the job it names.
 fn main() {
-    let args = Args::parse();
+    let cli = Cli::parse();
     // Both sides share Bevy's global task pools: a compute thread per core.
     wirebead::plugin::compute_on_all_cores().create_default_pools();
+    match cli.job {
+        None => circle(&cli.circle),
+        Some(Job::Circle(args)) => circle(&args),
+        Some(Job::Rope(args)) => rope::run(&args),
+        Some(Job::Carts(args)) => carts::run(&args),
+    }
+}
+
+/// Runs the circle job and prints its table.
+fn circle(args: &CircleArgs) {
     let dt = 1.0 / 60.0;
     let exact = pendulum_period(RADIUS, GRAVITY, std::f64::consts::FRAC_PI_2);
     let mut rows = Vec::new();
