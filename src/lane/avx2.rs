@@ -1,12 +1,12 @@
 //! [`F64x8`]: eight lanes in two AVX2 registers (x86-64 only).
 
 use std::arch::x86_64::{__m256d, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _CMP_NEQ_UQ};
-use std::ops::{Add, BitAnd, Div, Mul, Neg, Sub};
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
 use pulp::cast;
 use pulp::x86::V3;
 
-use super::{LANES, Lane};
+use super::{LANES, Lane, Mask};
 
 /// Eight `f64`s in two AVX2 registers, with the token that proves the
 /// processor runs AVX2 (the intrinsics are pulp's safe wrappers, callable
@@ -82,6 +82,40 @@ impl BitAnd for M64x8 {
             simd: s,
             m: halves!(s, _mm256_and_pd(self.m, other.m)),
         }
+    }
+}
+
+impl BitOr for M64x8 {
+    type Output = Self;
+    #[inline(always)]
+    fn bitor(self, other: Self) -> Self {
+        let s = self.simd;
+        Self {
+            simd: s,
+            m: halves!(s, _mm256_or_pd(self.m, other.m)),
+        }
+    }
+}
+
+impl Not for M64x8 {
+    type Output = Self;
+    #[inline(always)]
+    fn not(self) -> Self {
+        let s = self.simd;
+        let all = [cast::<[u64; 4], __m256d>([u64::MAX; 4]); 2];
+        Self {
+            simd: s,
+            m: halves!(s, _mm256_xor_pd(self.m, all)),
+        }
+    }
+}
+
+impl Mask for M64x8 {
+    #[inline(always)]
+    fn any(self) -> bool {
+        let s = self.simd;
+        let [a, b] = halves!(s, _mm256_movemask_pd(self.m));
+        (a | b) != 0
     }
 }
 
@@ -168,10 +202,26 @@ impl Lane for F64x8 {
         self.mask(halves!(s, _mm256_cmp_pd::<_CMP_GT_OQ>(self.v, other.v)))
     }
     #[inline(always)]
+    fn abs(self) -> Self {
+        // Clears the sign bit, as `f64::abs` does.
+        let s = self.simd;
+        self.with(halves!(
+            s,
+            _mm256_andnot_pd([s.avx._mm256_set1_pd(-0.0); 2], self.v)
+        ))
+    }
+    #[inline(always)]
     fn abs_le(self, bound: Self) -> M64x8 {
         let s = self.simd;
         let abs = halves!(s, _mm256_andnot_pd([s.avx._mm256_set1_pd(-0.0); 2], self.v));
         self.mask(halves!(s, _mm256_cmp_pd::<_CMP_LE_OQ>(abs, bound.v)))
+    }
+    #[inline(always)]
+    fn select(mask: M64x8, a: Self, b: Self) -> Self {
+        // blendv takes each lane from its second operand where the mask's
+        // sign bit is set.
+        let s = a.simd;
+        a.with(halves!(s, _mm256_blendv_pd(b.v, a.v, mask.m)))
     }
 }
 

@@ -10,7 +10,7 @@
 //! the vector instructions, and nothing is fused into an FMA, so a lane of
 //! [`F64x8`] computes bit for bit what `f64` computes.
 
-use std::ops::{Add, BitAnd, Div, Mul, Neg, Sub};
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -27,7 +27,7 @@ pub(crate) trait Lane:
     + Neg<Output = Self>
 {
     /// Per-lane truth values.
-    type Mask: Copy + BitAnd<Output = Self::Mask>;
+    type Mask: Mask;
     /// `v` in every lane.
     fn splat(self, v: f64) -> Self;
     /// The square root, correctly rounded.
@@ -40,8 +40,27 @@ pub(crate) trait Lane:
     fn is_nonzero(self) -> Self::Mask;
     /// `self > other` (false where either is NaN).
     fn gt(self, other: Self) -> Self::Mask;
+    /// `|self|`.
+    fn abs(self) -> Self;
     /// `|self| <= bound` (false where either is NaN).
     fn abs_le(self, bound: Self) -> Self::Mask;
+    /// `a` in the lanes where `mask` holds, `b` in the others.
+    fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+}
+
+/// Per-lane truth values: `bool` for one bead, a mask for eight.
+pub(crate) trait Mask:
+    Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self>
+{
+    /// Whether any lane holds.
+    fn any(self) -> bool;
+}
+
+impl Mask for bool {
+    #[inline(always)]
+    fn any(self) -> bool {
+        self
+    }
 }
 
 impl Lane for f64 {
@@ -71,8 +90,16 @@ impl Lane for f64 {
         self > other
     }
     #[inline(always)]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    #[inline(always)]
     fn abs_le(self, bound: Self) -> bool {
         self.abs() <= bound
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: Self, b: Self) -> Self {
+        if mask { a } else { b }
     }
 }
 
@@ -109,6 +136,18 @@ impl<T: Lane> V2<T> {
     #[inline(always)]
     pub(crate) fn plus(self, t: T, d: Self) -> Self {
         Self::new(self.x + t * d.x, self.y + t * d.y)
+    }
+
+    /// `self / t`, as glam divides a vector by a number.
+    #[inline(always)]
+    pub(crate) fn div(self, t: T) -> Self {
+        Self::new(self.x / t, self.y / t)
+    }
+
+    /// `a` in the lanes where `mask` holds, `b` in the others.
+    #[inline(always)]
+    pub(crate) fn select(mask: T::Mask, a: Self, b: Self) -> Self {
+        Self::new(T::select(mask, a.x, b.x), T::select(mask, a.y, b.y))
     }
 
     /// Both components finite.

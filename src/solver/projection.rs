@@ -13,14 +13,20 @@ use crate::geometry::{FixedTrack, ImplicitCurve, Track};
 /// of the wire's scale: a few ulps, which Newton's quadratic convergence
 /// reaches in two or three iterations.
 pub const NEWTON_TOLERANCE: f64 = 4.0 * f64::EPSILON;
-/// Where rounding keeps `|C|` from reaching [`NEWTON_TOLERANCE`], a residual
-/// below this (in wire scales) after the last iteration is accepted.
+/// Where rounding keeps `|C|` from reaching [`NEWTON_TOLERANCE`] (a bead
+/// far from the origin beside its wire's scale), a residual below this (in
+/// wire scales) is accepted once an iteration no longer halves it, or after
+/// the last iteration.
 pub const NEWTON_ACCEPT: f64 = 1e-10;
 /// The most Newton iterations a solve takes before it gives up.
 pub(crate) const NEWTON_MAX_ITERATIONS: u32 = 20;
 
-fn newton_done(residual: f64, scale: f64, last: bool) -> bool {
-    residual <= NEWTON_TOLERANCE * scale || (last && residual <= NEWTON_ACCEPT * scale)
+/// Whether a Newton solve is done: `|C|` within the tolerance, or within
+/// [`NEWTON_ACCEPT`] and stalled (no smaller than half the `previous`
+/// residual) or at the last iteration.
+pub(crate) fn newton_done(residual: f64, previous: f64, scale: f64, last: bool) -> bool {
+    residual <= NEWTON_TOLERANCE * scale
+        || (residual <= NEWTON_ACCEPT * scale && (last || residual > 0.5 * previous))
 }
 
 /// Newton's method on `s ↦ C(base + s dir, t)`: the root `s`.
@@ -36,8 +42,9 @@ pub(crate) fn newton_along<T: Track + ?Sized>(
     for i in 0..=NEWTON_MAX_ITERATIONS {
         let p = base + s * dir;
         let g = track.geometry(t, p);
+        let previous = residual;
         residual = g.c.abs();
-        if newton_done(residual, scale, i == NEWTON_MAX_ITERATIONS) {
+        if newton_done(residual, previous, scale, i == NEWTON_MAX_ITERATIONS) {
             return Ok(s);
         }
         if i == NEWTON_MAX_ITERATIONS {
@@ -78,8 +85,9 @@ pub(crate) fn project_on<T: Track + ?Sized>(
     let mut residual = f64::INFINITY;
     for i in 0..=NEWTON_MAX_ITERATIONS {
         let g = track.geometry(t, x);
+        let previous = residual;
         residual = g.c.abs();
-        if newton_done(residual, scale, i == NEWTON_MAX_ITERATIONS) {
+        if newton_done(residual, previous, scale, i == NEWTON_MAX_ITERATIONS) {
             converged = true;
             break;
         }
