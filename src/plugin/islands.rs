@@ -18,8 +18,12 @@ use crate::dynamics::{
     Joint, OnWire, Pin, Rod, SimParams, Spring, Wire, WireContact, WirePose,
 };
 use crate::solver::{
-    self, BeadState, Contact, Island, IslandRow, IslandWork, LinearForce, RowKind, SpringLink,
+    self, BeadState, Contact, Island, IslandRow, IslandWork, LinearForce, RowKind, SolveError,
+    SpringLink, StepSettings,
 };
+use bevy::tasks::ComputeTaskPool;
+
+use super::parallel::ParallelStep;
 
 /// Marks a bead stepped in an island (joined to another bead or a point,
 /// or on no wire); the per-bead step leaves it alone. Kept by the plugin.
@@ -64,6 +68,9 @@ struct CachedIsland {
     wire_rows: Vec<(usize, usize, Entity)>,
     /// The first row of each pin fixed to another entity, and the pin.
     anchored: Vec<(usize, Entity)>,
+    /// What this step did: not stepped (a bead of it has stopped), or the
+    /// step's result.
+    outcome: Option<Result<(), SolveError>>,
 }
 
 /// The islands of the current topology: beads joined by constraints and
@@ -384,6 +391,7 @@ pub(crate) fn prepare_islands(
                 links: link_rows,
                 wire_rows,
                 anchored,
+                outcome: None,
             }),
             Err(reason) => {
                 for &bead in &entities {
@@ -406,12 +414,14 @@ pub(crate) fn prepare_islands(
 }
 
 /// Steps every island whose beads have not diverged: gathers their states
-/// and forces, calls [`Island::step`], writes back the states, the
-/// diagnostics and the `Transform`s. An island whose step fails stops as a
-/// whole, each of its beads marked [`Diverged`].
+/// and forces, calls [`Island::step`] (the islands split over the compute
+/// task pool from [`ParallelStep::threshold`] beads in islands up), writes
+/// back the states, the diagnostics and the `Transform`s. An island whose
+/// step fails stops as a whole, each of its beads marked [`Diverged`].
 pub(crate) fn step_islands(
     params: Res<SimParams>,
     clock: Res<SimClock>,
+    parallel: Res<ParallelStep>,
     mut islands: ResMut<Islands>,
     mut beads: Query<
         (
@@ -431,12 +441,14 @@ pub(crate) fn step_islands(
 ) {
     let settings = params.step_settings();
     let gravity = params.gravity;
-    'islands: for cached in &mut islands.cached {
+    let mut stepped_beads = 0;
+    'gather: for cached in &mut islands.cached {
+        cached.outcome = None;
         cached.states.clear();
         cached.forces.clear();
         for &entity in &cached.report.beads {
             let Ok((bead, ..)) = beads.get(entity) else {
-                continue 'islands; // a bead of it stopped: so does the island
+                continue 'gather; // a bead of it stopped: so does the island
             };
             cached.states.push(bead.state());
             cached.forces.push(bead.step_force(gravity));
@@ -456,17 +468,44 @@ pub(crate) fn step_islands(
                 cached.island.place_axis(row + 1, at.y);
             }
         }
-        if let Err(e) = cached.island.step_at(
-            clock.time - settings.dt,
-            &mut cached.states,
-            &cached.forces,
-            &settings,
-            &mut cached.work,
-        ) {
-            for &bead in &cached.report.beads {
-                divergences.report(bead, DivergenceReason::Solve(e), clock.time);
+        cached.outcome = Some(Ok(()));
+        stepped_beads += cached.states.len();
+    }
+    let time = clock.time - settings.dt;
+    let pool = ComputeTaskPool::try_get().filter(|_| stepped_beads >= parallel.threshold);
+    let threads = pool.map_or(1, |pool| pool.thread_num().max(1));
+    match pool {
+        Some(pool) if threads > 1 => {
+            // A few chunks per thread, so that one slow island (a rope
+            // in substeps) does not leave the other threads idle.
+            let size = islands.cached.len().div_ceil(4 * threads).max(1);
+            pool.scope(|scope| {
+                for chunk in islands.cached.chunks_mut(size) {
+                    let settings = &settings;
+                    scope.spawn(async move {
+                        for cached in chunk {
+                            step_island(cached, time, settings);
+                        }
+                    });
+                }
+            });
+        }
+        _ => {
+            for cached in &mut islands.cached {
+                step_island(cached, time, &settings);
             }
-            continue;
+        }
+    }
+    for cached in &mut islands.cached {
+        match cached.outcome {
+            None => continue,
+            Some(Err(e)) => {
+                for &bead in &cached.report.beads {
+                    divergences.report(bead, DivergenceReason::Solve(e), clock.time);
+                }
+                continue;
+            }
+            Some(Ok(())) => {}
         }
         let rows = cached.work.rows();
         let pushed = cached.work.constraint_forces();
@@ -549,4 +588,19 @@ pub(crate) fn step_islands(
         cached.report.redundant = cached.work.redundant();
         cached.report.substeps = cached.work.substeps();
     }
+}
+
+/// Steps one gathered island (see [`step_islands`]), its result into
+/// its `outcome`.
+fn step_island(cached: &mut CachedIsland, time: f64, settings: &StepSettings) {
+    if cached.outcome.is_none() {
+        return;
+    }
+    cached.outcome = Some(cached.island.step_at(
+        time,
+        &mut cached.states,
+        &cached.forces,
+        settings,
+        &mut cached.work,
+    ));
 }

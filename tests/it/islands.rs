@@ -227,6 +227,56 @@ fn a_coupled_scene_runs_bit_identically_sequential_and_parallel() {
 }
 
 #[test]
+fn many_islands_split_over_threads_step_as_on_one() {
+    // 64 pendulums on carts, each its own island, released at different
+    // angles: stepped with the islands split over every core, the same bits
+    // as on one thread, and each cart still on its rail.
+    let run = |parallel: bool| {
+        let plugin = WireBeadPlugin::new(params(Method::Rattle, 1.0 / 60.0)).unwrap();
+        let headless = Headless::new(plugin);
+        let mut app = if parallel {
+            headless
+                .on_all_cores()
+                .parallel(ParallelStep { threshold: 1 })
+                .build()
+        } else {
+            headless.single_threaded().build()
+        };
+        let world = app.world_mut();
+        let mut carts = Vec::new();
+        for i in 0..64 {
+            let y = -3.0 * f64::from(i);
+            let angle = 0.1 + 0.04 * f64::from(i);
+            let rail = world
+                .spawn((Wire::line(), Transform::from_xyz(0.0, y as f32, 0.0)))
+                .id();
+            let cart = world
+                .spawn((Bead::at_rest(2.0, DVec2::new(0.0, y)).unwrap(), OnWire(rail)))
+                .id();
+            let swing = DVec2::new(angle.sin(), -angle.cos());
+            let bob = world
+                .spawn(Bead::at_rest(1.0, DVec2::new(0.0, y) + swing).unwrap())
+                .id();
+            world.spawn(Rod::new(cart, bob, 1.0).unwrap());
+            carts.push((cart, bob, y));
+        }
+        run_steps(&mut app, 120);
+        let islands = app.world().resource::<Islands>().iter().count();
+        assert_eq!(islands, 64, "{islands} islands");
+        carts
+            .iter()
+            .map(|&(cart, bob, y)| {
+                let (c, b) = (bead(&app, cart), bead(&app, bob));
+                assert!((c.position.y - y).abs() <= 1e-12, "a cart left its rail");
+                assert!(((b.position - c.position).length() - 1.0).abs() <= 1e-12);
+                (c.state(), b.state())
+            })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(run(false), run(true));
+}
+
+#[test]
 fn a_pin_on_an_entity_holds_its_bead_where_the_entity_is() {
     let mut app = app(params(Method::Rattle, 0.01));
     let world = app.world_mut();

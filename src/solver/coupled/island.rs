@@ -425,13 +425,6 @@ impl Island {
     }
 
     /// Whether a row is a stick row of a rough wire.
-    fn is_stick(&self, row: usize) -> bool {
-        self.rough
-            .iter()
-            .flatten()
-            .any(|rough| rough.stick == Some(row))
-    }
-
     /// Whether a row is one-sided.
     fn one_sided(&self) -> bool {
         self.sides.iter().any(|(side, _)| *side != 0.0)
@@ -520,16 +513,22 @@ impl Island {
             // the side it pushes toward, starts in flight; stick rows start
             // set aside (a bead slides until friction stops it).
             let whole = states.len() == self.beads();
-            work.inactive = (0..self.rows())
-                .map(|r| {
-                    let (side, _) = self.sides[r];
-                    self.is_stick(r)
-                        || (side != 0.0
-                            && whole
-                            && side * self.wire_row(r, states, time).c
-                                > OFF_THE_WIRE * self.rows[r].scale())
-                })
-                .collect();
+            work.inactive.clear();
+            work.inactive.resize(self.rows(), false);
+            for rough in self.rough.iter().flatten() {
+                if let Some(s) = rough.stick {
+                    work.inactive[s] = true;
+                }
+            }
+            for r in 0..self.rows() {
+                let (side, _) = self.sides[r];
+                if side != 0.0
+                    && whole
+                    && side * self.wire_row(r, states, time).c > OFF_THE_WIRE * self.rows[r].scale()
+                {
+                    work.inactive[r] = true;
+                }
+            }
             // A bead at rest on a rough wire starts held by static friction.
             for (r, rough) in self.rough.iter().enumerate() {
                 let Some(RoughRow { stick: Some(s), .. }) = rough else {
