@@ -4,8 +4,10 @@
 //!   from `ParallelStep::default()`), N beads each on its own circle or all
 //!   on one, N = 1 … 1,000,000, full beads (the default) and lean ones
 //!   (`WireBeadPlugin::lean`). Throughput is bead-steps per second.
-//! - `overhead`: at each N and for each kind of bead, the same math as one
-//!   fused loop over a `Vec` of plain structs (the floor), against the
+//! - `overhead`: at each N and for each kind of bead, the same physics
+//!   written out by hand as one plain loop over arrays (the floor,
+//!   `support::RawLoop`, which uses none of the plugin's or the solver's
+//!   code and is checked to move the beads as the plugin does), against the
 //!   plugin single-threaded and parallel.
 
 use std::hint::black_box;
@@ -52,8 +54,42 @@ fn scale(c: &mut Criterion) {
     group.finish();
 }
 
+/// Steps the floor and the plugin side by side from the same start and
+/// checks they move the beads alike (rounding aside): the floor is the
+/// same physics, written apart.
+fn floor_agrees_with_the_plugin(kind: Kind) {
+    let (n, steps) = (1_000, 120);
+    let mut raw = RawLoop::new(n, Layout::OwnWires, kind);
+    let mut app = plugin_app(n, Layout::OwnWires, Threads::Single, kind);
+    for _ in 0..steps {
+        assert_eq!(raw.step(), 0, "the floor diverged");
+        app.world_mut().run_schedule(FixedUpdate);
+    }
+    let world = app.world_mut();
+    let plugin: Vec<_> = world
+        .query::<&wirebead::Bead>()
+        .iter(world)
+        .map(|b| b.position)
+        .collect();
+    let worst = raw
+        .positions()
+        .zip(&plugin)
+        .map(|(a, b)| (a - *b).length())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "overhead/{}: the floor and the plugin {worst:.1e} m apart after {steps} steps",
+        kind.name()
+    );
+    assert!(
+        plugin.len() == n && worst <= 1e-9,
+        "the floor is not the plugin's physics"
+    );
+}
+
 fn overhead(c: &mut Criterion) {
     let mut group = c.benchmark_group("overhead");
+    floor_agrees_with_the_plugin(Kind::Full);
+    floor_agrees_with_the_plugin(Kind::Lean);
     for n in SIZES {
         configure(&mut group, n);
         for kind in [Kind::Full, Kind::Lean] {

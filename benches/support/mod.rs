@@ -5,10 +5,8 @@
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use wirebead::geometry::{Circle, Placed, Pose};
 use wirebead::headless::Headless;
 use wirebead::prelude::*;
-use wirebead::solver::{self, BeadState, LinearForce, StepSettings};
 
 /// How the beads are put on wires.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -124,15 +122,31 @@ pub fn plugin_app(n: usize, layout: Layout, threads: Threads, kind: Kind) -> App
     app
 }
 
-/// One lean bead as a plain struct: the state the plugin keeps.
-#[derive(Clone, Copy, Debug)]
-pub struct RawBead {
-    /// Position and velocity.
-    pub state: BeadState,
-    /// Mass.
-    pub mass: f64,
-    /// Index of its wire's pose.
-    pub wire: u32,
+/// The floor the plugin is measured against: the default method
+/// (semi-implicit Euler with Baumgarte stabilization, eq. 3 on a circle)
+/// written out by hand from the equations as one plain loop over arrays
+/// (one array per scalar), with none of the plugin's or the solver's code.
+/// The loop runs in a function compiled for AVX2 where the processor has
+/// it (pulp's dispatch), so the compiler vectorizes it; it takes no
+/// branches per bead. For full beads it also writes what the plugin
+/// shows: λ, `λN`, `C`, `Ċ`, the energies and the rendered position.
+pub struct RawLoop {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    vx: Vec<f64>,
+    vy: Vec<f64>,
+    mass: Vec<f64>,
+    /// Each bead's circle's centre.
+    ox: Vec<f64>,
+    oy: Vec<f64>,
+    /// For full beads: λ, `λN`, `C`, `Ċ`, kinetic and potential energy,
+    /// the rendered position; empty for lean ones.
+    extras: Vec<RawExtras>,
+    radius: f64,
+    dt: f64,
+    alpha: f64,
+    beta: f64,
+    gravity: DVec2,
 }
 
 /// What a full bead adds: diagnostics and the rendered position.
@@ -141,160 +155,115 @@ pub struct RawExtras {
     /// λ.
     pub lambda: f64,
     /// `λN`.
-    pub constraint_force: DVec2,
+    pub constraint_force: [f64; 2],
     /// `C`, `Ċ`, kinetic and potential energy.
     pub diagnostics: [f64; 4],
     /// The rendered position.
     pub rendered: [f32; 2],
 }
 
-/// The floor: the plugin's step as one fused loop over a `Vec`.
-pub struct RawLoop {
-    /// The beads.
-    pub beads: Vec<RawBead>,
-    /// Their extras, for [`Kind::Full`]; empty for [`Kind::Lean`].
-    pub extras: Vec<RawExtras>,
-    /// Each wire's pose.
-    pub poses: Vec<Pose>,
-    /// The shared shape.
-    pub circle: Circle,
-    /// The step's settings.
-    pub settings: StepSettings,
-    /// Gravity.
-    pub gravity: DVec2,
-}
-
 impl RawLoop {
     /// `n` beads laid out as [`plugin_app`] lays them out.
     pub fn new(n: usize, layout: Layout, kind: Kind) -> Self {
         let params = SimParams::default();
-        let poses: Vec<Pose> = match layout {
-            Layout::SharedWire => vec![Pose::IDENTITY],
-            Layout::OwnWires => (0..n).map(|i| Pose::new(grid_origin(i), 0.0)).collect(),
+        let origin = |i: usize| match layout {
+            Layout::SharedWire => DVec2::ZERO,
+            Layout::OwnWires => grid_origin(i),
         };
-        let beads = (0..n)
-            .map(|i| {
-                let wire = if layout == Layout::SharedWire { 0 } else { i };
-                (wire, poses[wire].origin, i)
-            })
-            .map(|(wire, origin, i)| RawBead {
-                state: BeadState {
-                    position: on_circle(origin, start_angle(i)),
-                    velocity: DVec2::ZERO,
-                },
-                mass: 1.0,
-                wire: wire as u32,
-            })
+        let at: Vec<DVec2> = (0..n)
+            .map(|i| on_circle(origin(i), start_angle(i)))
             .collect();
-        let extras = match kind {
-            Kind::Full => vec![RawExtras::default(); n],
-            Kind::Lean => Vec::new(),
-        };
         Self {
-            beads,
-            extras,
-            poses,
-            circle: Circle { radius: 1.0 },
-            settings: params.step_settings(),
+            x: at.iter().map(|p| p.x).collect(),
+            y: at.iter().map(|p| p.y).collect(),
+            vx: vec![0.0; n],
+            vy: vec![0.0; n],
+            mass: vec![1.0; n],
+            ox: (0..n).map(|i| origin(i).x).collect(),
+            oy: (0..n).map(|i| origin(i).y).collect(),
+            extras: match kind {
+                Kind::Full => vec![RawExtras::default(); n],
+                Kind::Lean => Vec::new(),
+            },
+            radius: 1.0,
+            dt: params.timestep,
+            alpha: params.alpha,
+            beta: params.beta,
             gravity: params.gravity,
         }
     }
 
-    /// One step of every bead; returns how many failed.
-    pub fn step(&mut self) -> usize {
-        if self.extras.is_empty() {
-            self.step_lean()
-        } else {
-            self.step_full()
-        }
+    /// The beads' positions.
+    pub fn positions(&self) -> impl Iterator<Item = DVec2> + '_ {
+        self.x.iter().zip(&self.y).map(|(&x, &y)| DVec2::new(x, y))
     }
 
-    /// Steps `beads` as the plugin does: [`solver::LANES`] at a time
-    /// through the batched circle step, the lanes it hands back and the
-    /// last partial chunk through `step`. `store` gets each bead's index and
-    /// result.
-    #[inline(always)]
-    fn step_chunks(
-        &self,
-        beads: &mut [RawBead],
-        mut store: impl FnMut(usize, &mut RawBead, Result<solver::StepOutput, solver::SolveError>),
-    ) {
-        let mut lanes = solver::CircleLanes::default();
-        let mut outs = solver::CircleSteps::default();
-        let mut chunks = beads.chunks_exact_mut(solver::LANES);
-        let mut start = 0;
-        for chunk in &mut chunks {
-            for (lane, bead) in chunk.iter().enumerate() {
-                let force = LinearForce::constant(bead.mass * self.gravity);
-                let pose = self.poses[bead.wire as usize];
-                lanes.set(
-                    lane,
-                    bead.state,
-                    &force,
-                    bead.mass,
-                    pose.origin,
-                    self.circle.radius,
-                );
-            }
-            solver::step_on_circles(&lanes, &self.settings, &mut outs);
-            for (lane, bead) in chunk.iter_mut().enumerate() {
-                // Two calls, so a finished lane's result stays in registers.
-                match outs.lane(lane) {
-                    Some(out) => store(start + lane, bead, Ok(out)),
-                    None => {
-                        let out = self.step_one(bead);
-                        store(start + lane, bead, out);
-                    }
+    /// One step of every bead; returns how many came out not finite.
+    pub fn step(&mut self) -> usize {
+        struct Kernel<'a>(&'a mut RawLoop);
+        impl pulp::NullaryFnOnce for Kernel<'_> {
+            type Output = usize;
+            #[inline(always)]
+            fn call(self) -> usize {
+                if self.0.extras.is_empty() {
+                    self.0.kernel::<false>()
+                } else {
+                    self.0.kernel::<true>()
                 }
             }
-            start += solver::LANES;
         }
-        for (k, bead) in chunks.into_remainder().iter_mut().enumerate() {
-            let out = self.step_one(bead);
-            store(start + k, bead, out);
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = pulp::x86::V3::try_new() {
+            return simd.vectorize(Kernel(self));
         }
+        pulp::NullaryFnOnce::call(Kernel(self))
     }
 
-    fn step_one(&self, bead: &RawBead) -> Result<solver::StepOutput, solver::SolveError> {
-        let placed = Placed {
-            curve: &self.circle,
-            pose: self.poses[bead.wire as usize],
-        };
-        let force = LinearForce::constant(bead.mass * self.gravity);
-        solver::step(&placed, bead.state, &force, bead.mass, &self.settings)
-    }
-
-    fn step_lean(&mut self) -> usize {
-        let mut failed = 0;
-        let mut beads = std::mem::take(&mut self.beads);
-        self.step_chunks(&mut beads, |_, bead, out| match out {
-            Ok(out) => bead.state = out.state,
-            Err(_) => failed += 1,
-        });
-        self.beads = beads;
-        failed
-    }
-
-    fn step_full(&mut self) -> usize {
-        let mut failed = 0;
-        let (mut beads, mut extras) = (
-            std::mem::take(&mut self.beads),
-            std::mem::take(&mut self.extras),
+    /// Eq. (3) on each bead's circle, `C = |p| - r` with `p` the position
+    /// from the centre: `N = p/|p|`, `vᵀHv = (|v|² - (N·v)²)/|p|`, then
+    /// the semi-implicit Euler step.
+    #[inline(always)]
+    fn kernel<const FULL: bool>(&mut self) -> usize {
+        let (h, r, alpha, beta) = (self.dt, self.radius, self.alpha, self.beta);
+        let (gx, gy) = (self.gravity.x, self.gravity.y);
+        let n = self.x.len();
+        let (x, y, vx, vy) = (
+            &mut self.x[..n],
+            &mut self.y[..n],
+            &mut self.vx[..n],
+            &mut self.vy[..n],
         );
-        self.step_chunks(&mut beads, |i, bead, out| match out {
-            Ok(out) => {
-                bead.state = out.state;
-                let (kinetic, potential) = out.state.energy(bead.mass, self.gravity);
-                extras[i] = RawExtras {
-                    lambda: out.lambda,
-                    constraint_force: out.constraint_force,
-                    diagnostics: [out.c, out.c_dot, kinetic, potential],
-                    rendered: [out.state.position.x as f32, out.state.position.y as f32],
+        let (mass, ox, oy) = (&self.mass[..n], &self.ox[..n], &self.oy[..n]);
+        let mut failed = 0usize;
+        for i in 0..n {
+            let m = mass[i];
+            let (px, py) = (x[i] - ox[i], y[i] - oy[i]);
+            let len = (px * px + py * py).sqrt();
+            let (nx, ny) = (px / len, py / len);
+            let (u, w) = (vx[i], vy[i]);
+            let nv = nx * u + ny * w;
+            let vhv = (u * u + w * w - nv * nv) / len;
+            let (fx, fy) = (m * gx, m * gy);
+            let lambda = (-m * vhv - m * alpha * (len - r) - m * beta * nv - (nx * fx + ny * fy))
+                / (nx * nx + ny * ny);
+            let u1 = u + h * (fx + lambda * nx) / m;
+            let w1 = w + h * (fy + lambda * ny) / m;
+            let (x1, y1) = (x[i] + h * u1, y[i] + h * w1);
+            (x[i], y[i], vx[i], vy[i]) = (x1, y1, u1, w1);
+            failed += usize::from(!(x1.is_finite() && y1.is_finite()));
+            if FULL {
+                let (qx, qy) = (x1 - ox[i], y1 - oy[i]);
+                let len1 = (qx * qx + qy * qy).sqrt();
+                let c_dot = (qx * u1 + qy * w1) / len1;
+                let speed2 = u1 * u1 + w1 * w1;
+                self.extras[i] = RawExtras {
+                    lambda,
+                    constraint_force: [lambda * nx, lambda * ny],
+                    diagnostics: [len1 - r, c_dot, 0.5 * m * speed2, -m * (gx * x1 + gy * y1)],
+                    rendered: [x1 as f32, y1 as f32],
                 };
             }
-            Err(_) => failed += 1,
-        });
-        (self.beads, self.extras) = (beads, extras);
+        }
         failed
     }
 }

@@ -251,7 +251,10 @@ fn many_islands_split_over_threads_step_as_on_one() {
                 .spawn((Wire::line(), Transform::from_xyz(0.0, y as f32, 0.0)))
                 .id();
             let cart = world
-                .spawn((Bead::at_rest(2.0, DVec2::new(0.0, y)).unwrap(), OnWire(rail)))
+                .spawn((
+                    Bead::at_rest(2.0, DVec2::new(0.0, y)).unwrap(),
+                    OnWire(rail),
+                ))
                 .id();
             let swing = DVec2::new(angle.sin(), -angle.cos());
             let bob = world
