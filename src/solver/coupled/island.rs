@@ -424,7 +424,12 @@ impl Island {
         }
     }
 
-    /// Whether a row is a stick row of a rough wire.
+    /// Whether the island's matrices may be factored dense: a few rows,
+    /// and no friction (see the `normal` module).
+    fn dense(&self) -> bool {
+        self.rows() <= 8 && self.rough.iter().all(Option::is_none)
+    }
+
     /// Whether a row is one-sided.
     fn one_sided(&self) -> bool {
         self.sides.iter().any(|(side, _)| *side != 0.0)
@@ -1132,7 +1137,13 @@ impl Island {
         factored: &mut Factored,
     ) -> Result<(), SolveError> {
         self.normal
-            .factor(&self.inverse_mass, gradient, inactive, factored)
+            .factor(
+                &self.inverse_mass,
+                gradient,
+                inactive,
+                self.dense(),
+                factored,
+            )
             .map_err(|r| {
                 let p = x[self.entry_bead[self.row_start[r]]];
                 SolveError::Singular { x: p.x, y: p.y }
@@ -1309,6 +1320,7 @@ impl Island {
                     along,
                     &mut work.lu,
                     &mut work.rhs,
+                    self.dense(),
                 );
             if !solved_exactly {
                 // A singular Newton matrix (a redundant row): the chord step.

@@ -4,7 +4,11 @@
 //!
 //! `A` is symmetric positive semidefinite, with a nonzero `(r, s)` wherever
 //! rows `r` and `s` share a bead. It is scaled to a unit diagonal
-//! (`S A S`, `S = diag(1/√A_rr)`) and factored `LDLᵀ` by faer's sparse
+//! (`S A S`, `S = diag(1/√A_rr)`) and factored `LDLᵀ`: as a small dense
+//! matrix for islands of up to eight rows with no friction (which rows of
+//! a redundant set carry the load decides which bead static friction
+//! releases, so a rough island keeps the sparse order), otherwise by
+//! faer's sparse
 //! Cholesky under an approximate-minimum-degree ordering, which for a chain
 //! or tree of rods eliminates leaf by leaf with no fill-in, so the cost is
 //! linear in the number of rows (Baraff 1996). A closed loop adds a little
@@ -34,6 +38,10 @@ use faer::{Conj, MatMut, Par, Side};
 pub const REDUNDANT_PIVOT: f64 = 1e-10;
 /// What a redundant row's pivot is replaced by: its λ becomes zero.
 const DROPPED_PIVOT: f64 = 1e30;
+/// Islands of at most this many rows factor `A` and the Newton matrix as
+/// small dense matrices: for a pendulum on a cart (two rows) the sparse
+/// machinery costs more than the arithmetic.
+const DENSE_ROWS: usize = 8;
 
 /// One product `w_bead · g_i · g_j` that makes up an entry of `A`.
 #[derive(Clone, Copy, Debug)]
@@ -67,6 +75,8 @@ pub(crate) struct NormalMatrix {
     terms: Vec<Term>,
     /// `None` for a single row, solved in closed form.
     symbolic: Option<SymbolicCholesky<usize>>,
+    /// Two to [`DENSE_ROWS`] rows: `A` may be factored as a dense matrix.
+    small: bool,
     /// The full pattern for the unsymmetric `J₁ W J₀ᵀ`, made when first
     /// needed; `None` inside if faer could not set it up.
     unsymmetric: OnceLock<Option<Unsymmetric>>,
@@ -99,6 +109,8 @@ pub(crate) struct Factored {
     scratch: Scratch,
     /// How many rows the factorization dropped as redundant.
     pub(crate) redundant: usize,
+    /// Whether `l_values` holds a dense factorization.
+    dense: bool,
 }
 
 impl NormalMatrix {
@@ -158,6 +170,7 @@ impl NormalMatrix {
             col_ptr[c + 1] = col_ptr[c + 1].max(col_ptr[c]);
         }
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let small = (2..=DENSE_ROWS).contains(&n);
         let symbolic = if n > 1 {
             let symbolic = factorize_symbolic_cholesky(
                 pattern.as_ref(),
@@ -178,6 +191,7 @@ impl NormalMatrix {
             term_start,
             terms,
             symbolic,
+            small,
             unsymmetric: OnceLock::new(),
         })
     }
@@ -238,24 +252,20 @@ impl NormalMatrix {
         first: &[DVec2],
         lu: &mut LuWork,
         rhs: &mut [f64],
+        dense: bool,
     ) -> bool {
+        if dense && self.n <= DENSE_ROWS {
+            return self.solve_unsymmetric_dense(inverse_mass, now, first, &mut lu.values, rhs);
+        }
         let Some(u) = self.unsymmetric() else {
             return false;
         };
         lu.values.clear();
-        lu.values.extend(u.source.iter().map(|&(k, mirror)| {
-            self.terms[self.term_start[k]..self.term_start[k + 1]]
+        lu.values.extend(
+            u.source
                 .iter()
-                .map(|t| {
-                    let (row, col) = if mirror {
-                        (t.right, t.left)
-                    } else {
-                        (t.left, t.right)
-                    };
-                    inverse_mass[t.bead] * now[row].dot(first[col])
-                })
-                .sum::<f64>()
-        }));
+                .map(|&(k, mirror)| self.unsymmetric_value(k, mirror, inverse_mass, now, first)),
+        );
         if lu.scratch.owner != self.id {
             lu.scratch.memory = None;
             lu.scratch.owner = self.id;
@@ -287,6 +297,120 @@ impl NormalMatrix {
         rhs.iter().all(|x| x.is_finite())
     }
 
+    /// The value of `J_now W J_firstᵀ` at the upper entry `k`, or at its
+    /// mirror below the diagonal.
+    fn unsymmetric_value(
+        &self,
+        k: usize,
+        mirror: bool,
+        inverse_mass: &[f64],
+        now: &[DVec2],
+        first: &[DVec2],
+    ) -> f64 {
+        self.terms[self.term_start[k]..self.term_start[k + 1]]
+            .iter()
+            .map(|t| {
+                let (row, col) = if mirror {
+                    (t.right, t.left)
+                } else {
+                    (t.left, t.right)
+                };
+                inverse_mass[t.bead] * now[row].dot(first[col])
+            })
+            .sum()
+    }
+
+    /// [`NormalMatrix::solve_unsymmetric`] for a small island: Gaussian
+    /// elimination with partial pivoting on the dense matrix (row-major in
+    /// `m`). A pivot below [`REDUNDANT_PIVOT`] of the matrix's largest
+    /// entry is a singular matrix: `false`.
+    fn solve_unsymmetric_dense(
+        &self,
+        inverse_mass: &[f64],
+        now: &[DVec2],
+        first: &[DVec2],
+        m: &mut Vec<f64>,
+        rhs: &mut [f64],
+    ) -> bool {
+        let n = self.n;
+        m.clear();
+        m.resize(n * n, 0.0);
+        for (col, k, row) in self.upper_entries() {
+            m[row * n + col] = self.unsymmetric_value(k, false, inverse_mass, now, first);
+            if row != col {
+                m[col * n + row] = self.unsymmetric_value(k, true, inverse_mass, now, first);
+            }
+        }
+        let largest = m.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if !(largest.is_finite() && largest > 0.0) {
+            return false;
+        }
+        for j in 0..n {
+            let pivot = (j..n)
+                .max_by(|&a, &b| m[a * n + j].abs().total_cmp(&m[b * n + j].abs()))
+                .unwrap_or(j);
+            if m[pivot * n + j].abs() <= REDUNDANT_PIVOT * largest {
+                return false;
+            }
+            if pivot != j {
+                for c in 0..n {
+                    m.swap(j * n + c, pivot * n + c);
+                }
+                rhs.swap(j, pivot);
+            }
+            for i in j + 1..n {
+                let factor = m[i * n + j] / m[j * n + j];
+                for c in j..n {
+                    m[i * n + c] -= factor * m[j * n + c];
+                }
+                rhs[i] -= factor * rhs[j];
+            }
+        }
+        for i in (0..n).rev() {
+            let mut x = rhs[i];
+            for c in i + 1..n {
+                x -= m[i * n + c] * rhs[c];
+            }
+            rhs[i] = x / m[i * n + i];
+        }
+        rhs.iter().all(|x| x.is_finite())
+    }
+
+    /// `LDLᵀ` of the scaled `A` as a dense matrix, row-major in `a`: the
+    /// unit lower triangle below the diagonal, `D` on it. A pivot at or
+    /// below [`REDUNDANT_PIVOT`] is replaced by [`DROPPED_PIVOT`], as the
+    /// sparse factorization does. Returns how many were.
+    fn factor_dense(&self, values: &[f64], a: &mut Vec<f64>) -> usize {
+        let n = self.n;
+        a.clear();
+        a.resize(n * n, 0.0);
+        for (col, k, row) in self.upper_entries() {
+            a[row * n + col] = values[k];
+            a[col * n + row] = values[k];
+        }
+        let mut dropped = 0;
+        for j in 0..n {
+            let mut d = a[j * n + j];
+            for k in 0..j {
+                let l = a[j * n + k];
+                d -= l * l * a[k * n + k];
+            }
+            if d.abs() <= REDUNDANT_PIVOT {
+                d = DROPPED_PIVOT;
+                dropped += 1;
+            }
+            a[j * n + j] = d;
+            for i in j + 1..n {
+                let mut v = a[i * n + j];
+                for k in 0..j {
+                    v -= a[i * n + k] * a[j * n + k] * a[k * n + k];
+                }
+                a[i * n + j] = v / d;
+            }
+        }
+        dropped
+    }
+
     /// Fills and factors `A = J_left W J_rightᵀ` (the same gradients on
     /// both sides for the symmetric `J W Jᵀ`). Returns the index of a row
     /// whose diagonal vanishes (a singular point: no direction to push
@@ -296,6 +420,7 @@ impl NormalMatrix {
         inverse_mass: &[f64],
         gradient: &[DVec2],
         inactive: &[bool],
+        dense: bool,
         f: &mut Factored,
     ) -> Result<(), usize> {
         let nnz = self.term_start.len() - 1;
@@ -323,11 +448,16 @@ impl NormalMatrix {
             f.scale.push(d.sqrt().recip());
         }
         f.redundant = 0;
+        f.dense = dense && self.small;
         let Some(symbolic) = &self.symbolic else {
             return Ok(());
         };
         for (col, k, row) in self.upper_entries() {
             f.values[k] *= f.scale[row] * f.scale[col];
+        }
+        if f.dense {
+            f.redundant = self.factor_dense(&f.values, &mut f.l_values);
+            return Ok(());
         }
         f.l_values.clear();
         f.l_values.resize(symbolic.len_val(), 0.0);
@@ -354,6 +484,10 @@ impl NormalMatrix {
 
     /// Solves `A λ = rhs` in place with the last factorization.
     pub(crate) fn solve(&self, f: &mut Factored, rhs: &mut [f64]) {
+        if f.dense {
+            self.solve_dense(f, rhs);
+            return;
+        }
         let Some(symbolic) = &self.symbolic else {
             if let (Some(b), Some(&k)) = (rhs.first_mut(), self.diagonal.first()) {
                 *b /= f.values[k];
@@ -371,6 +505,31 @@ impl NormalMatrix {
             Par::Seq,
             MemStack::new(memory),
         );
+        for (b, s) in rhs.iter_mut().zip(&f.scale) {
+            *b *= s;
+        }
+    }
+
+    /// [`NormalMatrix::solve`] with the dense `LDLᵀ` of
+    /// [`NormalMatrix::factor_dense`].
+    fn solve_dense(&self, f: &Factored, rhs: &mut [f64]) {
+        let (n, a) = (self.n, &f.l_values);
+        for (b, s) in rhs.iter_mut().zip(&f.scale) {
+            *b *= s;
+        }
+        for i in 0..n {
+            for k in 0..i {
+                rhs[i] -= a[i * n + k] * rhs[k];
+            }
+        }
+        for i in 0..n {
+            rhs[i] /= a[i * n + i];
+        }
+        for i in (0..n).rev() {
+            for k in i + 1..n {
+                rhs[i] -= a[k * n + i] * rhs[k];
+            }
+        }
         for (b, s) in rhs.iter_mut().zip(&f.scale) {
             *b *= s;
         }
@@ -394,5 +553,98 @@ impl NormalMatrix {
                     .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
             )
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A pinned chain of `links` rods bent at the beads, and a second set
+    /// of gradients turned a little from the first: rows 0 and 1 pin bead
+    /// 0, row 2 + i joins beads i and i + 1.
+    fn chain(links: usize) -> (Vec<usize>, Vec<usize>, Vec<DVec2>, Vec<DVec2>, Vec<f64>) {
+        let mut row_start = vec![0, 1, 2];
+        let mut entry_bead = vec![0, 0];
+        let mut first = vec![DVec2::X, DVec2::Y];
+        let mut now = vec![DVec2::X, DVec2::Y];
+        for i in 0..links {
+            entry_bead.extend([i, i + 1]);
+            let n = DVec2::from_angle(0.4 * i as f64);
+            let turned = DVec2::from_angle(0.4 * i as f64 + 0.05);
+            first.extend([-n, n]);
+            now.extend([-turned, turned]);
+            row_start.push(entry_bead.len());
+        }
+        let inverse_mass = (0..=links).map(|i| 1.0 / (1.0 + i as f64)).collect();
+        (row_start, entry_bead, first, now, inverse_mass)
+    }
+
+    #[test]
+    fn small_dense_solves_match_the_sparse_ones() {
+        for links in [1, 3, 6] {
+            let (row_start, entry_bead, first, now, inverse_mass) = chain(links);
+            let matrix = NormalMatrix::new(&row_start, &entry_bead, links + 1).unwrap();
+            assert!(matrix.small, "{links} links: not a small matrix");
+            let rows = row_start.len() - 1;
+            let rhs: Vec<f64> = (0..rows).map(|r| (r as f64 * 0.7).sin() - 0.2).collect();
+            let inactive = vec![false; rows];
+            let mut solved = [rhs.clone(), rhs.clone()];
+            for (dense, x) in [true, false].into_iter().zip(&mut solved) {
+                let mut f = Factored::default();
+                matrix
+                    .factor(&inverse_mass, &first, &inactive, dense, &mut f)
+                    .unwrap();
+                assert_eq!(f.dense, dense);
+                matrix.solve(&mut f, x);
+            }
+            let mut unsymmetric = [rhs.clone(), rhs.clone()];
+            for (dense, x) in [true, false].into_iter().zip(&mut unsymmetric) {
+                let mut lu = LuWork::default();
+                assert!(matrix.solve_unsymmetric(&inverse_mass, &now, &first, &mut lu, x, dense));
+            }
+            for [a, b] in [solved, unsymmetric] {
+                for (a, b) in a.iter().zip(&b) {
+                    assert!(
+                        (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
+                        "{links} links: {a} against {b}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_small_dense_matrix_drops_a_redundant_row_and_refuses_a_singular_newton_matrix() {
+        // The same rod twice between a pinned bead and a free one.
+        let row_start = [0, 1, 2, 4, 6];
+        let entry_bead = [0, 0, 0, 1, 0, 1];
+        let n = DVec2::new(0.6, 0.8);
+        let gradient = [DVec2::X, DVec2::Y, -n, n, -n, n];
+        let matrix = NormalMatrix::new(&row_start, &entry_bead, 2).unwrap();
+        let mut f = Factored::default();
+        matrix
+            .factor(&[1.0, 1.0], &gradient, &[false; 4], true, &mut f)
+            .unwrap();
+        assert_eq!(f.redundant, 1);
+        // A consistent right-hand side: the two rods ask for the same.
+        let mut rhs = vec![0.0, 0.0, 0.3, 0.3];
+        matrix.solve(&mut f, &mut rhs);
+        assert!(rhs.iter().all(|x| x.is_finite()), "{rhs:?}");
+        // With the pin rows taking bead 0's share the system reduces to
+        // λ₂ + λ₃ = 0.3: one rod carries it, the dropped one nothing.
+        let pushed = rhs[2] + rhs[3];
+        assert!((pushed - 0.3).abs() <= 1e-12, "the rods carry {pushed}");
+        assert_eq!(rhs[3], 0.0, "the redundant row carries {}", rhs[3]);
+        let mut lu = LuWork::default();
+        let mut rhs = vec![0.0, 0.0, 0.3, 0.3];
+        assert!(!matrix.solve_unsymmetric(
+            &[1.0, 1.0],
+            &gradient,
+            &gradient,
+            &mut lu,
+            &mut rhs,
+            true
+        ));
     }
 }
