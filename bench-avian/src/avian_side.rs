@@ -189,6 +189,27 @@ pub fn default_substeps() -> u32 {
     SubstepCount::default().0
 }
 
+/// The substep counts a job runs avian2d at: its default first, then each
+/// of `extra` not already listed.
+pub fn substep_counts(extra: &[u32]) -> Vec<u32> {
+    let mut counts = vec![default_substeps()];
+    for &k in extra {
+        if !counts.contains(&k) {
+            counts.push(k);
+        }
+    }
+    counts
+}
+
+/// A count the command line gives, which must be at least 1.
+pub fn positive(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("{text:?} is not a whole number ({e})")),
+    }
+}
+
 /// The first update of an app from [`physics_app`], after the bodies are
 /// spawned: runs the startup schedules and takes no physics step.
 ///

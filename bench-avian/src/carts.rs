@@ -70,13 +70,13 @@ pub enum Rail {
 #[derive(Args, Debug)]
 pub struct CartsArgs {
     /// Steps of 1/60 s to simulate.
-    #[arg(long, default_value_t = 600)]
+    #[arg(long, default_value_t = 600, value_parser = avian_side::positive)]
     pub steps: usize,
     /// Numbers of pendulums N, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "1000,10000")]
+    #[arg(long, value_delimiter = ',', default_value = "1000,10000", value_parser = avian_side::positive)]
     pub sizes: Vec<usize>,
     /// avian2d substep counts to run besides its default, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "50")]
+    #[arg(long, value_delimiter = ',', default_value = "50", value_parser = clap::value_parser!(u32).range(1..))]
     pub substeps: Vec<u32>,
     /// How avian2d holds a cart to its rail.
     #[arg(long, value_enum, default_value_t = Rail::Prismatic)]
@@ -324,17 +324,10 @@ fn run_avian(n: usize, substeps: u32, rail: Rail, steps: usize) -> CartsRun {
 
 /// Runs the carts job and prints its table and ratios.
 pub fn run(args: &CartsArgs) {
-    let mut counts = vec![avian_side::default_substeps()];
-    for &k in &args.substeps {
-        assert!(k >= 1, "avian2d needs at least one substep");
-        if !counts.contains(&k) {
-            counts.push(k);
-        }
-    }
+    let counts = avian_side::substep_counts(&args.substeps);
     // (N, ours, avian runs in the order of `counts`)
     let mut results = Vec::new();
     for &n in &args.sizes {
-        assert!(n >= 1, "the carts job needs at least one pendulum");
         let ours = run_ours(n, args.steps);
         eprintln!("done: N = {n}, {}", ours.name);
         let mut avian = Vec::new();

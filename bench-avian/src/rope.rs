@@ -50,13 +50,13 @@ const AVIAN_REFERENCE_SUBSTEPS: u32 = 50;
 #[derive(Args, Debug)]
 pub struct RopeArgs {
     /// Steps of 1/60 s to simulate.
-    #[arg(long, default_value_t = 600)]
+    #[arg(long, default_value_t = 600, value_parser = avian_side::positive)]
     pub steps: usize,
     /// Rope sizes N (number of rods), comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "10,100,1000")]
+    #[arg(long, value_delimiter = ',', default_value = "10,100,1000", value_parser = avian_side::positive)]
     pub sizes: Vec<usize>,
     /// avian2d substep counts to run besides its default (6), comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "20,50,100,200")]
+    #[arg(long, value_delimiter = ',', default_value = "20,50,100,200", value_parser = clap::value_parser!(u32).range(1..))]
     pub substeps: Vec<u32>,
 }
 
@@ -249,18 +249,11 @@ fn run_avian(n: usize, substeps: u32, steps: usize) -> RopeRun {
 
 /// Runs the rope job and prints its table and ratios.
 pub fn run(args: &RopeArgs) {
-    let default = avian_side::default_substeps();
-    let mut counts = vec![default];
-    for &k in &args.substeps {
-        assert!(k >= 1, "avian2d needs at least one substep");
-        if !counts.contains(&k) {
-            counts.push(k);
-        }
-    }
+    let counts = avian_side::substep_counts(&args.substeps);
+    let default = counts[0];
     // (N, ours, avian runs in the order of `counts`)
     let mut results = Vec::new();
     for &n in &args.sizes {
-        assert!(n >= 1, "a rope needs at least one rod");
         let ours = run_ours(n, args.steps);
         eprintln!("done: N = {n}, {}", ours.name());
         let mut avian = Vec::new();

@@ -193,6 +193,20 @@ fn a_restart_returns_an_island_to_its_start() {
     assert_eq!((bead(&app, cart).state(), bead(&app, bob).state()), first);
 }
 
+/// A headless app on one thread, or on every core with every loop split
+/// from one bead up.
+fn one_or_all_cores(plugin: WireBeadPlugin, parallel: bool) -> App {
+    let headless = Headless::new(plugin);
+    if parallel {
+        headless
+            .on_all_cores()
+            .parallel(ParallelStep { threshold: 1 })
+            .build()
+    } else {
+        headless.single_threaded().build()
+    }
+}
+
 #[test]
 fn a_coupled_scene_runs_bit_identically_sequential_and_parallel() {
     // The rope preset and the ring (a redundant row), each run twice on
@@ -203,15 +217,7 @@ fn a_coupled_scene_runs_bit_identically_sequential_and_parallel() {
         let preset = ScenePreset::from_ron(&std::fs::read_to_string(path).unwrap()).unwrap();
         let run = |parallel: bool| {
             let plugin = WireBeadPlugin::new(preset.params.clone()).unwrap();
-            let headless = Headless::new(plugin);
-            let mut app = if parallel {
-                headless
-                    .on_all_cores()
-                    .parallel(ParallelStep { threshold: 1 })
-                    .build()
-            } else {
-                headless.single_threaded().build()
-            };
+            let mut app = one_or_all_cores(plugin, parallel);
             let beads = preset.spawn(&mut app.world_mut().commands());
             app.world_mut().flush();
             run_steps(&mut app, 120);
@@ -233,15 +239,7 @@ fn many_islands_split_over_threads_step_as_on_one() {
     // as on one thread, and each cart still on its rail.
     let run = |parallel: bool| {
         let plugin = WireBeadPlugin::new(params(Method::Rattle, 1.0 / 60.0)).unwrap();
-        let headless = Headless::new(plugin);
-        let mut app = if parallel {
-            headless
-                .on_all_cores()
-                .parallel(ParallelStep { threshold: 1 })
-                .build()
-        } else {
-            headless.single_threaded().build()
-        };
+        let mut app = one_or_all_cores(plugin, parallel);
         let world = app.world_mut();
         let mut carts = Vec::new();
         for i in 0..64 {

@@ -259,6 +259,21 @@ fn pendulum_on_a_cart_conserves_momentum_and_swings_at_the_coupled_frequency() {
     assert!(drift <= 1e-12, "|C| reached {drift:e}");
 }
 
+/// A rope of `n` rods of length `l` from a pin at the origin, beads of
+/// 1 kg at rest along +x: the island, the states, the masses.
+fn horizontal_rope(n: usize, l: f64) -> (Island, Vec<BeadState>, Vec<f64>) {
+    let masses = vec![1.0; n + 1];
+    let mut rows: Vec<IslandRow> = pin(0, DVec2::ZERO).into();
+    rows.extend((0..n).map(|i| rod(i, i + 1, l)));
+    let island = Island::new(&masses, rows, vec![]).unwrap();
+    let states = at_rest(
+        &(0..=n)
+            .map(|i| DVec2::new(l * i as f64, 0.0))
+            .collect::<Vec<_>>(),
+    );
+    (island, states, masses)
+}
+
 #[test]
 fn a_horizontal_rope_keeps_every_rod_and_its_energy() {
     // 20 rods of 0.1 m from a pin, released horizontal, RATTLE for 10 s:
@@ -268,15 +283,7 @@ fn a_horizontal_rope_keeps_every_rod_and_its_energy() {
     // energy error reaches a large part of the energy released, so this
     // runs at 1/960 s.
     let (n, l, steps_per_second) = (20, 0.1, 960.0);
-    let masses = vec![1.0; n + 1];
-    let mut rows: Vec<IslandRow> = pin(0, DVec2::ZERO).into();
-    rows.extend((0..n).map(|i| rod(i, i + 1, l)));
-    let island = Island::new(&masses, rows, vec![]).unwrap();
-    let mut states = at_rest(
-        &(0..=n)
-            .map(|i| DVec2::new(l * i as f64, 0.0))
-            .collect::<Vec<_>>(),
-    );
+    let (island, mut states, masses) = horizontal_rope(n, l);
     let e0 = island.energy(&states, G);
     let (mut worst, mut energy, mut halved) = (0.0f64, 0.0f64, 0);
     run(
@@ -540,15 +547,7 @@ fn a_long_rope_at_a_sixtieth_is_stepped_in_substeps_that_follow_its_whips() {
     // follow, so steps are split, down to where the last step ended and
     // back up once the whip has passed; no step may fail.
     let (n, l) = (100, 0.1);
-    let masses = vec![1.0; n + 1];
-    let mut rows: Vec<IslandRow> = pin(0, DVec2::ZERO).into();
-    rows.extend((0..n).map(|i| rod(i, i + 1, l)));
-    let island = Island::new(&masses, rows, vec![]).unwrap();
-    let mut states = at_rest(
-        &(0..=n)
-            .map(|i| DVec2::new(l * i as f64, 0.0))
-            .collect::<Vec<_>>(),
-    );
+    let (island, mut states, masses) = horizontal_rope(n, l);
     let e0 = island.energy(&states, G);
     let (mut worst, mut energy) = (0.0f64, 0.0f64);
     let mut substeps = Vec::new();
