@@ -277,22 +277,20 @@ struct StepContext<'a> {
 
 impl StepContext<'_> {
     /// Steps a run of beads stored side by side. Beads on unrotated circles
-    /// go through the batched step, [`solver::LANES`] at a time, when the
-    /// method allows; the others, and the lanes it hands back, one by one.
+    /// go through the batched step, [`solver::LANES`] at a time; the
+    /// others, and the lanes it hands back, one by one.
     fn step_run(&self, mut run: BeadRun) {
-        let batched = solver::is_batched(self.settings.method);
         let mut lanes = solver::CircleLanes::default();
         let mut outs = solver::CircleSteps::default();
         let mut waiting = [0; solver::LANES];
         let mut queued = 0;
         for i in 0..run.beads.len() {
             let wire = self.wires.get(&run.on_wires[i]);
-            if batched
-                && let Ok(TableWire {
-                    shape: WireShape::Circle(circle),
-                    pose,
-                    track: None,
-                }) = wire
+            if let Ok(TableWire {
+                shape: WireShape::Circle(circle),
+                pose,
+                track: None,
+            }) = wire
                 && pose.is_unrotated()
             {
                 let bead = &run.beads[i];

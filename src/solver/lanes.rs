@@ -6,7 +6,7 @@
 use std::convert::Infallible;
 
 use super::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
-use super::method::{Method, Stabilization};
+use super::method::Method;
 use super::projection::{
     ENERGY_CORRECTION_LIMIT, NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE,
 };
@@ -127,20 +127,10 @@ impl CircleSteps {
     }
 }
 
-/// Whether [`step_on_circles`] takes steps of this method: explicit or
-/// semi-implicit Euler or RK4 with Baumgarte stabilization or none, RK4
-/// with projection, and RATTLE. (The Euler methods with projection restore
-/// the speed of eq. (9b) and go through [`step`].)
-pub fn is_batched(method: Method) -> bool {
-    match method {
-        Method::Rattle | Method::Rk4(_) => true,
-        Method::ExplicitEuler(s) | Method::SemiImplicitEuler(s) => s != Stabilization::Projection,
-    }
-}
-
 /// A step of eq. (3) for [`LANES`] beads on unrotated
-/// [`Circle`](crate::geometry::Circle)s at once, for the methods
-/// [`is_batched`] accepts, bit for bit what [`step`] returns for each.
+/// [`Circle`](crate::geometry::Circle)s at once, by any [`Method`] (RATTLE,
+/// RK4 and the Euler methods, with projection, Baumgarte stabilization or
+/// none), bit for bit what [`step`] returns for each.
 ///
 /// The lanes run as AVX2 vectors (pulp's `V3`, chosen at run time on
 /// x86-64; elsewhere every lane goes through [`step`]): the
@@ -148,8 +138,8 @@ pub fn is_batched(method: Method) -> bool {
 /// one after another. A lane the batch cannot finish (a non-finite state,
 /// the circle's centre, a step past the drift bound) comes back not
 /// [`done`](CircleSteps::done): take that bead through [`step`], which
-/// reports why. A method [`is_batched`] refuses, or a processor without
-/// AVX2, finishes no lane. Each lane has its own mass; its drift bound is
+/// reports why. A processor without AVX2 finishes no lane. Each lane has
+/// its own mass; its drift bound is
 /// `settings.drift_bound` times its radius, as [`step`] takes it.
 ///
 /// The result goes into `out` (reused from call to call, so that nothing
@@ -163,7 +153,7 @@ pub fn step_on_circles(b: &CircleLanes, settings: &StepSettings, out: &mut Circl
     }
     #[cfg(target_arch = "x86_64")]
     match avx2() {
-        Some(simd) if is_batched(settings.method) => simd.vectorize(StepLanes {
+        Some(simd) => simd.vectorize(StepLanes {
             simd,
             b,
             settings,
@@ -283,7 +273,7 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut Circ
                 regular = stages.regular;
                 stepped
             }
-            // `is_batched` leaves semi-implicit Euler here.
+            // RATTLE took the other branch.
             Method::SemiImplicitEuler(_) | Method::Rattle => semi_implicit_euler_lanes(x, v, a, h),
         };
         let end = circle.at(x1);
@@ -305,10 +295,14 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut Circ
         & end.len.is_nonzero()
         & end.c.abs_le(bound);
     let (x1, v1, end) = if settings.method.projects() {
-        // `is_batched` leaves RK4 with projection here: eq. (9), then the
-        // energy of eq. (9c).
+        // Eq. (9), then the speed of eq. (9b) after an Euler step, the
+        // energy of eq. (9c) after RK4.
         let (xp, vp, at, projected) = circle.project(x1, v1, end);
-        let (vr, restored) = circle.restore_energy(x, v, xp, vp, at, &force, m);
+        let (vr, restored) = if settings.method.is_euler() {
+            circle.restore_speed(x, v, vp, at, &force, m, h)
+        } else {
+            circle.restore_energy(x, v, xp, vp, at, &force, m)
+        };
         regular = regular & projected & restored;
         (xp, vr, at)
     } else {
@@ -514,6 +508,44 @@ impl<T: Lane> OnCircles<T> {
         (x, v, end, found & ok)
     }
 
+    /// Eq. (9b) (`restore_speed`) after an Euler step of length `h` from
+    /// `(x0, v0)`: the projected velocity `vp` (where the circle is `at`)
+    /// scaled to the speed of `v0 + h a_t`, `a_t` the applied acceleration
+    /// along the wire at `x0`, and its normal component removed again.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn restore_speed(
+        self,
+        x0: V2<T>,
+        v0: V2<T>,
+        vp: V2<T>,
+        at: At<T>,
+        force: &LinearForceLanes<T>,
+        m: T,
+        h: T,
+    ) -> (V2<T>, T::Mask) {
+        // A fixed wire: its velocity is zero at both ends of the step.
+        let zero = V2::new(m.splat(0.0), m.splat(0.0));
+        let relative = v0 - zero;
+        let applied = force.at(x0).div(m);
+        let start = self.at(x0);
+        let (nn, usable) = self.normal_length_squared(start);
+        let n = start.normal;
+        let kick = applied - n.scale(n.dot(applied) / nn);
+        let moved = relative.plus(h, kick);
+        let target = moved.dot(moved);
+        let now = vp - zero;
+        // `kinetic_scale`.
+        let ratio = target / now.dot(now);
+        let scale = T::select(
+            ratio.is_finite() & ratio.gt(m.splat(0.0)),
+            ratio.sqrt(),
+            m.splat(1.0),
+        );
+        let (v, ok) = self.tangential(at, zero + now.scale(scale));
+        (v, ok & usable)
+    }
+
     /// Eq. (9c) (`restore_energy`): the projected velocity `vp` at `xp`
     /// (where the circle is `at`) scaled so the energy is that of
     /// `(x0, v0)`, and its normal component removed again.
@@ -557,6 +589,7 @@ impl<T: Lane> OnCircles<T> {
 mod tests {
     use super::*;
     use crate::geometry::{Circle, Placed, Pose};
+    use crate::solver::Stabilization;
     use crate::solver::step;
     use crate::solver::test_support::{G, settings};
 
@@ -571,7 +604,7 @@ mod tests {
         // Beads in all directions, at all speeds, on circles of different
         // sizes and centres, with a spring's stiffness on some.
         let bound = 0.5;
-        for method in Method::ALL.into_iter().filter(|m| is_batched(*m)) {
+        for method in Method::ALL {
             let batch_settings = StepSettings {
                 drift_bound: bound,
                 ..settings(method, 1.0 / 60.0)
@@ -655,16 +688,5 @@ mod tests {
         done[0] = true;
         assert_eq!(outs.done, done, "{outs:?}");
         assert!(outs.lane(0).is_some() && outs.lane(1).is_none());
-        // What `is_batched` refuses, the batch finishes no lane of.
-        for method in [
-            Method::ExplicitEuler(Stabilization::Projection),
-            Method::SemiImplicitEuler(Stabilization::Projection),
-        ] {
-            assert!(!is_batched(method));
-            let refused = StepSettings { method, ..s };
-            outs.done = [true; LANES];
-            step_on_circles(&lanes, &refused, &mut outs);
-            assert_eq!(outs.done, [false; LANES]);
-        }
     }
 }

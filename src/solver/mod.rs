@@ -36,7 +36,7 @@ pub use coupled::{
     REDUNDANT_PIVOT, RowKind, RowReport, SpringLink, islands,
 };
 pub use euler::{explicit_euler, semi_implicit_euler};
-pub use lanes::{CircleLanes, CircleSteps, LANES, is_batched, step_on_circles};
+pub use lanes::{CircleLanes, CircleSteps, LANES, step_on_circles};
 pub use method::{Integrator, Method, Stabilization};
 pub use projection::{ENERGY_CORRECTION_LIMIT, NEWTON_ACCEPT, NEWTON_TOLERANCE, project};
 pub use rattle::rattle;
