@@ -211,6 +211,11 @@ impl Lane for F64x8 {
         ))
     }
     #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        let s = self.simd;
+        self.with(halves!(s, _mm256_max_pd(self.v, other.v)))
+    }
+    #[inline(always)]
     fn abs_le(self, bound: Self) -> M64x8 {
         let s = self.simd;
         let abs = halves!(s, _mm256_andnot_pd([s.avx._mm256_set1_pd(-0.0); 2], self.v));

@@ -42,6 +42,9 @@ pub(crate) trait Lane:
     fn gt(self, other: Self) -> Self::Mask;
     /// `|self|`.
     fn abs(self) -> Self;
+    /// The larger of `self` and `other`, as `f64::max` gives it where
+    /// neither is NaN.
+    fn max(self, other: Self) -> Self;
     /// `|self| <= bound` (false where either is NaN).
     fn abs_le(self, bound: Self) -> Self::Mask;
     /// `a` in the lanes where `mask` holds, `b` in the others.
@@ -92,6 +95,10 @@ impl Lane for f64 {
     #[inline(always)]
     fn abs(self) -> Self {
         f64::abs(self)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        f64::max(self, other)
     }
     #[inline(always)]
     fn abs_le(self, bound: Self) -> bool {

@@ -380,13 +380,14 @@ impl<T: Lane> OnCircles<T> {
         )
     }
 
-    /// Whether a Newton solve is done at residual `|c|` after `previous`,
-    /// as `newton_done` says.
+    /// Whether a Newton solve at the point `at` is done at residual `|c|`
+    /// after `previous`, as `newton_done` says.
     #[inline(always)]
-    fn converged(self, c: T, previous: T, last: bool) -> T::Mask {
+    fn converged(self, c: T, previous: T, at: V2<T>, last: bool) -> T::Mask {
         let r = self.radius;
         let residual = c.abs();
-        let within = residual.abs_le(r.splat(NEWTON_TOLERANCE) * r);
+        let reach = at.x.abs().max(at.y.abs());
+        let within = residual.abs_le(r.splat(NEWTON_TOLERANCE) * r.max(reach));
         let accepted = residual.abs_le(r.splat(NEWTON_ACCEPT) * r);
         if last {
             within | accepted
@@ -413,13 +414,10 @@ impl<T: Lane> OnCircles<T> {
         // evaluates it (a zero's sign can differ from `base`'s).
         let mut root = self.at(base.plus(s, dir));
         for i in 0..=NEWTON_MAX_ITERATIONS {
-            let g = if i == 0 {
-                root
-            } else {
-                self.at(base.plus(s, dir))
-            };
+            let p = base.plus(s, dir);
+            let g = if i == 0 { root } else { self.at(p) };
             let last = i == NEWTON_MAX_ITERATIONS;
-            let done = active & self.converged(g.c, previous, last);
+            let done = active & self.converged(g.c, previous, p, last);
             previous = g.c.abs();
             root = At::select(done, g, root);
             found = found | done;
@@ -492,7 +490,7 @@ impl<T: Lane> OnCircles<T> {
         for i in 0..=NEWTON_MAX_ITERATIONS {
             let g = if i == 0 { start } else { self.at(x) };
             let last = i == NEWTON_MAX_ITERATIONS;
-            let done = active & self.converged(g.c, previous, last);
+            let done = active & self.converged(g.c, previous, x, last);
             previous = g.c.abs();
             end = At::select(done, g, end);
             found = found | done;

@@ -10,8 +10,10 @@ use super::state::BeadState;
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
 
 /// Tolerance on `|C|` for the Newton solves (RATTLE, projection), in units
-/// of the wire's scale: a few ulps, which Newton's quadratic convergence
-/// reaches in two or three iterations.
+/// of the wire's scale or of the point's largest coordinate, whichever is
+/// larger: a few ulps, which Newton's quadratic convergence reaches in two
+/// or three iterations, and below which rounding the coordinates keeps `C`
+/// from going.
 pub const NEWTON_TOLERANCE: f64 = 4.0 * f64::EPSILON;
 /// Where rounding keeps `|C|` from reaching [`NEWTON_TOLERANCE`] (a bead
 /// far from the origin beside its wire's scale), a residual below this (in
@@ -21,11 +23,19 @@ pub const NEWTON_ACCEPT: f64 = 1e-10;
 /// The most Newton iterations a solve takes before it gives up.
 pub(crate) const NEWTON_MAX_ITERATIONS: u32 = 20;
 
-/// Whether a Newton solve is done: `|C|` within the tolerance, or within
-/// [`NEWTON_ACCEPT`] and stalled (no smaller than half the `previous`
-/// residual) or at the last iteration.
-pub(crate) fn newton_done(residual: f64, previous: f64, scale: f64, last: bool) -> bool {
-    residual <= NEWTON_TOLERANCE * scale
+/// Whether a Newton solve is done at a point whose largest coordinate is
+/// `reach` in size: `|C|` within the tolerance of the wire's scale or of
+/// the point's coordinates (rounding keeps `C` from going below a few ulps
+/// of them), or within [`NEWTON_ACCEPT`] and stalled (no smaller than half
+/// the `previous` residual) or at the last iteration.
+pub(crate) fn newton_done(
+    residual: f64,
+    previous: f64,
+    scale: f64,
+    reach: f64,
+    last: bool,
+) -> bool {
+    residual <= NEWTON_TOLERANCE * scale.max(reach)
         || (residual <= NEWTON_ACCEPT * scale && (last || residual > 0.5 * previous))
 }
 
@@ -44,7 +54,8 @@ pub(crate) fn newton_along<T: Track + ?Sized>(
         let g = track.geometry(t, p);
         let previous = residual;
         residual = g.c.abs();
-        if newton_done(residual, previous, scale, i == NEWTON_MAX_ITERATIONS) {
+        let reach = p.abs().max_element();
+        if newton_done(residual, previous, scale, reach, i == NEWTON_MAX_ITERATIONS) {
             return Ok(s);
         }
         if i == NEWTON_MAX_ITERATIONS {
@@ -87,7 +98,8 @@ pub(crate) fn project_on<T: Track + ?Sized>(
         let g = track.geometry(t, x);
         let previous = residual;
         residual = g.c.abs();
-        if newton_done(residual, previous, scale, i == NEWTON_MAX_ITERATIONS) {
+        let reach = x.abs().max_element();
+        if newton_done(residual, previous, scale, reach, i == NEWTON_MAX_ITERATIONS) {
             converged = true;
             break;
         }
