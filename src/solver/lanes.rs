@@ -251,8 +251,7 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut Circ
     };
     let h = m.splat(settings.dt);
     let circle = OnCircles { centre, radius };
-    let (x1, v1, lambda, constraint_force, end, mut regular) = if settings.method == Method::Rattle
-    {
+    let advanced = if settings.method == Method::Rattle {
         circle.rattle(x, v, &force, m, h)
     } else {
         let (first, normal, mut regular) =
@@ -276,16 +275,25 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut Circ
             // RATTLE took the other branch.
             Method::SemiImplicitEuler(_) | Method::Rattle => semi_implicit_euler_lanes(x, v, a, h),
         };
-        let end = circle.at(x1);
-        (
-            x1,
-            v1,
-            first.lambda,
-            normal.scale(first.lambda),
-            end,
+        Advanced {
+            x: x1,
+            v: v1,
+            lambda: first.lambda,
+            constraint_force: normal.scale(first.lambda),
+            end: circle.at(x1),
+            start_normal: normal,
             regular,
-        )
+        }
     };
+    let Advanced {
+        x: x1,
+        v: v1,
+        lambda,
+        constraint_force,
+        end,
+        start_normal,
+        mut regular,
+    } = advanced;
     let bound = m.splat(settings.drift_bound) * radius;
     regular = regular
         & x.is_finite()
@@ -299,7 +307,7 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut Circ
         // energy of eq. (9c) after RK4.
         let (xp, vp, at, projected) = circle.project(x1, v1, end);
         let (vr, restored) = if settings.method.is_euler() {
-            circle.restore_speed(x, v, vp, at, &force, m, h)
+            circle.restore_speed(x, v, start_normal, vp, at, &force, m, h)
         } else {
             circle.restore_energy(x, v, xp, vp, at, &force, m)
         };
@@ -341,6 +349,23 @@ impl<T: Lane> At<T> {
             normal: V2::select(mask, a.normal, b.normal),
         }
     }
+}
+
+/// What a step's integrator hands back on the lanes, before the
+/// divergence check and the projection.
+#[derive(Clone, Copy)]
+struct Advanced<T: Lane> {
+    x: V2<T>,
+    v: V2<T>,
+    /// λ and `λN` as the step reports them.
+    lambda: T,
+    constraint_force: V2<T>,
+    /// The circle at the new position.
+    end: At<T>,
+    /// `∇C` at the start, where the lanes with a usable one are `regular`.
+    start_normal: V2<T>,
+    /// The lanes the integrator finished.
+    regular: T::Mask,
 }
 
 /// Each lane's unrotated circle, for the steps that solve on it: RATTLE,
@@ -410,12 +435,17 @@ impl<T: Lane> OnCircles<T> {
         let mut active = self.sized();
         let mut found = active & !active;
         let mut previous = s.splat(f64::INFINITY);
-        // At s = 0 too the point is `base + 0 dir`, as the scalar solve
-        // evaluates it (a zero's sign can differ from `base`'s).
-        let mut root = self.at(base.plus(s, dir));
+        // Set in each lane where it is done.
+        let mut root = At {
+            len: s,
+            c: s,
+            normal: V2::new(s, s),
+        };
         for i in 0..=NEWTON_MAX_ITERATIONS {
+            // At s = 0 too the point is `base + 0 dir`, as the scalar solve
+            // evaluates it (a zero's sign can differ from `base`'s).
             let p = base.plus(s, dir);
-            let g = if i == 0 { root } else { self.at(p) };
+            let g = self.at(p);
             let last = i == NEWTON_MAX_ITERATIONS;
             let done = active & self.converged(g.c, previous, p, last);
             previous = g.c.abs();
@@ -432,17 +462,9 @@ impl<T: Lane> OnCircles<T> {
         (s, root, found)
     }
 
-    /// `rattle` on a fixed wire: the new position and velocity, λ, `λN`,
-    /// and the circle at the new position.
+    /// `rattle` on a fixed wire.
     #[inline(always)]
-    fn rattle(
-        self,
-        x0: V2<T>,
-        v0: V2<T>,
-        force: &LinearForceLanes<T>,
-        m: T,
-        h: T,
-    ) -> (V2<T>, V2<T>, T, V2<T>, At<T>, T::Mask) {
+    fn rattle(self, x0: V2<T>, v0: V2<T>, force: &LinearForceLanes<T>, m: T, h: T) -> Advanced<T> {
         let zero = V2::new(m.splat(0.0), m.splat(0.0));
         let g0 = self.at(x0);
         let n0 = g0.normal;
@@ -464,7 +486,15 @@ impl<T: Lane> OnCircles<T> {
         let mu = two_m * mu_scaled / h;
         let half = m.splat(0.5);
         let constraint_force = (n0.scale(lambda) + n1.scale(mu)).scale(half);
-        (x1, v1, half * (lambda + mu), constraint_force, g1, ok)
+        Advanced {
+            x: x1,
+            v: v1,
+            lambda: half * (lambda + mu),
+            constraint_force,
+            end: g1,
+            start_normal: n0,
+            regular: ok,
+        }
     }
 
     /// `v` without its normal component at the point where the circle is
@@ -507,7 +537,8 @@ impl<T: Lane> OnCircles<T> {
     }
 
     /// Eq. (9b) (`restore_speed`) after an Euler step of length `h` from
-    /// `(x0, v0)`: the projected velocity `vp` (where the circle is `at`)
+    /// `(x0, v0)`, where `∇C` was `n0` (usable, as the step's `regular`
+    /// lanes hold): the projected velocity `vp` (where the circle is `at`)
     /// scaled to the speed of `v0 + h a_t`, `a_t` the applied acceleration
     /// along the wire at `x0`, and its normal component removed again.
     #[inline(always)]
@@ -516,6 +547,7 @@ impl<T: Lane> OnCircles<T> {
         self,
         x0: V2<T>,
         v0: V2<T>,
+        n0: V2<T>,
         vp: V2<T>,
         at: At<T>,
         force: &LinearForceLanes<T>,
@@ -526,10 +558,7 @@ impl<T: Lane> OnCircles<T> {
         let zero = V2::new(m.splat(0.0), m.splat(0.0));
         let relative = v0 - zero;
         let applied = force.at(x0).div(m);
-        let start = self.at(x0);
-        let (nn, usable) = self.normal_length_squared(start);
-        let n = start.normal;
-        let kick = applied - n.scale(n.dot(applied) / nn);
+        let kick = applied - n0.scale(n0.dot(applied) / n0.dot(n0));
         let moved = relative.plus(h, kick);
         let target = moved.dot(moved);
         let now = vp - zero;
@@ -540,8 +569,7 @@ impl<T: Lane> OnCircles<T> {
             ratio.sqrt(),
             m.splat(1.0),
         );
-        let (v, ok) = self.tangential(at, zero + now.scale(scale));
-        (v, ok & usable)
+        self.tangential(at, zero + now.scale(scale))
     }
 
     /// Eq. (9c) (`restore_energy`): the projected velocity `vp` at `xp`

@@ -1127,22 +1127,23 @@ impl Island {
         }
     }
 
-    /// Factors `J W Jᵀ` for `gradient`; a vanishing row is a singular
-    /// point, reported at its first bead's position `x`.
-    fn factor(
-        &self,
-        gradient: &[DVec2],
-        x: &[DVec2],
-        inactive: &[bool],
-        factored: &mut Factored,
-    ) -> Result<(), SolveError> {
+    /// Factors `J W Jᵀ` at the work's current state (`work.gradient` at
+    /// `work.x`), or at the step's start (`work.first_gradient` at
+    /// `work.x0`); a vanishing row is a singular point, reported at its
+    /// first bead's position.
+    fn factor(&self, work: &mut IslandWork, at_start: bool) -> Result<(), SolveError> {
+        let (gradient, x) = if at_start {
+            (&work.first_gradient, &work.x0)
+        } else {
+            (&work.gradient, &work.x)
+        };
         self.normal
             .factor(
                 &self.inverse_mass,
                 gradient,
-                inactive,
+                &work.inactive,
                 self.dense(),
-                factored,
+                &mut work.factored,
             )
             .map_err(|r| {
                 let p = x[self.entry_bead[self.row_start[r]]];
@@ -1165,10 +1166,9 @@ impl Island {
             work.v.clone_from(&work.v0);
         }
         self.evaluate_at_new(work);
-        let (x, v) = (&work.x, &work.v);
-        self.applied(forces, x, v, &mut work.force);
+        self.applied(forces, &work.x, &work.v, &mut work.force);
         if self.rows() > 0 {
-            self.factor(&work.gradient, x, &work.inactive, &mut work.factored)?;
+            self.factor(work, false)?;
         }
         work.lambda.clear();
         for r in 0..self.rows() {
@@ -1178,7 +1178,7 @@ impl Island {
                     work.gradient[e].dot(self.inverse_mass[bead] * work.force[bead])
                 })
                 .sum();
-            let c_dot = self.rate(r, &work.gradient, v, &work.bias);
+            let c_dot = self.rate(r, &work.gradient, &work.v, &work.bias);
             work.lambda
                 .push(-work.curvature[r] - pushed - gains.alpha * work.c[r] - gains.beta * c_dot);
         }
@@ -1309,7 +1309,7 @@ impl Island {
             let along = match direction {
                 Direction::First => &work.first_gradient,
                 Direction::Current => {
-                    self.factor(&work.gradient, &work.x, &work.inactive, &mut work.factored)?;
+                    self.factor(work, false)?;
                     &work.gradient
                 }
             };
@@ -1374,7 +1374,7 @@ impl Island {
         if self.rows() == 0 {
             return Ok(());
         }
-        self.factor(&work.gradient, &work.x, &work.inactive, &mut work.factored)?;
+        self.factor(work, false)?;
         work.rhs.clear();
         for r in 0..self.rows() {
             work.rhs
@@ -1436,12 +1436,7 @@ impl Island {
             *f *= *w;
         }
         if self.rows() > 0 {
-            self.factor(
-                &work.first_gradient,
-                &work.x0,
-                &work.inactive,
-                &mut work.factored,
-            )?;
+            self.factor(work, true)?;
             work.rhs.clear();
             for r in 0..self.rows() {
                 work.rhs
@@ -1477,12 +1472,7 @@ impl Island {
         let n = self.beads();
         self.evaluate_at_start(work, work.time);
         if self.rows() > 0 {
-            self.factor(
-                &work.first_gradient,
-                &work.x0,
-                &work.inactive,
-                &mut work.factored,
-            )?;
+            self.factor(work, true)?;
         }
         self.applied(forces, &work.x0, &work.v0, &mut work.force);
         work.x.clear();
