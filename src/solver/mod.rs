@@ -32,8 +32,8 @@ mod step;
 
 pub use contact::{Contact, ContactEvent, SurfaceStep, free_step, step_surface};
 pub use coupled::{
-    CALM_STEPS, Constraint, Island, IslandError, IslandRow, IslandWork, MAX_HALVINGS, OFF_THE_WIRE,
-    REDUNDANT_PIVOT, RowKind, RowReport, SpringLink, islands,
+    CALM_STEPS, Constraint, EXACT_STEPS, Island, IslandError, IslandRow, IslandWork, MAX_BAND,
+    MAX_HALVINGS, OFF_THE_WIRE, REDUNDANT_PIVOT, RowKind, RowReport, SpringLink, islands,
 };
 pub use euler::{explicit_euler, semi_implicit_euler};
 pub use lanes::{CircleLanes, CircleSteps, LANES, step_on_circles};

@@ -98,7 +98,8 @@ impl RowKind {
     }
 
     /// `C`, its gradient (into `gradient`, one entry per bead of `beads`)
-    /// and `J̇q̇`, where the island's beads are at `x` with velocities `v`.
+    /// and, where `rates`, `J̇q̇` (else zero), where the island's beads are
+    /// at `x` with velocities `v`.
     /// `scratch` gathers a custom constraint's beads; `hint` is a wire's
     /// curve parameter where its bead was (see [`ImplicitCurve::parameter`]).
     #[inline]
@@ -110,6 +111,7 @@ impl RowKind {
         gradient: &mut [DVec2],
         scratch: &mut Vec<DVec2>,
         hint: f64,
+        rates: bool,
     ) -> (f64, f64) {
         match self {
             Self::Wire { shape, pose } => {
@@ -123,7 +125,7 @@ impl RowKind {
                 }
                 .geometry(p);
                 gradient[0] = g.normal;
-                (g.c, u.dot(g.hessian * u))
+                (g.c, if rates { u.dot(g.hessian * u) } else { 0.0 })
             }
             Self::Rod { length } => {
                 let (a, b) = (beads[0], beads[1]);
@@ -132,6 +134,9 @@ impl RowKind {
                 let n = d / distance;
                 gradient[0] = n;
                 gradient[1] = -n;
+                if !rates {
+                    return (distance - length, 0.0);
+                }
                 let relative = v[a] - v[b];
                 let along = n.dot(relative);
                 (
@@ -149,7 +154,12 @@ impl RowKind {
                 scratch.extend(beads.iter().map(|&i| v[i]));
                 let (xs, vs) = scratch.split_at(beads.len());
                 constraint.gradient(xs, gradient);
-                (constraint.value(xs), constraint.curvature(xs, vs))
+                let bend = if rates {
+                    constraint.curvature(xs, vs)
+                } else {
+                    0.0
+                };
+                (constraint.value(xs), bend)
             }
         }
     }

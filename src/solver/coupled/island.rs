@@ -28,6 +28,9 @@ pub const MAX_HALVINGS: u32 = 6;
 /// After this many steps in a row that needed no more halvings than they
 /// started with, a step tries one halving fewer.
 pub const CALM_STEPS: u32 = 8;
+/// The most exact Newton steps RATTLE's position solve takes before it
+/// takes the step as having no root near (and halves it).
+pub const EXACT_STEPS: u32 = 8;
 
 /// Why an island cannot be built: a constraint or spring that names a bead
 /// it cannot join.
@@ -123,6 +126,8 @@ pub struct Island {
     normal: NormalMatrix,
     /// The path of each wire row that moves (see [`Island::move_wire`]).
     paths: Vec<Option<PosePath>>,
+    /// How many rows have a path: with none, a step looks at no path.
+    moving: usize,
     /// Each row's side (+1, −1, or 0 for a two-sided row) and restitution
     /// (see [`Island::set_side`]).
     sides: Vec<(f64, f64)>,
@@ -334,6 +339,7 @@ impl Island {
             springs,
             normal,
             paths,
+            moving: 0,
             sides,
             rough,
         })
@@ -349,7 +355,9 @@ impl Island {
         }) = self.rows.get_mut(row)
         {
             *placed = pose;
-            self.paths[row] = None;
+            if self.paths[row].take().is_some() {
+                self.moving -= 1;
+            }
             if let Some(shape) = shape {
                 *placed_shape = shape;
             }
@@ -369,7 +377,9 @@ impl Island {
             ..
         }) = self.rows.get_mut(row)
         {
-            self.paths[row] = Some(path);
+            if self.paths[row].replace(path).is_none() {
+                self.moving += 1;
+            }
             if let Some(shape) = shape {
                 *placed_shape = shape;
             }
@@ -424,10 +434,10 @@ impl Island {
         }
     }
 
-    /// Whether the island's matrices may be factored dense: a few rows,
-    /// and no friction (see the `normal` module).
-    fn dense(&self) -> bool {
-        self.rows() <= 8 && self.rough.iter().all(Option::is_none)
+    /// Whether the island's matrices may be factored in the order of its
+    /// rows (dense or as a band): no friction (see the `normal` module).
+    fn natural_order(&self) -> bool {
+        self.rough.iter().all(Option::is_none)
     }
 
     /// Whether a row is one-sided.
@@ -437,7 +447,7 @@ impl Island {
 
     /// Whether a row's wire moves.
     fn moves(&self) -> bool {
-        self.paths.iter().any(Option::is_some)
+        self.moving > 0
     }
 
     /// Moves the line of the axis row `row` (one of a pin's rows) to
@@ -980,8 +990,17 @@ impl Island {
     }
 
     /// Evaluates every row at `(x, v)` at `work.time`: gradients, `C`,
-    /// `J̇q̇` and the bias `−∂C/∂t`, into `out`.
-    fn evaluate(&self, x: &[DVec2], v: &[DVec2], time: f64, held: Held<'_>, out: Rows<'_>) {
+    /// and where `rates`, `J̇q̇` and the bias `−∂C/∂t`, into `out` (without
+    /// `rates` those two keep what they held).
+    fn evaluate(
+        &self,
+        x: &[DVec2],
+        v: &[DVec2],
+        time: f64,
+        held: Held<'_>,
+        out: Rows<'_>,
+        rates: bool,
+    ) {
         let Held {
             inactive,
             hints,
@@ -998,7 +1017,9 @@ impl Island {
         gradient.resize(self.entry_bead.len(), DVec2::ZERO);
         c.resize(self.rows(), 0.0);
         curvature.resize(self.rows(), 0.0);
-        bias.clear();
+        if rates {
+            bias.clear();
+        }
         bias.resize(self.rows(), 0.0);
         for (r, kind) in self.rows.iter().enumerate() {
             let range = self.row_start[r]..self.row_start[r + 1];
@@ -1015,7 +1036,12 @@ impl Island {
                 (c[r], curvature[r], bias[r]) = (axis.dot(x[bead]) - offset, 0.0, 0.0);
                 continue;
             }
-            if let (Some(path), RowKind::Wire { shape, .. }) = (&self.paths[r], kind) {
+            let path = if self.moving > 0 {
+                self.paths[r].as_ref()
+            } else {
+                None
+            };
+            if let (Some(path), RowKind::Wire { shape, .. }) = (path, kind) {
                 // Eq. (13): the wire where it is at `time`, seen from its frame.
                 let bead = self.entry_bead[range.start];
                 let (p, u) = (x[bead], v[bead]);
@@ -1032,6 +1058,9 @@ impl Island {
                 let relative = u - w;
                 gradient[range.start] = g.normal;
                 c[r] = g.c;
+                if !rates {
+                    continue;
+                }
                 curvature[r] = relative.dot(g.hessian * relative)
                     - g.normal.dot(twist.acceleration_at(p, relative));
                 bias[r] = g.normal.dot(w);
@@ -1044,27 +1073,36 @@ impl Island {
                 &mut gradient[range],
                 scratch,
                 hint(r),
+                rates,
             );
             c[r] = value;
-            curvature[r] = bend;
+            if rates {
+                curvature[r] = bend;
+            }
         }
     }
 
     /// Evaluates the rows at the current state `work.x`, `work.v` (where
     /// the step ended, or the stage or Newton iterate being worked on).
     fn evaluate_at_new(&self, work: &mut IslandWork) {
-        self.evaluate_work(work, false, work.time);
+        self.evaluate_work(work, false, work.time, true);
+    }
+
+    /// [`Island::evaluate_at_new`] without `J̇q̇` and the bias: what a
+    /// position solve's iterations need.
+    fn evaluate_positions(&self, work: &mut IslandWork) {
+        self.evaluate_work(work, false, work.time, false);
     }
 
     /// Evaluates the rows at the step's start `work.x0`, `work.v0` into
     /// `work.first_gradient` (and `work.c`, `work.curvature`, `work.bias`).
     fn evaluate_at_start(&self, work: &mut IslandWork, time: f64) {
-        self.evaluate_work(work, true, time);
+        self.evaluate_work(work, true, time, true);
     }
 
     /// [`Island::evaluate`] on the work's state: the start's into
     /// `work.first_gradient`, or the current one into `work.gradient`.
-    fn evaluate_work(&self, work: &mut IslandWork, at_start: bool, time: f64) {
+    fn evaluate_work(&self, work: &mut IslandWork, at_start: bool, time: f64, rates: bool) {
         let (x, v, gradient) = if at_start {
             (&work.x0, &work.v0, &mut work.first_gradient)
         } else {
@@ -1086,6 +1124,7 @@ impl Island {
                 bias: &mut work.bias,
                 scratch: &mut work.scratch,
             },
+            rates,
         );
     }
 
@@ -1142,7 +1181,7 @@ impl Island {
                 &self.inverse_mass,
                 gradient,
                 &work.inactive,
-                self.dense(),
+                self.natural_order(),
                 &mut work.factored,
             )
             .map_err(|r| {
@@ -1251,8 +1290,12 @@ impl Island {
     /// matrix `J(x) W J₀ᵀ` is not symmetric: one row takes the exact step;
     /// several start as a chord iteration on the factored `J₀ W J₀ᵀ` (no
     /// new factorization, linear convergence at a rate set by how far the
-    /// rows turn over the step) and switch to exact Newton steps by sparse
-    /// LU once the chord stops shrinking `C` fourfold per iteration.
+    /// rows turn over the step) and switch to exact Newton steps (LU of
+    /// the band, dense or sparse matrix) once the chord stops shrinking `C`
+    /// fourfold per iteration. Two exact steps that do not shrink `C`, or
+    /// [`EXACT_STEPS`] that do not reach the tolerance, mean no root near:
+    /// the step is halved. The iterations evaluate `C` and the gradients
+    /// only, not `J̇q̇` or the bias.
     fn newton(&self, work: &mut IslandWork, direction: Direction) -> Result<(), SolveError> {
         let rows = self.rows();
         work.lambda.clear();
@@ -1260,9 +1303,10 @@ impl Island {
         let mut exact = direction == Direction::First && rows == 1;
         let mut previous = f64::INFINITY;
         let mut rising = 0;
+        let mut exacts = 0;
         let mut i = 0;
         loop {
-            self.evaluate_at_new(work);
+            self.evaluate_positions(work);
             let last = i == NEWTON_MAX_ITERATIONS;
             let tolerance = if last {
                 NEWTON_ACCEPT
@@ -1303,6 +1347,17 @@ impl Island {
                 rising = 0;
             }
             exact |= direction == Direction::First && worst > 0.25 * previous;
+            if exact && direction == Direction::First {
+                // Exact Newton steps converge quadratically near a root:
+                // this many that have not reached it mean there is none near.
+                exacts += 1;
+                if exacts > EXACT_STEPS {
+                    return Err(SolveError::NoConvergence {
+                        iterations: i,
+                        residual: worst,
+                    });
+                }
+            }
             previous = worst;
             work.rhs.clear();
             work.rhs.extend(work.c.iter().map(|c| -c));
@@ -1320,7 +1375,7 @@ impl Island {
                     along,
                     &mut work.lu,
                     &mut work.rhs,
-                    self.dense(),
+                    self.natural_order(),
                 );
             if !solved_exactly {
                 // A singular Newton matrix (a redundant row): the chord step.

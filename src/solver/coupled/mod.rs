@@ -21,6 +21,7 @@ mod tests;
 pub use constraint::{Constraint, RowKind, SpringLink};
 pub use group::islands;
 pub use island::{
-    CALM_STEPS, Island, IslandError, IslandRow, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RowReport,
+    CALM_STEPS, EXACT_STEPS, Island, IslandError, IslandRow, IslandWork, MAX_HALVINGS,
+    OFF_THE_WIRE, RowReport,
 };
-pub use normal::REDUNDANT_PIVOT;
+pub use normal::{MAX_BAND, REDUNDANT_PIVOT};

@@ -4,11 +4,14 @@
 //!
 //! `A` is symmetric positive semidefinite, with a nonzero `(r, s)` wherever
 //! rows `r` and `s` share a bead. It is scaled to a unit diagonal
-//! (`S A S`, `S = diag(1/√A_rr)`) and factored `LDLᵀ`: as a small dense
-//! matrix for islands of up to eight rows with no friction (which rows of
-//! a redundant set carry the load decides which bead static friction
-//! releases, so a rough island keeps the sparse order), otherwise by
-//! faer's sparse
+//! (`S A S`, `S = diag(1/√A_rr)`) and factored `LDLᵀ`. An island with no
+//! friction is factored in the order of its rows where that is cheap: as a
+//! small dense matrix up to eight rows, and as a band matrix where no two
+//! rows more than [`MAX_BAND`] apart share a bead (a rope or chain listed
+//! link by link, with its pin): cost linear in the rows, with no ordering,
+//! no indices and no fill outside the band. (Which rows of a redundant set
+//! carry the load decides which bead static friction releases, so a rough
+//! island keeps the sparse order.) Otherwise it is factored by faer's sparse
 //! Cholesky under an approximate-minimum-degree ordering, which for a chain
 //! or tree of rods eliminates leaf by leaf with no fill-in, so the cost is
 //! linear in the number of rows (Baraff 1996). A closed loop adds a little
@@ -42,6 +45,21 @@ const DROPPED_PIVOT: f64 = 1e30;
 /// small dense matrices: for a pendulum on a cart (two rows) the sparse
 /// machinery costs more than the arithmetic.
 const DENSE_ROWS: usize = 8;
+/// The widest band (rows apart that share a bead) factored as a band
+/// matrix: a pinned rope listed link by link has 2.
+pub const MAX_BAND: usize = 4;
+
+/// How a factorization is laid out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum Layout {
+    /// faer's sparse factorization (or a single row in closed form).
+    #[default]
+    Sparse,
+    /// A small dense matrix, row-major.
+    Dense,
+    /// A band matrix: row `i`'s `D` and the `L` entries left of it.
+    Band,
+}
 
 /// One product `w_bead · g_i · g_j` that makes up an entry of `A`.
 #[derive(Clone, Copy, Debug)]
@@ -70,6 +88,8 @@ pub(crate) struct NormalMatrix {
     pattern: SymbolicSparseColMat<usize>,
     /// Where each diagonal entry sits among the values.
     diagonal: Vec<usize>,
+    /// The column of each value.
+    column: Vec<usize>,
     /// The terms of value `k` are `terms[term_start[k]..term_start[k + 1]]`.
     term_start: Vec<usize>,
     terms: Vec<Term>,
@@ -77,6 +97,9 @@ pub(crate) struct NormalMatrix {
     symbolic: Option<SymbolicCholesky<usize>>,
     /// Two to [`DENSE_ROWS`] rows: `A` may be factored as a dense matrix.
     small: bool,
+    /// More rows than that, none sharing a bead with one more than this
+    /// many rows away: `A` may be factored as a band matrix.
+    band: Option<usize>,
     /// The full pattern for the unsymmetric `J₁ W J₀ᵀ`, made when first
     /// needed; `None` inside if faer could not set it up.
     unsymmetric: OnceLock<Option<Unsymmetric>>,
@@ -109,8 +132,8 @@ pub(crate) struct Factored {
     scratch: Scratch,
     /// How many rows the factorization dropped as redundant.
     pub(crate) redundant: usize,
-    /// Whether `l_values` holds a dense factorization.
-    dense: bool,
+    /// How `l_values` holds the factorization.
+    layout: Layout,
 }
 
 impl NormalMatrix {
@@ -169,8 +192,17 @@ impl NormalMatrix {
         for c in 0..n {
             col_ptr[c + 1] = col_ptr[c + 1].max(col_ptr[c]);
         }
-        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let small = (2..=DENSE_ROWS).contains(&n);
+        let width = (0..n)
+            .flat_map(|col| (col_ptr[col]..col_ptr[col + 1]).map(move |k| (col, k)))
+            .map(|(col, k)| col - row_idx[k])
+            .max()
+            .unwrap_or(0);
+        let band = (n > DENSE_ROWS && width <= MAX_BAND).then_some(width);
+        let column = (0..n)
+            .flat_map(|col| (col_ptr[col]..col_ptr[col + 1]).map(move |_| col))
+            .collect();
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let symbolic = if n > 1 {
             let symbolic = factorize_symbolic_cholesky(
                 pattern.as_ref(),
@@ -188,20 +220,23 @@ impl NormalMatrix {
             n,
             pattern,
             diagonal,
+            column,
             term_start,
             terms,
             symbolic,
             small,
+            band,
             unsymmetric: OnceLock::new(),
         })
     }
 
     /// The stored entries of the upper triangle: `(column, value index, row)`.
     fn upper_entries(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
-        let (col_ptr, row_idx) = (self.pattern.col_ptr(), self.pattern.row_idx());
-        (0..self.n).flat_map(move |col| {
-            (col_ptr[col]..col_ptr[col + 1]).map(move |k| (col, k, row_idx[k]))
-        })
+        self.column
+            .iter()
+            .zip(self.pattern.row_idx())
+            .enumerate()
+            .map(|(k, (&col, &row))| (col, k, row))
     }
 
     /// The pattern of both triangles and its symbolic LU.
@@ -243,8 +278,9 @@ impl NormalMatrix {
     }
 
     /// Solves `J_now W J_firstᵀ x = rhs` in place (the exact Newton matrix
-    /// of RATTLE's position solve) by faer's sparse LU. Returns `false`
-    /// where the matrix is singular or faer could not factor it.
+    /// of RATTLE's position solve): in the rows' order where `natural` and
+    /// the matrix is small or a band, else by faer's sparse LU. Returns
+    /// `false` where the matrix is singular or faer could not factor it.
     pub(crate) fn solve_unsymmetric(
         &self,
         inverse_mass: &[f64],
@@ -252,10 +288,13 @@ impl NormalMatrix {
         first: &[DVec2],
         lu: &mut LuWork,
         rhs: &mut [f64],
-        dense: bool,
+        natural: bool,
     ) -> bool {
-        if dense && self.n <= DENSE_ROWS {
+        if natural && self.n <= DENSE_ROWS {
             return self.solve_unsymmetric_dense(inverse_mass, now, first, &mut lu.values, rhs);
+        }
+        if let (true, Some(p)) = (natural, self.band) {
+            return self.solve_unsymmetric_band(p, inverse_mass, now, first, &mut lu.values, rhs);
         }
         let Some(u) = self.unsymmetric() else {
             return false;
@@ -376,6 +415,141 @@ impl NormalMatrix {
         rhs.iter().all(|x| x.is_finite())
     }
 
+    /// [`NormalMatrix::solve_unsymmetric`] for a band matrix of half-width
+    /// `p`: Gaussian elimination with partial pivoting among the `p` rows
+    /// below, which widens the upper band to `2p`. The row at position `i`
+    /// keeps columns `i − p ..= i + 2p` in `m[i·(3p+1)..]`. A pivot below
+    /// [`REDUNDANT_PIVOT`] of the matrix's largest entry is a singular
+    /// matrix: `false`.
+    fn solve_unsymmetric_band(
+        &self,
+        p: usize,
+        inverse_mass: &[f64],
+        now: &[DVec2],
+        first: &[DVec2],
+        m: &mut Vec<f64>,
+        rhs: &mut [f64],
+    ) -> bool {
+        let (n, w) = (self.n, 3 * p + 1);
+        // Entry (i, c) of the row at position i.
+        let at = |i: usize, c: usize| i * w + c + p - i;
+        m.clear();
+        m.resize(n * w, 0.0);
+        let mut largest = 0.0f64;
+        for (col, k, row) in self.upper_entries() {
+            let upper = self.unsymmetric_value(k, false, inverse_mass, now, first);
+            m[at(row, col)] = upper;
+            largest = largest.max(upper.abs());
+            if row != col {
+                let lower = self.unsymmetric_value(k, true, inverse_mass, now, first);
+                m[at(col, row)] = lower;
+                largest = largest.max(lower.abs());
+            }
+        }
+        if !(largest.is_finite() && largest > 0.0) {
+            return false;
+        }
+        for j in 0..n {
+            let below = (j + p).min(n - 1);
+            let right = (j + 2 * p).min(n - 1);
+            let mut pivot = j;
+            for i in j + 1..=below {
+                if m[at(i, j)].abs() > m[at(pivot, j)].abs() {
+                    pivot = i;
+                }
+            }
+            if m[at(pivot, j)].abs() <= REDUNDANT_PIVOT * largest {
+                return false;
+            }
+            if pivot != j {
+                for c in j..=right {
+                    m.swap(at(j, c), at(pivot, c));
+                }
+                rhs.swap(j, pivot);
+            }
+            let d = m[at(j, j)];
+            for i in j + 1..=below {
+                let factor = m[at(i, j)] / d;
+                if factor == 0.0 {
+                    continue;
+                }
+                for c in j..=right {
+                    m[at(i, c)] -= factor * m[at(j, c)];
+                }
+                rhs[i] -= factor * rhs[j];
+            }
+        }
+        for i in (0..n).rev() {
+            let mut x = rhs[i];
+            for c in i + 1..=(i + 2 * p).min(n - 1) {
+                x -= m[at(i, c)] * rhs[c];
+            }
+            rhs[i] = x / m[at(i, i)];
+        }
+        rhs.iter().all(|x| x.is_finite())
+    }
+
+    /// `LDLᵀ` of the scaled `A` as a band matrix of half-width `p`: row
+    /// `i` at `a[i·(p+1)..]`, `D_ii` first, then `L_{i,i−1}` to
+    /// `L_{i,i−p}`. A pivot at or below [`REDUNDANT_PIVOT`] is replaced by
+    /// [`DROPPED_PIVOT`], as the sparse factorization does. Returns how
+    /// many were.
+    fn factor_band(&self, p: usize, values: &[f64], a: &mut Vec<f64>) -> usize {
+        let (n, w) = (self.n, p + 1);
+        a.clear();
+        a.resize(n * w, 0.0);
+        for (col, k, row) in self.upper_entries() {
+            a[col * w + col - row] = values[k];
+        }
+        let mut dropped = 0;
+        for j in 0..n {
+            let low = j.saturating_sub(p);
+            for k in low..j {
+                let mut v = a[j * w + j - k];
+                for m in low.max(k.saturating_sub(p))..k {
+                    v -= a[j * w + j - m] * a[k * w + k - m] * a[m * w];
+                }
+                a[j * w + j - k] = v / a[k * w];
+            }
+            let mut d = a[j * w];
+            for k in low..j {
+                let l = a[j * w + j - k];
+                d -= l * l * a[k * w];
+            }
+            if d.abs() <= REDUNDANT_PIVOT {
+                d = DROPPED_PIVOT;
+                dropped += 1;
+            }
+            a[j * w] = d;
+        }
+        dropped
+    }
+
+    /// [`NormalMatrix::solve`] with the band `LDLᵀ` of
+    /// [`NormalMatrix::factor_band`].
+    fn solve_band(&self, p: usize, f: &Factored, rhs: &mut [f64]) {
+        let (n, w, a) = (self.n, p + 1, &f.l_values);
+        for (b, s) in rhs.iter_mut().zip(&f.scale) {
+            *b *= s;
+        }
+        for i in 0..n {
+            for k in i.saturating_sub(p)..i {
+                rhs[i] -= a[i * w + i - k] * rhs[k];
+            }
+        }
+        for i in 0..n {
+            rhs[i] /= a[i * w];
+        }
+        for i in (0..n).rev() {
+            for k in i + 1..(i + p + 1).min(n) {
+                rhs[i] -= a[k * w + k - i] * rhs[k];
+            }
+        }
+        for (b, s) in rhs.iter_mut().zip(&f.scale) {
+            *b *= s;
+        }
+    }
+
     /// `LDLᵀ` of the scaled `A` as a dense matrix, row-major in `a`: the
     /// unit lower triangle below the diagonal, `D` on it. A pivot at or
     /// below [`REDUNDANT_PIVOT`] is replaced by [`DROPPED_PIVOT`], as the
@@ -411,16 +585,16 @@ impl NormalMatrix {
         dropped
     }
 
-    /// Fills and factors `A = J_left W J_rightᵀ` (the same gradients on
-    /// both sides for the symmetric `J W Jᵀ`). Returns the index of a row
-    /// whose diagonal vanishes (a singular point: no direction to push
-    /// along) as the error.
+    /// Fills and factors `A = J W Jᵀ`, in the rows' order where `natural`
+    /// and the matrix is small or a band. Returns the index of a row whose
+    /// diagonal vanishes (a singular point: no direction to push along) as
+    /// the error.
     pub(crate) fn factor(
         &self,
         inverse_mass: &[f64],
         gradient: &[DVec2],
         inactive: &[bool],
-        dense: bool,
+        natural: bool,
         f: &mut Factored,
     ) -> Result<(), usize> {
         let nnz = self.term_start.len() - 1;
@@ -448,16 +622,27 @@ impl NormalMatrix {
             f.scale.push(d.sqrt().recip());
         }
         f.redundant = 0;
-        f.dense = dense && self.small;
+        f.layout = match (natural, self.small, self.band) {
+            (true, true, _) => Layout::Dense,
+            (true, _, Some(_)) => Layout::Band,
+            _ => Layout::Sparse,
+        };
         let Some(symbolic) = &self.symbolic else {
             return Ok(());
         };
         for (col, k, row) in self.upper_entries() {
             f.values[k] *= f.scale[row] * f.scale[col];
         }
-        if f.dense {
-            f.redundant = self.factor_dense(&f.values, &mut f.l_values);
-            return Ok(());
+        match (f.layout, self.band) {
+            (Layout::Dense, _) => {
+                f.redundant = self.factor_dense(&f.values, &mut f.l_values);
+                return Ok(());
+            }
+            (Layout::Band, Some(p)) => {
+                f.redundant = self.factor_band(p, &f.values, &mut f.l_values);
+                return Ok(());
+            }
+            _ => {}
         }
         f.l_values.clear();
         f.l_values.resize(symbolic.len_val(), 0.0);
@@ -484,9 +669,10 @@ impl NormalMatrix {
 
     /// Solves `A λ = rhs` in place with the last factorization.
     pub(crate) fn solve(&self, f: &mut Factored, rhs: &mut [f64]) {
-        if f.dense {
-            self.solve_dense(f, rhs);
-            return;
+        match (f.layout, self.band) {
+            (Layout::Dense, _) => return self.solve_dense(f, rhs),
+            (Layout::Band, Some(p)) => return self.solve_band(p, f, rhs),
+            _ => {}
         }
         let Some(symbolic) = &self.symbolic else {
             if let (Some(b), Some(&k)) = (rhs.first_mut(), self.diagonal.first()) {
@@ -580,38 +766,122 @@ mod tests {
         (row_start, entry_bead, first, now, inverse_mass)
     }
 
+    /// Solves `J W Jᵀ x = b` and `J_now W J_firstᵀ x = b` for a chain of
+    /// `links` rods in the rows' order (`natural`) and in faer's sparse
+    /// order, and checks the two agree to 1e-12; returns the layout of the
+    /// natural order's factorization.
+    fn natural_matches_sparse(links: usize) -> Layout {
+        let (row_start, entry_bead, first, now, inverse_mass) = chain(links);
+        let matrix = NormalMatrix::new(&row_start, &entry_bead, links + 1).unwrap();
+        let rows = row_start.len() - 1;
+        let rhs: Vec<f64> = (0..rows).map(|r| (r as f64 * 0.7).sin() - 0.2).collect();
+        let inactive = vec![false; rows];
+        let mut solved = [rhs.clone(), rhs.clone()];
+        let mut layout = Layout::Sparse;
+        for (natural, x) in [true, false].into_iter().zip(&mut solved) {
+            let mut f = Factored::default();
+            matrix
+                .factor(&inverse_mass, &first, &inactive, natural, &mut f)
+                .unwrap();
+            assert_eq!(f.redundant, 0, "{links} links");
+            if natural {
+                layout = f.layout;
+            }
+            matrix.solve(&mut f, x);
+        }
+        let mut unsymmetric = [rhs.clone(), rhs.clone()];
+        for (natural, x) in [true, false].into_iter().zip(&mut unsymmetric) {
+            let mut lu = LuWork::default();
+            assert!(matrix.solve_unsymmetric(&inverse_mass, &now, &first, &mut lu, x, natural));
+        }
+        for [a, b] in [solved, unsymmetric] {
+            for (a, b) in a.iter().zip(&b) {
+                assert!(
+                    (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
+                    "{links} links: {a} against {b}"
+                );
+            }
+        }
+        layout
+    }
+
     #[test]
     fn small_dense_solves_match_the_sparse_ones() {
         for links in [1, 3, 6] {
-            let (row_start, entry_bead, first, now, inverse_mass) = chain(links);
-            let matrix = NormalMatrix::new(&row_start, &entry_bead, links + 1).unwrap();
-            assert!(matrix.small, "{links} links: not a small matrix");
-            let rows = row_start.len() - 1;
-            let rhs: Vec<f64> = (0..rows).map(|r| (r as f64 * 0.7).sin() - 0.2).collect();
-            let inactive = vec![false; rows];
-            let mut solved = [rhs.clone(), rhs.clone()];
-            for (dense, x) in [true, false].into_iter().zip(&mut solved) {
-                let mut f = Factored::default();
-                matrix
-                    .factor(&inverse_mass, &first, &inactive, dense, &mut f)
-                    .unwrap();
-                assert_eq!(f.dense, dense);
-                matrix.solve(&mut f, x);
-            }
-            let mut unsymmetric = [rhs.clone(), rhs.clone()];
-            for (dense, x) in [true, false].into_iter().zip(&mut unsymmetric) {
-                let mut lu = LuWork::default();
-                assert!(matrix.solve_unsymmetric(&inverse_mass, &now, &first, &mut lu, x, dense));
-            }
-            for [a, b] in [solved, unsymmetric] {
-                for (a, b) in a.iter().zip(&b) {
-                    assert!(
-                        (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
-                        "{links} links: {a} against {b}"
-                    );
-                }
+            assert_eq!(natural_matches_sparse(links), Layout::Dense);
+        }
+    }
+
+    #[test]
+    fn band_solves_of_a_long_chain_match_the_sparse_ones() {
+        // The pin's rows and the first rod share bead 0: a band of 2.
+        for links in [7, 40, 500] {
+            assert_eq!(natural_matches_sparse(links), Layout::Band);
+        }
+    }
+
+    #[test]
+    fn a_band_matrix_drops_a_redundant_row_and_refuses_a_singular_newton_matrix() {
+        // A pinned chain of 20 rods, rod 10 listed twice.
+        let (mut row_start, mut entry_bead, mut gradient, _, _) = chain(20);
+        let twin = 2 + 10;
+        let entries = row_start[twin]..row_start[twin + 1];
+        let (beads, grads): (Vec<_>, Vec<_>) = entries
+            .clone()
+            .map(|e| (entry_bead[e], gradient[e]))
+            .unzip();
+        entry_bead.splice(entries.end..entries.end, beads);
+        gradient.splice(entries.end..entries.end, grads);
+        row_start.insert(twin + 1, entries.end);
+        for start in &mut row_start[twin + 2..] {
+            *start += 2;
+        }
+        let rows = row_start.len() - 1;
+        let matrix = NormalMatrix::new(&row_start, &entry_bead, 21).unwrap();
+        assert_eq!(matrix.band, Some(2));
+        let inverse_mass = vec![1.0; 21];
+        let mut f = Factored::default();
+        matrix
+            .factor(&inverse_mass, &gradient, &vec![false; rows], true, &mut f)
+            .unwrap();
+        assert_eq!((f.layout, f.redundant), (Layout::Band, 1));
+        // Every rod asks for the same push; the twins share one rod's.
+        let mut rhs: Vec<f64> = (0..rows).map(|r| if r < 2 { 0.0 } else { 0.3 }).collect();
+        let b = rhs.clone();
+        matrix.solve(&mut f, &mut rhs);
+        assert!(rhs.iter().all(|x| x.is_finite()), "{rhs:?}");
+        assert_eq!(
+            rhs[twin + 1],
+            0.0,
+            "the redundant row carries {}",
+            rhs[twin + 1]
+        );
+        // A λ that meets every row: J W Jᵀ λ = b.
+        let mut pushed = vec![DVec2::ZERO; 21];
+        for r in 0..rows {
+            for e in row_start[r]..row_start[r + 1] {
+                pushed[entry_bead[e]] += rhs[r] * gradient[e];
             }
         }
+        for r in 0..rows {
+            let met: f64 = (row_start[r]..row_start[r + 1])
+                .map(|e| gradient[e].dot(pushed[entry_bead[e]]))
+                .sum();
+            assert!(
+                (met - b[r]).abs() <= 1e-12,
+                "row {r}: {met} against {}",
+                b[r]
+            );
+        }
+        let mut lu = LuWork::default();
+        assert!(!matrix.solve_unsymmetric(
+            &inverse_mass,
+            &gradient,
+            &gradient,
+            &mut lu,
+            &mut rhs,
+            true
+        ));
     }
 
     #[test]
@@ -626,7 +896,7 @@ mod tests {
         matrix
             .factor(&[1.0, 1.0], &gradient, &[false; 4], true, &mut f)
             .unwrap();
-        assert_eq!(f.redundant, 1);
+        assert_eq!((f.layout, f.redundant), (Layout::Dense, 1));
         // A consistent right-hand side: the two rods ask for the same.
         let mut rhs = vec![0.0, 0.0, 0.3, 0.3];
         matrix.solve(&mut f, &mut rhs);
