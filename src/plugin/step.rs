@@ -35,10 +35,8 @@ pub(crate) fn prepare_step(
     params: Res<SimParams>,
     mut clock: ResMut<SimClock>,
     mut driven: Query<(&PrescribedMotion, &mut Transform, &mut WirePose)>,
-    mut followed: Query<
-        (Entity, Ref<Transform>, &mut WirePose),
-        (With<Wire>, Without<PrescribedMotion>),
-    >,
+    mut followed: Query<(Ref<Transform>, &mut WirePose), (With<Wire>, Without<PrescribedMotion>)>,
+    moved: Query<Entity, (With<Wire>, Without<PrescribedMotion>, Changed<Transform>)>,
     mut moving: Local<EntityHashSet>,
 ) {
     let (start, h) = (clock.time, params.timestep);
@@ -50,11 +48,14 @@ pub(crate) fn prepare_step(
             set_pose(&mut transform, path.pose(end));
         }
     }
+    // Only the wires whose `Transform` changed, and the ones that were
+    // still moving: the rest stay where they are, unvisited.
     let mut still_moving = EntityHashSet::default();
-    for (entity, transform, mut pose) in &mut followed {
-        if !transform.is_changed() && !moving.contains(&entity) {
+    let before = moving.iter().copied().filter(|&e| !moved.contains(e));
+    for entity in moved.iter().chain(before) {
+        let Ok((transform, mut pose)) = followed.get_mut(entity) else {
             continue;
-        }
+        };
         let Ok(now) = pose_of(&transform) else {
             pose.set_if_neq(WirePose::from_transform(&transform));
             continue;
@@ -265,6 +266,10 @@ impl WireTable {
     }
 }
 
+/// How many batches of [`solver::LANES`] beads one call of the batched step
+/// takes.
+const BATCHES: usize = 8;
+
 /// What stepping a run of beads needs, shared by the threads.
 struct StepContext<'a> {
     params: &'a SimParams,
@@ -277,12 +282,13 @@ struct StepContext<'a> {
 
 impl StepContext<'_> {
     /// Steps a run of beads stored side by side. Beads on unrotated circles
-    /// go through the batched step, [`solver::LANES`] at a time; the
-    /// others, and the lanes it hands back, one by one.
+    /// go through the batched step, [`solver::LANES`] at a time, up to
+    /// [`BATCHES`] batches per call; the others, and the lanes it hands
+    /// back, one by one.
     fn step_run(&self, mut run: BeadRun) {
-        let mut lanes = solver::CircleLanes::default();
-        let mut outs = solver::CircleSteps::default();
-        let mut waiting = [0; solver::LANES];
+        let mut lanes = [solver::CircleLanes::default(); BATCHES];
+        let mut outs = [solver::CircleSteps::default(); BATCHES];
+        let mut waiting = [0; BATCHES * solver::LANES];
         let mut queued = 0;
         for i in 0..run.beads.len() {
             let wire = self.wires.get(&run.on_wires[i]);
@@ -294,8 +300,8 @@ impl StepContext<'_> {
                 && pose.is_unrotated()
             {
                 let bead = &run.beads[i];
-                lanes.set(
-                    queued,
+                lanes[queued / solver::LANES].set(
+                    queued % solver::LANES,
                     bead.state(),
                     &bead.step_force(self.params.gravity),
                     bead.mass(),
@@ -304,22 +310,34 @@ impl StepContext<'_> {
                 );
                 waiting[queued] = i;
                 queued += 1;
-                if queued == solver::LANES {
-                    solver::step_on_circles(&lanes, &self.settings, &mut outs);
-                    for (lane, &j) in waiting.iter().enumerate() {
-                        match outs.lane(lane) {
-                            Some(out) => self.finish(run.outputs(j), out),
-                            None => self.step_one(&mut run, j),
-                        }
-                    }
+                if queued == waiting.len() {
+                    solver::step_on_circle_batches(&lanes, &self.settings, &mut outs);
+                    self.finish_batches(&mut run, &outs, &waiting);
                     queued = 0;
                 }
                 continue;
             }
             self.step_one(&mut run, i);
         }
-        for &j in &waiting[..queued] {
+        // The last, partial batches: full ones batched, the rest one by one.
+        let whole = queued / solver::LANES;
+        solver::step_on_circle_batches(&lanes[..whole], &self.settings, &mut outs[..whole]);
+        let batched = whole * solver::LANES;
+        self.finish_batches(&mut run, &outs[..whole], &waiting[..batched]);
+        for &j in &waiting[batched..queued] {
             self.step_one(&mut run, j);
+        }
+    }
+
+    /// Stores the batched steps of the beads `waiting` (in order, one lane
+    /// each); a lane the batch did not finish goes through
+    /// [`StepContext::step_one`].
+    fn finish_batches(&self, run: &mut BeadRun, outs: &[solver::CircleSteps], waiting: &[usize]) {
+        for (k, &j) in waiting.iter().enumerate() {
+            match outs[k / solver::LANES].lane(k % solver::LANES) {
+                Some(out) => self.finish(run.outputs(j), out),
+                None => self.step_one(run, j),
+            }
         }
     }
 

@@ -10,7 +10,7 @@
 //! | `euler`, `rk4`, `rattle`, `projection` | the integrators and post-stabilization, eqs. (6)–(9) |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
 //! | `contact` | [`step_surface`]: one-sided wires, landings and friction, eq. (14) |
-//! | `lanes` | [`step_on_circles`]: [`LANES`] beads on circles at once, bit for bit [`step`] |
+//! | `lanes` | [`step_on_circles`]: [`LANES`] beads on circles at once, bit for bit [`step`]; [`step_on_circle_batches`]: many such batches in one call |
 //! | `coupled` | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (10)–(12) |
 //!
 //! The equations below are numbered as the code and the tests cite them.
@@ -36,7 +36,7 @@ pub use coupled::{
     MAX_HALVINGS, OFF_THE_WIRE, REDUNDANT_PIVOT, RowKind, RowReport, SpringLink, islands,
 };
 pub use euler::{explicit_euler, semi_implicit_euler};
-pub use lanes::{CircleLanes, CircleSteps, LANES, step_on_circles};
+pub use lanes::{CircleLanes, CircleSteps, LANES, step_on_circle_batches, step_on_circles};
 pub use method::{Integrator, Method, Stabilization};
 pub use projection::{ENERGY_CORRECTION_LIMIT, NEWTON_ACCEPT, NEWTON_TOLERANCE, project};
 pub use rattle::rattle;

@@ -8,7 +8,7 @@ use bevy::prelude::*;
 use wirebead::prelude::*;
 use wirebead::{Oscillate, ScenePreset};
 
-use crate::common::{Recording, app, run_for};
+use crate::common::{Recording, app, run_for, spawn_bead, spawn_wire};
 
 fn preset(file: &str) -> ScenePreset {
     let path = format!("{}/assets/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
@@ -535,4 +535,42 @@ fn a_scene_with_a_rough_wire_stops_lone_beads_and_carts_at_the_coulomb_distance(
         );
         assert!(b.velocity.length() < 1e-9);
     }
+}
+
+/// A wire the game moves in one step and then leaves is taken to have
+/// moved at constant speed during that step and to be at rest from the
+/// next on: its bead stays on it where it now is.
+#[test]
+fn a_wire_moved_once_then_left_holds_its_bead_where_it_now_is() {
+    let mut app = app(SimParams {
+        method: Method::Rattle,
+        ..default()
+    });
+    let wire = spawn_wire(&mut app, Wire::circle(1.0).unwrap(), Transform::default());
+    let bead = spawn_bead(
+        &mut app,
+        wire,
+        BeadParams {
+            mass: 1.0,
+            initial_position: DVec2::new(0.6, -0.8),
+            initial_velocity: DVec2::ZERO,
+        },
+    );
+    let steps = |app: &mut App, n: usize| {
+        for _ in 0..n {
+            app.world_mut().run_schedule(FixedUpdate);
+        }
+    };
+    steps(&mut app, 10);
+    // Five centimetres to the right in one step (3 m/s at 1/60 s).
+    let mut transform = app.world_mut().get_mut::<Transform>(wire).unwrap();
+    transform.translation.x = 0.05;
+    steps(&mut app, 120);
+    let p = app.world().get::<Bead>(bead).unwrap().position;
+    let off = ((p - DVec2::new(f64::from(0.05f32), 0.0)).length() - 1.0).abs();
+    eprintln!("moved once, then left: the bead is {off:.1e} m off the wire after 2 s");
+    assert!(
+        off < 1e-12,
+        "the bead is {off:e} m off the wire where it now is"
+    );
 }
