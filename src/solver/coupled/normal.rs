@@ -5,11 +5,12 @@
 //! `A` is symmetric positive semidefinite, with a nonzero `(r, s)` wherever
 //! rows `r` and `s` share a bead. It is scaled to a unit diagonal
 //! (`S A S`, `S = diag(1/√A_rr)`) and factored `LDLᵀ`. An island with no
-//! friction is factored in the order of its rows where that is cheap: as a
-//! small dense matrix up to eight rows, and as a band matrix where no two
-//! rows more than [`MAX_BAND`] apart share a bead (a rope or chain listed
-//! link by link, with its pin): cost linear in the rows, with no ordering,
-//! no indices and no fill outside the band. (Which rows of a redundant set
+//! friction is factored in the order of its rows, as a band matrix, where
+//! that is cheap: where no two rows more than [`MAX_BAND`] apart share a
+//! bead (a rope or chain listed link by link, with its pin), and for up to
+//! eight rows whatever the band (a small dense matrix). The cost is linear
+//! in the rows, with no ordering, no indices and no fill outside the band.
+//! (Which rows of a redundant set
 //! carry the load decides which bead static friction releases, so a rough
 //! island keeps the sparse order.) Otherwise it is factored by faer's sparse
 //! Cholesky under an approximate-minimum-degree ordering, which for a chain
@@ -41,9 +42,10 @@ use faer::{Conj, MatMut, Par, Side};
 pub const REDUNDANT_PIVOT: f64 = 1e-10;
 /// What a redundant row's pivot is replaced by: its λ becomes zero.
 const DROPPED_PIVOT: f64 = 1e30;
-/// Islands of at most this many rows factor `A` and the Newton matrix as
-/// small dense matrices: for a pendulum on a cart (two rows) the sparse
-/// machinery costs more than the arithmetic.
+/// Islands of at most this many rows factor `A` and the Newton matrix in
+/// their rows' order whatever their band (as small dense matrices): for a
+/// pendulum on a cart (two rows) the sparse machinery costs more than the
+/// arithmetic.
 const DENSE_ROWS: usize = 8;
 /// The widest band (rows apart that share a bead) factored as a band
 /// matrix: a pinned rope listed link by link has 2.
@@ -52,11 +54,9 @@ pub const MAX_BAND: usize = 4;
 /// How a factorization is laid out.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 enum Layout {
-    /// faer's sparse factorization (or a single row in closed form).
+    /// faer's sparse factorization, or a single row in closed form.
     #[default]
     Sparse,
-    /// A small dense matrix, row-major.
-    Dense,
     /// A band matrix: row `i`'s `D` and the `L` entries left of it.
     Band,
 }
@@ -95,10 +95,9 @@ pub(crate) struct NormalMatrix {
     terms: Vec<Term>,
     /// `None` for a single row, solved in closed form.
     symbolic: Option<SymbolicCholesky<usize>>,
-    /// Two to [`DENSE_ROWS`] rows: `A` may be factored as a dense matrix.
-    small: bool,
-    /// More rows than that, none sharing a bead with one more than this
-    /// many rows away: `A` may be factored as a band matrix.
+    /// No row sharing a bead with one more than this many rows away, where
+    /// that is at most [`MAX_BAND`] or the matrix has at most
+    /// [`DENSE_ROWS`] rows: `A` may be factored as a band matrix.
     band: Option<usize>,
     /// The full pattern for the unsymmetric `J₁ W J₀ᵀ`, made when first
     /// needed; `None` inside if faer could not set it up.
@@ -192,13 +191,12 @@ impl NormalMatrix {
         for c in 0..n {
             col_ptr[c + 1] = col_ptr[c + 1].max(col_ptr[c]);
         }
-        let small = (2..=DENSE_ROWS).contains(&n);
         let width = (0..n)
             .flat_map(|col| (col_ptr[col]..col_ptr[col + 1]).map(move |k| (col, k)))
             .map(|(col, k)| col - row_idx[k])
             .max()
             .unwrap_or(0);
-        let band = (n > DENSE_ROWS && width <= MAX_BAND).then_some(width);
+        let band = (n <= DENSE_ROWS || width <= MAX_BAND).then_some(width);
         let column = (0..n)
             .flat_map(|col| (col_ptr[col]..col_ptr[col + 1]).map(move |_| col))
             .collect();
@@ -224,7 +222,6 @@ impl NormalMatrix {
             term_start,
             terms,
             symbolic,
-            small,
             band,
             unsymmetric: OnceLock::new(),
         })
@@ -279,7 +276,7 @@ impl NormalMatrix {
 
     /// Solves `J_now W J_firstᵀ x = rhs` in place (the exact Newton matrix
     /// of RATTLE's position solve): in the rows' order where `natural` and
-    /// the matrix is small or a band, else by faer's sparse LU. Returns
+    /// the matrix is a band, else by faer's sparse LU. Returns
     /// `false` where the matrix is singular or faer could not factor it.
     pub(crate) fn solve_unsymmetric(
         &self,
@@ -290,9 +287,6 @@ impl NormalMatrix {
         rhs: &mut [f64],
         natural: bool,
     ) -> bool {
-        if natural && self.n <= DENSE_ROWS {
-            return self.solve_unsymmetric_dense(inverse_mass, now, first, &mut lu.values, rhs);
-        }
         if let (true, Some(p)) = (natural, self.band) {
             return self.solve_unsymmetric_band(p, inverse_mass, now, first, &mut lu.values, rhs);
         }
@@ -357,62 +351,6 @@ impl NormalMatrix {
                 inverse_mass[t.bead] * now[row].dot(first[col])
             })
             .sum()
-    }
-
-    /// [`NormalMatrix::solve_unsymmetric`] for a small island: Gaussian
-    /// elimination with partial pivoting on the dense matrix (row-major in
-    /// `m`). A pivot below [`REDUNDANT_PIVOT`] of the matrix's largest
-    /// entry is a singular matrix: `false`.
-    fn solve_unsymmetric_dense(
-        &self,
-        inverse_mass: &[f64],
-        now: &[DVec2],
-        first: &[DVec2],
-        m: &mut Vec<f64>,
-        rhs: &mut [f64],
-    ) -> bool {
-        let n = self.n;
-        m.clear();
-        m.resize(n * n, 0.0);
-        for (col, k, row) in self.upper_entries() {
-            m[row * n + col] = self.unsymmetric_value(k, false, inverse_mass, now, first);
-            if row != col {
-                m[col * n + row] = self.unsymmetric_value(k, true, inverse_mass, now, first);
-            }
-        }
-        let largest = m.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        if !(largest.is_finite() && largest > 0.0) {
-            return false;
-        }
-        for j in 0..n {
-            let pivot = (j..n)
-                .max_by(|&a, &b| m[a * n + j].abs().total_cmp(&m[b * n + j].abs()))
-                .unwrap_or(j);
-            if m[pivot * n + j].abs() <= REDUNDANT_PIVOT * largest {
-                return false;
-            }
-            if pivot != j {
-                for c in 0..n {
-                    m.swap(j * n + c, pivot * n + c);
-                }
-                rhs.swap(j, pivot);
-            }
-            for i in j + 1..n {
-                let factor = m[i * n + j] / m[j * n + j];
-                for c in j..n {
-                    m[i * n + c] -= factor * m[j * n + c];
-                }
-                rhs[i] -= factor * rhs[j];
-            }
-        }
-        for i in (0..n).rev() {
-            let mut x = rhs[i];
-            for c in i + 1..n {
-                x -= m[i * n + c] * rhs[c];
-            }
-            rhs[i] = x / m[i * n + i];
-        }
-        rhs.iter().all(|x| x.is_finite())
     }
 
     /// [`NormalMatrix::solve_unsymmetric`] for a band matrix of half-width
@@ -550,43 +488,8 @@ impl NormalMatrix {
         }
     }
 
-    /// `LDLᵀ` of the scaled `A` as a dense matrix, row-major in `a`: the
-    /// unit lower triangle below the diagonal, `D` on it. A pivot at or
-    /// below [`REDUNDANT_PIVOT`] is replaced by [`DROPPED_PIVOT`], as the
-    /// sparse factorization does. Returns how many were.
-    fn factor_dense(&self, values: &[f64], a: &mut Vec<f64>) -> usize {
-        let n = self.n;
-        a.clear();
-        a.resize(n * n, 0.0);
-        for (col, k, row) in self.upper_entries() {
-            a[row * n + col] = values[k];
-            a[col * n + row] = values[k];
-        }
-        let mut dropped = 0;
-        for j in 0..n {
-            let mut d = a[j * n + j];
-            for k in 0..j {
-                let l = a[j * n + k];
-                d -= l * l * a[k * n + k];
-            }
-            if d.abs() <= REDUNDANT_PIVOT {
-                d = DROPPED_PIVOT;
-                dropped += 1;
-            }
-            a[j * n + j] = d;
-            for i in j + 1..n {
-                let mut v = a[i * n + j];
-                for k in 0..j {
-                    v -= a[i * n + k] * a[j * n + k] * a[k * n + k];
-                }
-                a[i * n + j] = v / d;
-            }
-        }
-        dropped
-    }
-
     /// Fills and factors `A = J W Jᵀ`, in the rows' order where `natural`
-    /// and the matrix is small or a band. Returns the index of a row whose
+    /// and the matrix is a band. Returns the index of a row whose
     /// diagonal vanishes (a singular point: no direction to push along) as
     /// the error.
     pub(crate) fn factor(
@@ -622,27 +525,18 @@ impl NormalMatrix {
             f.scale.push(d.sqrt().recip());
         }
         f.redundant = 0;
-        f.layout = match (natural, self.small, self.band) {
-            (true, true, _) => Layout::Dense,
-            (true, _, Some(_)) => Layout::Band,
-            _ => Layout::Sparse,
-        };
+        f.layout = Layout::Sparse;
         let Some(symbolic) = &self.symbolic else {
+            // A single row: solved in closed form.
             return Ok(());
         };
         for (col, k, row) in self.upper_entries() {
             f.values[k] *= f.scale[row] * f.scale[col];
         }
-        match (f.layout, self.band) {
-            (Layout::Dense, _) => {
-                f.redundant = self.factor_dense(&f.values, &mut f.l_values);
-                return Ok(());
-            }
-            (Layout::Band, Some(p)) => {
-                f.redundant = self.factor_band(p, &f.values, &mut f.l_values);
-                return Ok(());
-            }
-            _ => {}
+        if let (true, Some(p)) = (natural, self.band) {
+            f.layout = Layout::Band;
+            f.redundant = self.factor_band(p, &f.values, &mut f.l_values);
+            return Ok(());
         }
         f.l_values.clear();
         f.l_values.resize(symbolic.len_val(), 0.0);
@@ -669,10 +563,8 @@ impl NormalMatrix {
 
     /// Solves `A λ = rhs` in place with the last factorization.
     pub(crate) fn solve(&self, f: &mut Factored, rhs: &mut [f64]) {
-        match (f.layout, self.band) {
-            (Layout::Dense, _) => return self.solve_dense(f, rhs),
-            (Layout::Band, Some(p)) => return self.solve_band(p, f, rhs),
-            _ => {}
+        if let (Layout::Band, Some(p)) = (f.layout, self.band) {
+            return self.solve_band(p, f, rhs);
         }
         let Some(symbolic) = &self.symbolic else {
             if let (Some(b), Some(&k)) = (rhs.first_mut(), self.diagonal.first()) {
@@ -691,31 +583,6 @@ impl NormalMatrix {
             Par::Seq,
             MemStack::new(memory),
         );
-        for (b, s) in rhs.iter_mut().zip(&f.scale) {
-            *b *= s;
-        }
-    }
-
-    /// [`NormalMatrix::solve`] with the dense `LDLᵀ` of
-    /// [`NormalMatrix::factor_dense`].
-    fn solve_dense(&self, f: &Factored, rhs: &mut [f64]) {
-        let (n, a) = (self.n, &f.l_values);
-        for (b, s) in rhs.iter_mut().zip(&f.scale) {
-            *b *= s;
-        }
-        for i in 0..n {
-            for k in 0..i {
-                rhs[i] -= a[i * n + k] * rhs[k];
-            }
-        }
-        for i in 0..n {
-            rhs[i] /= a[i * n + i];
-        }
-        for i in (0..n).rev() {
-            for k in i + 1..n {
-                rhs[i] -= a[k * n + i] * rhs[k];
-            }
-        }
         for (b, s) in rhs.iter_mut().zip(&f.scale) {
             *b *= s;
         }
@@ -806,9 +673,9 @@ mod tests {
     }
 
     #[test]
-    fn small_dense_solves_match_the_sparse_ones() {
+    fn small_matrices_in_the_rows_order_match_the_sparse_ones() {
         for links in [1, 3, 6] {
-            assert_eq!(natural_matches_sparse(links), Layout::Dense);
+            assert_eq!(natural_matches_sparse(links), Layout::Band);
         }
     }
 
@@ -885,7 +752,7 @@ mod tests {
     }
 
     #[test]
-    fn a_small_dense_matrix_drops_a_redundant_row_and_refuses_a_singular_newton_matrix() {
+    fn a_small_matrix_drops_a_redundant_row_and_refuses_a_singular_newton_matrix() {
         // The same rod twice between a pinned bead and a free one.
         let row_start = [0, 1, 2, 4, 6];
         let entry_bead = [0, 0, 0, 1, 0, 1];
@@ -896,7 +763,7 @@ mod tests {
         matrix
             .factor(&[1.0, 1.0], &gradient, &[false; 4], true, &mut f)
             .unwrap();
-        assert_eq!((f.layout, f.redundant), (Layout::Dense, 1));
+        assert_eq!((f.layout, f.redundant), (Layout::Band, 1));
         // A consistent right-hand side: the two rods ask for the same.
         let mut rhs = vec![0.0, 0.0, 0.3, 0.3];
         matrix.solve(&mut f, &mut rhs);
