@@ -435,7 +435,7 @@ impl Island {
     }
 
     /// Whether the island's matrices may be factored in the order of its
-    /// rows (dense or as a band): no friction (see the `normal` module).
+    /// rows (as a band): no friction (see the `normal` module).
     fn natural_order(&self) -> bool {
         self.rough.iter().all(Option::is_none)
     }
@@ -1291,7 +1291,7 @@ impl Island {
     /// several start as a chord iteration on the factored `J₀ W J₀ᵀ` (no
     /// new factorization, linear convergence at a rate set by how far the
     /// rows turn over the step) and switch to exact Newton steps (LU of
-    /// the band, dense or sparse matrix) once the chord stops shrinking `C`
+    /// the band or sparse matrix) once the chord stops shrinking `C`
     /// fourfold per iteration. Two exact steps that do not shrink `C`, or
     /// [`EXACT_STEPS`] that do not reach the tolerance, mean no root near:
     /// the step is halved. The iterations evaluate `C` and the gradients
