@@ -10,13 +10,13 @@
 //! bead (a rope or chain listed link by link, with its pin), and for up to
 //! eight rows whatever the band (a small dense matrix). The cost is linear
 //! in the rows, with no ordering, no indices and no fill outside the band.
-//! (Which rows of a redundant set
-//! carry the load decides which bead static friction releases, so a rough
-//! island keeps the sparse order.) Otherwise it is factored by faer's sparse
-//! Cholesky under an approximate-minimum-degree ordering, which for a chain
-//! or tree of rods eliminates leaf by leaf with no fill-in, so the cost is
-//! linear in the number of rows (Baraff 1996). A closed loop adds a little
-//! fill and still factors.
+//! (Which rows of a redundant set carry the load decides which bead static
+//! friction releases, so a rough island keeps the sparse order.) Otherwise
+//! it is factored by faer's sparse Cholesky under an
+//! approximate-minimum-degree ordering, which for a chain or tree of rods
+//! eliminates leaf by leaf with no fill-in, so the cost is linear in the
+//! number of rows (Baraff 1996). A closed loop adds a little fill and still
+//! factors.
 //!
 //! Redundant constraints (the same rod twice; a chain pulled straight
 //! between two pins) make `A` singular. A pivot that falls below
