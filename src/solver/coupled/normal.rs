@@ -61,6 +61,183 @@ enum Layout {
     Band,
 }
 
+/// A band ordering of the rows: no two rows that share a bead are more
+/// than `width` places apart.
+#[derive(Clone, Debug)]
+struct Band {
+    width: usize,
+    /// Each row's place in the band (`None`: its own index).
+    position: Option<Vec<usize>>,
+}
+
+impl Band {
+    /// Row `r`'s place in the band.
+    #[inline(always)]
+    fn at(&self, r: usize) -> usize {
+        self.position.as_ref().map_or(r, |p| p[r])
+    }
+
+    /// `rhs` (by row) into `out` (by place in the band).
+    fn gather(&self, rhs: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.resize(rhs.len(), 0.0);
+        for (r, &b) in rhs.iter().enumerate() {
+            out[self.at(r)] = b;
+        }
+    }
+
+    /// `solved` (by place in the band) back into `rhs` (by row).
+    fn scatter(&self, solved: &[f64], rhs: &mut [f64]) {
+        for (r, b) in rhs.iter_mut().enumerate() {
+            *b = solved[self.at(r)];
+        }
+    }
+}
+
+/// The band ordering of a matrix of `n` rows whose upper entries are at
+/// `(row[k], column[k])`: the rows' own order where its band is at most
+/// [`MAX_BAND`] or there are at most [`DENSE_ROWS`] rows, else a reverse
+/// Cuthill–McKee order where that band is at most [`MAX_BAND`].
+fn band_of(column: &[usize], row: &[usize], n: usize) -> Option<Band> {
+    let width = |at: &dyn Fn(usize) -> usize| {
+        column
+            .iter()
+            .zip(row)
+            .map(|(&c, &r)| at(c).abs_diff(at(r)))
+            .max()
+            .unwrap_or(0)
+    };
+    let own = width(&|r| r);
+    if n <= DENSE_ROWS || own <= MAX_BAND {
+        return Some(Band {
+            width: own,
+            position: None,
+        });
+    }
+    let mut neighbours = vec![Vec::new(); n];
+    for (&c, &r) in column.iter().zip(row) {
+        if c != r {
+            neighbours[c].push(r);
+            neighbours[r].push(c);
+        }
+    }
+    let position = cuthill_mckee(&neighbours);
+    let reordered = width(&|r| position[r]);
+    (reordered <= MAX_BAND).then_some(Band {
+        width: reordered,
+        position: Some(position),
+    })
+}
+
+/// Solves the band matrix `m` of half-width `p` (largest entry `largest`)
+/// in place of `rhs`: Gaussian elimination with partial pivoting among
+/// the `p` rows below, which widens the upper band to `2p`. The row at
+/// position `i` keeps columns `i − p ..= i + 2p` in `m[i·(3p+1)..]`. A
+/// pivot below [`REDUNDANT_PIVOT`] of `largest` is a singular matrix:
+/// `false`.
+fn eliminate_band(p: usize, largest: f64, m: &mut [f64], rhs: &mut [f64]) -> bool {
+    let (n, w) = (rhs.len(), 3 * p + 1);
+    // Entry (i, c) of the row at position i.
+    let at = |i: usize, c: usize| i * w + c + p - i;
+    for j in 0..n {
+        let below = (j + p).min(n - 1);
+        let right = (j + 2 * p).min(n - 1);
+        let mut pivot = j;
+        for i in j + 1..=below {
+            if m[at(i, j)].abs() > m[at(pivot, j)].abs() {
+                pivot = i;
+            }
+        }
+        if m[at(pivot, j)].abs() <= REDUNDANT_PIVOT * largest {
+            return false;
+        }
+        if pivot != j {
+            for c in j..=right {
+                m.swap(at(j, c), at(pivot, c));
+            }
+            rhs.swap(j, pivot);
+        }
+        let d = m[at(j, j)];
+        for i in j + 1..=below {
+            let factor = m[at(i, j)] / d;
+            if factor == 0.0 {
+                continue;
+            }
+            for c in j..=right {
+                m[at(i, c)] -= factor * m[at(j, c)];
+            }
+            rhs[i] -= factor * rhs[j];
+        }
+    }
+    for i in (0..n).rev() {
+        let mut x = rhs[i];
+        for c in i + 1..=(i + 2 * p).min(n - 1) {
+            x -= m[at(i, c)] * rhs[c];
+        }
+        rhs[i] = x / m[at(i, i)];
+    }
+    rhs.iter().all(|x| x.is_finite())
+}
+
+/// Solves `L D Lᵀ x = rhs` in place with the band factors of
+/// [`NormalMatrix::factor_band`] (half-width `p`, rows in the band's order).
+fn substitute_band(p: usize, a: &[f64], rhs: &mut [f64]) {
+    let (n, w) = (rhs.len(), p + 1);
+    for i in 0..n {
+        for k in i.saturating_sub(p)..i {
+            rhs[i] -= a[i * w + i - k] * rhs[k];
+        }
+    }
+    for i in 0..n {
+        rhs[i] /= a[i * w];
+    }
+    for i in (0..n).rev() {
+        for k in i + 1..(i + p + 1).min(n) {
+            rhs[i] -= a[k * w + k - i] * rhs[k];
+        }
+    }
+}
+
+/// Each row's place in a reverse Cuthill–McKee order of the rows, where
+/// `neighbours[r]` are the rows that share a bead with row `r`: a
+/// breadth-first walk from a row of fewest neighbours, each row's new
+/// neighbours taken fewest first, reversed. For a chain of rods listed in
+/// any order it gives back the chain's band; a ring of rods gets a band of
+/// two.
+fn cuthill_mckee(neighbours: &[Vec<usize>]) -> Vec<usize> {
+    let n = neighbours.len();
+    let degree = |r: usize| neighbours[r].len();
+    let mut starts: Vec<usize> = (0..n).collect();
+    starts.sort_by_key(|&r| degree(r));
+    let mut placed = vec![false; n];
+    let mut order = Vec::with_capacity(n);
+    let mut next = Vec::new();
+    for start in starts {
+        if placed[start] {
+            continue;
+        }
+        placed[start] = true;
+        order.push(start);
+        let mut head = order.len() - 1;
+        while head < order.len() {
+            let r = order[head];
+            head += 1;
+            next.clear();
+            next.extend(neighbours[r].iter().copied().filter(|&s| !placed[s]));
+            next.sort_by_key(|&s| degree(s));
+            for &s in &next {
+                placed[s] = true;
+                order.push(s);
+            }
+        }
+    }
+    let mut position = vec![0; n];
+    for (place, &r) in order.iter().rev().enumerate() {
+        position[r] = place;
+    }
+    position
+}
+
 /// One product `w_bead · g_i · g_j` that makes up an entry of `A`.
 #[derive(Clone, Copy, Debug)]
 struct Term {
@@ -95,10 +272,10 @@ pub(crate) struct NormalMatrix {
     terms: Vec<Term>,
     /// `None` for a single row, solved in closed form.
     symbolic: Option<SymbolicCholesky<usize>>,
-    /// No row sharing a bead with one more than this many rows away, where
-    /// that is at most [`MAX_BAND`] or the matrix has at most
-    /// [`DENSE_ROWS`] rows: `A` may be factored as a band matrix.
-    band: Option<usize>,
+    /// Where `A` may be factored as a band matrix: at most [`DENSE_ROWS`]
+    /// rows, or a band of at most [`MAX_BAND`] in the rows' order or in a
+    /// reverse Cuthill–McKee order of them.
+    band: Option<Band>,
     /// The full pattern for the unsymmetric `J₁ W J₀ᵀ`, made when first
     /// needed; `None` inside if faer could not set it up.
     unsymmetric: OnceLock<Option<Unsymmetric>>,
@@ -118,6 +295,8 @@ struct Unsymmetric {
 #[derive(Default)]
 pub(crate) struct LuWork {
     values: Vec<f64>,
+    /// The right-hand side in a band's order of the rows.
+    order: Vec<f64>,
     numeric: NumericLu<usize, f64>,
     scratch: Scratch,
 }
@@ -133,6 +312,8 @@ pub(crate) struct Factored {
     pub(crate) redundant: usize,
     /// How `l_values` holds the factorization.
     layout: Layout,
+    /// The right-hand side in a band's order of the rows.
+    order: Vec<f64>,
 }
 
 impl NormalMatrix {
@@ -191,15 +372,10 @@ impl NormalMatrix {
         for c in 0..n {
             col_ptr[c + 1] = col_ptr[c + 1].max(col_ptr[c]);
         }
-        let width = (0..n)
-            .flat_map(|col| (col_ptr[col]..col_ptr[col + 1]).map(move |k| (col, k)))
-            .map(|(col, k)| col - row_idx[k])
-            .max()
-            .unwrap_or(0);
-        let band = (n <= DENSE_ROWS || width <= MAX_BAND).then_some(width);
-        let column = (0..n)
+        let column: Vec<usize> = (0..n)
             .flat_map(|col| (col_ptr[col]..col_ptr[col + 1]).map(move |_| col))
             .collect();
+        let band = band_of(&column, &row_idx, n);
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let symbolic = if n > 1 {
             let symbolic = factorize_symbolic_cholesky(
@@ -287,8 +463,9 @@ impl NormalMatrix {
         rhs: &mut [f64],
         natural: bool,
     ) -> bool {
-        if let (true, Some(p)) = (natural, self.band) {
-            return self.solve_unsymmetric_band(p, inverse_mass, now, first, &mut lu.values, rhs);
+        if let (true, Some(band)) = (natural, &self.band) {
+            let LuWork { values, order, .. } = lu;
+            return self.solve_unsymmetric_band(band, inverse_mass, now, first, values, order, rhs);
         }
         let Some(u) = self.unsymmetric() else {
             return false;
@@ -353,91 +530,62 @@ impl NormalMatrix {
             .sum()
     }
 
-    /// [`NormalMatrix::solve_unsymmetric`] for a band matrix of half-width
-    /// `p`: Gaussian elimination with partial pivoting among the `p` rows
-    /// below, which widens the upper band to `2p`. The row at position `i`
-    /// keeps columns `i − p ..= i + 2p` in `m[i·(3p+1)..]`. A pivot below
-    /// [`REDUNDANT_PIVOT`] of the matrix's largest entry is a singular
-    /// matrix: `false`.
+    /// [`NormalMatrix::solve_unsymmetric`] for a band matrix: filled in the
+    /// band's order of the rows, solved by [`eliminate_band`] (in `order`
+    /// where the band reorders the rows).
+    #[allow(clippy::too_many_arguments)]
     fn solve_unsymmetric_band(
         &self,
-        p: usize,
+        band: &Band,
         inverse_mass: &[f64],
         now: &[DVec2],
         first: &[DVec2],
         m: &mut Vec<f64>,
+        order: &mut Vec<f64>,
         rhs: &mut [f64],
     ) -> bool {
-        let (n, w) = (self.n, 3 * p + 1);
-        // Entry (i, c) of the row at position i.
-        let at = |i: usize, c: usize| i * w + c + p - i;
+        let (n, p) = (self.n, band.width);
+        let w = 3 * p + 1;
         m.clear();
         m.resize(n * w, 0.0);
         let mut largest = 0.0f64;
         for (col, k, row) in self.upper_entries() {
+            let (i, c) = (band.at(row), band.at(col));
             let upper = self.unsymmetric_value(k, false, inverse_mass, now, first);
-            m[at(row, col)] = upper;
+            m[i * w + c + p - i] = upper;
             largest = largest.max(upper.abs());
             if row != col {
                 let lower = self.unsymmetric_value(k, true, inverse_mass, now, first);
-                m[at(col, row)] = lower;
+                m[c * w + i + p - c] = lower;
                 largest = largest.max(lower.abs());
             }
         }
         if !(largest.is_finite() && largest > 0.0) {
             return false;
         }
-        for j in 0..n {
-            let below = (j + p).min(n - 1);
-            let right = (j + 2 * p).min(n - 1);
-            let mut pivot = j;
-            for i in j + 1..=below {
-                if m[at(i, j)].abs() > m[at(pivot, j)].abs() {
-                    pivot = i;
-                }
-            }
-            if m[at(pivot, j)].abs() <= REDUNDANT_PIVOT * largest {
-                return false;
-            }
-            if pivot != j {
-                for c in j..=right {
-                    m.swap(at(j, c), at(pivot, c));
-                }
-                rhs.swap(j, pivot);
-            }
-            let d = m[at(j, j)];
-            for i in j + 1..=below {
-                let factor = m[at(i, j)] / d;
-                if factor == 0.0 {
-                    continue;
-                }
-                for c in j..=right {
-                    m[at(i, c)] -= factor * m[at(j, c)];
-                }
-                rhs[i] -= factor * rhs[j];
-            }
+        if band.position.is_none() {
+            return eliminate_band(p, largest, m, rhs);
         }
-        for i in (0..n).rev() {
-            let mut x = rhs[i];
-            for c in i + 1..=(i + 2 * p).min(n - 1) {
-                x -= m[at(i, c)] * rhs[c];
-            }
-            rhs[i] = x / m[at(i, i)];
-        }
-        rhs.iter().all(|x| x.is_finite())
+        band.gather(rhs, order);
+        let solved = eliminate_band(p, largest, m, order);
+        band.scatter(order, rhs);
+        solved
     }
 
-    /// `LDLᵀ` of the scaled `A` as a band matrix of half-width `p`: row
-    /// `i` at `a[i·(p+1)..]`, `D_ii` first, then `L_{i,i−1}` to
-    /// `L_{i,i−p}`. A pivot at or below [`REDUNDANT_PIVOT`] is replaced by
+    /// `LDLᵀ` of the scaled `A` as a band matrix of half-width `p`, its
+    /// rows in the band's order: row `i` at `a[i·(p+1)..]`, `D_ii` first,
+    /// then `L_{i,i−1}` to `L_{i,i−p}`. A pivot at or below [`REDUNDANT_PIVOT`] is replaced by
     /// [`DROPPED_PIVOT`], as the sparse factorization does. Returns how
     /// many were.
-    fn factor_band(&self, p: usize, values: &[f64], a: &mut Vec<f64>) -> usize {
-        let (n, w) = (self.n, p + 1);
+    fn factor_band(&self, band: &Band, values: &[f64], a: &mut Vec<f64>) -> usize {
+        let (n, p) = (self.n, band.width);
+        let w = p + 1;
         a.clear();
         a.resize(n * w, 0.0);
         for (col, k, row) in self.upper_entries() {
-            a[col * w + col - row] = values[k];
+            let (i, j) = (band.at(row), band.at(col));
+            let (low, high) = (i.min(j), i.max(j));
+            a[high * w + high - low] = values[k];
         }
         let mut dropped = 0;
         for j in 0..n {
@@ -465,23 +613,16 @@ impl NormalMatrix {
 
     /// [`NormalMatrix::solve`] with the band `LDLᵀ` of
     /// [`NormalMatrix::factor_band`].
-    fn solve_band(&self, p: usize, f: &Factored, rhs: &mut [f64]) {
-        let (n, w, a) = (self.n, p + 1, &f.l_values);
+    fn solve_band(&self, band: &Band, f: &mut Factored, rhs: &mut [f64]) {
         for (b, s) in rhs.iter_mut().zip(&f.scale) {
             *b *= s;
         }
-        for i in 0..n {
-            for k in i.saturating_sub(p)..i {
-                rhs[i] -= a[i * w + i - k] * rhs[k];
-            }
-        }
-        for i in 0..n {
-            rhs[i] /= a[i * w];
-        }
-        for i in (0..n).rev() {
-            for k in i + 1..(i + p + 1).min(n) {
-                rhs[i] -= a[k * w + k - i] * rhs[k];
-            }
+        if band.position.is_none() {
+            substitute_band(band.width, &f.l_values, rhs);
+        } else {
+            band.gather(rhs, &mut f.order);
+            substitute_band(band.width, &f.l_values, &mut f.order);
+            band.scatter(&f.order, rhs);
         }
         for (b, s) in rhs.iter_mut().zip(&f.scale) {
             *b *= s;
@@ -533,9 +674,9 @@ impl NormalMatrix {
         for (col, k, row) in self.upper_entries() {
             f.values[k] *= f.scale[row] * f.scale[col];
         }
-        if let (true, Some(p)) = (natural, self.band) {
+        if let (true, Some(band)) = (natural, &self.band) {
             f.layout = Layout::Band;
-            f.redundant = self.factor_band(p, &f.values, &mut f.l_values);
+            f.redundant = self.factor_band(band, &f.values, &mut f.l_values);
             return Ok(());
         }
         f.l_values.clear();
@@ -563,8 +704,8 @@ impl NormalMatrix {
 
     /// Solves `A λ = rhs` in place with the last factorization.
     pub(crate) fn solve(&self, f: &mut Factored, rhs: &mut [f64]) {
-        if let (Layout::Band, Some(p)) = (f.layout, self.band) {
-            return self.solve_band(p, f, rhs);
+        if let (Layout::Band, Some(band)) = (f.layout, &self.band) {
+            return self.solve_band(band, f, rhs);
         }
         let Some(symbolic) = &self.symbolic else {
             if let (Some(b), Some(&k)) = (rhs.first_mut(), self.diagonal.first()) {
@@ -616,7 +757,7 @@ mod tests {
     /// A pinned chain of `links` rods bent at the beads, and a second set
     /// of gradients turned a little from the first: rows 0 and 1 pin bead
     /// 0, row 2 + i joins beads i and i + 1.
-    fn chain(links: usize) -> (Vec<usize>, Vec<usize>, Vec<DVec2>, Vec<DVec2>, Vec<f64>) {
+    fn chain(links: usize) -> Rows {
         let mut row_start = vec![0, 1, 2];
         let mut entry_bead = vec![0, 0];
         let mut first = vec![DVec2::X, DVec2::Y];
@@ -633,24 +774,65 @@ mod tests {
         (row_start, entry_bead, first, now, inverse_mass)
     }
 
-    /// Solves `J W Jᵀ x = b` and `J_now W J_firstᵀ x = b` for a chain of
-    /// `links` rods in the rows' order (`natural`) and in faer's sparse
-    /// order, and checks the two agree to 1e-12; returns the layout of the
-    /// natural order's factorization.
-    fn natural_matches_sparse(links: usize) -> Layout {
-        let (row_start, entry_bead, first, now, inverse_mass) = chain(links);
-        let matrix = NormalMatrix::new(&row_start, &entry_bead, links + 1).unwrap();
-        let rows = row_start.len() - 1;
-        let rhs: Vec<f64> = (0..rows).map(|r| (r as f64 * 0.7).sin() - 0.2).collect();
-        let inactive = vec![false; rows];
+    /// Rows as [`chain`] gives them: row starts, each entry's bead, the
+    /// first and the current gradients, the inverse masses.
+    type Rows = (Vec<usize>, Vec<usize>, Vec<DVec2>, Vec<DVec2>, Vec<f64>);
+
+    /// A ring of `beads` rods, each bead joined to the next and the last to
+    /// the first, with gradients as [`chain`]'s.
+    fn ring(beads: usize) -> Rows {
+        let (mut row_start, mut entry_bead, mut first, mut now) = (vec![0], vec![], vec![], vec![]);
+        for i in 0..beads {
+            entry_bead.extend([i, (i + 1) % beads]);
+            let n = DVec2::from_angle(0.4 * i as f64);
+            let turned = DVec2::from_angle(0.4 * i as f64 + 0.05);
+            first.extend([-n, n]);
+            now.extend([-turned, turned]);
+            row_start.push(entry_bead.len());
+        }
+        let inverse_mass = (0..beads).map(|i| 1.0 / (1.0 + i as f64)).collect();
+        (row_start, entry_bead, first, now, inverse_mass)
+    }
+
+    /// The same rows listed in another order: row `r` becomes row
+    /// `(r · stride) mod n` (`stride` prime to the number of rows `n`).
+    fn shuffled((row_start, entry_bead, first, now, inverse_mass): Rows, stride: usize) -> Rows {
+        let n = row_start.len() - 1;
+        let mut from = vec![usize::MAX; n];
+        for r in 0..n {
+            from[(r * stride) % n] = r;
+        }
+        assert!(!from.contains(&usize::MAX), "{stride} is not prime to {n}");
+        let (mut starts, mut beads, mut firsts, mut nows) = (vec![0], vec![], vec![], vec![]);
+        for &r in &from {
+            let entries = row_start[r]..row_start[r + 1];
+            beads.extend_from_slice(&entry_bead[entries.clone()]);
+            firsts.extend_from_slice(&first[entries.clone()]);
+            nows.extend_from_slice(&now[entries]);
+            starts.push(beads.len());
+        }
+        (starts, beads, firsts, nows, inverse_mass)
+    }
+
+    /// Solves `J W Jᵀ x = b` and `J_now W J_firstᵀ x = b` for `rows` in
+    /// the rows' order or a band's (`natural`) and in faer's sparse order,
+    /// and checks the two agree to 1e-12; returns the layout of the
+    /// natural order's factorization and whether its band reorders the
+    /// rows.
+    fn natural_matches_sparse_for(rows: &Rows, what: &str) -> (Layout, bool) {
+        let (row_start, entry_bead, first, now, inverse_mass) = rows;
+        let matrix = NormalMatrix::new(row_start, entry_bead, inverse_mass.len()).unwrap();
+        let n = row_start.len() - 1;
+        let rhs: Vec<f64> = (0..n).map(|r| (r as f64 * 0.7).sin() - 0.2).collect();
+        let inactive = vec![false; n];
         let mut solved = [rhs.clone(), rhs.clone()];
         let mut layout = Layout::Sparse;
         for (natural, x) in [true, false].into_iter().zip(&mut solved) {
             let mut f = Factored::default();
             matrix
-                .factor(&inverse_mass, &first, &inactive, natural, &mut f)
+                .factor(inverse_mass, first, &inactive, natural, &mut f)
                 .unwrap();
-            assert_eq!(f.redundant, 0, "{links} links");
+            assert_eq!(f.redundant, 0, "{what}");
             if natural {
                 layout = f.layout;
             }
@@ -659,17 +841,23 @@ mod tests {
         let mut unsymmetric = [rhs.clone(), rhs.clone()];
         for (natural, x) in [true, false].into_iter().zip(&mut unsymmetric) {
             let mut lu = LuWork::default();
-            assert!(matrix.solve_unsymmetric(&inverse_mass, &now, &first, &mut lu, x, natural));
+            assert!(matrix.solve_unsymmetric(inverse_mass, now, first, &mut lu, x, natural));
         }
         for [a, b] in [solved, unsymmetric] {
             for (a, b) in a.iter().zip(&b) {
                 assert!(
                     (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
-                    "{links} links: {a} against {b}"
+                    "{what}: {a} against {b}"
                 );
             }
         }
-        layout
+        let reordered = matrix.band.as_ref().is_some_and(|b| b.position.is_some());
+        (layout, reordered)
+    }
+
+    /// [`natural_matches_sparse_for`] a chain of `links` rods in order.
+    fn natural_matches_sparse(links: usize) -> Layout {
+        natural_matches_sparse_for(&chain(links), &format!("{links} links")).0
     }
 
     #[test]
@@ -685,6 +873,31 @@ mod tests {
         for links in [7, 40, 500] {
             assert_eq!(natural_matches_sparse(links), Layout::Band);
         }
+    }
+
+    #[test]
+    fn a_chain_listed_out_of_order_and_a_ring_are_solved_as_bands_once_reordered() {
+        for links in [40, 500] {
+            // Out of order the rows' own band is wide; reordered it is 2.
+            let rows = shuffled(chain(links), 11);
+            let what = format!("{links} links out of order");
+            assert_eq!(
+                natural_matches_sparse_for(&rows, &what),
+                (Layout::Band, true)
+            );
+        }
+        for beads in [9, 40, 300] {
+            let what = format!("a ring of {beads} rods");
+            assert_eq!(
+                natural_matches_sparse_for(&ring(beads), &what),
+                (Layout::Band, true)
+            );
+        }
+        // A chain in order keeps its own order.
+        assert_eq!(
+            natural_matches_sparse_for(&chain(40), "40 links"),
+            (Layout::Band, false)
+        );
     }
 
     #[test]
@@ -705,7 +918,8 @@ mod tests {
         }
         let rows = row_start.len() - 1;
         let matrix = NormalMatrix::new(&row_start, &entry_bead, 21).unwrap();
-        assert_eq!(matrix.band, Some(2));
+        let band = matrix.band.as_ref().expect("a band");
+        assert_eq!((band.width, band.position.is_none()), (2, true));
         let inverse_mass = vec![1.0; 21];
         let mut f = Factored::default();
         matrix
