@@ -5,11 +5,12 @@
 //! `A` is symmetric positive semidefinite, with a nonzero `(r, s)` wherever
 //! rows `r` and `s` share a bead. It is scaled to a unit diagonal
 //! (`S A S`, `S = diag(1/√A_rr)`) and factored `LDLᵀ`. An island with no
-//! friction is factored in the order of its rows, as a band matrix, where
-//! that is cheap: where no two rows more than [`MAX_BAND`] apart share a
-//! bead (a rope or chain listed link by link, with its pin), and for up to
-//! eight rows whatever the band (a small dense matrix). The cost is linear
-//! in the rows, with no ordering, no indices and no fill outside the band.
+//! friction is factored as a band matrix where that is cheap: where no two
+//! rows more than [`MAX_BAND`] apart share a bead (a rope or chain listed
+//! link by link, with its pin), in the rows' own order or else in a reverse
+//! Cuthill–McKee order of them (a chain listed in any order, a ring of
+//! rods), and for up to eight rows whatever the band (a small dense
+//! matrix). The cost is linear in the rows, with no fill outside the band.
 //! (Which rows of a redundant set carry the load decides which bead static
 //! friction releases, so a rough island keeps the sparse order.) Otherwise
 //! it is factored by faer's sparse Cholesky under an
