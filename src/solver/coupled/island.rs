@@ -133,6 +133,9 @@ pub struct Island {
     sides: Vec<(f64, f64)>,
     /// Each wire row's friction, if it has any (see [`Island::set_rough`]).
     rough: Vec<Option<RoughRow>>,
+    /// How many rows have friction: with none, the matrices may be factored
+    /// in the rows' order, and a step looks at no friction.
+    rough_rows: usize,
 }
 
 /// Friction and damping along one wire row, and the row that holds its bead
@@ -342,6 +345,7 @@ impl Island {
             moving: 0,
             sides,
             rough,
+            rough_rows: 0,
         })
     }
 
@@ -426,18 +430,26 @@ impl Island {
         if let (Some(RowKind::Wire { .. }), Some(slot)) =
             (self.rows.get(row), self.rough.get_mut(row))
         {
-            *slot = Some(RoughRow {
+            let was = slot.replace(RoughRow {
                 friction,
                 damping: damping.max(0.0),
                 stick,
             });
+            if was.is_none() {
+                self.rough_rows += 1;
+            }
         }
     }
 
     /// Whether the island's matrices may be factored in the order of its
     /// rows (as a band): no friction (see the `normal` module).
     fn natural_order(&self) -> bool {
-        self.rough.iter().all(Option::is_none)
+        !self.is_rough()
+    }
+
+    /// Whether a row has friction.
+    fn is_rough(&self) -> bool {
+        self.rough_rows > 0
     }
 
     /// Whether a row is one-sided.
@@ -561,7 +573,7 @@ impl Island {
             }
         }
         let one_sided = self.one_sided();
-        let rough = self.rough.iter().any(Option::is_some);
+        let rough = self.is_rough();
         if one_sided || rough {
             self.leave(time, states, forces, work)?;
         }
@@ -953,7 +965,7 @@ impl Island {
             }
         }
         if settings.method.projects() {
-            let rough = self.rough.iter().any(Option::is_some);
+            let rough = self.is_rough();
             let restore = if self.moves() {
                 // A moving wire does work: there is no energy or speed to keep.
                 Restore::Nothing
