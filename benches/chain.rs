@@ -24,42 +24,18 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use wirebead::headless::Headless;
-use wirebead::solver::{
-    BeadState, Island, IslandRow, IslandWork, LinearForce, Method, RowKind, StepSettings,
-};
+use wirebead::solver::{BeadState, Island, IslandWork, LinearForce, Method, StepSettings};
 use wirebead::{Bead, OnWire, ParallelStep, Rod, SimParams, Wire, WireBeadPlugin};
 
-/// The link length.
-const LINK: f64 = 0.1;
+#[path = "support/rope.rs"]
+mod rope;
+
 /// What each iteration runs: the first quarter second after the release.
 const SECONDS: f64 = 0.25;
 const SIZES: [usize; 5] = [10, 100, 1_000, 10_000, 100_000];
 /// The step sizes: the game's 1/60 s, and one at which the rope's RATTLE
 /// steps need no substeps over that quarter second.
 const STEPS_PER_SECOND: [u32; 2] = [60, 960];
-
-/// The rope: its island, its beads at rest along +x, their weights.
-fn rope(n: usize) -> (Island, Vec<BeadState>, Vec<LinearForce>) {
-    let mut rows: Vec<IslandRow> = [DVec2::X, DVec2::Y]
-        .map(|axis| IslandRow {
-            kind: RowKind::Axis { axis, offset: 0.0 },
-            beads: vec![0],
-        })
-        .to_vec();
-    rows.extend((0..n).map(|i| IslandRow {
-        kind: RowKind::Rod { length: LINK },
-        beads: vec![i, i + 1],
-    }));
-    let island = Island::new(&vec![1.0; n + 1], rows, vec![]).expect("a valid rope");
-    let states = (0..=n)
-        .map(|i| BeadState {
-            position: DVec2::new(i as f64 * LINK, 0.0),
-            velocity: DVec2::ZERO,
-        })
-        .collect();
-    let forces = vec![LinearForce::constant(DVec2::new(0.0, -10.0)); n + 1];
-    (island, states, forces)
-}
 
 fn settings(per_second: u32) -> StepSettings {
     StepSettings {
@@ -111,24 +87,14 @@ fn run(
             .map_err(|e| format!("step {k}: {e}"))?;
         m.most = m.most.max(work.substeps());
         m.total += work.substeps();
-        for w in states.windows(2) {
-            let stretch = ((w[1].position - w[0].position).length() - LINK).abs() / LINK;
-            m.stretch = m.stretch.max(stretch);
-        }
+        m.stretch = m.stretch.max(rope::max_stretch(states));
         let far = states
             .iter()
             .map(|s| s.position.abs().max_element())
             .fold(0.0, f64::max);
-        m.floor = m.floor.max(f64::EPSILON * far / LINK);
+        m.floor = m.floor.max(f64::EPSILON * far / rope::LINK);
     }
     Ok(m)
-}
-
-fn energy(states: &[BeadState]) -> f64 {
-    states
-        .iter()
-        .map(|s| 0.5 * s.velocity.length_squared() + 10.0 * s.position.y)
-        .sum()
 }
 
 fn chain(c: &mut Criterion) {
@@ -144,7 +110,7 @@ fn chain(c: &mut Criterion) {
             group.sample_size(10);
             group.warm_up_time(Duration::from_millis(500));
             group.measurement_time(Duration::from_secs(if n >= 10_000 { 20 } else { 5 }));
-            let (island, start, forces) = rope(n);
+            let (island, start, forces) = (rope::island(n), rope::released(n), rope::weights(n));
             let name = format!("rattle-1/{per_second}");
             let id = format!("chain/{name}/{n}");
             // The accuracy and substeps, reported once, where the filter
@@ -161,7 +127,7 @@ fn chain(c: &mut Criterion) {
                             m.floor,
                             m.total,
                             m.most,
-                            energy(&states) - energy(&start)
+                            rope::energy(&states) - rope::energy(&start)
                         ),
                         Err(why) => eprintln!("{id}: {why}"),
                     }

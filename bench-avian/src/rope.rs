@@ -31,16 +31,15 @@ use bevy::app::App;
 use bevy::math::DVec2;
 use bevy::prelude::Entity;
 use clap::Args;
-use wirebead::solver::{
-    BeadState, Island, IslandRow, IslandWork, LinearForce, Method, RowKind, StepSettings,
-};
+use wirebead::solver::{BeadState, IslandWork, Method, StepSettings};
 
 use crate::avian_side;
 
-/// The link length, metres.
-const LINK: f64 = 0.1;
-/// Magnitude of gravity, m/s², pointing along -y.
-const GRAVITY: f64 = 10.0;
+// The rope `benches/chain.rs` steps, shared with it.
+#[path = "../../benches/support/rope.rs"]
+mod chain_rope;
+use chain_rope::{GRAVITY, LINK, energy, max_stretch, released};
+
 /// The timestep, seconds.
 const DT: f64 = 1.0 / 60.0;
 /// The substep count whose ratio to ours is always printed, if it was run.
@@ -84,58 +83,9 @@ impl RopeRun {
     }
 }
 
-/// The largest relative stretch of the rope's links; infinite if a
-/// position is not finite.
-fn max_stretch(states: &[BeadState]) -> f64 {
-    states.windows(2).fold(0.0, |worst: f64, w| {
-        let stretch = ((w[1].position - w[0].position).length() - LINK).abs() / LINK;
-        if stretch.is_finite() {
-            worst.max(stretch)
-        } else {
-            f64::INFINITY
-        }
-    })
-}
-
-/// The rope's total energy, J: beads of 1 kg, `|v|²/2 + |g| y` each.
-fn energy(states: &[BeadState]) -> f64 {
-    states
-        .iter()
-        .map(|s| 0.5 * s.velocity.length_squared() + GRAVITY * s.position.y)
-        .sum()
-}
-
-/// The rope at the release: N + 1 beads of 1 kg at rest at `(0.1 i, 0)`.
-fn released(n: usize) -> Vec<BeadState> {
-    (0..=n)
-        .map(|i| BeadState {
-            position: DVec2::new(i as f64 * LINK, 0.0),
-            velocity: DVec2::ZERO,
-        })
-        .collect()
-}
-
-/// Our rope as `benches/chain.rs` builds it: the island and the beads'
-/// weights.
-fn our_rope(n: usize) -> (Island, Vec<LinearForce>) {
-    let mut rows: Vec<IslandRow> = [DVec2::X, DVec2::Y]
-        .map(|axis| IslandRow {
-            kind: RowKind::Axis { axis, offset: 0.0 },
-            beads: vec![0],
-        })
-        .to_vec();
-    rows.extend((0..n).map(|i| IslandRow {
-        kind: RowKind::Rod { length: LINK },
-        beads: vec![i, i + 1],
-    }));
-    let island = Island::new(&vec![1.0; n + 1], rows, vec![]).expect("a valid rope");
-    let forces = vec![LinearForce::constant(DVec2::new(0.0, -GRAVITY)); n + 1];
-    (island, forces)
-}
-
 /// Our rope of `n` rods for `steps` steps of RATTLE at 1/60 s.
 fn run_ours(n: usize, steps: usize) -> RopeRun {
-    let (island, forces) = our_rope(n);
+    let (island, forces) = (chain_rope::island(n), chain_rope::weights(n));
     let settings = StepSettings {
         dt: DT,
         method: Method::Rattle,
