@@ -21,7 +21,6 @@ use crate::solver::{
     self, BeadState, Contact, Island, IslandRow, IslandWork, LinearForce, RowKind, SolveError,
     SpringLink, StepSettings,
 };
-use bevy::tasks::ComputeTaskPool;
 
 use super::parallel::ParallelStep;
 
@@ -472,10 +471,8 @@ pub(crate) fn step_islands(
         stepped_beads += cached.states.len();
     }
     let time = clock.time - settings.dt;
-    let pool = ComputeTaskPool::try_get().filter(|_| stepped_beads >= parallel.threshold);
-    let threads = pool.map_or(1, |pool| pool.thread_num().max(1));
-    match pool {
-        Some(pool) if threads > 1 => {
+    match parallel.pool(stepped_beads) {
+        Some((pool, threads)) => {
             // A few chunks per thread, so that one slow island (a rope
             // in substeps) does not leave the other threads idle.
             let size = islands.cached.len().div_ceil(4 * threads).max(1);
@@ -490,7 +487,7 @@ pub(crate) fn step_islands(
                 }
             });
         }
-        _ => {
+        None => {
             for cached in &mut islands.cached {
                 step_island(cached, time, &settings);
             }

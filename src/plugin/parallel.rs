@@ -1,6 +1,7 @@
 //! [`ParallelStep`]: when the step's per-bead loops split over threads.
 
 use bevy::prelude::*;
+use bevy::tasks::ComputeTaskPool;
 
 /// When the step's per-bead systems run in parallel: a system whose query
 /// has at least `threshold` beads splits them over the compute task pool
@@ -19,6 +20,16 @@ impl ParallelStep {
     pub const OFF: Self = Self {
         threshold: usize::MAX,
     };
+
+    /// The compute task pool and its thread count where a system with
+    /// `beads` beads splits them over threads: at or above the threshold,
+    /// with a pool of more than one thread. `None`: it loops in its own
+    /// thread.
+    pub(crate) fn pool(&self, beads: usize) -> Option<(&'static ComputeTaskPool, usize)> {
+        let pool = ComputeTaskPool::try_get().filter(|_| beads >= self.threshold)?;
+        let threads = pool.thread_num();
+        (threads > 1).then_some((pool, threads))
+    }
 }
 
 impl Default for ParallelStep {

@@ -10,7 +10,6 @@ use bevy::ecs::entity::EntityHashSet;
 use bevy::ecs::system::{SystemChangeTick, SystemParam};
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use bevy::tasks::ComputeTaskPool;
 
 use super::islands::InIsland;
 use super::parallel::ParallelStep;
@@ -664,15 +663,15 @@ pub(crate) fn step_beads(
         time: clock.time,
     };
     let count = beads.iter().size_hint().1.unwrap_or(usize::MAX);
-    let pool = ComputeTaskPool::try_get().filter(|_| count >= parallel.threshold);
-    let threads = pool.map_or(1, |pool| pool.thread_num().max(1));
+    let pool = parallel.pool(count);
+    let threads = pool.map_or(1, |(_, threads)| threads);
     let Ok(tables) = beads.contiguous_iter_mut() else {
         error!("wirebead: the bead query is not table-dense; no bead was stepped");
         return;
     };
     let split = |table| split_table(table, threads);
     match pool {
-        Some(pool) if threads > 1 => {
+        Some((pool, _)) => {
             pool.scope(|scope| {
                 for run in tables.flat_map(split) {
                     let ctx = &ctx;
@@ -680,7 +679,7 @@ pub(crate) fn step_beads(
                 }
             });
         }
-        _ => {
+        None => {
             for run in tables.flat_map(split) {
                 ctx.step_run(run);
             }
