@@ -33,18 +33,20 @@ use crate::preset::ScenePresetPlugin;
 pub struct Headless {
     plugin: WireBeadPlugin,
     single_threaded: bool,
-    all_cores: bool,
     parallel: Option<ParallelStep>,
     assets: Option<PathBuf>,
 }
 
 impl Headless {
-    /// An app with `plugin`, Bevy's default executors and task pools.
+    /// An app with `plugin`, Bevy's default executors, and a compute pool
+    /// with a thread for every core ([`compute_on_all_cores`]). Bevy's task
+    /// pools belong to the process and the first app made sets them up, so
+    /// every headless app asks for the same pools: whichever test of a
+    /// binary runs first, a step that splits over threads has every core.
     pub fn new(plugin: WireBeadPlugin) -> Self {
         Self {
             plugin,
             single_threaded: false,
-            all_cores: false,
             parallel: None,
             assets: None,
         }
@@ -55,15 +57,6 @@ impl Headless {
     pub fn single_threaded(self) -> Self {
         Self {
             single_threaded: true,
-            ..self
-        }
-    }
-
-    /// A compute pool with a thread for every core
-    /// ([`compute_on_all_cores`]).
-    pub fn on_all_cores(self) -> Self {
-        Self {
-            all_cores: true,
             ..self
         }
     }
@@ -91,11 +84,7 @@ impl Headless {
     pub fn build(self) -> App {
         let mut app = App::new();
         let minimal = MinimalPlugins.set(TaskPoolPlugin {
-            task_pool_options: if self.all_cores {
-                compute_on_all_cores()
-            } else {
-                TaskPoolOptions::default()
-            },
+            task_pool_options: compute_on_all_cores(),
         });
         app.add_plugins((minimal, self.plugin));
         if let Some(dir) = self.assets {

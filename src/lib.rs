@@ -44,6 +44,7 @@
 //! | [`BeadDiagnostics`], [`Diverged`], [`BeadDiverged`] | `C`, `Ċ`, λ and energy each step; divergence reports |
 //! | [`SimClock`], [`ParallelStep`] | steps and seconds since the last restart; when the step splits over threads |
 //! | [`ScenePresetPlugin`], [`ScenePreset`] | scenes as RON assets (`*.scene.ron`), hot-reloaded |
+//! | `debug_render::WireBeadDebugPlugin` | gizmo drawing of wires, beads, links and forces (feature `debug-render`) |
 //! | `gui::WireBeadGuiPlugin` | the windowed scene (feature `gui`): picking drag, egui panel, plots |
 //!
 //! ## The modules, bottom up
@@ -59,19 +60,25 @@
 //! | [`plugin`] | the sets, the systems, the plugin |
 //! | [`controls`], [`preset`] | keyboard controls; scene files |
 //! | [`headless`] | the one headless harness the tests, benches and tools build on |
+//! | `debug_render` | gizmo drawing of the simulation (feature `debug-render`) |
 //! | `gui` | the windowed scene |
 //!
 //! ## Feature flags
 //!
 //! | feature | default | what it adds |
 //! |---|---|---|
-//! | `gui` | yes | the windowed scene: rendering, picking, the egui panel and plots |
 //! | `parallel` | yes | Bevy's `multi_threaded`: the step splits over the compute pool |
+//! | `debug-render` | no | `debug_render::WireBeadDebugPlugin`: wires, beads, links and forces drawn with gizmos |
+//! | `gui` | no | the windowed scene the examples run: rendering, picking, the egui panel and plots |
 //!
-//! With `default-features = false` the crate needs only Bevy's headless core.
+//! The default build is headless: Bevy's core and nothing that opens a
+//! window; with `default-features = false` the step also runs on one
+//! thread.
 #![warn(missing_docs)]
 
 pub mod controls;
+#[cfg(feature = "debug-render")]
+pub mod debug_render;
 mod dynamics;
 pub mod geometry;
 #[cfg(feature = "gui")]

@@ -40,6 +40,7 @@ use crate::validate::{ParamError, finite, finite_vector, non_negative, positive}
 
 /// A bead of a scene file: its name (optional) and its parameters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct BeadPreset {
     /// The name links refer to it by; empty for none (it is then
@@ -78,6 +79,7 @@ impl BeadPreset {
 
 /// A rod of a scene file: `|x_a − x_b| = length`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RodPreset {
     /// The first bead's name.
     pub a: String,
@@ -89,6 +91,7 @@ pub struct RodPreset {
 
 /// A pin of a scene file: a bead held at a point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PinPreset {
     /// The bead's name.
     pub bead: String,
@@ -117,6 +120,7 @@ impl ConstraintPreset {
 
 /// A spring of a scene file (see [`Spring`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SpringPreset {
     /// The first bead's name.
     pub a: String,
@@ -133,6 +137,7 @@ pub struct SpringPreset {
 
 /// One wire of a preset and the beads on it.
 #[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct WirePreset {
     /// The shape, in the wire's frame.
     pub shape: WireShape,
@@ -182,6 +187,7 @@ impl WirePreset {
 
 /// A whole scene: parameters, wires and beads.
 #[derive(Asset, TypePath, Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ScenePreset {
     /// A human-readable name.
     pub name: String,
@@ -202,6 +208,31 @@ pub struct ScenePreset {
     pub springs: Vec<SpringPreset>,
 }
 
+impl PresetError {
+    /// A parse error at `path` (as `serde_path_to_error` writes it, the
+    /// field last): an unknown field names itself and its item.
+    fn at(path: String, error: ron::error::SpannedError) -> Self {
+        match &error.code {
+            ron::Error::NoSuchStructField {
+                expected, found, ..
+            } => {
+                let item = match path.rsplit_once('.') {
+                    Some((item, _)) => item.to_owned(),
+                    None => "the scene".to_owned(),
+                };
+                PresetError::UnknownField {
+                    field: found.clone(),
+                    item,
+                    line: error.span.start.line,
+                    column: error.span.start.col,
+                    known: expected.join(", "),
+                }
+            }
+            _ => PresetError::Parse(error),
+        }
+    }
+}
+
 /// What is wrong with a scene file.
 #[derive(Debug, thiserror::Error)]
 pub enum PresetError {
@@ -213,6 +244,23 @@ pub enum PresetError {
         .0.code
     )]
     Parse(#[from] ron::error::SpannedError),
+    /// A field the format does not have (a misspelt name, or one from a
+    /// later version): refused rather than ignored.
+    #[error(
+        "unknown field `{field}` in {item} at line {line}, column {column}; the file was refused (known fields: {known})"
+    )]
+    UnknownField {
+        /// The field as written.
+        field: String,
+        /// Where it is: `the scene`, `wires[2]`, `wires[0].beads[1]`.
+        item: String,
+        /// The line it is on.
+        line: usize,
+        /// Its column.
+        column: usize,
+        /// The fields that item has.
+        known: String,
+    },
     /// The file could not be read.
     #[error("cannot read scene file: {0}")]
     Io(#[from] std::io::Error),
@@ -264,7 +312,15 @@ pub enum PresetError {
 impl ScenePreset {
     /// Parses and validates a preset.
     pub fn from_ron(text: &str) -> Result<Self, PresetError> {
-        let preset: Self = ron::from_str(text)?;
+        let mut de = ron::Deserializer::from_str(text)?;
+        let preset: Self = match serde_path_to_error::deserialize(&mut de) {
+            Ok(preset) => preset,
+            Err(err) => {
+                let item = err.path().to_string();
+                return Err(PresetError::at(item, de.span_error(err.into_inner())));
+            }
+        };
+        de.end().map_err(|e| de.span_error(e))?;
         preset.validate()?;
         Ok(preset)
     }
@@ -707,7 +763,7 @@ mod tests {
         );
     }
 
-    /// The format the issue fixes, verbatim.
+    /// The format as the module doc gives it, with a spring and a pin.
     const CART: &str = r#"(
         name: "Pendulum on a cart",
         params: (integrator: Rattle),
@@ -716,6 +772,45 @@ mod tests {
         constraints: [Rod((a: "cart", b: "bob", length: 1.0)), Pin((bead: "bead2", at: (1.0, -1.0)))],
         springs: [(a: "bob", b: "bead2", rest_length: 1.0, stiffness: 50.0, damping: 0.1)],
     )"#;
+
+    #[test]
+    fn an_unknown_field_is_refused_in_one_line_naming_it_and_its_item() {
+        let refuse = |from: &str, to: &str| {
+            let text = GOOD.replace(from, to);
+            assert_ne!(text, GOOD, "{from} is not in the file");
+            ScenePreset::from_ron(&text).unwrap_err().to_string()
+        };
+        let err = refuse(
+            "angle_degrees: 30.0,",
+            "angle_degrees: 30.0, restitutoin: 0.5,",
+        );
+        assert!(
+            err.starts_with("unknown field `restitutoin` in wires[0] at line 5, column "),
+            "{err}"
+        );
+        assert!(err.contains("known fields: shape, position,"), "{err}");
+        assert!(!err.contains('\n'), "{err}");
+        let err = refuse("mass: 1.0", "mas: 1.0");
+        assert!(
+            err.starts_with("unknown field `mas` in wires[0].beads[0] at line 6"),
+            "{err}"
+        );
+        let err = refuse("alpha: 50.0", "alhpa: 50.0");
+        assert!(
+            err.starts_with("unknown field `alhpa` in params at line 3"),
+            "{err}"
+        );
+        let err = refuse("name: \"two\",", "name: \"two\", wire: [],");
+        assert!(
+            err.starts_with("unknown field `wire` in the scene at line 2"),
+            "{err}"
+        );
+        let err = refuse("radius: 2.0", "radius: 2.0, centre: (0.0, 0.0)");
+        assert!(
+            err.starts_with("unknown field `centre` in wires[0].shape"),
+            "{err}"
+        );
+    }
 
     #[test]
     fn a_coupled_scene_names_its_beads_and_links() {

@@ -88,7 +88,7 @@ pub fn plugin_app(n: usize, layout: Layout, threads: Threads, kind: Kind) -> App
         Kind::Full => WireBeadPlugin::default(),
         Kind::Lean => WireBeadPlugin::default().lean(),
     };
-    let harness = Headless::new(plugin).on_all_cores();
+    let harness = Headless::new(plugin);
     let mut app = match threads {
         Threads::Single => harness.single_threaded().parallel(ParallelStep::OFF),
         Threads::Parallel => harness,

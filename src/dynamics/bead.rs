@@ -12,6 +12,7 @@ use crate::validate::{ParamError, finite_vector, positive};
 /// The per-bead parameters of the assignment's panel: mass, initial position and
 /// initial velocity.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Reflect)]
+#[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct BeadParams {
     /// Mass in kg.

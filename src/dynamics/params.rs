@@ -94,6 +94,7 @@ impl SimParams {
 /// [`SimParams`] as a scene file writes it: the method as an integrator
 /// and an optional stabilization, every field optional.
 #[derive(Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 #[serde(default)]
 struct SimParamsFile {
     timestep: f64,

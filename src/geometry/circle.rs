@@ -9,6 +9,7 @@ use crate::lane::{Lane, Sym2, V2};
 /// A circle of radius `r` about the local origin: `C = |x| - r`, the assignment's
 /// wire. Singular at the centre.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Circle {
     /// The radius.
     pub radius: f64,

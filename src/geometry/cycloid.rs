@@ -24,6 +24,7 @@ pub struct Cycloid {
 
 /// What a scene file says of a cycloid.
 #[derive(Clone, Copy, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 struct CycloidSpec {
     radius: f64,
 }

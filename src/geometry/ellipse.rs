@@ -9,6 +9,7 @@ use super::ImplicitCurve;
 /// `C = (ℓ/2)(x²/a² + y²/b² - 1)` with `ℓ = sqrt(ab)`, so that a circle
 /// (`a = b`) has `|∇C| = 1` on the wire. Singular at the centre.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Ellipse {
     /// Semi-axis along local x.
     pub a: f64,

@@ -84,6 +84,7 @@ pub enum WireMotion {
 
 /// See [`WireMotion::Oscillate`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Oscillate {
     /// The displacement's amplitude (world units, both axes).
     pub amplitude: DVec2,
@@ -93,6 +94,7 @@ pub struct Oscillate {
 
 /// See [`WireMotion::Spin`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Spin {
     /// Radians per second, counter-clockwise positive.
     pub angular_velocity: f64,

@@ -8,6 +8,7 @@ use super::ImplicitCurve;
 /// The parabola `y = x² / (4f)` with focal length `f` (opening up for
 /// `f > 0`): `C = y - x²/(4f)`. Its scale is `f`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Parabola {
     /// The focal length: the vertex's radius of curvature is `2f`.
     pub focal_length: f64,

@@ -9,6 +9,7 @@ use super::ImplicitCurve;
 
 /// A sine track `y = A sin(2π x / λ)`: `C = y - A sin(kx)`, `k = 2π/λ`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Sine {
     /// The amplitude `A`.
     pub amplitude: f64,

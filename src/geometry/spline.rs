@@ -33,6 +33,7 @@ pub enum SplineKind {
 /// What a scene file says of a spline:
 /// `Spline((points: [(0.0, 1.0), …], kind: CatmullRom, closed: false))`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct SplineSpec {
     /// How the points make the curve.

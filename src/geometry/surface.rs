@@ -51,6 +51,7 @@ impl Side {
 /// `μk |λ∇C|` against its velocity along the wire; a bead at rest stays at
 /// rest while the force along the wire is at most `μs |λ∇C|`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Friction {
     /// μs.
     #[serde(rename = "static")]
@@ -98,6 +99,7 @@ impl Friction {
 
 /// Everything a wire does to its beads besides holding them on it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct Surface {
     /// Which way it pushes.

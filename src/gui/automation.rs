@@ -11,8 +11,9 @@ use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
 use serde::{Deserialize, Serialize};
 
+use crate::debug_render::{hatch_point, wire_points};
 use crate::geometry::Placed;
-use crate::gui::render::{FramedView, SceneCamera, hatch_length, hatch_point, wire_points};
+use crate::gui::render::{FramedView, SceneCamera, hatch_length};
 use crate::preset::ActivePreset;
 use crate::{Bead, Diverged, DragTarget, Pin, Rod, Wire, WireContact, pose_of};
 

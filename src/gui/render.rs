@@ -1,19 +1,17 @@
-//! Drawing the scene: a camera that frames the wires, wires as gizmo
-//! strokes, beads as meshes, fading trails, and force arrows. Simulation
-//! state is `f64`; it becomes `f32` here, at the edge.
+//! Drawing the scene: a camera that frames the wires, beads as meshes,
+//! fading trails; the wires, links and forces through the debug renderer
+//! in the scene's style. Simulation state is `f64`; it becomes `f32` here,
+//! at the edge.
 
 use std::collections::{HashMap, VecDeque};
-use std::f64::consts::TAU;
 
 use bevy::camera::ScalingMode;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::geometry::{ImplicitCurve, Placed, Pose, WireShape};
-use crate::{
-    Bead, BeadDiagnostics, DragTarget, OnWire, Pin, Restart, Rod, Spring, Wire, WireBeadSystems,
-    WireContact, pose_of,
-};
+use crate::debug_render::{DebugRenderStyle, DebugRenderSystems, WireBeadDebugPlugin, wire_points};
+use crate::geometry::{Pose, WireShape};
+use crate::{Bead, OnWire, Restart, Rod, Wire, WireBeadSystems, WireContact, pose_of};
 
 /// Colours and sizes of the scene.
 #[derive(Resource, Clone, Debug)]
@@ -105,6 +103,9 @@ pub struct SceneRenderPlugin;
 
 impl Plugin for SceneRenderPlugin {
     fn build(&self, app: &mut App) {
+        if !app.is_plugin_added::<WireBeadDebugPlugin>() {
+            app.add_plugins(WireBeadDebugPlugin);
+        }
         app.init_resource::<SceneStyle>()
             .init_resource::<FramedView>()
             .add_systems(Startup, (spawn_camera, style_gizmos))
@@ -116,14 +117,44 @@ impl Plugin for SceneRenderPlugin {
                     clear_trails_on_restart,
                     frame_camera,
                     size_and_colour_beads,
-                    draw_wires,
+                    style_debug_render,
                     draw_trails,
-                    draw_links,
-                    draw_forces,
                 )
-                    .chain(),
+                    .chain()
+                    .before(DebugRenderSystems),
             );
     }
+}
+
+/// The debug renderer draws the wires, links and forces: in the scene's
+/// colours, sized to the framed view, beads left to their meshes.
+fn style_debug_render(
+    view: Res<FramedView>,
+    style: Res<SceneStyle>,
+    mut debug: ResMut<DebugRenderStyle>,
+) {
+    let (center, size) = (view.center.as_dvec2(), view.size.as_dvec2());
+    *debug = DebugRenderStyle {
+        wire: style.wire,
+        hatch: style.hatch,
+        bead: style.bead,
+        diverged: style.diverged,
+        rod: style.rod,
+        pin: style.pin,
+        spring: style.spring,
+        constraint_force: style.constraint_force,
+        drag: style.drag,
+        beads: false,
+        bead_radius: style.bead_radius * view.size.y,
+        hatch_length: hatch_length(&view),
+        force_scale: style.force_scale * view.size.y,
+        bounds: (center - size, center + size),
+    };
+}
+
+/// The length of a hatch stroke in world units, for the framed view.
+pub fn hatch_length(view: &FramedView) -> f64 {
+    0.018 * f64::from(view.size.y)
 }
 
 fn spawn_camera(mut commands: Commands, style: Res<SceneStyle>) {
@@ -193,47 +224,6 @@ pub fn wire_bounds(shape: &WireShape, pose: &Pose) -> (DVec2, DVec2) {
         (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
         |(lo, hi), p| (lo.min(*p), hi.max(*p)),
     )
-}
-
-/// Points along a wire in world coordinates. Closed shapes are sampled whole;
-/// open ones over `half_span` on each side of their origin (default: a few
-/// wire scales).
-pub fn wire_points(shape: &WireShape, pose: &Pose, half_span: Option<f64>) -> Vec<DVec2> {
-    let n = 256;
-    let local: Vec<DVec2> = match shape {
-        WireShape::Circle(c) => (0..=n)
-            .map(|i| DVec2::from_angle(TAU * i as f64 / n as f64) * c.radius)
-            .collect(),
-        WireShape::Ellipse(e) => (0..=n)
-            .map(|i| {
-                let a = TAU * i as f64 / n as f64;
-                DVec2::new(e.a * a.cos(), e.b * a.sin())
-            })
-            .collect(),
-        WireShape::Cycloid(c) => c.polyline().collect(),
-        WireShape::Spline(s) => s.polyline().collect(),
-        open => {
-            let scale = open.curve().scale();
-            let span = half_span.unwrap_or(match open {
-                WireShape::Sine(s) => 1.5 * s.wavelength,
-                WireShape::Parabola(p) => 3.0 * p.focal_length.abs(),
-                _ => 2.0 * scale,
-            });
-            (0..=n)
-                .map(|i| {
-                    let x = -span + 2.0 * span * i as f64 / n as f64;
-                    match open {
-                        WireShape::Sine(s) => {
-                            DVec2::new(x, s.amplitude * (TAU * x / s.wavelength).sin())
-                        }
-                        WireShape::Parabola(p) => DVec2::new(x, x * x / (4.0 * p.focal_length)),
-                        _ => DVec2::new(x, 0.0),
-                    }
-                })
-                .collect()
-        }
-    };
-    local.into_iter().map(|p| pose.to_world(p)).collect()
 }
 
 fn wire_pose(transform: &Transform) -> Pose {
@@ -347,125 +337,6 @@ fn size_and_colour_beads(
     }
 }
 
-/// Draws every wire as a gizmo stroke.
-pub fn draw_wires(
-    wires: Query<(&Wire, &Transform)>,
-    view: Res<FramedView>,
-    style: Res<SceneStyle>,
-    mut gizmos: Gizmos,
-) {
-    for (wire, transform) in &wires {
-        let pose = wire_pose(transform);
-        match wire.shape() {
-            WireShape::Custom(curve) => {
-                // A game's own curve: traced where it crosses the view.
-                let center = view.center.as_dvec2();
-                let half = view.size.as_dvec2();
-                let placed = Placed {
-                    curve: curve.as_ref(),
-                    pose,
-                };
-                for (a, b) in implicit_segments(&placed, center - half, center + half, [192, 128]) {
-                    gizmos.line_2d(a.as_vec2(), b.as_vec2(), style.wire);
-                }
-            }
-            shape => {
-                // Open wires run past the edges of the view.
-                let span =
-                    (view.size.length() as f64) + (pose.origin - view.center.as_dvec2()).length();
-                let points = wire_points(shape, &pose, Some(span));
-                gizmos.linestrip_2d(points.iter().map(|p| p.as_vec2()), style.wire);
-                let side = wire.surface().side.sign();
-                if side != 0.0 {
-                    let placed = Placed {
-                        curve: shape.curve(),
-                        pose,
-                    };
-                    hatch(&mut gizmos, &placed, &points, side, &view, style.hatch);
-                }
-            }
-        }
-    }
-}
-
-/// Marks the closed side of a one-sided wire: short slanted strokes on the
-/// side it does not push toward (like the hatching of a wall in a
-/// drawing), so the open side is the clear one.
-fn hatch(
-    gizmos: &mut Gizmos,
-    curve: &dyn ImplicitCurve,
-    points: &[DVec2],
-    side: f64,
-    view: &FramedView,
-    colour: Color,
-) {
-    let length = hatch_length(view);
-    let mut travelled = 0.0;
-    for pair in points.windows(2) {
-        travelled += (pair[1] - pair[0]).length();
-        if travelled < 1.5 * length {
-            continue;
-        }
-        travelled = 0.0;
-        let p = pair[1];
-        let end = hatch_point(curve, p, side, length);
-        gizmos.line_2d(p.as_vec2(), end.as_vec2(), colour);
-    }
-}
-
-/// The length of a hatch stroke in world units, for the framed view.
-pub fn hatch_length(view: &FramedView) -> f64 {
-    0.018 * f64::from(view.size.y)
-}
-
-/// The far end of the hatch stroke from `p` on a wire that pushes toward
-/// `side` (a stroke of `length` toward the other side, slanted along the
-/// wire): a negative `side` gives the mirror stroke, on the open side.
-pub fn hatch_point(curve: &dyn ImplicitCurve, p: DVec2, side: f64, length: f64) -> DVec2 {
-    let normal = curve.gradient(p).normalize_or_zero();
-    let along = DVec2::new(-normal.y, normal.x);
-    p - side * length * normal + 0.5 * length * along
-}
-
-/// The zero set of `curve` inside the rectangle `lo..hi`, as line segments:
-/// marching squares on a grid of `cells` (x, y), the crossings on each cell
-/// edge placed by linear interpolation of `C`. Draws any [`ImplicitCurve`]
-/// without knowing its shape.
-pub fn implicit_segments(
-    curve: &dyn ImplicitCurve,
-    lo: DVec2,
-    hi: DVec2,
-    cells: [usize; 2],
-) -> Vec<(DVec2, DVec2)> {
-    let [nx, ny] = cells.map(|n| n.max(1));
-    let step = (hi - lo) / DVec2::new(nx as f64, ny as f64);
-    let node = |i: usize, j: usize| lo + step * DVec2::new(i as f64, j as f64);
-    let values: Vec<f64> = (0..=ny)
-        .flat_map(|j| (0..=nx).map(move |i| (i, j)))
-        .map(|(i, j)| curve.value(node(i, j)))
-        .collect();
-    let value = |i: usize, j: usize| values[j * (nx + 1) + i];
-    let crossing = |(pa, va): (DVec2, f64), (pb, vb): (DVec2, f64)| {
-        let differ = (va < 0.0) != (vb < 0.0);
-        (differ && va.is_finite() && vb.is_finite()).then(|| pa + (pb - pa) * (va / (va - vb)))
-    };
-    let mut segments = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
-                .map(|(a, b)| (node(a, b), value(a, b)));
-            let points: Vec<DVec2> = (0..4)
-                .filter_map(|k| crossing(corners[k], corners[(k + 1) % 4]))
-                .collect();
-            // Two crossings make one segment; a saddle's four make two.
-            for pair in points.chunks_exact(2) {
-                segments.push((pair[0], pair[1]));
-            }
-        }
-    }
-    segments
-}
-
 /// Draws each trail fading with age, in the flight colour where the bead
 /// was off its wire.
 fn draw_trails(beads: Query<&Trail>, style: Res<SceneStyle>, mut gizmos: Gizmos) {
@@ -475,94 +346,6 @@ fn draw_trails(beads: Query<&Trail>, style: Res<SceneStyle>, mut gizmos: Gizmos)
             let colour = if *flying { style.flight } else { style.trail };
             (*p, colour.with_alpha((i as f32 + 1.0) / n))
         }));
-    }
-}
-
-/// Draws rods as lines between their beads, pins as small squares at
-/// their points and springs as zigzags.
-pub fn draw_links(
-    beads: Query<&Bead>,
-    rods: Query<&Rod>,
-    pins: Query<&Pin>,
-    transforms: Query<&Transform>,
-    springs: Query<&Spring>,
-    view: Res<FramedView>,
-    style: Res<SceneStyle>,
-    mut gizmos: Gizmos,
-) {
-    let at = |e: Entity| beads.get(e).ok().map(|b| b.position.as_vec2());
-    for rod in &rods {
-        if let (Some(a), Some(b)) = (at(rod.beads()[0]), at(rod.beads()[1])) {
-            gizmos.line_2d(a, b, style.rod);
-        }
-    }
-    let side = 1.2 * style.bead_radius * view.size.y;
-    for at in pins.iter().filter_map(|pin| pin.locate(&transforms)) {
-        gizmos.rect_2d(
-            Isometry2d::from_translation(at.as_vec2()),
-            Vec2::splat(side),
-            style.pin,
-        );
-    }
-    let width = 0.6 * style.bead_radius * view.size.y;
-    for spring in &springs {
-        if let (Some(a), Some(b)) = (at(spring.beads()[0]), at(spring.beads()[1])) {
-            gizmos.linestrip_2d(zigzag(a, b, 12, width), style.spring);
-        }
-    }
-}
-
-/// A zigzag of `turns` teeth of half-width `width` from `a` to `b`, with a
-/// straight lead at each end.
-pub fn zigzag(a: Vec2, b: Vec2, turns: usize, width: f32) -> Vec<Vec2> {
-    let d = b - a;
-    let normal = d.perp().normalize_or_zero() * width;
-    let (start, end) = (a + 0.1 * d, a + 0.9 * d);
-    let mut points = vec![a, start];
-    for i in 0..turns {
-        let t = (i as f32 + 0.5) / turns as f32;
-        let side = if i % 2 == 0 { 1.0 } else { -1.0 };
-        points.push(start.lerp(end, t) + side * normal);
-    }
-    points.extend([end, b]);
-    points
-}
-
-/// Draws the constraint force on each bead on a wire (on a bead hanging
-/// from rods it lies along them and would hide them; the panel lists every
-/// rod's λ), and the drag spring.
-fn draw_forces(
-    beads: Query<(
-        &Bead,
-        Option<&BeadDiagnostics>,
-        Option<&DragTarget>,
-        Has<OnWire>,
-    )>,
-    params: Res<crate::SimParams>,
-    view: Res<FramedView>,
-    style: Res<SceneStyle>,
-    mut gizmos: Gizmos,
-) {
-    let g = params.gravity.length().max(1e-3) as f32;
-    for (bead, diagnostics, drag, on_wire) in &beads {
-        // Forces are drawn in units of the bead's weight.
-        let per_newton = style.force_scale * view.size.y / (bead.mass() as f32 * g);
-        let at = bead.position.as_vec2();
-        let force = diagnostics
-            .filter(|_| on_wire)
-            .map_or(Vec2::ZERO, |d| d.constraint_force.as_vec2())
-            * per_newton;
-        if force.length() > 1e-4 * view.size.y {
-            gizmos.arrow_2d(at, at + force, style.constraint_force);
-        }
-        if let Some(target) = drag {
-            gizmos.line_2d(at, target.get().as_vec2(), style.drag);
-            gizmos.circle_2d(
-                Isometry2d::from_translation(target.get().as_vec2()),
-                0.5 * style.bead_radius * view.size.y,
-                style.drag,
-            );
-        }
     }
 }
 
@@ -576,43 +359,4 @@ pub fn screen_to_world(
         .viewport_to_world_2d(camera_transform, screen)
         .ok()
         .map(|p| p.as_dvec2())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::geometry::Circle;
-
-    /// Marching squares on a moved circle: every segment end lies on the
-    /// circle to within the interpolation error, and the segments add up to
-    /// its circumference.
-    #[test]
-    fn implicit_segments_trace_a_circle() {
-        let circle = Circle { radius: 1.5 };
-        let pose = Pose::new(DVec2::new(2.0, -1.0), 0.3);
-        let placed = Placed {
-            curve: &circle,
-            pose,
-        };
-        let segments = implicit_segments(
-            &placed,
-            DVec2::new(-1.0, -4.0),
-            DVec2::new(5.0, 2.0),
-            [120, 120],
-        );
-        assert!(segments.len() > 100, "{} segments", segments.len());
-        let cell = 6.0 / 120.0;
-        for (a, b) in &segments {
-            for p in [a, b] {
-                let off = ((*p - pose.origin).length() - 1.5).abs();
-                assert!(off < 0.05 * cell, "a point {off:.2e} off the circle");
-            }
-        }
-        let length: f64 = segments.iter().map(|(a, b)| (*b - *a).length()).sum();
-        let circumference = TAU * 1.5;
-        assert!(
-            (length - circumference).abs() < 1e-3 * circumference,
-            "traced length {length} against {circumference}"
-        );
-    }
 }

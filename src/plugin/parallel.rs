@@ -32,6 +32,24 @@ impl ParallelStep {
     }
 }
 
+/// How the last step split its work: for the lone beads and for the
+/// islands, the compute pool's threads it split over (0 when it looped in
+/// its own thread) and the runs or chunks it made. For tuning
+/// [`ParallelStep::threshold`], and the proof in the tests that a step was
+/// split.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
+#[reflect(Resource)]
+pub struct StepSplit {
+    /// Threads the last bead step split over (0: none).
+    pub bead_threads: usize,
+    /// Runs of lone beads the last bead step made.
+    pub bead_runs: usize,
+    /// Threads the last island step split over (0: none).
+    pub island_threads: usize,
+    /// Chunks of islands the last island step made.
+    pub island_chunks: usize,
+}
+
 impl Default for ParallelStep {
     /// Parallel from 4,096 beads up.
     fn default() -> Self {

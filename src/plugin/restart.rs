@@ -1,11 +1,12 @@
-//! [`Restart`] and the [`SimClock`] it resets: applying the pending edits,
-//! as the assignment's space bar did.
+//! [`RestartPlugin`]: [`Restart`] applies the pending edits and returns
+//! every bead to its initial state, as the assignment's space bar did.
 
 use bevy::prelude::*;
 
+use super::clock::SimClock;
 use super::islands::Islands;
-
-use super::step::{prescribed, set_pose};
+use super::schedule::WireBeadSystems;
+use super::wires::{prescribed, set_pose};
 use crate::dynamics::{
     Bead, BeadDiagnostics, Diverged, OnWire, PendingBead, PendingParams, PendingWire,
     PrescribedMotion, SimParams, Wire, WireContact, WirePose,
@@ -22,16 +23,15 @@ use crate::solver::constraint_state_on;
 #[derive(Message, Clone, Copy, Debug, Default)]
 pub struct Restart;
 
-/// Simulated time since the last [`Restart`]: steps taken and seconds.
-/// Advanced in [`WireBeadSystems::Prepare`](crate::WireBeadSystems::Prepare),
-/// so during a step it already reads the time the step reaches.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Reflect)]
-#[reflect(Resource)]
-pub struct SimClock {
-    /// Steps since the last restart.
-    pub steps: u64,
-    /// Seconds since the last restart.
-    pub time: f64,
+/// Handles [`Restart`] in [`WireBeadSystems::Restart`].
+#[derive(Default)]
+pub struct RestartPlugin;
+
+impl Plugin for RestartPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_message::<Restart>()
+            .add_systems(PreUpdate, apply_restart.in_set(WireBeadSystems::Restart));
+    }
 }
 
 /// The diagnostics of a bead's current state on `curve`, before any step.
@@ -47,14 +47,9 @@ fn diagnose<T: Track>(track: &T, bead: &Bead, gravity: bevy::math::DVec2) -> Bea
     }
 }
 
-/// Sets `Time<Fixed>` to the applied timestep at startup.
-pub(crate) fn apply_timestep(params: Res<SimParams>, mut time: ResMut<Time<Fixed>>) {
-    time.set_timestep_seconds(params.timestep);
-}
-
 /// Handles [`Restart`]: applies the pending wire shapes and parameters and
 /// returns every bead to its initial state.
-pub(crate) fn apply_restart(
+fn apply_restart(
     mut restarts: MessageReader<Restart>,
     pending: Res<PendingParams>,
     mut params: ResMut<SimParams>,

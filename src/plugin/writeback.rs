@@ -1,12 +1,27 @@
-//! [`WireBeadSystems::Writeback`](crate::WireBeadSystems::Writeback): `f64`
-//! positions into `Transform`s, converted at this edge.
+//! [`WritebackPlugin`]: `f64` positions into `Transform`s, converted at
+//! this edge, in [`WireBeadSystems::Writeback`].
 
 use bevy::ecs::change_detection::Tick;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::parallel::ParallelStep;
+use super::schedule::WireBeadSystems;
 use crate::dynamics::Bead;
+
+/// Keeps each bead's `Transform` at its position where the step did not
+/// write it itself (a restart, a game's own edit).
+#[derive(Default)]
+pub struct WritebackPlugin;
+
+impl Plugin for WritebackPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<LastStep>().add_systems(
+            FixedUpdate,
+            write_transforms.in_set(WireBeadSystems::Writeback),
+        );
+    }
+}
 
 /// The change tick of the last run of the step: it wrote the `Transform`
 /// of every bead it changed then.
@@ -17,7 +32,7 @@ pub(crate) struct LastStep(pub(crate) Tick);
 /// where the bead changed other than by the last step (a restart, a
 /// game's own edit); the step writes the ones it steps. A non-finite
 /// position is never written.
-pub(crate) fn write_transforms(
+fn write_transforms(
     parallel: Res<ParallelStep>,
     stepped: Res<LastStep>,
     mut beads: Query<(Ref<Bead>, &mut Transform), Changed<Bead>>,

@@ -1,8 +1,12 @@
-//! Every shipped preset file, mutated 10,000 times (truncated, a byte
-//! flipped, a number replaced by 0, a negative, NaN or a huge value, two
-//! names swapped): never a panic; each mutant either is refused with a
-//! one-line message, or loads and steps with no NaN in a `Transform`
-//! (a bead whose state blows up is marked diverged, not hidden).
+//! Every shipped preset file, mutated (truncated, a byte flipped, a number
+//! replaced by 0, a negative, NaN or a huge value, two names swapped):
+//! never a panic; each mutant either is refused with a one-line message,
+//! or loads and steps with no NaN in a `Transform` (a bead whose state
+//! blows up is marked diverged, not hidden).
+//!
+//! A debug `cargo test` tries [`DEBUG_CASES`] mutants of each file; a
+//! release build (`cargo test --release --test it fuzz`, as CI runs it)
+//! the full [`RELEASE_CASES`], 140,000 over the 14 shipped files.
 
 use bevy::prelude::*;
 use proptest::prelude::*;
@@ -161,8 +165,18 @@ fn load_and_step(app: &mut App, text: &str) -> Result<(), TestCaseError> {
     Ok(())
 }
 
+/// Mutants of each file in a debug build: a few hundred in all.
+const DEBUG_CASES: u32 = 25;
+/// Mutants of each file in a release build.
+const RELEASE_CASES: u32 = 10_000;
+
 #[test]
 fn mutated_presets_never_panic_and_never_leave_a_nan() {
+    let cases = if cfg!(debug_assertions) {
+        DEBUG_CASES
+    } else {
+        RELEASE_CASES
+    };
     for name in SHIPPED {
         let text = std::fs::read_to_string(shipped_dir().join(name)).unwrap();
         let app = RefCell::new(
@@ -170,10 +184,11 @@ fn mutated_presets_never_panic_and_never_leave_a_nan() {
                 .single_threaded()
                 .build(),
         );
-        // A fixed seed: the same 10,000 mutants on every run.
+        // A fixed seed: the same mutants on every run (the debug ones are
+        // the first of the release ones).
         let mut runner = TestRunner::new_with_rng(
             Config {
-                cases: 10_000,
+                cases,
                 failure_persistence: None,
                 ..Config::default()
             },

@@ -6,6 +6,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::geometry::{Line, Pose, WireShape};
 use wirebead::headless::Headless;
+use wirebead::plugin::StepSplit;
 use wirebead::prelude::*;
 use wirebead::solver::{BeadState, Island, IslandRow, IslandWork, LinearForce, RowKind};
 
@@ -199,7 +200,6 @@ fn one_or_all_cores(plugin: WireBeadPlugin, parallel: bool) -> App {
     let headless = Headless::new(plugin);
     if parallel {
         headless
-            .on_all_cores()
             .parallel(ParallelStep { threshold: 1 })
             .build()
     } else {
@@ -264,6 +264,21 @@ fn many_islands_split_over_threads_step_as_on_one() {
         run_steps(&mut app, 120);
         let islands = app.world().resource::<Islands>().iter().count();
         assert_eq!(islands, 64, "{islands} islands");
+        // The parallel run split the islands over more than one thread,
+        // in more than one chunk; the sequential one did not.
+        let split = *app.world().resource::<StepSplit>();
+        if !parallel {
+            assert_eq!(
+                (split.island_threads, split.island_chunks),
+                (0, 1),
+                "{split:?}"
+            );
+        } else if bevy::tasks::available_parallelism() > 1 {
+            assert!(
+                split.island_threads > 1 && split.island_chunks > 1,
+                "{split:?}"
+            );
+        }
         carts
             .iter()
             .map(|&(cart, bob, y)| {

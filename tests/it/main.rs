@@ -7,6 +7,8 @@ mod bad_input;
 mod baumgarte;
 mod common;
 mod controls;
+#[cfg(feature = "debug-render")]
+mod debug_render;
 mod fuzz;
 mod islands;
 mod layers;

@@ -4,6 +4,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::headless::{Headless, run_steps};
+use wirebead::plugin::StepSplit;
 use wirebead::prelude::*;
 
 const BEADS_PER_WIRE: usize = 1500;
@@ -13,7 +14,6 @@ const BEADS_PER_WIRE: usize = 1500;
 /// (a singular point). Returns the app and the beads in spawn order.
 fn scene(parallel: ParallelStep, plugin: WireBeadPlugin) -> (App, Vec<Entity>) {
     let mut app = Headless::new(plugin)
-        .on_all_cores()
         .parallel(parallel)
         .build();
     let wires = [
@@ -138,6 +138,15 @@ fn parallel_step_matches_sequential_bit_for_bit() {
     }
     for app in [&sequential, &parallel] {
         assert_eq!(app.world().resource::<SimClock>().steps, u64::from(STEPS));
+    }
+    // The parallel run was split: a pool of more than one thread, and
+    // more than one run of beads handed to it; the sequential one was not.
+    let split = |app: &App| *app.world().resource::<StepSplit>();
+    assert_eq!(split(&sequential).bead_threads, 0);
+    assert_eq!(split(&sequential).bead_runs, 1);
+    if bevy::tasks::available_parallelism() > 1 {
+        assert!(split(&parallel).bead_threads > 1, "{:?}", split(&parallel));
+        assert!(split(&parallel).bead_runs > 1, "{:?}", split(&parallel));
     }
 }
 

@@ -1,5 +1,5 @@
 //! A bead on a vertical circle is a pendulum: its period and its energy are
-//! known exactly (`../shared/PHYSICS.md`, "Reference truth").
+//! known exactly (`wirebead::reference`: the elliptic-integral period and the conserved energy).
 
 use crate::common::*;
 use wirebead::prelude::*;

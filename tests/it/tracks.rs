@@ -1,5 +1,5 @@
 //! Tracks that move: prescribed motions and wires a game moves, through
-//! the plugin (`../shared` PHYSICS, moving wires; the Kapitza pendulum).
+//! the plugin (docs/method.md, "Moving wires"; the Kapitza pendulum).
 
 use std::f64::consts::TAU;
 

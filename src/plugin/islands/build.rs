@@ -1,0 +1,306 @@
+//! Rebuilding the [`Islands`] after the topology changed: which beads the
+//! links join, each island's rows, and the [`InIsland`] markers.
+
+use std::collections::HashMap;
+
+use bevy::ecs::system::SystemParam;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use super::{CachedIsland, InIsland, IslandReport, Islands, LinkRows};
+use crate::dynamics::{Bead, DivergenceReason, Joint, OnWire, Pin, Rod, Spring, Wire, WirePose};
+use crate::plugin::clock::SimClock;
+use crate::plugin::report::Divergences;
+use crate::solver::{self, Island, IslandRow, IslandWork, RowKind, SpringLink};
+
+/// Every link in the world, as the rebuild reads them.
+#[derive(SystemParam)]
+pub(super) struct Links<'w, 's> {
+    rods: Query<'w, 's, (Entity, &'static Rod)>,
+    pins: Query<'w, 's, (Entity, &'static Pin)>,
+    joints: Query<'w, 's, (Entity, &'static Joint)>,
+    springs: Query<'w, 's, (Entity, &'static Spring)>,
+}
+
+/// A link while the islands are built: its rows and the beads it names.
+struct Pending {
+    entity: Entity,
+    rows: Vec<IslandRow>,
+    pin: bool,
+    anchored: bool,
+}
+
+/// The two rows that hold a bead at `at`.
+fn pin_rows(at: DVec2) -> Vec<IslandRow> {
+    [DVec2::X, DVec2::Y]
+        .map(|axis| IslandRow {
+            kind: RowKind::Axis {
+                axis,
+                offset: axis.dot(at),
+            },
+            beads: vec![0],
+        })
+        .to_vec()
+}
+
+/// Rebuilds [`Islands`] after the topology changed, and keeps the
+/// [`InIsland`] marker on exactly the beads in one.
+pub(super) fn prepare_islands(
+    mut islands: ResMut<Islands>,
+    links: Links,
+    beads: Query<(Entity, &Bead, Option<&OnWire>, Has<InIsland>)>,
+    wires: Query<(&Wire, &WirePose)>,
+    transforms: Query<&Transform>,
+    mut commands: Commands,
+    mut divergences: Divergences,
+    clock: Res<SimClock>,
+) {
+    islands.dirty = false;
+    islands.cached.clear();
+    let is_bead = |e: Entity| beads.contains(e);
+    let missing = |what: &str, link: Entity, bead: Entity| {
+        warn!("wirebead: {what} {link} names {bead}, which is not a bead; the {what} is left out");
+    };
+    // Every link with the beads it names (as entities, for now).
+    let mut named: Vec<(Pending, Vec<Entity>)> = Vec::new();
+    let mut springs: Vec<(Entity, Spring)> = Vec::new();
+    for (entity, rod) in &links.rods {
+        let beads = rod.beads();
+        match beads.iter().find(|b| !is_bead(**b)) {
+            Some(&b) => missing("rod", entity, b),
+            None => named.push((
+                Pending {
+                    entity,
+                    rows: vec![IslandRow {
+                        kind: RowKind::Rod {
+                            length: rod.length(),
+                        },
+                        beads: vec![0, 1],
+                    }],
+                    pin: false,
+                    anchored: false,
+                },
+                beads.to_vec(),
+            )),
+        }
+    }
+    for (entity, pin) in &links.pins {
+        if !is_bead(pin.bead()) {
+            missing("pin", entity, pin.bead());
+            continue;
+        }
+        let Some(at) = pin.locate(&transforms) else {
+            warn!(
+                "wirebead: pin {entity} is fixed to {}, which has no finite Transform; the pin is left out",
+                pin.anchor().unwrap_or(Entity::PLACEHOLDER)
+            );
+            continue;
+        };
+        named.push((
+            Pending {
+                entity,
+                rows: pin_rows(at),
+                pin: true,
+                anchored: pin.anchor().is_some(),
+            },
+            vec![pin.bead()],
+        ));
+    }
+    for (entity, joint) in &links.joints {
+        match joint.beads().iter().find(|b| !is_bead(**b)) {
+            Some(&b) => missing("joint", entity, b),
+            None => named.push((
+                Pending {
+                    entity,
+                    rows: vec![IslandRow {
+                        kind: RowKind::Custom(joint.constraint().clone()),
+                        beads: (0..joint.beads().len()).collect(),
+                    }],
+                    pin: false,
+                    anchored: false,
+                },
+                joint.beads().to_vec(),
+            )),
+        }
+    }
+    for (entity, spring) in &links.springs {
+        match spring.beads().iter().find(|b| !is_bead(**b)) {
+            Some(&b) => missing("spring", entity, b),
+            None => springs.push((entity, *spring)),
+        }
+    }
+    // The beads in islands: every bead a link names, and every bead on no
+    // wire.
+    let mut index: HashMap<Entity, usize> = HashMap::new();
+    let mut members: Vec<Entity> = Vec::new();
+    let mut join = |bead: Entity, members: &mut Vec<Entity>| {
+        *index.entry(bead).or_insert_with(|| {
+            members.push(bead);
+            members.len() - 1
+        })
+    };
+    for (_, beads_named) in &named {
+        for &b in beads_named {
+            join(b, &mut members);
+        }
+    }
+    for (_, spring) in &springs {
+        for b in spring.beads() {
+            join(b, &mut members);
+        }
+    }
+    for (entity, _, on_wire, _) in &beads {
+        if on_wire.is_none() {
+            join(entity, &mut members);
+        }
+    }
+    let named_count = named.len();
+    let link_beads: Vec<Vec<usize>> = named
+        .iter()
+        .map(|(_, b)| b.iter().map(|e| index[e]).collect())
+        .chain(
+            springs
+                .iter()
+                .map(|(_, s)| s.beads().iter().map(|e| index[e]).collect()),
+        )
+        .collect();
+    let groups = solver::islands(members.len(), link_beads.iter().map(Vec::as_slice));
+    let mut group_of = vec![(0, 0); members.len()];
+    for (g, group) in groups.iter().enumerate() {
+        for (local, &m) in group.iter().enumerate() {
+            group_of[m] = (g, local);
+        }
+    }
+    // Sort the links into their groups, with bead indices local to them.
+    let mut group_links: Vec<Vec<(Pending, Vec<usize>)>> =
+        (0..groups.len()).map(|_| Vec::new()).collect();
+    let mut group_springs: Vec<Vec<SpringLink>> = vec![Vec::new(); groups.len()];
+    for ((pending, _), local) in named.into_iter().zip(&link_beads) {
+        let g = group_of[local[0]].0;
+        let local = local.iter().map(|&m| group_of[m].1).collect();
+        group_links[g].push((pending, local));
+    }
+    for ((_, spring), local) in springs.iter().zip(&link_beads[named_count..]) {
+        let (rest_length, stiffness, damping) = spring.law();
+        let g = group_of[local[0]].0;
+        group_springs[g].push(SpringLink {
+            a: group_of[local[0]].1,
+            b: group_of[local[1]].1,
+            rest_length,
+            stiffness,
+            damping,
+        });
+    }
+    for ((group, links), springs) in groups.iter().zip(group_links).zip(group_springs) {
+        let entities: Vec<Entity> = group.iter().map(|&m| members[m]).collect();
+        let mut masses = Vec::with_capacity(group.len());
+        let mut rows = Vec::new();
+        let mut wire_rows = Vec::new();
+        let mut invalid = None;
+        let mut sides = Vec::new();
+        for (local, &entity) in entities.iter().enumerate() {
+            let Ok((_, bead, on_wire, _)) = beads.get(entity) else {
+                invalid = Some(format!("entity {entity} is no longer a bead"));
+                break;
+            };
+            masses.push(bead.mass());
+            let Some(on_wire) = on_wire else { continue };
+            match wires.get(on_wire.0).map(|(w, p)| (w, p.get())) {
+                Ok((wire, Ok(pose))) => {
+                    sides.push((rows.len(), local, *wire.surface()));
+                    wire_rows.push((local, rows.len(), on_wire.0));
+                    rows.push(IslandRow {
+                        kind: RowKind::Wire {
+                            shape: wire.shape().clone(),
+                            pose: pose.pose(clock.time),
+                        },
+                        beads: vec![local],
+                    });
+                }
+                Ok((_, Err(e))) => invalid = Some(e.to_string()),
+                Err(_) => invalid = Some(format!("entity {} has no Wire", on_wire.0)),
+            }
+        }
+        let mut link_rows = Vec::new();
+        let mut anchored = Vec::new();
+        for (pending, local) in links {
+            let start = rows.len();
+            if pending.anchored {
+                anchored.push((start, pending.entity));
+            }
+            link_rows.push(if pending.pin {
+                LinkRows::Pin(pending.entity, start)
+            } else {
+                LinkRows::One(pending.entity, start)
+            });
+            for mut row in pending.rows {
+                row.beads = row.beads.iter().map(|&i| local[i]).collect();
+                rows.push(row);
+            }
+        }
+        // A rough wire's bead gets a row to hold it still while static
+        // friction can (set aside while it slides).
+        let mut sticks = Vec::new();
+        for &(row, local, surface) in &sides {
+            if surface.friction.is_some() {
+                sticks.push((row, rows.len()));
+                rows.push(IslandRow {
+                    kind: RowKind::Axis {
+                        axis: DVec2::X,
+                        offset: 0.0,
+                    },
+                    beads: vec![local],
+                });
+            }
+        }
+        let row_count = rows.len();
+        let built = match invalid {
+            Some(why) => Err(DivergenceReason::InvalidWire(why)),
+            None => Island::new(&masses, rows, springs)
+                .map_err(|e| DivergenceReason::InvalidConstraint(e.to_string())),
+        };
+        let built = built.map(|mut island| {
+            for (row, _, surface) in sides {
+                island.set_side(row, surface.side, surface.restitution);
+                if surface.resists() {
+                    let stick = sticks.iter().find(|s| s.0 == row).map(|s| s.1);
+                    island.set_rough(row, surface.friction, surface.damping, stick);
+                }
+            }
+            island
+        });
+        match built {
+            Ok(island) => islands.cached.push(CachedIsland {
+                report: IslandReport {
+                    beads: entities,
+                    rows: row_count,
+                    ..default()
+                },
+                island,
+                work: IslandWork::default(),
+                states: Vec::with_capacity(group.len()),
+                forces: Vec::with_capacity(group.len()),
+                links: link_rows,
+                wire_rows,
+                anchored,
+                outcome: None,
+            }),
+            Err(reason) => {
+                for &bead in &entities {
+                    divergences.report(bead, reason.clone(), clock.time);
+                }
+            }
+        }
+    }
+    for (entity, _, _, marked) in &beads {
+        match (index.contains_key(&entity), marked) {
+            (true, false) => {
+                commands.entity(entity).try_insert(InIsland);
+            }
+            (false, true) => {
+                commands.entity(entity).try_remove::<InIsland>();
+            }
+            _ => {}
+        }
+    }
+}

@@ -1,0 +1,154 @@
+//! [`IslandPlugin`]: islands in the ECS. The beads joined by [`Rod`]s,
+//! [`Pin`]s, [`Joint`]s and [`Spring`]s, and free beads (on no wire), are
+//! grouped and cached in [`Islands`] until the topology changes, and
+//! stepped each step by [`Island`]. A bead on a wire and joined to
+//! nothing keeps the per-bead step (and its batched fast path).
+//!
+//! | file | what it holds |
+//! |---|---|
+//! | `build` | rebuilding the islands when the topology changes |
+//! | `step` | stepping them: gather, solve (in parallel), write back |
+
+mod build;
+mod step;
+
+use bevy::ecs::lifecycle::{Add, Insert, Remove};
+use bevy::prelude::*;
+
+use super::clock::advance_clock;
+use super::schedule::WireBeadSystems;
+use crate::dynamics::{Bead, ConstraintDiagnostics, Joint, OnWire, Pin, Rod, Spring, Wire};
+use crate::solver::{BeadState, Island, IslandWork, LinearForce, SolveError};
+
+/// Builds and steps the [`Islands`]: beads joined by links, and free beads.
+#[derive(Default)]
+pub struct IslandPlugin;
+
+impl Plugin for IslandPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<Islands>()
+            .register_type::<Rod>()
+            .register_type::<Pin>()
+            .register_type::<Spring>()
+            .register_type::<ConstraintDiagnostics>()
+            .add_observer(topology_changed::<Add, Bead>)
+            .add_observer(topology_changed::<Remove, Bead>)
+            .add_observer(topology_changed::<Insert, OnWire>)
+            .add_observer(topology_changed::<Remove, OnWire>)
+            .add_observer(topology_changed::<Insert, Wire>)
+            .add_observer(topology_changed::<Remove, Wire>)
+            .add_observer(topology_changed::<Insert, Rod>)
+            .add_observer(topology_changed::<Remove, Rod>)
+            .add_observer(topology_changed::<Insert, Pin>)
+            .add_observer(topology_changed::<Remove, Pin>)
+            .add_observer(topology_changed::<Insert, Spring>)
+            .add_observer(topology_changed::<Remove, Spring>)
+            .add_observer(topology_changed::<Insert, Joint>)
+            .add_observer(topology_changed::<Remove, Joint>)
+            .add_systems(
+                FixedUpdate,
+                (
+                    build::prepare_islands
+                        .run_if(islands_changed)
+                        .after(advance_clock)
+                        .in_set(WireBeadSystems::Prepare),
+                    step::step_islands
+                        .run_if(any_island)
+                        .in_set(WireBeadSystems::Step),
+                ),
+            );
+    }
+}
+
+/// Marks a bead stepped in an island (joined to another bead or a point,
+/// or on no wire); the per-bead step leaves it alone. Kept by the plugin.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub(crate) struct InIsland;
+
+/// What the last step of one island reported.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct IslandReport {
+    /// The island's beads.
+    pub beads: Vec<Entity>,
+    /// Its constraint rows (a pin counts two).
+    pub rows: usize,
+    /// Kinetic and gravitational energy of its beads plus the energy in
+    /// its springs, after the last step.
+    pub energy: f64,
+    /// How many rows the last solve dropped as redundant.
+    pub redundant: usize,
+    /// How many substeps the last step took (more than one where a Newton
+    /// solve had no root at the full step).
+    pub substeps: u32,
+}
+
+/// Which link a range of rows belongs to, for its diagnostics.
+#[derive(Clone, Copy, Debug)]
+enum LinkRows {
+    /// One row: a rod or a joint.
+    One(Entity, usize),
+    /// A pin's two rows.
+    Pin(Entity, usize),
+}
+
+/// One island as the step keeps it.
+struct CachedIsland {
+    report: IslandReport,
+    island: Island,
+    work: IslandWork,
+    states: Vec<BeadState>,
+    forces: Vec<LinearForce>,
+    links: Vec<LinkRows>,
+    /// The wire row of each bead on a wire: (bead, row, wire entity).
+    wire_rows: Vec<(usize, usize, Entity)>,
+    /// The first row of each pin fixed to another entity, and the pin.
+    anchored: Vec<(usize, Entity)>,
+    /// What this step did: not stepped (a bead of it has stopped), or the
+    /// step's result.
+    outcome: Option<Result<(), SolveError>>,
+}
+
+/// The islands of the current topology: beads joined by constraints and
+/// springs, each solved as one system. Rebuilt when a link, a bead or a
+/// wire is added, changed or removed, or the run restarts.
+#[derive(Resource, Default)]
+pub struct Islands {
+    cached: Vec<CachedIsland>,
+    dirty: bool,
+}
+
+impl Islands {
+    /// What the last step of each island reported.
+    pub fn iter(&self) -> impl Iterator<Item = &IslandReport> {
+        self.cached.iter().map(|c| &c.report)
+    }
+
+    /// The report of the island holding `bead`, if it is in one.
+    pub fn of(&self, bead: Entity) -> Option<&IslandReport> {
+        self.iter().find(|r| r.beads.contains(&bead))
+    }
+
+    /// Asks for a rebuild before the next step.
+    pub(crate) fn mark_dirty(&mut self) {
+        self.dirty = true;
+    }
+}
+
+/// Marks the islands for a rebuild: observed on the lifecycle events that
+/// change which beads are joined or on which wire.
+fn topology_changed<E: EntityEvent, B: Bundle>(_: On<E, B>, mut islands: ResMut<Islands>) {
+    islands.mark_dirty();
+}
+
+/// Whether the islands need a rebuild: the run condition of
+/// [`build::prepare_islands`], so a step with nothing changed costs the executor
+/// no task.
+fn islands_changed(islands: Res<Islands>) -> bool {
+    islands.dirty
+}
+
+/// Whether there is an island to step: the run condition of
+/// [`step::step_islands`].
+fn any_island(islands: Res<Islands>) -> bool {
+    !islands.cached.is_empty()
+}

@@ -1,0 +1,84 @@
+//! [`ParamsPlugin`]: what every other plugin of the group reads: the
+//! applied and pending parameters, the order of the step's sets, the
+//! compute-pool setting, and what a bead brings along.
+
+use bevy::prelude::*;
+
+use super::parallel::{ParallelStep, StepSplit};
+use super::schedule;
+use crate::dynamics::{
+    Bead, BeadDiagnostics, BeadDiverged, ContactChanged, PendingBead, PendingParams, SimParams,
+};
+
+/// The parameters ([`SimParams`], [`PendingParams`]), the step's sets in
+/// order, [`ParallelStep`], and each bead's `Transform` and
+/// [`BeadDiagnostics`] (unless the beads are lean).
+#[derive(Clone, Debug)]
+pub struct ParamsPlugin {
+    /// The initial parameters, unless the app has its own.
+    pub params: SimParams,
+    /// Whether a bead brings a `Transform` and [`BeadDiagnostics`].
+    pub transforms_and_diagnostics: bool,
+}
+
+impl Default for ParamsPlugin {
+    fn default() -> Self {
+        Self {
+            params: SimParams::default(),
+            transforms_and_diagnostics: true,
+        }
+    }
+}
+
+impl ParamsPlugin {
+    /// Inserts the initial parameters (or keeps the app's own, saying so)
+    /// and a pending copy of them.
+    fn insert_params(&self, app: &mut App) {
+        match app.world().get_resource::<SimParams>() {
+            None => {
+                app.insert_resource(self.params.clone());
+            }
+            Some(existing) if *existing != self.params => {
+                info!(
+                    "wirebead: the app's own SimParams resource was kept; the plugin's parameters were not applied"
+                );
+            }
+            Some(_) => {}
+        }
+        let applied = app.world().resource::<SimParams>().clone();
+        let mut pending = PendingParams::default();
+        if let Err(err) = pending.set(applied) {
+            error!("wirebead: the initial SimParams are invalid ({err}); using the defaults");
+            app.insert_resource(SimParams::default());
+        }
+        app.insert_resource(pending);
+    }
+}
+
+impl Plugin for ParamsPlugin {
+    fn build(&self, app: &mut App) {
+        if self.transforms_and_diagnostics {
+            for registered in [
+                app.try_register_required_components::<Bead, Transform>(),
+                app.try_register_required_components::<Bead, BeadDiagnostics>(),
+            ] {
+                if let Err(err) = registered {
+                    warn!("wirebead: could not give beads their Transform and diagnostics: {err}");
+                }
+            }
+        }
+        self.insert_params(app);
+        schedule::configure(app);
+        app.init_resource::<ParallelStep>()
+            .init_resource::<StepSplit>()
+            .register_type::<StepSplit>()
+            .add_message::<BeadDiverged>()
+            .add_message::<ContactChanged>()
+            .register_type::<Bead>()
+            .register_type::<BeadDiagnostics>()
+            .register_type::<PendingBead>()
+            .register_type::<SimParams>()
+            .register_type::<ParallelStep>()
+            .register_type::<PendingParams>();
+    }
+}

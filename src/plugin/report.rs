@@ -1,0 +1,107 @@
+//! Reports the bead step and the island step share: divergences (the
+//! [`Diverged`] marker, the [`BeadDiverged`] message and a warning) and
+//! changes of contact (the [`ContactChanged`] message and a line in the
+//! log), each found inside a possibly parallel loop and sent after it.
+
+use std::sync::{Mutex, PoisonError};
+
+use bevy::ecs::system::SystemParam;
+use bevy::prelude::*;
+
+use crate::dynamics::{BeadDiverged, ContactChanged, Diverged, DivergenceReason};
+use crate::solver::ContactEvent;
+
+/// Divergences found inside a (possibly parallel) loop, reported after it.
+#[derive(Default)]
+pub(crate) struct FoundDivergences(Mutex<Vec<(Entity, DivergenceReason, f64)>>);
+
+impl FoundDivergences {
+    pub(crate) fn push(&self, bead: Entity, reason: DivergenceReason, time: f64) {
+        self.0
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .push((bead, reason, time));
+    }
+
+    pub(crate) fn report(&mut self, divergences: &mut Divergences) {
+        let found = self.0.get_mut().unwrap_or_else(PoisonError::into_inner);
+        for (bead, reason, time) in found.drain(..) {
+            divergences.report(bead, reason, time);
+        }
+    }
+}
+
+/// Marks beads diverged: inserts [`Diverged`], sends [`BeadDiverged`] and
+/// logs a warning.
+#[derive(SystemParam)]
+pub(crate) struct Divergences<'w, 's> {
+    commands: Commands<'w, 's>,
+    messages: MessageWriter<'w, BeadDiverged>,
+}
+
+impl Divergences<'_, '_> {
+    /// Reports that `bead` stopped at simulated time `time`.
+    pub(crate) fn report(&mut self, bead: Entity, reason: DivergenceReason, time: f64) {
+        warn!(
+            "wirebead: bead {bead} diverged at t = {time:.4} s: {reason}; press Space (send Restart) to recover"
+        );
+        self.commands.entity(bead).try_insert(Diverged {
+            reason: reason.clone(),
+            time,
+        });
+        self.messages.write(BeadDiverged { bead, reason });
+    }
+}
+
+/// Sends [`ContactChanged`] and logs the change in one line.
+#[derive(SystemParam)]
+pub(crate) struct ContactReports<'w> {
+    messages: MessageWriter<'w, ContactChanged>,
+}
+
+impl ContactReports<'_> {
+    /// Reports that `bead`'s contact changed.
+    pub(crate) fn report(&mut self, bead: Entity, event: ContactEvent) {
+        info!("wirebead: bead {bead} {}", describe_event(&event));
+        self.messages.write(ContactChanged { bead, event });
+    }
+}
+
+/// A change of contact in words, for the log.
+fn describe_event(event: &ContactEvent) -> String {
+    match *event {
+        ContactEvent::Left { time, position } => format!(
+            "left its wire at t = {time:.4} s at ({:.3}, {:.3}), where the wire would have had to pull",
+            position.x, position.y
+        ),
+        ContactEvent::Landed {
+            time,
+            position,
+            normal_speed,
+            bounced,
+        } => format!(
+            "landed on its wire at t = {time:.4} s at ({:.3}, {:.3}) at {normal_speed:.3} m/s across it and {}",
+            position.x,
+            position.y,
+            if bounced { "bounced off" } else { "stayed on" }
+        ),
+    }
+}
+
+/// Changes of contact found inside a (possibly parallel) loop, sent after
+/// it.
+#[derive(Default)]
+pub(crate) struct FoundEvents(Mutex<Vec<(Entity, ContactEvent)>>);
+
+impl FoundEvents {
+    pub(crate) fn push(&self, bead: Entity, event: ContactEvent) {
+        self.0
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .push((bead, event));
+    }
+
+    pub(crate) fn take(&mut self) -> Vec<(Entity, ContactEvent)> {
+        std::mem::take(self.0.get_mut().unwrap_or_else(PoisonError::into_inner))
+    }
+}

@@ -1,0 +1,315 @@
+//! One run of beads stored side by side, stepped on one thread: the
+//! batched step for beads on unrotated circles, the single-bead step for
+//! the rest, the outputs written in the same pass.
+
+use bevy::ecs::change_detection::ContiguousMut;
+use bevy::prelude::*;
+
+use super::table::{TableWire, WireTable, with_curve};
+use crate::dynamics::{Bead, BeadDiagnostics, DivergenceReason, OnWire, SimParams, WireContact};
+use crate::geometry::{FixedTrack, MovingTrack, Near, Placed, Surface, Track, WireShape};
+use crate::plugin::report::{FoundDivergences, FoundEvents};
+use crate::plugin::writeback::place;
+use crate::solver::{self, BeadState, Contact, LinearForce, StepOutput, StepSettings};
+
+/// How many batches of [`solver::LANES`] beads one call of the batched step
+/// takes.
+const BATCHES: usize = 8;
+
+/// What stepping a run of beads needs, shared by the threads.
+pub(super) struct StepContext<'a> {
+    pub(super) params: &'a SimParams,
+    pub(super) settings: StepSettings,
+    pub(super) wires: &'a WireTable,
+    pub(super) found: &'a FoundDivergences,
+    pub(super) events: &'a FoundEvents,
+    pub(super) time: f64,
+}
+
+impl StepContext<'_> {
+    /// Steps a run of beads stored side by side. Beads on unrotated circles
+    /// go through the batched step, [`solver::LANES`] at a time, up to
+    /// [`BATCHES`] batches per call; the others, and the lanes it hands
+    /// back, one by one.
+    pub(super) fn step_run(&self, mut run: BeadRun) {
+        let mut lanes = [solver::CircleLanes::default(); BATCHES];
+        let mut outs = [solver::CircleSteps::default(); BATCHES];
+        let mut waiting = [0; BATCHES * solver::LANES];
+        let mut queued = 0;
+        for i in 0..run.beads.len() {
+            if let Some((centre, radius)) = self.wires.circle(&run.on_wires[i]) {
+                let bead = &run.beads[i];
+                lanes[queued / solver::LANES].set(
+                    queued % solver::LANES,
+                    bead.state(),
+                    &bead.step_force(self.params.gravity),
+                    bead.mass(),
+                    centre,
+                    radius,
+                );
+                waiting[queued] = i;
+                queued += 1;
+                if queued == waiting.len() {
+                    solver::step_on_circle_batches(&lanes, &self.settings, &mut outs);
+                    self.finish_batches(&mut run, &outs, &waiting);
+                    queued = 0;
+                }
+                continue;
+            }
+            self.step_one(&mut run, i);
+        }
+        // The last, partial batches: full ones batched, the rest one by one.
+        let whole = queued / solver::LANES;
+        solver::step_on_circle_batches(&lanes[..whole], &self.settings, &mut outs[..whole]);
+        let batched = whole * solver::LANES;
+        self.finish_batches(&mut run, &outs[..whole], &waiting[..batched]);
+        for &j in &waiting[batched..queued] {
+            self.step_one(&mut run, j);
+        }
+    }
+
+    /// Stores the batched steps of the beads `waiting` (in order, one lane
+    /// each); a lane the batch did not finish goes through
+    /// [`StepContext::step_one`].
+    fn finish_batches(&self, run: &mut BeadRun, outs: &[solver::CircleSteps], waiting: &[usize]) {
+        for (k, &j) in waiting.iter().enumerate() {
+            match outs[k / solver::LANES].lane(k % solver::LANES) {
+                Some(out) => self.finish(run.outputs(j), out),
+                None => self.step_one(run, j),
+            }
+        }
+    }
+
+    /// Bead `i` of `run` through [`solver::step`]; a failure is recorded.
+    fn step_one(&self, run: &mut BeadRun, i: usize) {
+        let contact = run.contacts.as_deref_mut().map(|c| &mut c[i]);
+        let bead = &run.beads[i];
+        let result = match self.wires.get(&run.on_wires[i]) {
+            Err(reason) => Err(reason),
+            Ok(wire) if !wire.surface().is_plain() || wire.shape.is_traced() => {
+                self.step_on_surface(wire, bead, run.entities[i], contact)
+            }
+            Ok(TableWire {
+                shape,
+                pose,
+                track: None,
+            }) => with_curve!(shape, curve => {
+                self.step_bead(&FixedTrack(&Placed { curve, pose: *pose }), bead)
+            }),
+            Ok(wire) => {
+                let path = &wire.path();
+                with_curve!(&wire.shape, curve => {
+                    self.step_bead(&MovingTrack { curve, path }, bead)
+                })
+            }
+        };
+        match result {
+            Ok(out) => self.finish(run.outputs(i), out),
+            Err(reason) => {
+                // The bead keeps its state; its `Transform` shows it.
+                let outputs = run.outputs(i);
+                if let Some(transform) = outputs.transform {
+                    place(transform, outputs.bead.position);
+                }
+                self.found.push(run.entities[i], reason, self.time);
+            }
+        }
+    }
+
+    /// Eq. (3) and the integrator for one bead, the step starting at
+    /// `time − dt`.
+    fn step_bead<T: Track + ?Sized>(
+        &self,
+        track: &T,
+        bead: &Bead,
+    ) -> Result<StepOutput, DivergenceReason> {
+        let (state, force, start) = self.start(bead)?;
+        solver::step_on(track, start, state, &force, bead.mass(), &self.settings)
+            .map_err(DivergenceReason::Solve)
+    }
+
+    /// [`solver::step_surface`] for one bead on `track`.
+    fn surface_step<T: Track + ?Sized>(
+        &self,
+        track: &T,
+        bead: &Bead,
+        surface: &Surface,
+        contact: Contact,
+    ) -> Result<solver::SurfaceStep, DivergenceReason> {
+        let (state, force, start) = self.start(bead)?;
+        let (mass, settings) = (bead.mass(), &self.settings);
+        solver::step_surface(
+            track, start, state, &force, mass, settings, surface, contact,
+        )
+        .map_err(DivergenceReason::Solve)
+    }
+
+    /// A bead's state (checked finite), the force on it and the time the
+    /// step starts.
+    fn start(&self, bead: &Bead) -> Result<(BeadState, LinearForce, f64), DivergenceReason> {
+        let state = bead.state();
+        if !state.is_finite() {
+            return Err(DivergenceReason::NonFiniteState);
+        }
+        let force = bead.step_force(self.params.gravity);
+        Ok((state, force, self.time - self.settings.dt))
+    }
+
+    /// One bead on a wire with a surface (one-sided, rough or damped):
+    /// [`solver::step_surface`] from its contact, which it updates; a
+    /// change of contact is recorded.
+    fn step_on_surface(
+        &self,
+        wire: &TableWire,
+        bead: &Bead,
+        entity: Entity,
+        contact: Option<&mut WireContact>,
+    ) -> Result<StepOutput, DivergenceReason> {
+        let from = contact.as_deref().map_or(Contact::OnWire, WireContact::get);
+        let hint = contact.as_deref().map_or(f64::NAN, WireContact::along);
+        let (shape, path, surface) = (&wire.shape, &wire.path(), wire.surface());
+        let curve = &Near {
+            curve: shape.curve(),
+            hint,
+        };
+        let stepped = match path.fixed() {
+            Some(pose) => {
+                self.surface_step(&FixedTrack(&Placed { curve, pose }), bead, surface, from)
+            }
+            None => self.surface_step(&MovingTrack { curve, path }, bead, surface, from),
+        }?;
+        if let Some(contact) = contact {
+            contact.contact = stepped.contact;
+            let local = path.pose(self.time).to_local(stepped.output.state.position);
+            contact.along = shape.curve().parameter(local, hint) as f32;
+        }
+        if let Some(event) = stepped.event {
+            self.events.push(entity, event);
+        }
+        Ok(stepped.output)
+    }
+
+    /// Stores a step's result: the new state (which consumes the force),
+    /// the diagnostics, the `Transform`'s translation.
+    #[inline(always)]
+    fn finish(&self, outputs: BeadOutputs, out: StepOutput) {
+        let BeadOutputs {
+            bead,
+            diagnostics,
+            transform,
+        } = outputs;
+        bead.advance_to(out.state);
+        if let Some(diagnostics) = diagnostics {
+            let (kinetic, potential) = out.state.energy(bead.mass(), self.params.gravity);
+            *diagnostics = BeadDiagnostics {
+                c: out.c,
+                c_dot: out.c_dot,
+                lambda: out.lambda,
+                constraint_force: out.constraint_force,
+                kinetic,
+                potential,
+            };
+        }
+        if let Some(transform) = transform {
+            place(transform, out.state.position);
+        }
+    }
+}
+
+/// A run of beads stored side by side: their entities, states and wires,
+/// and, when they have them, their diagnostics and transforms.
+pub(super) struct BeadRun<'w> {
+    entities: &'w [Entity],
+    beads: &'w mut [Bead],
+    on_wires: &'w [OnWire],
+    diagnostics: Option<&'w mut [BeadDiagnostics]>,
+    transforms: Option<&'w mut [Transform]>,
+    contacts: Option<&'w mut [WireContact]>,
+}
+
+/// What one bead's step writes.
+struct BeadOutputs<'a> {
+    bead: &'a mut Bead,
+    diagnostics: Option<&'a mut BeadDiagnostics>,
+    transform: Option<&'a mut Transform>,
+}
+
+impl BeadRun<'_> {
+    #[inline(always)]
+    fn outputs(&mut self, i: usize) -> BeadOutputs<'_> {
+        BeadOutputs {
+            bead: &mut self.beads[i],
+            diagnostics: self.diagnostics.as_deref_mut().map(|d| &mut d[i]),
+            transform: self.transforms.as_deref_mut().map(|t| &mut t[i]),
+        }
+    }
+}
+
+/// The columns of one table of beads, as the step's query hands them out.
+pub(super) type BeadTable<'w> = (
+    &'w [Entity],
+    ContiguousMut<'w, Bead>,
+    &'w [OnWire],
+    Option<ContiguousMut<'w, BeadDiagnostics>>,
+    Option<ContiguousMut<'w, Transform>>,
+    Option<ContiguousMut<'w, WireContact>>,
+);
+
+/// An optional column cut into runs of `n`; `None` for every run if absent
+/// (marked changed if present).
+fn column_runs<'w, T>(
+    column: Option<ContiguousMut<'w, T>>,
+    n: usize,
+) -> impl Iterator<Item = Option<&'w mut [T]>> {
+    column
+        .into_iter()
+        .flat_map(move |c| ContiguousMut::split(c).0.chunks_mut(n).map(Some))
+        .chain(std::iter::repeat_with(|| None))
+}
+
+/// The contact column cut into runs of `n`, not marked changed: a step
+/// marks the few beads whose contact changed itself.
+fn contact_runs<'w>(
+    column: Option<ContiguousMut<'w, WireContact>>,
+    n: usize,
+) -> impl Iterator<Item = Option<&'w mut [WireContact]>> {
+    column
+        .into_iter()
+        .flat_map(move |c| {
+            ContiguousMut::bypass_change_detection_split(c)
+                .0
+                .chunks_mut(n)
+                .map(Some)
+        })
+        .chain(std::iter::repeat_with(|| None))
+}
+
+/// Cuts one table's beads into runs: one for a single thread, else about a
+/// quarter of each thread's share, so a slow thread does not hold the
+/// others up. Marks the beads, diagnostics and transforms changed.
+pub(super) fn split_table<'w>(
+    (entities, beads, on_wires, diagnostics, transforms, contacts): BeadTable<'w>,
+    threads: usize,
+) -> Vec<BeadRun<'w>> {
+    let runs = if threads > 1 { 4 * threads } else { 1 };
+    let n = entities.len().div_ceil(runs).max(1);
+    let beads = ContiguousMut::split(beads).0;
+    entities
+        .chunks(n)
+        .zip(beads.chunks_mut(n))
+        .zip(on_wires.chunks(n))
+        .zip(column_runs(diagnostics, n))
+        .zip(column_runs(transforms, n))
+        .zip(contact_runs(contacts, n))
+        .map(
+            |(((((entities, beads), on_wires), diagnostics), transforms), contacts)| BeadRun {
+                entities,
+                beads,
+                on_wires,
+                diagnostics,
+                transforms,
+                contacts,
+            },
+        )
+        .collect()
+}
