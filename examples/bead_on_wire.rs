@@ -16,6 +16,7 @@ use std::path::PathBuf;
 use bevy::prelude::*;
 use bevy::window::WindowResolution;
 use clap::Parser;
+use wirebead::LoadPreset;
 use wirebead::gui::{AutomationPlugin, WireBeadGuiPlugin};
 use wirebead::prelude::*;
 

@@ -108,15 +108,13 @@ pub use preset::{ActivePreset, LoadPreset, SceneLink, ScenePreset, ScenePresetPl
 pub use solver::{Constraint, Integrator, Method, Stabilization};
 pub use validate::ParamError;
 
-/// The types most apps need: `use wirebead::prelude::*;`.
+/// The nouns a game uses: `use wirebead::prelude::*;`. Everything else
+/// is at the crate root (`wirebead::Islands`, `wirebead::PendingParams`, …).
 pub mod prelude {
     pub use crate::{
-        Bead, BeadDiagnostics, BeadDiverged, BeadParams, Constraint, ConstraintDiagnostics,
-        ContactChanged, Diverged, DragTarget, Friction, ImplicitCurve, Integrator, Islands, Joint,
-        KeyboardControlsPlugin, LoadPreset, Method, OnWire, ParallelStep, ParamError, PendingBead,
-        PendingParams, Pin, PrescribedMotion, Restart, Rod, ScenePreset, ScenePresetPlugin, Side,
-        SimClock, SimParams, Spring, Stabilization, Surface, Wire, WireBeadPlugin, WireBeadSystems,
-        WireBeads, WireContact, WireKind, WireMotion, WireShape,
+        Bead, BeadDiagnostics, BeadParams, Diverged, ImplicitCurve, Method, OnWire, Pin,
+        PrescribedMotion, Restart, Rod, SimParams, Spring, Surface, Wire, WireBeadPlugin,
+        WireBeadSystems, WireContact, WireMotion, WireShape,
     };
 }
 

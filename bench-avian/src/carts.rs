@@ -38,6 +38,7 @@ use bevy::app::App;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use clap::{Args, ValueEnum};
+use wirebead::SimClock;
 use wirebead::headless::Headless;
 use wirebead::prelude::*;
 use wirebead::solver::BeadState;

@@ -38,6 +38,7 @@ use std::time::Instant;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use clap::{Args, Parser, Subcommand};
+use wirebead::SimClock;
 use wirebead::headless::Headless;
 use wirebead::prelude::*;
 use wirebead::reference::{pendulum_period, period_from_crossings};

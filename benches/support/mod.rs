@@ -5,6 +5,7 @@
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
+use wirebead::ParallelStep;
 use wirebead::headless::Headless;
 use wirebead::prelude::*;
 

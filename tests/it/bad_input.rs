@@ -5,6 +5,7 @@ use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::prelude::*;
+use wirebead::{DragTarget, PendingBead, PendingParams, ScenePreset};
 
 fn scene() -> (App, Entity) {
     let mut app = app(SimParams::default());

@@ -5,6 +5,7 @@ use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::prelude::*;
+use wirebead::{BeadDiverged, Integrator, Stabilization};
 
 /// The assignment's setup: a vertical unit circle, the bead starting at the bottom
 /// with a sideways push, semi-implicit Euler. Returns the samples of 10 s.

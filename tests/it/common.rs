@@ -4,6 +4,7 @@
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
+use wirebead::SimClock;
 use wirebead::headless::Headless;
 pub use wirebead::headless::{run_for, run_steps};
 use wirebead::prelude::*;

@@ -5,6 +5,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::controls::KeyboardControlsPlugin;
 use wirebead::prelude::*;
+use wirebead::{PendingBead, PendingParams};
 
 fn press(app: &mut App, key: KeyCode, steps: u32) {
     app.world_mut()

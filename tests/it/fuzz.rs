@@ -15,6 +15,7 @@ use std::cell::RefCell;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use wirebead::headless::{Headless, run_steps};
 use wirebead::prelude::*;
+use wirebead::{PendingParams, ScenePreset};
 use wirebead::preset::FromPreset;
 
 use crate::presets::{SHIPPED, shipped_dir};

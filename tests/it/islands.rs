@@ -9,6 +9,7 @@ use wirebead::headless::Headless;
 use wirebead::plugin::StepSplit;
 use wirebead::prelude::*;
 use wirebead::solver::{BeadState, Island, IslandRow, IslandWork, LinearForce, RowKind};
+use wirebead::{ConstraintDiagnostics, Islands, ParallelStep, ScenePreset, Stabilization};
 
 use crate::common::{app, bead, params, run_steps};
 
@@ -199,9 +200,7 @@ fn a_restart_returns_an_island_to_its_start() {
 fn one_or_all_cores(plugin: WireBeadPlugin, parallel: bool) -> App {
     let headless = Headless::new(plugin);
     if parallel {
-        headless
-            .parallel(ParallelStep { threshold: 1 })
-            .build()
+        headless.parallel(ParallelStep { threshold: 1 }).build()
     } else {
         headless.single_threaded().build()
     }

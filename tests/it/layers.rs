@@ -408,48 +408,57 @@ fn name(module: &[String]) -> String {
     }
 }
 
-/// A cycle in `edges`, if there is one, as the modules along it.
-fn find_cycle(edges: &BTreeMap<Module, BTreeSet<Module>>) -> Option<Vec<Module>> {
-    // 0: unvisited, 1: on the current path, 2: done.
-    let mut state: HashMap<&Module, u8> = HashMap::new();
-    let mut path: Vec<&Module> = Vec::new();
-    fn visit<'a>(
+/// Every import circle in `edges`: each set of two or more modules that
+/// reach each other (a strongly connected component, by Kosaraju's two
+/// passes).
+fn circles(edges: &BTreeMap<Module, BTreeSet<Module>>) -> Vec<Vec<Module>> {
+    fn finish<'a>(
         node: &'a Module,
         edges: &'a BTreeMap<Module, BTreeSet<Module>>,
-        state: &mut HashMap<&'a Module, u8>,
-        path: &mut Vec<&'a Module>,
-    ) -> Option<Vec<Module>> {
-        state.insert(node, 1);
-        path.push(node);
+        seen: &mut BTreeSet<&'a Module>,
+        order: &mut Vec<&'a Module>,
+    ) {
+        if !seen.insert(node) {
+            return;
+        }
         for next in edges.get(node).into_iter().flatten() {
-            match state.get(next).copied().unwrap_or(0) {
-                1 => {
-                    let start = path.iter().position(|m| *m == next).unwrap();
-                    let mut cycle: Vec<Module> =
-                        path[start..].iter().map(|m| (*m).clone()).collect();
-                    cycle.push(next.clone());
-                    return Some(cycle);
-                }
-                0 => {
-                    if let Some(cycle) = visit(next, edges, state, path) {
-                        return Some(cycle);
-                    }
-                }
-                _ => {}
-            }
+            finish(next, edges, seen, order);
         }
-        path.pop();
-        state.insert(node, 2);
-        None
+        order.push(node);
     }
+    let mut reverse: BTreeMap<&Module, Vec<&Module>> = BTreeMap::new();
+    for (from, targets) in edges {
+        for to in targets {
+            reverse.entry(to).or_default().push(from);
+        }
+    }
+    let (mut seen, mut order) = (BTreeSet::new(), Vec::new());
     for node in edges.keys() {
-        if state.get(node).copied().unwrap_or(0) == 0 {
-            if let Some(cycle) = visit(node, edges, &mut state, &mut path) {
-                return Some(cycle);
+        finish(node, edges, &mut seen, &mut order);
+    }
+    let mut placed: BTreeSet<&Module> = BTreeSet::new();
+    let mut found = Vec::new();
+    for &root in order.iter().rev() {
+        if placed.contains(root) {
+            continue;
+        }
+        let mut component = Vec::new();
+        let mut stack = vec![root];
+        placed.insert(root);
+        while let Some(node) = stack.pop() {
+            component.push(node.clone());
+            for &back in reverse.get(node).into_iter().flatten() {
+                if placed.insert(back) {
+                    stack.push(back);
+                }
             }
         }
+        if component.len() > 1 {
+            component.sort();
+            found.push(component);
+        }
     }
-    None
+    found
 }
 
 fn library() -> Crate {
@@ -520,9 +529,31 @@ fn no_module_uses_one_above_it() {
 
 #[test]
 fn no_files_import_each_other_in_a_circle() {
-    let edges = library().edges();
-    if let Some(cycle) = find_cycle(&edges) {
-        let names: Vec<String> = cycle.iter().map(|m| name(m)).collect();
-        panic!("an import circle: {}", names.join(" → "));
-    }
+    let found: Vec<String> = circles(&library().edges())
+        .iter()
+        .map(|circle| {
+            circle
+                .iter()
+                .map(|m| name(m))
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
+        .collect();
+    assert!(
+        found.is_empty(),
+        "import circles among these modules: {}",
+        found.join("; ")
+    );
+}
+
+#[test]
+fn a_circle_is_found_whatever_its_length() {
+    let module = |n: &str| vec![n.to_owned()];
+    let mut edges = BTreeMap::new();
+    edges.insert(module("a"), BTreeSet::from([module("b")]));
+    edges.insert(module("b"), BTreeSet::from([module("c")]));
+    edges.insert(module("c"), BTreeSet::from([module("a"), module("d")]));
+    edges.insert(module("d"), BTreeSet::new());
+    edges.insert(module("e"), BTreeSet::from([module("e"), module("a")]));
+    assert_eq!(circles(&edges), [[module("a"), module("b"), module("c")]]);
 }

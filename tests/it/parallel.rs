@@ -6,6 +6,7 @@ use bevy::prelude::*;
 use wirebead::headless::{Headless, run_steps};
 use wirebead::plugin::StepSplit;
 use wirebead::prelude::*;
+use wirebead::{ParallelStep, SimClock};
 
 const BEADS_PER_WIRE: usize = 1500;
 
@@ -13,9 +14,7 @@ const BEADS_PER_WIRE: usize = 1500;
 /// spread along it with different speeds, plus beads at the circle's centre
 /// (a singular point). Returns the app and the beads in spawn order.
 fn scene(parallel: ParallelStep, plugin: WireBeadPlugin) -> (App, Vec<Entity>) {
-    let mut app = Headless::new(plugin)
-        .parallel(parallel)
-        .build();
+    let mut app = Headless::new(plugin).parallel(parallel).build();
     let wires = [
         (Wire::circle(1.0).unwrap(), Transform::default()),
         (

@@ -2,6 +2,7 @@
 //! known exactly (`wirebead::reference`: the elliptic-integral period and the conserved energy).
 
 use crate::common::*;
+use wirebead::Stabilization;
 use wirebead::prelude::*;
 use wirebead::reference::pendulum_period;
 

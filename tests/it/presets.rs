@@ -9,6 +9,7 @@ use wirebead::SceneLink;
 use wirebead::headless::{Headless, idle, run_steps};
 use wirebead::prelude::*;
 use wirebead::preset::{ActivePreset, FromPreset};
+use wirebead::{ConstraintDiagnostics, Islands, LoadPreset, ScenePreset};
 
 pub(crate) const SHIPPED: &[&str] = &[
     "assignment_circle.scene.ron",

@@ -6,6 +6,7 @@ use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::prelude::*;
+use wirebead::{PendingBead, PendingParams, SimClock, Stabilization};
 
 fn scene() -> (App, Entity) {
     let mut app = app(SimParams::default());

@@ -10,6 +10,7 @@ use bevy::prelude::*;
 use wirebead::geometry::{Placed, Pose};
 use wirebead::pose_of;
 use wirebead::prelude::*;
+use wirebead::{DragTarget, Integrator, Stabilization, WireBeads};
 
 /// A circle written as a game would write its own curve:
 /// `C = (|x|² - r²) / (2r)`.

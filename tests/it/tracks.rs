@@ -6,6 +6,7 @@ use std::f64::consts::TAU;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::prelude::*;
+use wirebead::{ContactChanged, Side, SimClock, Stabilization};
 use wirebead::{Oscillate, ScenePreset};
 
 use crate::common::{Recording, app, run_for, spawn_bead, spawn_wire};
