@@ -1,5 +1,6 @@
 //! The constraint solve and the integrators, as pure functions over plain
-//! values: nothing here knows about the ECS. One file per piece:
+//! values: nothing here knows about the ECS. One file (or folder, with a
+//! table of its own) per piece:
 //!
 //! | file | what it holds |
 //! |---|---|
@@ -9,9 +10,9 @@
 //! | `solve` | λ of eq. (3) in closed form |
 //! | `euler`, `rk4`, `rattle`, `projection` | the integrators and post-stabilization, eqs. (6)–(9) |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
-//! | `contact` | [`step_surface`]: one-sided wires, landings and friction, eq. (14) |
-//! | `lanes` | [`step_on_circles`]: [`LANES`] beads on circles at once, bit for bit [`step`]; [`step_on_circle_batches`]: many such batches in one call |
-//! | `coupled` | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (10)–(12) |
+//! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eq. (14): on the wire, in flight, where an event falls |
+//! | `lanes/` (`circle`) | [`step_on_circles`]: [`LANES`] beads on circles at once, bit for bit [`step`]; [`step_on_circle_batches`]: many such batches in one call; the solves on each lane's circle |
+//! | `coupled/` (`island/`, `normal/`, …) | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (10)–(12) |
 //!
 //! The equations below are numbered as the code and the tests cite them.
 //!

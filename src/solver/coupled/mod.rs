@@ -2,14 +2,16 @@
 //!
 //! Beads joined by constraints (rods, pins, wires, a game's own
 //! [`Constraint`]) and by [`SpringLink`]s form [`islands`]; each
-//! [`Island`] is stepped as one system by every [`Method`](super::Method):
+//! [`Island`] is stepped as one system by every [`Method`](super::Method).
+//! One file or folder (with a table of its own) per piece:
 //!
 //! | file | what it holds |
 //! |---|---|
 //! | `constraint` | [`Constraint`], [`RowKind`] (what one row contributes), [`SpringLink`] |
 //! | `group` | [`islands`]: which beads are joined |
-//! | `normal` | `J W Jᵀ`: its pattern, symbolic and numeric factorization (faer) |
-//! | `island` | [`Island`]: eq. (10) and each method on an island |
+//! | `normal/` (`pattern`, `order`, `band_ldlt`, `band_lu`, `sparse_ldlt`, `sparse_lu`) | `J W Jᵀ`: its patterns, band ordering, and band and sparse (faer) factorizations |
+//! | `island/` (`build`, `rows`, `step`, `integrators`, `newton`, `projection`, `contact`) | [`Island`]: building, row evaluation, each method, projection, contact and friction |
+//! | `tests/` (`methods`, `rows`, `ropes`, `contact`) | islands against the single-bead solver and physics |
 
 mod constraint;
 mod group;

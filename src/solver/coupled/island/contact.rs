@@ -1,0 +1,223 @@
+//! One-sided rows and friction on an island, eq. (14): beads that leave a
+//! wire, land on it again (or bounce), slide against friction, stop and
+//! stick.
+
+use bevy::math::DVec2;
+
+use super::integrators::Stage;
+use super::newton::Direction;
+use super::rows::RowAt;
+use super::{Island, IslandWork, RoughRow};
+use crate::solver::contact::ContactEvent;
+use crate::solver::coupled::constraint::RowKind;
+use crate::solver::settings::Gains;
+use crate::solver::solve::SolveError;
+use crate::solver::state::{BeadState, LinearForce};
+
+impl Island {
+    /// Eq. (14b) on the island at the step's start (λ from
+    /// [`Island::leave`]): releases every stick row whose force passes
+    /// static friction, and adds kinetic friction and damping to the force
+    /// on each sliding bead. Returns each rough row's bead and its sliding
+    /// velocity at the start.
+    pub(super) fn resist(
+        &self,
+        time: f64,
+        states: &[BeadState],
+        forces: &mut [LinearForce],
+        work: &mut IslandWork,
+    ) -> Vec<(usize, usize, DVec2)> {
+        let mut slides = Vec::new();
+        for (r, rough) in self.rough.iter().enumerate() {
+            let Some(rough) = rough else { continue };
+            let bead = self.entry_bead[self.row_start[r]];
+            if work.inactive[r] {
+                // In flight: nothing to rub against, nothing to stick to.
+                if let Some(s) = rough.stick {
+                    work.inactive[s] = true;
+                }
+                continue;
+            }
+            let row = self.wire_row(r, states, time);
+            let nn = row.normal.length_squared();
+            if nn.is_nan() || nn <= 0.0 {
+                continue;
+            }
+            let press = work.lambda[r].abs() * nn.sqrt();
+            let sliding = row.sliding(states[bead].velocity);
+            let mut direction = sliding;
+            if let Some(s) = rough.stick
+                && !work.inactive[s]
+            {
+                let hold = work.lambda[s];
+                if hold.abs() <= rough.friction.static_coefficient * press {
+                    continue; // held still
+                }
+                // It gives way: it slides toward the pull, against λ's push.
+                work.inactive[s] = true;
+                if let RowKind::Axis { axis, .. } = self.rows[s] {
+                    direction = -hold * axis;
+                }
+            }
+            let speed = direction.length();
+            if speed > 0.0 {
+                forces[bead].force -=
+                    (rough.friction.kinetic_coefficient * press / speed) * direction;
+            }
+            forces[bead].force -= rough.damping * sliding;
+            slides.push((r, bead, sliding));
+        }
+        slides
+    }
+
+    /// Where friction stopped a sliding bead during the step (its sliding
+    /// velocity reversed), puts its stick row across the wire there and
+    /// projects the island's velocities onto the rows with it: the bead
+    /// stays put while static friction can hold it.
+    pub(super) fn stop(
+        &self,
+        time: f64,
+        states: &mut [BeadState],
+        slides: &[(usize, usize, DVec2)],
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        let mut stopped = false;
+        for &(r, bead, before) in slides {
+            let Some(RoughRow {
+                stick: Some(s),
+                friction,
+                ..
+            }) = self.rough[r]
+            else {
+                continue;
+            };
+            if work.inactive[r] || self.paths[r].is_some() || !friction.is_some() {
+                continue;
+            }
+            let row = self.wire_row(r, states, time);
+            let sliding = row.sliding(states[bead].velocity);
+            if before != DVec2::ZERO && sliding.dot(before) >= 0.0 {
+                continue;
+            }
+            if before == DVec2::ZERO && sliding == DVec2::ZERO {
+                continue;
+            }
+            let axis = row.tangent();
+            self.place_stick(s, axis, axis.dot(states[bead].position), work);
+            stopped = true;
+        }
+        if stopped {
+            work.time = time;
+            work.x.clear();
+            work.x.extend(states.iter().map(|s| s.position));
+            work.v.clear();
+            work.v.extend(states.iter().map(|s| s.velocity));
+            self.evaluate_at_new(work);
+            self.project_velocity(work)?;
+            for (state, v) in states.iter_mut().zip(&work.v) {
+                state.velocity = *v;
+            }
+        }
+        Ok(())
+    }
+
+    /// Takes stick row `s` back, as the line `axis·x = offset`.
+    pub(super) fn place_stick(&self, s: usize, axis: DVec2, offset: f64, work: &mut IslandWork) {
+        work.inactive[s] = false;
+        work.sticks.resize(self.rows(), None);
+        work.sticks[s] = Some((axis, offset));
+    }
+
+    /// Sets aside every one-sided row whose λ (eq. 10 with no
+    /// stabilization) at the step's start has the sign its wire cannot
+    /// push with.
+    pub(super) fn leave(
+        &self,
+        time: f64,
+        states: &[BeadState],
+        forces: &[LinearForce],
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        if states.len() != self.beads() || forces.len() != self.beads() {
+            return Ok(()); // `advance` reports it
+        }
+        work.x0.clear();
+        work.x0.extend(states.iter().map(|s| s.position));
+        work.v0.clear();
+        work.v0.extend(states.iter().map(|s| s.velocity));
+        work.time = time;
+        self.accelerate(forces, Gains::NONE, work, Stage::Start)?;
+        for r in 0..self.rows() {
+            let (side, _) = self.sides[r];
+            if side != 0.0 && !work.inactive[r] && side * work.lambda[r] < 0.0 {
+                work.inactive[r] = true;
+                let bead = self.entry_bead[self.row_start[r]];
+                let position = states[bead].position;
+                work.events
+                    .push((r, bead, ContactEvent::Left { time, position }));
+            }
+        }
+        Ok(())
+    }
+
+    /// Lands every bead whose set-aside one-sided row it crossed during the
+    /// step: the island projected onto its rows with that one back, the
+    /// bead's velocity across the wire reversed and scaled by the
+    /// restitution.
+    pub(super) fn land(
+        &self,
+        time: f64,
+        states: &mut [BeadState],
+        forces: &[LinearForce],
+        h: f64,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        work.time = time;
+        for r in 0..self.rows() {
+            let (side, restitution) = self.sides[r];
+            if side == 0.0 || !work.inactive[r] {
+                continue;
+            }
+            let bead = self.entry_bead[self.row_start[r]];
+            let RowAt { c, normal, wire } = self.wire_row(r, states, time);
+            if side * c > 0.0 {
+                continue;
+            }
+            // Back on: onto every held row, then the velocities.
+            let BeadState { position, velocity } = states[bead];
+            work.inactive[r] = false;
+            work.x.clear();
+            work.x.extend(states.iter().map(|s| s.position));
+            work.v.clear();
+            work.v.extend(states.iter().map(|s| s.velocity));
+            self.newton(work, Direction::Current)?;
+            self.evaluate_at_new(work);
+            let nn = normal.length_squared().max(f64::MIN_POSITIVE);
+            let across = normal.dot(velocity - wire);
+            let normal_speed = across.abs() / nn.sqrt();
+            let push =
+                (normal.dot(forces[bead].at(position)) * self.inverse_mass[bead]).abs() / nn.sqrt();
+            let bounced = restitution > 0.0 && restitution * normal_speed > push * h;
+            if bounced {
+                work.bias[r] -= restitution * across;
+            }
+            self.project_velocity(work)?;
+            for (state, (x, v)) in states.iter_mut().zip(work.x.iter().zip(&work.v)) {
+                state.position = *x;
+                state.velocity = *v;
+            }
+            work.inactive[r] = bounced;
+            work.events.push((
+                r,
+                bead,
+                ContactEvent::Landed {
+                    time,
+                    position: states[bead].position,
+                    normal_speed,
+                    bounced,
+                },
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,181 @@
+//! Eq. (10) on an island (λ and the accelerations, from `J W Jᵀ`
+//! factored), and the RK4 and RATTLE steps built on it.
+
+use super::newton::Direction;
+use super::{Island, IslandWork, RowReport};
+use crate::solver::settings::Gains;
+use crate::solver::solve::SolveError;
+use crate::solver::state::LinearForce;
+
+impl Island {
+    /// Factors `J W Jᵀ` at the work's current state (`work.gradient` at
+    /// `work.x`), or at the step's start (`work.first_gradient` at
+    /// `work.x0`); a vanishing row is a singular point, reported at its
+    /// first bead's position.
+    pub(super) fn factor(&self, work: &mut IslandWork, at_start: bool) -> Result<(), SolveError> {
+        let (gradient, x) = if at_start {
+            (&work.first_gradient, &work.x0)
+        } else {
+            (&work.gradient, &work.x)
+        };
+        self.normal
+            .factor(
+                &self.inverse_mass,
+                gradient,
+                &work.inactive,
+                self.natural_order(),
+                &mut work.factored,
+            )
+            .map_err(|r| {
+                let p = x[self.entry_bead[self.row_start[r]]];
+                SolveError::Singular { x: p.x, y: p.y }
+            })
+    }
+
+    /// Eq. (10) at a stage `(x, v)`: λ, and the accelerations
+    /// `W (Q + Jᵀλ)` into `work.acceleration`, at `work.x, work.v` (set to
+    /// `work.x0, work.v0` first at the step's start).
+    pub(super) fn accelerate(
+        &self,
+        forces: &[LinearForce],
+        gains: Gains,
+        work: &mut IslandWork,
+        stage: Stage,
+    ) -> Result<(), SolveError> {
+        if stage == Stage::Start {
+            work.x.clone_from(&work.x0);
+            work.v.clone_from(&work.v0);
+        }
+        self.evaluate_at_new(work);
+        self.applied(forces, &work.x, &work.v, &mut work.force);
+        if self.rows() > 0 {
+            self.factor(work, false)?;
+        }
+        work.lambda.clear();
+        for r in 0..self.rows() {
+            let pushed: f64 = (self.row_start[r]..self.row_start[r + 1])
+                .map(|e| {
+                    let bead = self.entry_bead[e];
+                    work.gradient[e].dot(self.inverse_mass[bead] * work.force[bead])
+                })
+                .sum();
+            let c_dot = self.rate(r, &work.gradient, &work.v, &work.bias);
+            work.lambda
+                .push(-work.curvature[r] - pushed - gains.alpha * work.c[r] - gains.beta * c_dot);
+        }
+        self.normal.solve(&mut work.factored, &mut work.lambda);
+        work.acceleration.clear();
+        work.acceleration.extend(
+            work.force
+                .iter()
+                .zip(&self.inverse_mass)
+                .map(|(f, w)| *w * *f),
+        );
+        self.push(&work.gradient, &work.lambda, &mut work.acceleration);
+        Ok(())
+    }
+
+    /// Keeps the last solve's λ as the step's report.
+    pub(super) fn keep_lambda(&self, work: &mut IslandWork) {
+        work.reports.clear();
+        work.reports
+            .extend(work.lambda.iter().map(|&lambda| RowReport {
+                lambda,
+                ..RowReport::default()
+            }));
+    }
+
+    /// Eq. (7) on the island: four solves of eq. (10); λ reported is the
+    /// first stage's.
+    pub(super) fn rk4(
+        &self,
+        forces: &[LinearForce],
+        gains: Gains,
+        h: f64,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        self.accelerate(forces, gains, work, Stage::Start)?;
+        self.keep_lambda(work);
+        let n = self.beads();
+        let start = work.time;
+        work.x_sum.clone_from(&work.v0);
+        work.v_sum.clone_from(&work.acceleration);
+        for (weight, advance) in [(2.0, 0.5 * h), (2.0, 0.5 * h), (1.0, h)] {
+            // The stage's state from the previous stage's derivative, which
+            // is (work.v, work.acceleration).
+            for i in 0..n {
+                let (dx, dv) = (work.v[i], work.acceleration[i]);
+                work.x[i] = work.x0[i] + advance * dx;
+                work.v[i] = work.v0[i] + advance * dv;
+            }
+            work.time = start + advance;
+            self.accelerate(forces, gains, work, Stage::Later)?;
+            for i in 0..n {
+                work.x_sum[i] += weight * work.v[i];
+                work.v_sum[i] += weight * work.acceleration[i];
+            }
+        }
+        let sixth = h / 6.0;
+        for i in 0..n {
+            work.x[i] = work.x0[i] + sixth * work.x_sum[i];
+            work.v[i] = work.v0[i] + sixth * work.v_sum[i];
+        }
+        Ok(())
+    }
+
+    /// Eq. (8) for an island: SHAKE's position solve (Newton on all of the
+    /// island's `C` along `W J₀ᵀ`), then the linear velocity solve.
+    pub(super) fn rattle(
+        &self,
+        forces: &[LinearForce],
+        h: f64,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        let n = self.beads();
+        self.evaluate_at_start(work, work.time);
+        if self.rows() > 0 {
+            self.factor(work, true)?;
+        }
+        self.applied(forces, &work.x0, &work.v0, &mut work.force);
+        work.x.clear();
+        work.v.clear();
+        for i in 0..n {
+            let w = self.inverse_mass[i];
+            work.x
+                .push(work.x0[i] + h * work.v0[i] + (0.5 * h * h * w) * work.force[i]);
+            work.v.push(work.v0[i]);
+        }
+        work.time += h;
+        self.newton(work, Direction::First)?;
+        let to_lambda = 2.0 / (h * h);
+        work.reports.clear();
+        work.reports.extend(work.lambda.iter().map(|&mu| RowReport {
+            lambda: 0.5 * to_lambda * mu,
+            ..RowReport::default()
+        }));
+        // v½ and the second half kick, at the new positions.
+        for i in 0..n {
+            work.v[i] = (work.x[i] - work.x0[i]) / h;
+        }
+        self.applied(forces, &work.x, &work.v, &mut work.force);
+        for i in 0..n {
+            work.v[i] += (0.5 * h * self.inverse_mass[i]) * work.force[i];
+        }
+        self.evaluate_at_new(work);
+        self.project_velocity(work)?;
+        let to_mu = 2.0 / h;
+        for (report, nu) in work.reports.iter_mut().zip(&work.rhs) {
+            report.lambda += 0.5 * to_mu * nu;
+        }
+        Ok(())
+    }
+}
+
+/// Which state a solve of eq. (10) is at.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Stage {
+    /// The step's start, `work.x0, work.v0`.
+    Start,
+    /// A later stage, `work.x, work.v`.
+    Later,
+}

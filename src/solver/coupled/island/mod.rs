@@ -1,0 +1,331 @@
+//! [`Island`]: beads joined by constraints and springs, stepped together by
+//! every method of [`Method`](crate::solver::Method), eqs. (10)–(12). One
+//! file per piece:
+//!
+//! | file | what it holds |
+//! |---|---|
+//! | `mod` | [`Island`] and what may change between steps (wires, axes, sides, friction), [`IslandWork`], [`RowReport`] |
+//! | `build` | [`Island::new`]: the rows and springs checked and laid out, [`IslandRow`], [`IslandError`] |
+//! | `rows` | each row's `C`, gradient, `J̇q̇` and bias (eq. 13 for a moving wire), and the products with `J` |
+//! | `step` | [`Island::step`]: the step's outline, the Euler steps, the drift check, substeps and halvings |
+//! | `integrators` | eq. (10) on an island (λ and the accelerations), RK4, RATTLE |
+//! | `newton` | the Newton position solve and its check that the root continues the start |
+//! | `projection` | post-stabilization, eq. (11), and the velocity projection |
+//! | `contact` | one-sided rows (leaving, landing, bouncing) and friction (sliding, stopping, sticking) |
+
+use bevy::math::DVec2;
+
+use super::constraint::{RowKind, SpringLink};
+use super::normal::{Factored, LuWork, NormalMatrix};
+use crate::geometry::{Friction, Pose, PosePath, Side, WireShape};
+use crate::solver::contact::ContactEvent;
+use crate::solver::state::BeadState;
+
+mod build;
+mod contact;
+mod integrators;
+mod newton;
+mod projection;
+mod rows;
+mod step;
+
+pub use build::{IslandError, IslandRow};
+
+/// How far off a one-sided wire, on the side it pushes toward, a bead must
+/// start (in units of the wire's scale) to start in flight.
+pub const OFF_THE_WIRE: f64 = 1e-9;
+
+/// How many times a step may be halved when its Newton solve finds no
+/// root: at most 2⁶ = 64 substeps.
+pub const MAX_HALVINGS: u32 = 6;
+
+/// After this many steps in a row that needed no more halvings than they
+/// started with, a step tries one halving fewer.
+pub const CALM_STEPS: u32 = 8;
+/// The most exact Newton steps RATTLE's position solve takes before it
+/// takes the step as having no root near (and halves it).
+pub const EXACT_STEPS: u32 = 8;
+
+/// What a step reports of one row.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RowReport {
+    /// The multiplier λ the step applied (for RATTLE the mean of its
+    /// position and velocity multipliers).
+    pub lambda: f64,
+    /// `C` after the step.
+    pub c: f64,
+    /// `Ċ` after the step.
+    pub c_dot: f64,
+}
+
+/// Beads joined by constraints (rows) and springs, stepped as one system:
+/// the topology, built once, and what it needs to solve eq. (10) fast (the
+/// pattern and symbolic factorization of `J W Jᵀ`). Positions, velocities
+/// and forces come with each step.
+pub struct Island {
+    inverse_mass: Vec<f64>,
+    rows: Vec<RowKind>,
+    /// Row `r`'s gradient entries are `row_start[r]..row_start[r + 1]`.
+    row_start: Vec<usize>,
+    /// The bead of each gradient entry.
+    entry_bead: Vec<usize>,
+    springs: Vec<SpringLink>,
+    normal: NormalMatrix,
+    /// The path of each wire row that moves (see [`Island::move_wire`]).
+    paths: Vec<Option<PosePath>>,
+    /// How many rows have a path: with none, a step looks at no path.
+    moving: usize,
+    /// Each row's side (+1, −1, or 0 for a two-sided row) and restitution
+    /// (see [`Island::set_side`]).
+    sides: Vec<(f64, f64)>,
+    /// Each wire row's friction, if it has any (see [`Island::set_rough`]).
+    rough: Vec<Option<RoughRow>>,
+    /// How many rows have friction: with none, the matrices may be factored
+    /// in the rows' order, and a step looks at no friction.
+    rough_rows: usize,
+}
+
+/// Friction and damping along one wire row, and the row that holds its bead
+/// still while static friction does.
+#[derive(Clone, Copy, Debug)]
+struct RoughRow {
+    friction: Friction,
+    damping: f64,
+    /// An axis row, set aside while the bead slides.
+    stick: Option<usize>,
+}
+
+/// The buffers one island's step works in, kept between steps so a step
+/// allocates nothing. Also what the last step reported.
+#[derive(Default)]
+pub struct IslandWork {
+    x0: Vec<DVec2>,
+    v0: Vec<DVec2>,
+    x: Vec<DVec2>,
+    v: Vec<DVec2>,
+    x_sum: Vec<DVec2>,
+    v_sum: Vec<DVec2>,
+    force: Vec<DVec2>,
+    acceleration: Vec<DVec2>,
+    gradient: Vec<DVec2>,
+    first_gradient: Vec<DVec2>,
+    c: Vec<f64>,
+    curvature: Vec<f64>,
+    /// Each row's `−∂C/∂t` (the moving wire's `∇C·w`; zero for the rest):
+    /// `Ċ = J v − bias`.
+    bias: Vec<f64>,
+    /// The time the rows are evaluated at.
+    time: f64,
+    /// The rows set aside: one-sided wires their beads have left.
+    inactive: Vec<bool>,
+    /// Each wire row's curve parameter where its bead was after the last
+    /// step (NaN: unknown), so a self-crossing track keeps it on its branch.
+    hints: Vec<f64>,
+    /// Where each stick row holds its bead: the line `axis·x = offset`.
+    sticks: Vec<Option<(DVec2, f64)>>,
+    /// What the last step did to one-sided rows: (row, bead, event).
+    events: Vec<(usize, usize, ContactEvent)>,
+    rhs: Vec<f64>,
+    lambda: Vec<f64>,
+    lu: LuWork,
+    scratch: Vec<DVec2>,
+    factored: Factored,
+    reports: Vec<RowReport>,
+    bead_forces: Vec<DVec2>,
+    substeps: u32,
+    /// How many halvings deep the last step's substeps went; the next
+    /// step starts there (see [`Island::step`]).
+    level: u32,
+    /// Steps in a row that went no deeper than they started.
+    calm: u32,
+    /// The states at the start of a step, restored if it fails.
+    start: Vec<BeadState>,
+}
+
+impl IslandWork {
+    /// What the last successful step reported of each row.
+    pub fn rows(&self) -> &[RowReport] {
+        &self.reports
+    }
+
+    /// The constraint force `Σ λ ∇C` on each bead at the end of the last
+    /// step (λ as [`IslandWork::rows`] reports it).
+    pub fn constraint_forces(&self) -> &[DVec2] {
+        &self.bead_forces
+    }
+
+    /// How many substeps the last step took: 1, or more where it was
+    /// halved (see [`Island::step`]).
+    pub fn substeps(&self) -> u32 {
+        self.substeps
+    }
+
+    /// How many rows the last factorization dropped as redundant.
+    pub fn redundant(&self) -> usize {
+        self.factored.redundant
+    }
+
+    /// Whether row `row` holds its bead: false for a one-sided wire the
+    /// bead has left (see [`Island::set_side`]).
+    pub fn holds(&self, row: usize) -> bool {
+        !self.inactive.get(row).copied().unwrap_or(false)
+    }
+
+    /// The beads that left or landed on a one-sided row in the last step:
+    /// `(row, bead, event)`.
+    pub fn events(&self) -> &[(usize, usize, ContactEvent)] {
+        &self.events
+    }
+}
+
+impl Island {
+    /// Moves the wire of row `row` to `pose` (a wire that moves between
+    /// steps), and gives it `shape` where one is given (a wire edited in
+    /// place); rows of other kinds are left as they are.
+    pub fn place_wire(&mut self, row: usize, shape: Option<WireShape>, pose: Pose) {
+        if let Some(RowKind::Wire {
+            shape: placed_shape,
+            pose: placed,
+        }) = self.rows.get_mut(row)
+        {
+            *placed = pose;
+            if self.paths[row].take().is_some() {
+                self.moving -= 1;
+            }
+            if let Some(shape) = shape {
+                *placed_shape = shape;
+            }
+        }
+    }
+
+    /// Puts the wire of row `row` on `path`, a wire that moves during the
+    /// step: its rows are evaluated where the wire is at each stage's
+    /// time, with the terms of eq. (13) (the step's times come from
+    /// [`Island::step_at`]). `shape` as for [`Island::place_wire`].
+    pub fn move_wire(&mut self, row: usize, shape: Option<WireShape>, path: PosePath) {
+        if let Some(pose) = path.fixed() {
+            return self.place_wire(row, shape, pose);
+        }
+        if let Some(RowKind::Wire {
+            shape: placed_shape,
+            ..
+        }) = self.rows.get_mut(row)
+        {
+            if self.paths[row].replace(path).is_none() {
+                self.moving += 1;
+            }
+            if let Some(shape) = shape {
+                *placed_shape = shape;
+            }
+        }
+    }
+
+    /// Makes the wire of row `row` one-sided (see
+    /// [`Side`](crate::geometry::Side)) with restitution `restitution`:
+    /// where λ takes the sign the wire cannot push with at a step's start,
+    /// the row is set aside and its bead flies with the rest of the island;
+    /// where the bead crosses the wire again by a step's end, it lands
+    /// there (the island projected onto it, the bead's normal velocity
+    /// reversed and scaled by the restitution, the row kept aside if it
+    /// bounced). Events fall on step boundaries here, so their timing is
+    /// first order in the step (a lone bead's are located within the step).
+    pub fn set_side(&mut self, row: usize, side: Side, restitution: f64) {
+        if let (Some(RowKind::Wire { .. }), Some(slot)) =
+            (self.rows.get(row), self.sides.get_mut(row))
+        {
+            *slot = (side.sign(), restitution.clamp(0.0, 1.0));
+        }
+    }
+
+    /// Gives the wire of row `row` Coulomb friction and viscous damping
+    /// along it, eq. (14b). `stick` names an axis row of the same bead
+    /// (`RowKind::Axis`, any axis) the island uses to hold the bead still
+    /// while static friction can: it is set aside while the bead slides,
+    /// placed across the wire where the bead stops, and set aside again
+    /// when the force it needs passes `μs |λ∇C|`. Kinetic friction and
+    /// damping act as forces held at their value at the step's start. A
+    /// bead on a moving wire does not stick in an island (it slides).
+    pub fn set_rough(
+        &mut self,
+        row: usize,
+        friction: Friction,
+        damping: f64,
+        stick: Option<usize>,
+    ) {
+        let stick = stick.filter(|&s| {
+            matches!(self.rows.get(s), Some(RowKind::Axis { .. }))
+                && self.entry_bead.get(self.row_start[s])
+                    == self.entry_bead.get(self.row_start[row])
+        });
+        if let (Some(RowKind::Wire { .. }), Some(slot)) =
+            (self.rows.get(row), self.rough.get_mut(row))
+        {
+            let was = slot.replace(RoughRow {
+                friction,
+                damping: damping.max(0.0),
+                stick,
+            });
+            if was.is_none() {
+                self.rough_rows += 1;
+            }
+        }
+    }
+
+    /// Whether the island's matrices may be factored in the order of its
+    /// rows (as a band): no friction (see the `normal` module).
+    fn natural_order(&self) -> bool {
+        !self.is_rough()
+    }
+
+    /// Whether a row has friction.
+    fn is_rough(&self) -> bool {
+        self.rough_rows > 0
+    }
+
+    /// Whether a row is one-sided.
+    fn one_sided(&self) -> bool {
+        self.sides.iter().any(|(side, _)| *side != 0.0)
+    }
+
+    /// Whether a row's wire moves.
+    fn moves(&self) -> bool {
+        self.moving > 0
+    }
+
+    /// Moves the line of the axis row `row` (one of a pin's rows) to
+    /// `axis·x = offset`; rows of other kinds are left as they are.
+    pub fn place_axis(&mut self, row: usize, offset: f64) {
+        if let Some(RowKind::Axis { offset: placed, .. }) = self.rows.get_mut(row) {
+            *placed = offset;
+        }
+    }
+
+    /// How many beads.
+    pub fn beads(&self) -> usize {
+        self.inverse_mass.len()
+    }
+
+    /// How many constraint rows.
+    pub fn rows(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Kinetic plus gravitational energy of the beads in `states`, plus the
+    /// springs' stored energy.
+    pub fn energy(&self, states: &[BeadState], gravity: DVec2) -> f64 {
+        let beads: f64 = states
+            .iter()
+            .zip(&self.inverse_mass)
+            .map(|(s, w)| {
+                let (kinetic, potential) = s.energy(w.recip(), gravity);
+                kinetic + potential
+            })
+            .sum();
+        let springs: f64 = self
+            .springs
+            .iter()
+            .map(|s| s.stored(states[s.a].position, states[s.b].position))
+            .sum();
+        beads + springs
+    }
+}

@@ -1,0 +1,162 @@
+//! The Newton position solve of RATTLE and of projection, and its check
+//! that the root it found continues the step's start.
+
+use super::{EXACT_STEPS, Island, IslandWork};
+use crate::solver::projection::{NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE};
+use crate::solver::solve::SolveError;
+
+impl Island {
+    /// Newton's method for `C(x + W Jᵀ μ) = 0` from `work.x`, along the
+    /// gradients of `direction`: moves `work.x` onto the constraints and
+    /// returns with `work.lambda` holding the total μ.
+    ///
+    /// Along the current gradients (projection) each iteration factors
+    /// `J W Jᵀ` afresh. Along the first gradients (RATTLE) the Newton
+    /// matrix `J(x) W J₀ᵀ` is not symmetric: one row takes the exact step;
+    /// several start as a chord iteration on the factored `J₀ W J₀ᵀ` (no
+    /// new factorization, linear convergence at a rate set by how far the
+    /// rows turn over the step) and switch to exact Newton steps (LU of
+    /// the band or sparse matrix) once the chord stops shrinking `C`
+    /// fourfold per iteration. Two exact steps that do not shrink `C`, or
+    /// [`EXACT_STEPS`] that do not reach the tolerance, mean no root near:
+    /// the step is halved. The iterations evaluate `C` and the gradients
+    /// only, not `J̇q̇` or the bias.
+    pub(super) fn newton(
+        &self,
+        work: &mut IslandWork,
+        direction: Direction,
+    ) -> Result<(), SolveError> {
+        let rows = self.rows();
+        work.lambda.clear();
+        work.lambda.resize(rows, 0.0);
+        let mut exact = direction == Direction::First && rows == 1;
+        let mut previous = f64::INFINITY;
+        let mut rising = 0;
+        let mut exacts = 0;
+        let mut i = 0;
+        loop {
+            self.evaluate_positions(work);
+            let last = i == NEWTON_MAX_ITERATIONS;
+            let tolerance = if last {
+                NEWTON_ACCEPT
+            } else {
+                NEWTON_TOLERANCE
+            };
+            let mut done = true;
+            let mut worst = 0.0f64;
+            for r in 0..rows {
+                let scale = self.rows[r].scale().max(f64::MIN_POSITIVE);
+                let residual = work.c[r].abs();
+                worst = worst.max(residual / scale);
+                done &= residual <= tolerance * scale;
+            }
+            // Rounding keeps C from the tolerance where coordinates are
+            // large beside a row's scale: stop once it no longer shrinks.
+            let stalled = worst <= NEWTON_ACCEPT && worst > 0.5 * previous;
+            if done || stalled {
+                return self.same_branch(work, direction, worst);
+            }
+            if last || !worst.is_finite() {
+                return Err(SolveError::NoConvergence {
+                    iterations: NEWTON_MAX_ITERATIONS,
+                    residual: worst,
+                });
+            }
+            if exact && direction == Direction::First && worst >= previous {
+                // Exact Newton steps converge fast near a root; two that do
+                // not shrink C mean there is none near: halve the step.
+                rising += 1;
+                if rising == 2 {
+                    return Err(SolveError::NoConvergence {
+                        iterations: i,
+                        residual: worst,
+                    });
+                }
+            } else {
+                rising = 0;
+            }
+            exact |= direction == Direction::First && worst > 0.25 * previous;
+            if exact && direction == Direction::First {
+                // Exact Newton steps converge quadratically near a root:
+                // this many that have not reached it mean there is none near.
+                exacts += 1;
+                if exacts > EXACT_STEPS {
+                    return Err(SolveError::NoConvergence {
+                        iterations: i,
+                        residual: worst,
+                    });
+                }
+            }
+            previous = worst;
+            work.rhs.clear();
+            work.rhs.extend(work.c.iter().map(|c| -c));
+            let along = match direction {
+                Direction::First => &work.first_gradient,
+                Direction::Current => {
+                    self.factor(work, false)?;
+                    &work.gradient
+                }
+            };
+            let solved_exactly = exact
+                && self.normal.solve_unsymmetric(
+                    &self.inverse_mass,
+                    &work.gradient,
+                    along,
+                    &mut work.lu,
+                    &mut work.rhs,
+                    self.natural_order(),
+                );
+            if !solved_exactly {
+                // A singular Newton matrix (a redundant row): the chord step.
+                work.rhs.clear();
+                work.rhs.extend(work.c.iter().map(|c| -c));
+                self.normal.solve(&mut work.factored, &mut work.rhs);
+            }
+            for (total, step) in work.lambda.iter_mut().zip(&work.rhs) {
+                *total += step;
+            }
+            self.push(along, &work.rhs, &mut work.x);
+            i += 1;
+        }
+    }
+
+    /// Checks that a Newton solution is the continuation of the start: no
+    /// row's gradient may have turned by a right angle or more from the
+    /// direction it was moved along (a rod flipped end over end, a bead
+    /// carried across its wire's centre). Such a root is refused as no
+    /// convergence, so the step is halved.
+    fn same_branch(
+        &self,
+        work: &IslandWork,
+        direction: Direction,
+        residual: f64,
+    ) -> Result<(), SolveError> {
+        if direction == Direction::Current {
+            return Ok(());
+        }
+        for r in 0..self.rows() {
+            if work.inactive.get(r) == Some(&true) {
+                continue;
+            }
+            let turn: f64 = (self.row_start[r]..self.row_start[r + 1])
+                .map(|e| work.gradient[e].dot(work.first_gradient[e]))
+                .sum();
+            if turn.is_nan() || turn <= 0.0 {
+                return Err(SolveError::NoConvergence {
+                    iterations: NEWTON_MAX_ITERATIONS,
+                    residual,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The gradients a Newton iteration moves along.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Direction {
+    /// Those at the step's start (RATTLE), factored before the iteration.
+    First,
+    /// Those at each iterate (projection), factored at each.
+    Current,
+}

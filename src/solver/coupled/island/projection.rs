@@ -1,0 +1,117 @@
+//! Post-stabilization on an island, eq. (11): positions back onto the
+//! constraints, velocities onto `J v = 0`, and the energy or speed kept.
+
+use bevy::math::DVec2;
+
+use super::newton::Direction;
+use super::{Island, IslandWork};
+use crate::solver::projection::{energy_scale, kinetic_scale};
+use crate::solver::solve::SolveError;
+use crate::solver::state::LinearForce;
+
+impl Island {
+    /// Removes the velocity's component off the constraints:
+    /// `v ← v − W Jᵀ (J W Jᵀ)⁻¹ J v` at `work.x` (rows evaluated there).
+    /// Returns with the multipliers (of `−J v`) in `work.rhs`.
+    pub(super) fn project_velocity(&self, work: &mut IslandWork) -> Result<(), SolveError> {
+        if self.rows() == 0 {
+            return Ok(());
+        }
+        self.factor(work, false)?;
+        work.rhs.clear();
+        for r in 0..self.rows() {
+            work.rhs
+                .push(-self.rate(r, &work.gradient, &work.v, &work.bias));
+        }
+        self.normal.solve(&mut work.factored, &mut work.rhs);
+        self.push(&work.gradient, &work.rhs, &mut work.v);
+        Ok(())
+    }
+
+    /// Post-stabilization, eq. (11): Newton steps along the current
+    /// gradients bring every `C` to zero and the velocity is projected onto
+    /// `J v = 0`; then the velocities are scaled by one factor for the
+    /// island (which keeps `J v = 0`). After an Euler step of length `h`
+    /// the factor gives the kinetic energy of `v₀ + h P₀ W Q`: the start
+    /// velocity plus the step's kick with its part off the constraints at
+    /// the start removed (`P₀` the mass-weighted projection onto
+    /// `J₀ v = 0`), eq. (9b). After RK4 it keeps the energy of a
+    /// conservative island (no spring damping) what it was, eq. (9c).
+    pub(super) fn project(
+        &self,
+        forces: &[LinearForce],
+        restore: Restore,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        self.newton(work, Direction::Current)?;
+        self.evaluate_at_new(work);
+        self.project_velocity(work)?;
+        let kinetic = |v: &[DVec2]| -> f64 {
+            v.iter()
+                .zip(&self.inverse_mass)
+                .map(|(v, w)| 0.5 * v.length_squared() / w)
+                .sum()
+        };
+        let now = kinetic(&work.v);
+        let h = match restore {
+            Restore::Nothing => return Ok(()),
+            Restore::Speed(h) => h,
+            Restore::Energy => {
+                if self.springs.iter().any(|s| s.damping != 0.0) {
+                    return Ok(());
+                }
+                let potential = |x: &[DVec2]| -> f64 {
+                    let applied: f64 = forces.iter().zip(x).map(|(f, x)| f.potential(*x)).sum();
+                    applied + self.springs.iter().map(|s| s.energy(x)).sum::<f64>()
+                };
+                let target = kinetic(&work.v0) + potential(&work.x0) - potential(&work.x);
+                let scale = energy_scale(target, now);
+                for v in &mut work.v {
+                    *v *= scale;
+                }
+                return Ok(());
+            }
+        };
+        // The applied kick W Q at the start, its part off J₀ removed.
+        self.evaluate_at_start(work, work.time - h);
+        self.applied(forces, &work.x0, &work.v0, &mut work.force);
+        for (f, w) in work.force.iter_mut().zip(&self.inverse_mass) {
+            *f *= *w;
+        }
+        if self.rows() > 0 {
+            self.factor(work, true)?;
+            work.rhs.clear();
+            for r in 0..self.rows() {
+                work.rhs
+                    .push(-self.along(r, &work.first_gradient, &work.force));
+            }
+            self.normal.solve(&mut work.factored, &mut work.rhs);
+            self.push(&work.first_gradient, &work.rhs, &mut work.force);
+        }
+        let target: f64 = work
+            .v0
+            .iter()
+            .zip(&work.force)
+            .zip(&self.inverse_mass)
+            .map(|((v, a), w)| 0.5 * (*v + h * *a).length_squared() / w)
+            .sum();
+        let scale = kinetic_scale(target, now);
+        for v in &mut work.v {
+            *v *= scale;
+        }
+        // The gradients where the step ended, for the report.
+        self.evaluate_at_new(work);
+        Ok(())
+    }
+}
+
+/// How a projection ends (see [`Island::project`]).
+#[derive(Clone, Copy, PartialEq)]
+pub(super) enum Restore {
+    /// As projected: an island on a moving wire, which does work on it.
+    Nothing,
+    /// The pre-kick speed after an Euler step of this length, eq. (9b).
+    Speed(f64),
+    /// The energy of the step's start after RK4, eq. (9c).
+    Energy,
+}

@@ -1,0 +1,292 @@
+//! Each row of an island evaluated at a state: `C`, its gradient, `J̇q̇` and
+//! the bias of a moving wire (eq. 13), and the products with `J` and
+//! `W Jᵀ` that the solves are made of.
+
+use bevy::math::DVec2;
+
+use super::{Island, IslandWork};
+use crate::geometry::{ImplicitCurve, Near, Placed, Pose, Twist, WireShape};
+use crate::solver::coupled::constraint::RowKind;
+use crate::solver::state::{BeadState, LinearForce};
+
+impl Island {
+    /// Wire row `r` where its bead is in `states` at `time`, whether the
+    /// row is held or not (zero for a row of another kind).
+    pub(super) fn wire_row(&self, r: usize, states: &[BeadState], time: f64) -> RowAt {
+        let (Some((shape, pose, twist)), Some(state)) = (
+            self.wire_at(r, time),
+            states.get(self.entry_bead[self.row_start[r]]),
+        ) else {
+            return RowAt::default();
+        };
+        let g = Placed {
+            curve: shape.curve(),
+            pose,
+        }
+        .geometry(state.position);
+        RowAt {
+            c: g.c,
+            normal: g.normal,
+            wire: twist.velocity_at(state.position),
+        }
+    }
+
+    /// The shape of wire row `r` and where its wire is at `time`, with its
+    /// twist; none for a row of another kind.
+    fn wire_at(&self, r: usize, time: f64) -> Option<(&WireShape, Pose, Twist)> {
+        let RowKind::Wire { shape, pose } = &self.rows[r] else {
+            return None;
+        };
+        let (pose, twist) = match &self.paths[r] {
+            Some(path) => path.at(time),
+            None => (*pose, Twist::default()),
+        };
+        Some((shape, pose, twist))
+    }
+
+    /// Keeps each wire row's curve parameter where its bead is now (at
+    /// `time`), and reports each set-aside row's own `C` and `Ċ`.
+    pub(super) fn follow(&self, time: f64, states: &[BeadState], work: &mut IslandWork) {
+        work.hints.resize(self.rows(), f64::NAN);
+        for r in 0..self.rows() {
+            let (Some((shape, pose, _)), Some(state)) = (
+                self.wire_at(r, time),
+                states.get(self.entry_bead[self.row_start[r]]),
+            ) else {
+                continue;
+            };
+            let local = pose.to_local(state.position);
+            work.hints[r] = shape.curve().parameter(local, work.hints[r]);
+            if work.inactive.get(r) == Some(&true)
+                && let Some(report) = work.reports.get_mut(r)
+            {
+                let row = self.wire_row(r, states, time);
+                report.c = row.c;
+                report.c_dot = row.normal.dot(state.velocity - row.wire);
+            }
+        }
+    }
+
+    /// Evaluates every row at `(x, v)` at `work.time`: gradients, `C`,
+    /// and where `rates`, `J̇q̇` and the bias `−∂C/∂t`, into `out` (without
+    /// `rates` those two keep what they held).
+    fn evaluate(
+        &self,
+        x: &[DVec2],
+        v: &[DVec2],
+        time: f64,
+        held: Held<'_>,
+        out: Rows<'_>,
+        rates: bool,
+    ) {
+        let Held {
+            inactive,
+            hints,
+            sticks,
+        } = held;
+        let hint = |r: usize| hints.get(r).copied().unwrap_or(f64::NAN);
+        let Rows {
+            gradient,
+            c,
+            curvature,
+            bias,
+            scratch,
+        } = out;
+        gradient.resize(self.entry_bead.len(), DVec2::ZERO);
+        c.resize(self.rows(), 0.0);
+        curvature.resize(self.rows(), 0.0);
+        if rates {
+            bias.clear();
+        }
+        bias.resize(self.rows(), 0.0);
+        for (r, kind) in self.rows.iter().enumerate() {
+            let range = self.row_start[r]..self.row_start[r + 1];
+            if inactive.get(r) == Some(&true) {
+                // Set aside: no force, no error.
+                gradient[range].fill(DVec2::ZERO);
+                (c[r], curvature[r], bias[r]) = (0.0, 0.0, 0.0);
+                continue;
+            }
+            if let Some(Some((axis, offset))) = sticks.get(r) {
+                // A stick row, placed where its bead stopped.
+                let bead = self.entry_bead[range.start];
+                gradient[range.start] = *axis;
+                (c[r], curvature[r], bias[r]) = (axis.dot(x[bead]) - offset, 0.0, 0.0);
+                continue;
+            }
+            let path = if self.moving > 0 {
+                self.paths[r].as_ref()
+            } else {
+                None
+            };
+            if let (Some(path), RowKind::Wire { shape, .. }) = (path, kind) {
+                // Eq. (13): the wire where it is at `time`, seen from its frame.
+                let bead = self.entry_bead[range.start];
+                let (p, u) = (x[bead], v[bead]);
+                let (pose, twist) = path.at(time);
+                let g = Placed {
+                    curve: &Near {
+                        curve: shape.curve(),
+                        hint: hint(r),
+                    },
+                    pose,
+                }
+                .geometry(p);
+                let w = twist.velocity_at(p);
+                let relative = u - w;
+                gradient[range.start] = g.normal;
+                c[r] = g.c;
+                if !rates {
+                    continue;
+                }
+                curvature[r] = relative.dot(g.hessian * relative)
+                    - g.normal.dot(twist.acceleration_at(p, relative));
+                bias[r] = g.normal.dot(w);
+                continue;
+            }
+            let (value, bend) = kind.evaluate(
+                &self.entry_bead[range.clone()],
+                x,
+                v,
+                &mut gradient[range],
+                scratch,
+                hint(r),
+                rates,
+            );
+            c[r] = value;
+            if rates {
+                curvature[r] = bend;
+            }
+        }
+    }
+
+    /// Evaluates the rows at the current state `work.x`, `work.v` (where
+    /// the step ended, or the stage or Newton iterate being worked on).
+    pub(super) fn evaluate_at_new(&self, work: &mut IslandWork) {
+        self.evaluate_work(work, false, work.time, true);
+    }
+
+    /// [`Island::evaluate_at_new`] without `J̇q̇` and the bias: what a
+    /// position solve's iterations need.
+    pub(super) fn evaluate_positions(&self, work: &mut IslandWork) {
+        self.evaluate_work(work, false, work.time, false);
+    }
+
+    /// Evaluates the rows at the step's start `work.x0`, `work.v0` into
+    /// `work.first_gradient` (and `work.c`, `work.curvature`, `work.bias`).
+    pub(super) fn evaluate_at_start(&self, work: &mut IslandWork, time: f64) {
+        self.evaluate_work(work, true, time, true);
+    }
+
+    /// [`Island::evaluate`] on the work's state: the start's into
+    /// `work.first_gradient`, or the current one into `work.gradient`.
+    fn evaluate_work(&self, work: &mut IslandWork, at_start: bool, time: f64, rates: bool) {
+        let (x, v, gradient) = if at_start {
+            (&work.x0, &work.v0, &mut work.first_gradient)
+        } else {
+            (&work.x, &work.v, &mut work.gradient)
+        };
+        self.evaluate(
+            x,
+            v,
+            time,
+            Held {
+                inactive: &work.inactive,
+                hints: &work.hints,
+                sticks: &work.sticks,
+            },
+            Rows {
+                gradient,
+                c: &mut work.c,
+                curvature: &mut work.curvature,
+                bias: &mut work.bias,
+                scratch: &mut work.scratch,
+            },
+            rates,
+        );
+    }
+
+    /// `Σ g·v` over row `r`'s entries (`J v` of one row).
+    pub(super) fn along(&self, r: usize, gradient: &[DVec2], v: &[DVec2]) -> f64 {
+        (self.row_start[r]..self.row_start[r + 1])
+            .map(|e| gradient[e].dot(v[self.entry_bead[e]]))
+            .sum()
+    }
+
+    /// `Ċ_r = Σ g·v − bias` over row `r`'s entries: the rate relative to
+    /// a moving wire.
+    pub(super) fn rate(&self, r: usize, gradient: &[DVec2], v: &[DVec2], bias: &[f64]) -> f64 {
+        self.along(r, gradient, v) - bias[r]
+    }
+
+    /// The applied forces at `(x, v)`: each bead's external force, plus
+    /// the springs.
+    pub(super) fn applied(
+        &self,
+        forces: &[LinearForce],
+        x: &[DVec2],
+        v: &[DVec2],
+        out: &mut Vec<DVec2>,
+    ) {
+        out.clear();
+        out.extend(forces.iter().zip(x).map(|(f, &p)| f.at(p)));
+        for spring in &self.springs {
+            let f = spring.force(x, v);
+            out[spring.a] += f;
+            out[spring.b] -= f;
+        }
+    }
+
+    /// Adds `W Jᵀ μ` (with `gradient`) to `out`.
+    pub(super) fn push(&self, gradient: &[DVec2], mu: &[f64], out: &mut [DVec2]) {
+        for (r, &m) in mu.iter().enumerate() {
+            let entries = self.row_start[r]..self.row_start[r + 1];
+            for (&bead, g) in self.entry_bead[entries.clone()]
+                .iter()
+                .zip(&gradient[entries])
+            {
+                out[bead] += (m * self.inverse_mass[bead]) * *g;
+            }
+        }
+    }
+}
+
+/// A wire row where its bead is: `C`, `∇C`, and the velocity of the
+/// wire's point there.
+#[derive(Clone, Copy, Default)]
+pub(super) struct RowAt {
+    pub(super) c: f64,
+    pub(super) normal: DVec2,
+    pub(super) wire: DVec2,
+}
+
+impl RowAt {
+    /// The part of `velocity`, relative to the wire, along it.
+    pub(super) fn sliding(&self, velocity: DVec2) -> DVec2 {
+        let relative = velocity - self.wire;
+        let nn = self.normal.length_squared();
+        relative - self.normal * (self.normal.dot(relative) / nn)
+    }
+
+    /// The unit direction along the wire: a stick row's axis.
+    pub(super) fn tangent(&self) -> DVec2 {
+        DVec2::new(-self.normal.y, self.normal.x).normalize_or_zero()
+    }
+}
+
+/// Which rows [`Island::evaluate`] holds, and where along their curves
+/// the wire rows' beads were.
+struct Held<'a> {
+    inactive: &'a [bool],
+    hints: &'a [f64],
+    sticks: &'a [Option<(DVec2, f64)>],
+}
+
+/// Where [`Island::evaluate`] writes.
+struct Rows<'a> {
+    gradient: &'a mut Vec<DVec2>,
+    c: &'a mut Vec<f64>,
+    curvature: &'a mut Vec<f64>,
+    bias: &'a mut Vec<f64>,
+    scratch: &'a mut Vec<DVec2>,
+}

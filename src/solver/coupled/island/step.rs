@@ -1,0 +1,254 @@
+//! [`Island::step`]: the outline of an island's step, the Euler steps and
+//! the divergence check, and the substeps a step is halved into where its
+//! Newton solve finds no root.
+
+use bevy::math::DVec2;
+
+use super::integrators::Stage;
+use super::projection::Restore;
+use super::{CALM_STEPS, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow};
+use crate::solver::method::Method;
+use crate::solver::settings::StepSettings;
+use crate::solver::solve::SolveError;
+use crate::solver::state::{BeadState, LinearForce};
+
+impl Island {
+    /// One step of every bead of the island under `settings`: `states`
+    /// (one per bead) advance, `forces` (one per bead, gravity included)
+    /// are the external forces. On an error the states are left as they
+    /// were. What the step reports of each row is in
+    /// [`IslandWork::rows`].
+    ///
+    /// Where a Newton solve (RATTLE's positions, projection) finds no
+    /// root, as when a rope's free end whips round faster than a step can
+    /// follow, that part of the step and the rest of it are taken in
+    /// substeps of half the length, halved again if need be, down to
+    /// 2^[`MAX_HALVINGS`] substeps. The next step starts as finely as this
+    /// one ended, and tries one halving fewer after [`CALM_STEPS`] steps
+    /// that needed no more, so a long rope does not fail its way down to
+    /// the same level every step; [`IslandWork::substeps`] says how many
+    /// the last step took.
+    pub fn step(
+        &self,
+        states: &mut [BeadState],
+        forces: &[LinearForce],
+        settings: &StepSettings,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        self.step_at(0.0, states, forces, settings, work)
+    }
+
+    /// [`Island::step`] for a step that starts at time `time`: the time
+    /// at which wires on a path (see [`Island::move_wire`]) are placed.
+    pub fn step_at(
+        &self,
+        time: f64,
+        states: &mut [BeadState],
+        forces: &[LinearForce],
+        settings: &StepSettings,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        work.events.clear();
+        if work.inactive.len() != self.rows() {
+            // A fresh island: a bead that starts off a one-sided wire, on
+            // the side it pushes toward, starts in flight; stick rows start
+            // set aside (a bead slides until friction stops it).
+            let whole = states.len() == self.beads();
+            work.inactive.clear();
+            work.inactive.resize(self.rows(), false);
+            for rough in self.rough.iter().flatten() {
+                if let Some(s) = rough.stick {
+                    work.inactive[s] = true;
+                }
+            }
+            for r in 0..self.rows() {
+                let (side, _) = self.sides[r];
+                if side != 0.0
+                    && whole
+                    && side * self.wire_row(r, states, time).c > OFF_THE_WIRE * self.rows[r].scale()
+                {
+                    work.inactive[r] = true;
+                }
+            }
+            // A bead at rest on a rough wire starts held by static friction.
+            for (r, rough) in self.rough.iter().enumerate() {
+                let Some(RoughRow { stick: Some(s), .. }) = rough else {
+                    continue;
+                };
+                let bead = self.entry_bead[self.row_start[r]];
+                if work.inactive[r] || self.paths[r].is_some() || !whole {
+                    continue;
+                }
+                let row = self.wire_row(r, states, time);
+                if states[bead].velocity == row.wire {
+                    let axis = row.tangent();
+                    self.place_stick(*s, axis, axis.dot(states[bead].position), work);
+                }
+            }
+        }
+        let one_sided = self.one_sided();
+        let rough = self.is_rough();
+        if one_sided || rough {
+            self.leave(time, states, forces, work)?;
+        }
+        let mut resisted = Vec::new();
+        let slides = if rough && states.len() == self.beads() && forces.len() == self.beads() {
+            resisted.extend_from_slice(forces);
+            self.resist(time, states, &mut resisted, work)
+        } else {
+            Vec::new()
+        };
+        let forces = if rough { &resisted[..] } else { forces };
+        self.substeps(time, states, forces, settings, work)?;
+        if one_sided {
+            self.land(time + settings.dt, states, forces, settings.dt, work)?;
+        }
+        if rough {
+            self.stop(time + settings.dt, states, &slides, work)?;
+        }
+        self.follow(time + settings.dt, states, work);
+        Ok(())
+    }
+
+    /// The step of length `settings.dt` as `2^level` equal substeps, from
+    /// the level the last step ended at (one level fewer after
+    /// [`CALM_STEPS`] steps that needed no more). Where a substep's Newton
+    /// solve finds no root, it and the rest of the step are taken at half
+    /// the length, down to 2^[`MAX_HALVINGS`] substeps. On an error the
+    /// states are left as they were.
+    fn substeps(
+        &self,
+        time: f64,
+        states: &mut [BeadState],
+        forces: &[LinearForce],
+        settings: &StepSettings,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        let was = work.level.min(MAX_HALVINGS);
+        let mut level = if work.calm >= CALM_STEPS {
+            was.saturating_sub(1)
+        } else {
+            was
+        };
+        let first = level;
+        work.substeps = 0;
+        work.start.clear();
+        work.start.extend_from_slice(states);
+        // Progress through the step in its finest substeps.
+        let finest = 1u64 << MAX_HALVINGS;
+        let mut done = 0u64;
+        while done < finest {
+            let fraction = (done as f64) / (finest as f64);
+            let piece = StepSettings {
+                dt: settings.dt / f64::from(1u32 << level),
+                ..*settings
+            };
+            match self.advance(time + fraction * settings.dt, states, forces, &piece, work) {
+                Ok(()) => done += finest >> level,
+                Err(SolveError::NoConvergence { .. }) if level < MAX_HALVINGS => level += 1,
+                Err(error) => {
+                    states.copy_from_slice(&work.start);
+                    return Err(error);
+                }
+            }
+        }
+        work.calm = if level == first && first == was {
+            work.calm + 1
+        } else {
+            0
+        };
+        work.level = level;
+        Ok(())
+    }
+
+    /// One step of length `settings.dt`, with no halving.
+    fn advance(
+        &self,
+        time: f64,
+        states: &mut [BeadState],
+        forces: &[LinearForce],
+        settings: &StepSettings,
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        let n = self.beads();
+        if states.len() != n || forces.len() != n {
+            return Err(SolveError::WrongLength {
+                beads: n,
+                states: states.len(),
+                forces: forces.len(),
+            });
+        }
+        if states.iter().any(|s| !s.is_finite()) {
+            return Err(SolveError::NonFinite);
+        }
+        work.x0.clear();
+        work.x0.extend(states.iter().map(|s| s.position));
+        work.v0.clear();
+        work.v0.extend(states.iter().map(|s| s.velocity));
+        let h = settings.dt;
+        let gains = settings.gains();
+        work.time = time;
+        match settings.method {
+            Method::Rattle => self.rattle(forces, h, work)?,
+            Method::ExplicitEuler(_) | Method::SemiImplicitEuler(_) => {
+                self.accelerate(forces, gains, work, Stage::Start)?;
+                let semi = matches!(settings.method, Method::SemiImplicitEuler(_));
+                for i in 0..n {
+                    let (x, v, a) = (work.x0[i], work.v0[i], work.acceleration[i]);
+                    let v1 = v + h * a;
+                    work.x[i] = x + h * if semi { v1 } else { v };
+                    work.v[i] = v1;
+                }
+                self.keep_lambda(work);
+            }
+            Method::Rk4(_) => self.rk4(forces, gains, h, work)?,
+        }
+        if work.x.iter().chain(&work.v).any(|p| !p.is_finite()) {
+            return Err(SolveError::NonFinite);
+        }
+        work.time = time + h;
+        self.evaluate_at_new(work);
+        for r in 0..self.rows() {
+            let bound = settings.drift_bound * self.rows[r].scale();
+            let c = work.c[r];
+            if c.is_nan() || c.abs() > bound {
+                return Err(SolveError::DriftExceeded { c, bound });
+            }
+        }
+        if settings.method.projects() {
+            let rough = self.is_rough();
+            let restore = if self.moves() {
+                // A moving wire does work: there is no energy or speed to keep.
+                Restore::Nothing
+            } else if settings.method.is_euler() {
+                // Friction is in the kick (the forces it is given).
+                Restore::Speed(settings.dt)
+            } else if rough {
+                // Friction takes energy away: none to keep.
+                Restore::Nothing
+            } else {
+                Restore::Energy
+            };
+            self.project(forces, restore, work)?;
+        }
+        work.bead_forces.clear();
+        work.bead_forces.resize(n, DVec2::ZERO);
+        for (r, report) in work.reports.iter_mut().enumerate() {
+            report.c = work.c[r];
+            report.c_dot = self.rate(r, &work.gradient, &work.v, &work.bias);
+            let entries = self.row_start[r]..self.row_start[r + 1];
+            for (&bead, g) in self.entry_bead[entries.clone()]
+                .iter()
+                .zip(&work.gradient[entries])
+            {
+                work.bead_forces[bead] += report.lambda * *g;
+            }
+        }
+        for (state, (x, v)) in states.iter_mut().zip(work.x.iter().zip(&work.v)) {
+            state.position = *x;
+            state.velocity = *v;
+        }
+        work.substeps += 1;
+        Ok(())
+    }
+}

@@ -1,0 +1,253 @@
+//! One-sided rows and friction on an island: a cart that lands, bounces,
+//! flies off a hump, and stops and sticks on a rough line.
+
+use bevy::math::DVec2;
+
+use super::*;
+use crate::geometry::{Circle, Line};
+use crate::solver::Stabilization;
+
+/// A cart of two beads joined by a rod, dropped from 1 m onto a one-sided
+/// floor (`Positive`: it only pushes up), both beads on it: with
+/// restitution 0 it lands and stays, exactly on the floor and at rest,
+/// held by λ ≥ 0; with restitution ½ it bounces to a quarter of the drop.
+#[test]
+fn a_two_bead_cart_lands_on_a_one_sided_floor_and_stays_or_bounces() {
+    use crate::geometry::Side;
+    let floor = WireShape::Line(Line);
+    let drop = 1.0;
+    for restitution in [0.0, 0.5] {
+        let mut island = Island::new(
+            &[1.0, 1.0],
+            vec![
+                wire(0, floor.clone(), Pose::IDENTITY),
+                wire(1, floor.clone(), Pose::IDENTITY),
+                rod(0, 1, 1.0),
+            ],
+            vec![],
+        )
+        .unwrap();
+        island.set_side(0, Side::Positive, restitution);
+        island.set_side(1, Side::Positive, restitution);
+        let mut states = at_rest(&[DVec2::new(0.0, drop), DVec2::new(1.0, drop)]);
+        let forces = weights(&[1.0, 1.0]);
+        let s = settings(Method::Rattle, 1.0 / 240.0);
+        let mut work = IslandWork::default();
+        let (mut landings, mut top_after, mut landed) = (Vec::new(), 0.0f64, false);
+        for k in 0..480 {
+            let t = k as f64 / 240.0;
+            island
+                .step_at(t, &mut states, &forces, &s, &mut work)
+                .unwrap();
+            for &(_, _, event) in work.events() {
+                if let crate::solver::ContactEvent::Landed { normal_speed, .. } = event {
+                    landings.push(normal_speed);
+                    landed = true;
+                }
+            }
+            if landed {
+                top_after = top_after.max(states[0].position.y);
+            }
+            if landed && restitution == 0.0 {
+                for (r, report) in work.rows().iter().enumerate().take(2) {
+                    assert!(work.holds(r), "row {r} let go at step {k}");
+                    assert!(
+                        report.lambda >= 0.0,
+                        "the floor pulled: λ = {}",
+                        report.lambda
+                    );
+                }
+            }
+        }
+        let impact = (2.0 * 9.81 * drop).sqrt();
+        if restitution == 0.0 {
+            assert_eq!(landings.len(), 2, "{landings:?}");
+        } else {
+            // Each bounce lands at half the speed of the one before.
+            assert!(landings.len() >= 4, "{landings:?}");
+            for speed in &landings[2..4] {
+                let expected = restitution * impact;
+                assert!(
+                    (speed - expected).abs() < 2.0 * 9.81 / 240.0,
+                    "landed again at {speed}, not {expected}"
+                );
+            }
+        }
+        for speed in &landings[..2] {
+            assert!(
+                (speed - impact).abs() < 9.81 / 240.0,
+                "landed at {speed}, not {impact}"
+            );
+        }
+        if restitution == 0.0 {
+            for state in &states {
+                assert!(state.position.y.abs() < 1e-12, "{state:?}");
+                assert!(state.velocity.length() < 1e-12, "{state:?}");
+            }
+        } else {
+            let expected = restitution * restitution * drop;
+            let error = (top_after - expected).abs() / expected;
+            eprintln!(
+                "bounce: up to {top_after:.4} m, expected {expected} (relative error {error:.2e})"
+            );
+            assert!(error < 0.05, "bounced to {top_after}, not {expected}");
+        }
+    }
+}
+
+/// A two-bead cart going over the top of a one-sided hump (`Positive`
+/// outside a circle of radius 2) faster than `sqrt(g r)` leaves it at once:
+/// both rows are set aside, and the cart flies as a rigid body, its centre
+/// of mass falling at `g` to 1e-9 while the rod holds.
+#[test]
+fn a_two_bead_cart_too_fast_for_a_one_sided_hump_flies_off_it() {
+    use crate::geometry::Side;
+    let hump = WireShape::Circle(Circle { radius: 2.0 });
+    let mut island = Island::new(
+        &[1.0, 1.0],
+        vec![
+            wire(0, hump.clone(), Pose::IDENTITY),
+            wire(1, hump.clone(), Pose::IDENTITY),
+            rod(0, 1, 4.0 * 5f64.to_radians().sin()),
+        ],
+        vec![],
+    )
+    .unwrap();
+    island.set_side(0, Side::Positive, 0.0);
+    island.set_side(1, Side::Positive, 0.0);
+    let speed = 5.0; // v² / r = 12.5 > g
+    let mut states: Vec<BeadState> = [-5f64, 5.0]
+        .map(|deg| {
+            let a = deg.to_radians();
+            BeadState {
+                position: 2.0 * DVec2::new(a.sin(), a.cos()),
+                velocity: speed * DVec2::new(a.cos(), -a.sin()),
+            }
+        })
+        .to_vec();
+    let forces = weights(&[1.0, 1.0]);
+    let h = 1.0 / 240.0;
+    let s = settings(Method::Rattle, h);
+    let mut work = IslandWork::default();
+    island
+        .step_at(0.0, &mut states, &forces, &s, &mut work)
+        .unwrap();
+    let left = work
+        .events()
+        .iter()
+        .filter(|e| matches!(e.2, crate::solver::ContactEvent::Left { .. }))
+        .count();
+    assert_eq!(left, 2, "{:?}", work.events());
+    let centre = |s: &[BeadState]| 0.5 * (s[0].velocity + s[1].velocity);
+    let mut worst = 0.0f64;
+    for k in 1..60 {
+        let before = centre(&states);
+        island
+            .step_at(k as f64 * h, &mut states, &forces, &s, &mut work)
+            .unwrap();
+        assert!(!work.holds(0) && !work.holds(1));
+        worst = worst.max(((centre(&states) - before) / h - G).length());
+        let stretch =
+            (states[0].position - states[1].position).length() - 4.0 * 5f64.to_radians().sin();
+        assert!(stretch.abs() < 1e-12, "the rod stretched by {stretch:e}");
+    }
+    assert!(
+        worst < 1e-9,
+        "the centre of mass fell at g off by {worst:e}"
+    );
+}
+
+/// A cart of two beads joined by a rod, both on a rough line tilted by
+/// `degrees`, the rough rows with their stick rows.
+fn rough_cart(degrees: f64, friction: crate::geometry::Friction) -> Island {
+    let line = WireShape::Line(Line);
+    let pose = Pose::new(DVec2::ZERO, degrees.to_radians());
+    let stick = |bead| IslandRow {
+        kind: RowKind::Axis {
+            axis: DVec2::X,
+            offset: 0.0,
+        },
+        beads: vec![bead],
+    };
+    let mut island = Island::new(
+        &[1.0, 2.0],
+        vec![
+            wire(0, line.clone(), pose),
+            wire(1, line.clone(), pose),
+            rod(0, 1, 0.5),
+            stick(0),
+            stick(1),
+        ],
+        vec![],
+    )
+    .unwrap();
+    island.set_rough(0, friction, 0.0, Some(3));
+    island.set_rough(1, friction, 0.0, Some(4));
+    island
+}
+
+/// Friction in an island: a two-bead cart sent at 3 m/s along a rough
+/// horizontal line (μk = 0.3) stops after `v0² / (2 μk g)` and stays; from
+/// rest on a slope gentler than `atan μs` it stays exactly where it is,
+/// on a steeper one it slides.
+#[test]
+fn a_two_bead_cart_on_a_rough_line_stops_at_the_coulomb_distance_and_sticks() {
+    use crate::geometry::Friction;
+    let friction = Friction::new(0.5, 0.3).unwrap();
+    let forces = weights(&[1.0, 2.0]);
+    let h = 1.0 / 240.0;
+    for method in [Method::Rattle, Method::Rk4(Stabilization::Projection)] {
+        let s = settings(method, h);
+        let island = rough_cart(0.0, friction);
+        let v0 = 3.0;
+        let mut states: Vec<BeadState> = [0.5, 0.0]
+            .map(|x| BeadState {
+                position: DVec2::new(x, 0.0),
+                velocity: DVec2::new(v0, 0.0),
+            })
+            .to_vec();
+        let mut work = IslandWork::default();
+        for k in 0..720 {
+            island
+                .step_at(k as f64 * h, &mut states, &forces, &s, &mut work)
+                .unwrap();
+        }
+        let expected = v0 * v0 / (2.0 * 0.3 * 9.81);
+        let travelled = states[1].position.x;
+        let error = (travelled - expected).abs() / expected;
+        eprintln!("{method}: the cart stopped after {travelled:.6} m (relative error {error:.2e})");
+        assert!(
+            error < 1e-3,
+            "{method}: stopped after {travelled}, not {expected}"
+        );
+        assert!(
+            states.iter().all(|s| s.velocity.length() < 1e-9),
+            "{states:?}"
+        );
+    }
+    let limit = 0.5f64.atan().to_degrees();
+    for (degrees, slides) in [(limit - 2.0, false), (limit + 2.0, true)] {
+        let island = rough_cart(degrees, friction);
+        let a = degrees.to_radians();
+        let start: Vec<BeadState> = [0.5, 0.0]
+            .map(|d| BeadState {
+                position: d * DVec2::new(a.cos(), a.sin()),
+                velocity: DVec2::ZERO,
+            })
+            .to_vec();
+        let mut states = start.clone();
+        let mut work = IslandWork::default();
+        let s = settings(Method::Rattle, h);
+        for k in 0..240 {
+            island
+                .step_at(k as f64 * h, &mut states, &forces, &s, &mut work)
+                .unwrap();
+        }
+        let moved = (states[1].position - start[1].position).length();
+        if slides {
+            assert!(moved > 0.1, "at {degrees:.1}° the cart stuck");
+        } else {
+            assert!(moved < 1e-12, "at {degrees:.1}° the cart crept {moved:e}");
+        }
+    }
+}
