@@ -1,9 +1,8 @@
 //! The two Euler steps of eq. (6): explicit (`x` first) and semi-implicit
 //! (`v` first, the assignment's).
 
-use super::Advance;
 use super::solve::Solved;
-use super::state::BeadState;
+use super::state::{Advance, BeadState};
 use crate::lane::{Lane, V2};
 
 /// Explicit Euler on lanes: `x₁ = x₀ + h v₀`, `v₁ = v₀ + h a₀`.

@@ -8,11 +8,11 @@
 //! | `settings` | [`StepSettings`]: what is the same for every bead in a step |
 //! | `state` | [`BeadState`], [`LinearForce`] |
 //! | `solve` | λ of eq. (3) in closed form |
-//! | `euler`, `rk4`, `rattle`, `projection` | the integrators and post-stabilization, eqs. (6)–(9) |
+//! | `euler`, `rk4`, `rattle`, `projection` | the integrators and post-stabilization, eqs. (6)–(11) |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
-//! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eq. (14): on the wire, in flight, where an event falls |
+//! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eqs. (16)–(17): on the wire, in flight, where an event falls |
 //! | `lanes/` (`circle`) | [`step_on_circles`]: [`LANES`] beads on circles at once, bit for bit [`step`]; [`step_on_circle_batches`]: many such batches in one call; the solves on each lane's circle |
-//! | `coupled/` (`island/`, `normal/`, …) | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (10)–(12) |
+//! | `coupled/` (`island/`, `normal/`, …) | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (12)–(14) |
 //!
 //! The equations below are numbered as the code and the tests cite them.
 //!
@@ -44,8 +44,8 @@ pub use rattle::rattle;
 pub use rk4::rk4;
 pub use settings::{Gains, StepSettings};
 pub use solve::{SolveError, Solved, lambda, solve};
-pub use state::{BeadState, LinearForce};
-pub use step::{Advance, StepOutput, constraint_state, constraint_state_on, step, step_on};
+pub use state::{Advance, BeadState, LinearForce};
+pub use step::{StepOutput, constraint_state, constraint_state_on, step, step_on};
 
 /// What the solver's unit tests share.
 #[cfg(test)]

@@ -1,6 +1,6 @@
 //! Newton's method on `C`, shared by RATTLE's position solve and
 //! post-stabilization projection, eq. (9), and the energy-restoring
-//! velocity scale that completes the projection, eq. (9b).
+//! velocity scale that completes the projection, eq. (10).
 
 use bevy::math::DVec2;
 
@@ -152,7 +152,7 @@ fn along_wire(n: DVec2, a: DVec2, x: DVec2) -> Result<DVec2, SolveError> {
     Ok(a - (n.dot(a) / nn) * n)
 }
 
-/// Eq. (9b): the factor that scales a projected velocity of kinetic
+/// Eq. (10): the factor that scales a projected velocity of kinetic
 /// energy `kinetic_now` to the kinetic energy `kinetic_target`; 1 where
 /// either is zero or not finite (nothing to scale, or nothing to scale to).
 pub(crate) fn kinetic_scale(kinetic_target: f64, kinetic_now: f64) -> f64 {
@@ -164,7 +164,7 @@ pub(crate) fn kinetic_scale(kinetic_target: f64, kinetic_now: f64) -> f64 {
     }
 }
 
-/// Eq. (9b) for one bead after an Euler step of length `h` from `start`
+/// Eq. (10) for one bead after an Euler step of length `h` from `start`
 /// at time `t`: `projected`'s velocity scaled to the speed of
 /// `v₀ + h a_t`, the start velocity plus the step's kick without its
 /// normal part (`a_t` the applied acceleration's component along the wire
@@ -205,13 +205,13 @@ pub(crate) fn restore_speed<T: Track + ?Sized>(
     })
 }
 
-/// The largest relative change of speed eq. (9c) makes: a fourth-order
+/// The largest relative change of speed eq. (11) makes: a fourth-order
 /// step's energy error is far below it; a larger mismatch means a bead at
 /// a turning point or at rest, where the ratio of two near-zero kinetic
 /// energies says nothing, and the velocity is left as projected.
 pub const ENERGY_CORRECTION_LIMIT: f64 = 1e-3;
 
-/// Eq. (9c): the factor that brings a projected velocity of kinetic energy
+/// Eq. (11): the factor that brings a projected velocity of kinetic energy
 /// `kinetic_now` to the energy balance `kinetic_target` of a conservative
 /// system, or 1 where the change would exceed
 /// [`ENERGY_CORRECTION_LIMIT`].
@@ -224,7 +224,7 @@ pub(crate) fn energy_scale(kinetic_target: f64, kinetic_now: f64) -> f64 {
     }
 }
 
-/// Eq. (9c) for one bead after an RK4 step from `start`: `projected`'s
+/// Eq. (11) for one bead after an RK4 step from `start`: `projected`'s
 /// velocity scaled so that the energy is the start's, kinetic plus the
 /// potential of the linear force of eq. (5) (gravity and the drag spring),
 /// and its normal component removed again.

@@ -1,10 +1,9 @@
 //! RATTLE for one bead on one wire, eq. (8).
 
-use super::Advance;
 use super::projection::newton_along;
 use super::settings::Gains;
 use super::solve::{SolveError, normal_length_squared, resistance, solve_on};
-use super::state::{BeadState, LinearForce};
+use super::state::{Advance, BeadState, LinearForce};
 use bevy::math::DVec2;
 
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
@@ -42,7 +41,7 @@ pub(crate) fn rattle_on<T: Track + ?Sized>(
     let n0 = track.geometry(t, x0).normal;
     normal_length_squared(n0, x0)?;
     // Friction and damping along the wire, held at their start value
-    // through the step (eq. 14).
+    // through the step (eq. 17).
     let resisted = match track.surface() {
         Some((surface, sliding)) => {
             let twist = track.twist(t);

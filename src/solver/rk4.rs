@@ -1,9 +1,8 @@
 //! Classical fourth-order Runge–Kutta with λ solved at every stage, eq. (7).
 
-use super::Advance;
 use super::settings::Gains;
 use super::solve::{SolveError, Solved, solve_on};
-use super::state::{BeadState, LinearForce};
+use super::state::{Advance, BeadState, LinearForce};
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
 use crate::lane::{Lane, V2};
 

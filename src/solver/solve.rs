@@ -209,7 +209,7 @@ pub(crate) fn solve_on<T: Track + ?Sized>(
     })
 }
 
-/// Eq. (14): the force along the wire that friction and damping put on a
+/// Eq. (17): the force along the wire that friction and damping put on a
 /// bead whose velocity relative to the wire is `relative`, pressed on it
 /// with `|λ ∇C|`, under the applied force `applied` (in the wire's frame),
 /// in a step that started sliding along `sliding`. Sliding, kinetic

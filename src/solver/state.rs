@@ -86,6 +86,19 @@ impl<T: Lane> LinearForceLanes<T> {
     }
 }
 
+/// What an integrator hands back: the new state and the constraint force
+/// it applied.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Advance {
+    /// The new state.
+    pub state: BeadState,
+    /// The constraint multiplier the step applied (for RATTLE the mean of
+    /// its position and velocity multipliers).
+    pub lambda: f64,
+    /// The constraint force the step applied.
+    pub constraint_force: DVec2,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,19 +14,6 @@ use super::solve::{SolveError, solve_on};
 use super::state::{BeadState, LinearForce};
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
 
-/// What an integrator hands back: the new state and the constraint force
-/// it applied.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Advance {
-    /// The new state.
-    pub state: BeadState,
-    /// The constraint multiplier the step applied (for RATTLE the mean of
-    /// its position and velocity multipliers).
-    pub lambda: f64,
-    /// The constraint force the step applied.
-    pub constraint_force: DVec2,
-}
-
 /// The result of one step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepOutput {
@@ -62,8 +49,8 @@ pub fn step<C: ImplicitCurve + ?Sized>(
 /// time `t`. Every method takes the wire's motion into account: the
 /// explicit ones through eq. (3) in the wire's frame at each stage's time,
 /// RATTLE and projection by solving `C(x, t + h) = 0` and
-/// `∇C·(ẋ − w) = 0` at the step's end. On a moving wire eq. (9b) restores
-/// the speed relative to the wire, and eq. (9c) is not applied: a moving
+/// `∇C·(ẋ − w) = 0` at the step's end. On a moving wire eq. (10) restores
+/// the speed relative to the wire, and eq. (11) is not applied: a moving
 /// wire does work on the bead, so there is no energy to keep.
 #[inline(always)]
 pub fn step_on<T: Track + ?Sized>(
@@ -103,7 +90,7 @@ pub fn step_on<T: Track + ?Sized>(
         let projected = if settings.method.is_euler() {
             restore_speed(track, t, state, projected, force, mass, h)?
         } else if T::MOVES || track.surface().is_some_and(|(s, _)| s.resists()) {
-            // Eq. (9c) keeps a conservative system's energy: a moving wire
+            // Eq. (11) keeps a conservative system's energy: a moving wire
             // does work, friction and damping take it away.
             projected
         } else {
@@ -250,7 +237,7 @@ mod tests {
 
     #[test]
     fn euler_with_projection_adds_no_energy_on_the_pendulum() {
-        // The 135° pendulum (r = 1) for 10 s at 1/60 s: without eq. (9b)
+        // The 135° pendulum (r = 1) for 10 s at 1/60 s: without eq. (10)
         // semi-implicit Euler with projection gained 184 m·g·r; with it the
         // energy stays within a few hundredths of m·g·r, for both Euler
         // steps.
@@ -267,7 +254,7 @@ mod tests {
 
     #[test]
     fn rk4_with_projection_keeps_the_pendulums_energy_to_rounding() {
-        // Eq. (9c): the 135° pendulum (r = 1) for 10 s at 1/60 s keeps its
+        // Eq. (11): the 135° pendulum (r = 1) for 10 s at 1/60 s keeps its
         // energy to 1e-12 m·g·r (RK4 alone: 8.6e-6), and a bead at rest
         // at the bottom stays at rest.
         let theta0 = 135f64.to_radians();
@@ -285,7 +272,7 @@ mod tests {
 
     /// A bead on a line spinning at ω about a point of it, with no
     /// gravity, from rest on the line at r₀, slides out as
-    /// `r₀ cosh(ωt)` (`../shared` PHYSICS, moving wires). Every method
+    /// `r₀ cosh(ωt)` (docs/method.md, "Moving wires"). Every method
     /// follows it to its order, and the constraint-holding ones stay on
     /// the turning line.
     #[test]

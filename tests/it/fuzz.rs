@@ -15,8 +15,8 @@ use std::cell::RefCell;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use wirebead::headless::{Headless, run_steps};
 use wirebead::prelude::*;
-use wirebead::{PendingParams, ScenePreset};
 use wirebead::preset::FromPreset;
+use wirebead::{PendingParams, ScenePreset};
 
 use crate::presets::{SHIPPED, shipped_dir};
 

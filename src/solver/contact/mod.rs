@@ -1,4 +1,4 @@
-//! One-sided wires, landings and friction for one bead, eq. (14): a step
+//! One-sided wires, landings and friction for one bead, eqs. (16)–(17): a step
 //! that may leave the wire, fly, land (bouncing with a restitution), stop
 //! and stick.
 //!
@@ -86,7 +86,7 @@ const MAX_EVENTS: u32 = 4;
 ///
 /// On the wire, a one-sided wire's bead leaves where eq. (3)'s λ (with
 /// α = β = 0) changes to the sign the wire cannot push with; friction and
-/// damping enter eq. (14) at every stage (RK4, Euler) or at the step's
+/// damping enter eq. (17) at every stage (RK4, Euler) or at the step's
 /// start (RATTLE); a bead whose sliding friction stops stays at rest while
 /// the force along the wire is within static friction. In flight, the
 /// bead follows its forces alone by the method's own integrator without

@@ -1,4 +1,4 @@
-//! Constraint rows: what one constraint contributes to eq. (10), and the
+//! Constraint rows: what one constraint contributes to eq. (12), and the
 //! [`Constraint`] trait for a game's own. Springs, which are forces and not
 //! constraints, are here too, since they also join beads.
 

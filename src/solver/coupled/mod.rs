@@ -1,4 +1,4 @@
-//! Many constraints at once: Witkin's system, eqs. (10)–(12).
+//! Many constraints at once: Witkin's system, eqs. (12)–(14).
 //!
 //! Beads joined by constraints (rods, pins, wires, a game's own
 //! [`Constraint`]) and by [`SpringLink`]s form [`islands`]; each

@@ -106,7 +106,7 @@ pub(super) struct Advanced<T: Lane> {
 /// Each lane's unrotated circle, for the steps that solve on it: RATTLE,
 /// projection and the energy restore, written as
 /// [`rattle`](fn@crate::solver::rattle), [`project`](crate::solver::project)
-/// and eq. (9c) compute them for one bead (on a fixed wire, with no
+/// and eq. (11) compute them for one bead (on a fixed wire, with no
 /// surface), operation for operation, so each lane returns their bits.
 /// Each also returns the lanes where the scalar function would have
 /// succeeded; the others mean nothing.
@@ -284,7 +284,7 @@ impl<T: Lane> OnCircles<T> {
         (x, v, end, found & ok)
     }
 
-    /// Eq. (9b) (`restore_speed`) after an Euler step of length `h` from
+    /// Eq. (10) (`restore_speed`) after an Euler step of length `h` from
     /// `(x0, v0)`, where `∇C` was `n0` (usable, as the step's `regular`
     /// lanes hold): the projected velocity `vp` (where the circle is `at`)
     /// scaled to the speed of `v0 + h a_t`, `a_t` the applied acceleration
@@ -320,7 +320,7 @@ impl<T: Lane> OnCircles<T> {
         self.tangential(at, zero + now.scale(scale))
     }
 
-    /// Eq. (9c) (`restore_energy`): the projected velocity `vp` at `xp`
+    /// Eq. (11) (`restore_energy`): the projected velocity `vp` at `xp`
     /// (where the circle is `at`) scaled so the energy is that of
     /// `(x0, v0)`, and its normal component removed again.
     #[inline(always)]

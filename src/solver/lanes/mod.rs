@@ -284,8 +284,8 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut Circ
         & end.len.is_nonzero()
         & end.c.abs_le(bound);
     let (x1, v1, end) = if settings.method.projects() {
-        // Eq. (9), then the speed of eq. (9b) after an Euler step, the
-        // energy of eq. (9c) after RK4.
+        // Eq. (9), then the speed of eq. (10) after an Euler step, the
+        // energy of eq. (11) after RK4.
         let (xp, vp, at, projected) = circle.project(x1, v1, end);
         let (vr, restored) = if settings.method.is_euler() {
             circle.restore_speed(x, v, start_normal, vp, at, &force, m, h)

@@ -1,4 +1,4 @@
-//! One-sided rows and friction on an island, eq. (14): beads that leave a
+//! One-sided rows and friction on an island, eqs. (16)–(17): beads that leave a
 //! wire, land on it again (or bounce), slide against friction, stop and
 //! stick.
 
@@ -15,7 +15,7 @@ use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
 
 impl Island {
-    /// Eq. (14b) on the island at the step's start (λ from
+    /// Eq. (17) on the island at the step's start (λ from
     /// [`Island::leave`]): releases every stick row whose force passes
     /// static friction, and adds kinetic friction and damping to the force
     /// on each sliding bead. Returns each rough row's bead and its sliding
@@ -128,7 +128,7 @@ impl Island {
         work.sticks[s] = Some((axis, offset));
     }
 
-    /// Sets aside every one-sided row whose λ (eq. 10 with no
+    /// Sets aside every one-sided row whose λ (eq. 12 with no
     /// stabilization) at the step's start has the sign its wire cannot
     /// push with.
     pub(super) fn leave(

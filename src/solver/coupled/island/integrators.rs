@@ -1,4 +1,4 @@
-//! Eq. (10) on an island (λ and the accelerations, from `J W Jᵀ`
+//! Eq. (12) on an island (λ and the accelerations, from `J W Jᵀ`
 //! factored), and the RK4 and RATTLE steps built on it.
 
 use super::newton::Direction;
@@ -32,7 +32,7 @@ impl Island {
             })
     }
 
-    /// Eq. (10) at a stage `(x, v)`: λ, and the accelerations
+    /// Eq. (12) at a stage `(x, v)`: λ, and the accelerations
     /// `W (Q + Jᵀλ)` into `work.acceleration`, at `work.x, work.v` (set to
     /// `work.x0, work.v0` first at the step's start).
     pub(super) fn accelerate(
@@ -85,7 +85,7 @@ impl Island {
             }));
     }
 
-    /// Eq. (7) on the island: four solves of eq. (10); λ reported is the
+    /// Eq. (7) on the island: four solves of eq. (12); λ reported is the
     /// first stage's.
     pub(super) fn rk4(
         &self,
@@ -171,7 +171,7 @@ impl Island {
     }
 }
 
-/// Which state a solve of eq. (10) is at.
+/// Which state a solve of eq. (12) is at.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub(super) enum Stage {
     /// The step's start, `work.x0, work.v0`.

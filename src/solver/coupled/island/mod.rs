@@ -1,16 +1,16 @@
 //! [`Island`]: beads joined by constraints and springs, stepped together by
-//! every method of [`Method`](crate::solver::Method), eqs. (10)–(12). One
+//! every method of [`Method`](crate::solver::Method), eqs. (12)–(14). One
 //! file per piece:
 //!
 //! | file | what it holds |
 //! |---|---|
 //! | `mod` | [`Island`] and what may change between steps (wires, axes, sides, friction), [`IslandWork`], [`RowReport`] |
 //! | `build` | [`Island::new`]: the rows and springs checked and laid out, [`IslandRow`], [`IslandError`] |
-//! | `rows` | each row's `C`, gradient, `J̇q̇` and bias (eq. 13 for a moving wire), and the products with `J` |
+//! | `rows` | each row's `C`, gradient, `J̇q̇` and bias (eq. 15 for a moving wire), and the products with `J` |
 //! | `step` | [`Island::step`]: the step's outline, the Euler steps, the drift check, substeps and halvings |
-//! | `integrators` | eq. (10) on an island (λ and the accelerations), RK4, RATTLE |
+//! | `integrators` | eq. (12) on an island (λ and the accelerations), RK4, RATTLE |
 //! | `newton` | the Newton position solve and its check that the root continues the start |
-//! | `projection` | post-stabilization, eq. (11), and the velocity projection |
+//! | `projection` | post-stabilization, eq. (13), and the velocity projection |
 //! | `contact` | one-sided rows (leaving, landing, bouncing) and friction (sliding, stopping, sticking) |
 
 use bevy::math::DVec2;
@@ -59,7 +59,7 @@ pub struct RowReport {
 }
 
 /// Beads joined by constraints (rows) and springs, stepped as one system:
-/// the topology, built once, and what it needs to solve eq. (10) fast (the
+/// the topology, built once, and what it needs to solve eq. (12) fast (the
 /// pattern and symbolic factorization of `J W Jᵀ`). Positions, velocities
 /// and forces come with each step.
 pub struct Island {
@@ -200,7 +200,7 @@ impl Island {
 
     /// Puts the wire of row `row` on `path`, a wire that moves during the
     /// step: its rows are evaluated where the wire is at each stage's
-    /// time, with the terms of eq. (13) (the step's times come from
+    /// time, with the terms of eq. (15) (the step's times come from
     /// [`Island::step_at`]). `shape` as for [`Island::place_wire`].
     pub fn move_wire(&mut self, row: usize, shape: Option<WireShape>, path: PosePath) {
         if let Some(pose) = path.fixed() {
@@ -238,7 +238,7 @@ impl Island {
     }
 
     /// Gives the wire of row `row` Coulomb friction and viscous damping
-    /// along it, eq. (14b). `stick` names an axis row of the same bead
+    /// along it, eq. (17). `stick` names an axis row of the same bead
     /// (`RowKind::Axis`, any axis) the island uses to hold the bead still
     /// while static friction can: it is set aside while the bead slides,
     /// placed across the wire where the bead stops, and set aside again

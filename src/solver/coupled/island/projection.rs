@@ -1,4 +1,4 @@
-//! Post-stabilization on an island, eq. (11): positions back onto the
+//! Post-stabilization on an island, eq. (13): positions back onto the
 //! constraints, velocities onto `J v = 0`, and the energy or speed kept.
 
 use bevy::math::DVec2;
@@ -28,15 +28,15 @@ impl Island {
         Ok(())
     }
 
-    /// Post-stabilization, eq. (11): Newton steps along the current
+    /// Post-stabilization, eq. (13): Newton steps along the current
     /// gradients bring every `C` to zero and the velocity is projected onto
     /// `J v = 0`; then the velocities are scaled by one factor for the
     /// island (which keeps `J v = 0`). After an Euler step of length `h`
     /// the factor gives the kinetic energy of `v₀ + h P₀ W Q`: the start
     /// velocity plus the step's kick with its part off the constraints at
     /// the start removed (`P₀` the mass-weighted projection onto
-    /// `J₀ v = 0`), eq. (9b). After RK4 it keeps the energy of a
-    /// conservative island (no spring damping) what it was, eq. (9c).
+    /// `J₀ v = 0`), eq. (10). After RK4 it keeps the energy of a
+    /// conservative island (no spring damping) what it was, eq. (11).
     pub(super) fn project(
         &self,
         forces: &[LinearForce],
@@ -110,8 +110,8 @@ impl Island {
 pub(super) enum Restore {
     /// As projected: an island on a moving wire, which does work on it.
     Nothing,
-    /// The pre-kick speed after an Euler step of this length, eq. (9b).
+    /// The pre-kick speed after an Euler step of this length, eq. (10).
     Speed(f64),
-    /// The energy of the step's start after RK4, eq. (9c).
+    /// The energy of the step's start after RK4, eq. (11).
     Energy,
 }

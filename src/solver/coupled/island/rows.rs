@@ -1,5 +1,5 @@
 //! Each row of an island evaluated at a state: `C`, its gradient, `J̇q̇` and
-//! the bias of a moving wire (eq. 13), and the products with `J` and
+//! the bias of a moving wire (eq. 15), and the products with `J` and
 //! `W Jᵀ` that the solves are made of.
 
 use bevy::math::DVec2;
@@ -120,7 +120,7 @@ impl Island {
                 None
             };
             if let (Some(path), RowKind::Wire { shape, .. }) = (path, kind) {
-                // Eq. (13): the wire where it is at `time`, seen from its frame.
+                // Eq. (15): the wire where it is at `time`, seen from its frame.
                 let bead = self.entry_bead[range.start];
                 let (p, u) = (x[bead], v[bead]);
                 let (pose, twist) = path.at(time);

@@ -1,4 +1,4 @@
-//! The island's matrix `A = J W Jᵀ` of eq. (10): its sparsity pattern and
+//! The island's matrix `A = J W Jᵀ` of eq. (12): its sparsity pattern and
 //! symbolic factorization, built once per topology, and the numeric
 //! factorization and solves of each step.
 //!

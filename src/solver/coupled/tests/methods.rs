@@ -246,7 +246,7 @@ fn rattle_keeps_a_spring_pair_on_a_track_to_second_order_in_energy() {
 fn euler_with_projection_adds_no_energy_to_an_island() {
     // The double pendulum at 1/240 s for 10 s: semi-implicit Euler with
     // projection keeps the energy within 5 % of m g L = 9.81 J (0.15 J
-    // measured; 17 J without eq. (9b)).
+    // measured; 17 J without eq. (10)).
     let worst = double_pendulum_run(
         Method::SemiImplicitEuler(Stabilization::Projection),
         1.0 / 240.0,
@@ -295,7 +295,7 @@ fn double_pendulum_energy_stays_bounded_over_1000_seconds_with_rattle() {
 #[test]
 fn double_pendulum_keeps_its_energy_to_1e_6_with_rk4_and_projection() {
     // 100 s at 1/240 s: within 1e-6 of m g l = 9.81 J. RK4 alone drifts by
-    // 6.7e-6 of it here; eq. (9c) keeps the energy of the conservative
+    // 6.7e-6 of it here; eq. (11) keeps the energy of the conservative
     // island at the start's.
     let (_, worst) =
         double_pendulum_run(Method::Rk4(Stabilization::Projection), 1.0 / 240.0, 24_000);
@@ -399,7 +399,7 @@ fn each_method_converges_at_its_order_on_the_pendulum_on_a_cart() {
 
 /// Two beads on a line spinning at ω about a point of it (no gravity),
 /// joined by a rod along the line: the rod's pull cancels in the centre
-/// of mass, which slides out as `r₀ cosh ωt` like a single bead (eq. 13
+/// of mass, which slides out as `r₀ cosh ωt` like a single bead (eq. 15
 /// on an island). Every method follows it at its order; the methods that
 /// hold the constraints hold all three rows.
 #[test]
