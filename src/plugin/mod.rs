@@ -3,7 +3,7 @@
 //!
 //! | plugin | file | what it adds |
 //! |---|---|---|
-//! | [`ParamsPlugin`] | `params` | [`SimParams`](crate::SimParams) and the pending edits, the sets' order, [`ParallelStep`], a bead's `Transform` and diagnostics |
+//! | [`ParamsPlugin`] | `params` | [`SimParams`] and the pending edits, the sets' order, [`ParallelStep`], a bead's `Transform` and diagnostics |
 //! | [`ClockPlugin`] | `clock` | [`SimClock`] and the fixed timestep |
 //! | [`WirePosePlugin`] | `wires` | each wire placed for the step: its prescribed motion, or the game's moves |
 //! | [`DragPlugin`] | `forces` | the drag spring toward a [`DragTarget`](crate::DragTarget) |

@@ -30,7 +30,7 @@ impl Plugin for WirePosePlugin {
 
 /// Places every wire for the coming step, from [`SimClock::time`] to one
 /// timestep later (the clock advances after this).
-fn place_wires(
+pub(crate) fn place_wires(
     params: Res<SimParams>,
     clock: Res<SimClock>,
     mut driven: Query<(&PrescribedMotion, &mut Transform, &mut WirePose)>,

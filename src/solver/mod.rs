@@ -11,7 +11,7 @@
 //! | `euler`, `rk4`, `rattle`, `projection` | the integrators and post-stabilization, eqs. (6)–(11) |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
 //! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eqs. (16)–(17): on the wire, in flight, where an event falls |
-//! | `lanes/` (`circle`) | [`step_on_circles`]: [`LANES`] beads on circles at once, bit for bit [`step`]; [`step_on_circle_batches`]: many such batches in one call; the solves on each lane's circle |
+//! | `lanes/` (`circle`) | the batched step: eight beads on circles at once, bit for bit [`step`](fn@step), many such batches in one call; the solves on each lane's circle (crate-private) |
 //! | `coupled/` (`island/`, `normal/`, …) | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (12)–(14) |
 //!
 //! The equations below are numbered as the code and the tests cite them.
@@ -33,13 +33,12 @@ mod step;
 
 pub use contact::{Contact, ContactEvent, SurfaceStep, free_step, step_surface};
 pub use coupled::{
-    CALM_STEPS, Constraint, EXACT_STEPS, Island, IslandError, IslandRow, IslandWork, MAX_BAND,
-    MAX_HALVINGS, OFF_THE_WIRE, REDUNDANT_PIVOT, RowKind, RowReport, SpringLink, islands,
+    Constraint, Island, IslandError, IslandRow, IslandWork, RowKind, RowReport, SpringLink, islands,
 };
 pub use euler::{explicit_euler, semi_implicit_euler};
-pub use lanes::{CircleLanes, CircleSteps, LANES, step_on_circle_batches, step_on_circles};
+pub(crate) use lanes::{CircleLanes, CircleSteps, LANES, step_on_circle_batches};
 pub use method::{Integrator, Method, Stabilization};
-pub use projection::{ENERGY_CORRECTION_LIMIT, NEWTON_ACCEPT, NEWTON_TOLERANCE, project};
+pub use projection::project;
 pub use rattle::rattle;
 pub use rk4::rk4;
 pub use settings::{Gains, StepSettings};

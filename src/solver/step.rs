@@ -137,7 +137,8 @@ mod tests {
     use super::*;
     use crate::geometry::{Circle, Sine};
     use crate::solver::test_support::{G, settings};
-    use crate::solver::{NEWTON_ACCEPT, Stabilization};
+    use crate::solver::Stabilization;
+    use crate::solver::projection::NEWTON_ACCEPT;
 
     #[test]
     fn singular_point_is_an_error_not_a_nan() {

@@ -11,7 +11,7 @@ use super::{CachedIsland, InIsland, IslandReport, Islands, LinkRows};
 use crate::dynamics::{Bead, DivergenceReason, Joint, OnWire, Pin, Rod, Spring, Wire, WirePose};
 use crate::plugin::clock::SimClock;
 use crate::plugin::report::Divergences;
-use crate::solver::{self, Island, IslandRow, IslandWork, RowKind, SpringLink};
+use crate::solver::{self, BeadState, Island, IslandRow, IslandWork, RowKind, SpringLink};
 
 /// Every link in the world, as the rebuild reads them.
 #[derive(SystemParam)]
@@ -48,7 +48,7 @@ fn pin_rows(at: DVec2) -> Vec<IslandRow> {
 pub(super) fn prepare_islands(
     mut islands: ResMut<Islands>,
     links: Links,
-    beads: Query<(Entity, &Bead, Option<&OnWire>, Has<InIsland>)>,
+    mut beads: Query<(Entity, &mut Bead, Option<&OnWire>, Has<InIsland>)>,
     wires: Query<(&Wire, &WirePose)>,
     transforms: Query<&Transform>,
     mut commands: Commands,
@@ -270,21 +270,31 @@ pub(super) fn prepare_islands(
             island
         });
         match built {
-            Ok(island) => islands.cached.push(CachedIsland {
-                report: IslandReport {
-                    beads: entities,
-                    rows: row_count,
-                    ..default()
-                },
-                island,
-                work: IslandWork::default(),
-                states: Vec::with_capacity(group.len()),
-                forces: Vec::with_capacity(group.len()),
-                links: link_rows,
-                wire_rows,
-                anchored,
-                outcome: None,
-            }),
+            Ok(mut island) => {
+                let work = start_island(
+                    &mut island,
+                    &entities,
+                    &wire_rows,
+                    &wires,
+                    &mut beads,
+                    &clock,
+                );
+                islands.cached.push(CachedIsland {
+                    report: IslandReport {
+                        beads: entities,
+                        rows: row_count,
+                        ..default()
+                    },
+                    island,
+                    work,
+                    states: Vec::with_capacity(group.len()),
+                    forces: Vec::with_capacity(group.len()),
+                    links: link_rows,
+                    wire_rows,
+                    anchored,
+                    outcome: None,
+                });
+            }
             Err(reason) => {
                 for &bead in &entities {
                     divergences.report(bead, reason.clone(), clock.time);
@@ -303,4 +313,57 @@ pub(super) fn prepare_islands(
             _ => {}
         }
     }
+}
+
+/// Starts a fresh island where its beads are: each wire row on its wire's
+/// motion, and the beads' velocities projected onto the island's
+/// constraints ([`Island::project_velocities`]), so that the state a run
+/// starts from is the one simulated. A change is logged in one line.
+fn start_island(
+    island: &mut Island,
+    entities: &[Entity],
+    wire_rows: &[(usize, usize, Entity)],
+    wires: &Query<(&Wire, &WirePose)>,
+    beads: &mut Query<(Entity, &mut Bead, Option<&OnWire>, Has<InIsland>)>,
+    clock: &SimClock,
+) -> IslandWork {
+    for &(_, row, wire) in wire_rows {
+        if let Ok((_, pose)) = wires.get(wire)
+            && let Ok(path) = pose.get()
+        {
+            island.move_wire(row, None, path);
+        }
+    }
+    let mut work = IslandWork::default();
+    let mut states: Vec<BeadState> = Vec::with_capacity(entities.len());
+    for &entity in entities {
+        match beads.get(entity) {
+            Ok((_, bead, ..)) if bead.state().is_finite() => states.push(bead.state()),
+            // A bead whose state is not finite: the step reports it.
+            _ => return work,
+        }
+    }
+    let Ok((before, after)) = island.project_velocities(clock.time, &mut states, &mut work) else {
+        // No projection (a singular point): the step meets it and reports.
+        return work;
+    };
+    let mut changed = Vec::new();
+    for (&entity, state) in entities.iter().zip(&states) {
+        if let Ok((_, mut bead, ..)) = beads.get_mut(entity) {
+            let change = (state.velocity - bead.velocity).length();
+            if change > 1e-9 * bead.velocity.length().max(1.0) {
+                changed.push(entity.to_string());
+            }
+            if bead.velocity != state.velocity {
+                bead.velocity = state.velocity;
+            }
+        }
+    }
+    if !changed.is_empty() {
+        info!(
+            "wirebead: the velocities of beads {} broke their constraints and were projected onto them; their island's kinetic energy went from {before:.6} J to {after:.6} J",
+            changed.join(", ")
+        );
+    }
+    work
 }

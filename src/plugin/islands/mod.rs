@@ -17,6 +17,7 @@ use bevy::prelude::*;
 
 use super::clock::advance_clock;
 use super::schedule::WireBeadSystems;
+use super::wires::place_wires;
 use crate::dynamics::{Bead, ConstraintDiagnostics, Joint, OnWire, Pin, Rod, Spring, Wire};
 use crate::solver::{BeadState, Island, IslandWork, LinearForce, SolveError};
 
@@ -45,12 +46,22 @@ impl Plugin for IslandPlugin {
             .add_observer(topology_changed::<Remove, Spring>)
             .add_observer(topology_changed::<Insert, Joint>)
             .add_observer(topology_changed::<Remove, Joint>)
+            // Built as soon as the topology changes or a run restarts, so
+            // that the state a run starts from is the one simulated, and
+            // again before a step if a game changed it since.
+            .add_systems(
+                PreUpdate,
+                build::prepare_islands
+                    .run_if(islands_changed)
+                    .after(WireBeadSystems::Restart),
+            )
             .add_systems(
                 FixedUpdate,
                 (
                     build::prepare_islands
                         .run_if(islands_changed)
-                        .after(advance_clock)
+                        .after(place_wires)
+                        .before(advance_clock)
                         .in_set(WireBeadSystems::Prepare),
                     step::step_islands
                         .run_if(any_island)

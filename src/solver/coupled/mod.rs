@@ -22,8 +22,4 @@ mod tests;
 
 pub use constraint::{Constraint, RowKind, SpringLink};
 pub use group::islands;
-pub use island::{
-    CALM_STEPS, EXACT_STEPS, Island, IslandError, IslandRow, IslandWork, MAX_HALVINGS,
-    OFF_THE_WIRE, RowReport,
-};
-pub use normal::{MAX_BAND, REDUNDANT_PIVOT};
+pub use island::{Island, IslandError, IslandRow, IslandWork, RowReport};

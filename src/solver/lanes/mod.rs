@@ -154,7 +154,8 @@ impl CircleSteps {
 /// large is copied or cleared per call). Many batches go faster through
 /// [`step_on_circle_batches`].
 #[inline]
-pub fn step_on_circles(b: &CircleLanes, settings: &StepSettings, out: &mut CircleSteps) {
+#[cfg(test)]
+pub(super) fn step_on_circles(b: &CircleLanes, settings: &StepSettings, out: &mut CircleSteps) {
     step_on_circle_batches(std::slice::from_ref(b), settings, std::slice::from_mut(out));
 }
 

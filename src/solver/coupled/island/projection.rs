@@ -7,9 +7,67 @@ use super::newton::Direction;
 use super::{Island, IslandWork};
 use crate::solver::projection::{energy_scale, kinetic_scale};
 use crate::solver::solve::SolveError;
-use crate::solver::state::LinearForce;
+use crate::solver::state::{BeadState, LinearForce};
 
 impl Island {
+    /// Projects the beads' velocities onto the island's two-sided
+    /// constraints at `time`: `v ← v − W Jᵀ (J W Jᵀ)⁻¹ (J v − bias)`, the
+    /// velocities nearest the given ones in the kinetic-energy norm that
+    /// meet `Ċ = 0` on every rod, pin, joint and two-sided wire (a moving
+    /// wire's own velocity kept). One-sided wires and friction's stick
+    /// rows are left to the step, which lets a bead leave or land. The
+    /// positions are not moved. Returns the kinetic energy before and
+    /// after; a state that meets its constraints is returned as it was,
+    /// to rounding.
+    ///
+    /// For the first state of a run: initial velocities that break a
+    /// constraint (a crank that turns while its piston is at rest) would
+    /// otherwise be projected by the first step, so that the state the
+    /// run starts from is not the one simulated.
+    pub fn project_velocities(
+        &self,
+        time: f64,
+        states: &mut [BeadState],
+        work: &mut IslandWork,
+    ) -> Result<(f64, f64), SolveError> {
+        let kinetic = |states: &[BeadState]| -> f64 {
+            states
+                .iter()
+                .zip(&self.inverse_mass)
+                .map(|(s, w)| 0.5 * s.velocity.length_squared() / w)
+                .sum()
+        };
+        let before = kinetic(states);
+        if states.len() != self.beads() {
+            return Ok((before, before));
+        }
+        let fresh = work.inactive.len() != self.rows();
+        if fresh {
+            self.start_rows(time, states, work);
+        }
+        let held = work.inactive.clone();
+        for (r, inactive) in work.inactive.iter_mut().enumerate() {
+            *inactive |= self.sides[r].0 != 0.0;
+        }
+        work.time = time;
+        work.x.clear();
+        work.x.extend(states.iter().map(|s| s.position));
+        work.v.clear();
+        work.v.extend(states.iter().map(|s| s.velocity));
+        self.evaluate_at_new(work);
+        let projected = self.project_velocity(work);
+        work.inactive = held;
+        if fresh {
+            // The first step starts its rows from the projected state.
+            work.inactive.clear();
+        }
+        projected?;
+        for (state, v) in states.iter_mut().zip(&work.v) {
+            state.velocity = *v;
+        }
+        Ok((before, kinetic(states)))
+    }
+
     /// Removes the velocity's component off the constraints:
     /// `v ← v − W Jᵀ (J W Jᵀ)⁻¹ J v` at `work.x` (rows evaluated there).
     /// Returns with the multipliers (of `−J v`) in `work.rhs`.

@@ -23,8 +23,8 @@ impl Island {
     /// root, as when a rope's free end whips round faster than a step can
     /// follow, that part of the step and the rest of it are taken in
     /// substeps of half the length, halved again if need be, down to
-    /// 2^[`MAX_HALVINGS`] substeps. The next step starts as finely as this
-    /// one ended, and tries one halving fewer after [`CALM_STEPS`] steps
+    /// 2⁶ = 64 substeps. The next step starts as finely as this
+    /// one ended, and tries one halving fewer after eight steps
     /// that needed no more, so a long rope does not fail its way down to
     /// the same level every step; [`IslandWork::substeps`] says how many
     /// the last step took.
@@ -50,41 +50,7 @@ impl Island {
     ) -> Result<(), SolveError> {
         work.events.clear();
         if work.inactive.len() != self.rows() {
-            // A fresh island: a bead that starts off a one-sided wire, on
-            // the side it pushes toward, starts in flight; stick rows start
-            // set aside (a bead slides until friction stops it).
-            let whole = states.len() == self.beads();
-            work.inactive.clear();
-            work.inactive.resize(self.rows(), false);
-            for rough in self.rough.iter().flatten() {
-                if let Some(s) = rough.stick {
-                    work.inactive[s] = true;
-                }
-            }
-            for r in 0..self.rows() {
-                let (side, _) = self.sides[r];
-                if side != 0.0
-                    && whole
-                    && side * self.wire_row(r, states, time).c > OFF_THE_WIRE * self.rows[r].scale()
-                {
-                    work.inactive[r] = true;
-                }
-            }
-            // A bead at rest on a rough wire starts held by static friction.
-            for (r, rough) in self.rough.iter().enumerate() {
-                let Some(RoughRow { stick: Some(s), .. }) = rough else {
-                    continue;
-                };
-                let bead = self.entry_bead[self.row_start[r]];
-                if work.inactive[r] || self.paths[r].is_some() || !whole {
-                    continue;
-                }
-                let row = self.wire_row(r, states, time);
-                if states[bead].velocity == row.wire {
-                    let axis = row.tangent();
-                    self.place_stick(*s, axis, axis.dot(states[bead].position), work);
-                }
-            }
+            self.start_rows(time, states, work);
         }
         let one_sided = self.one_sided();
         let rough = self.is_rough();
@@ -108,6 +74,45 @@ impl Island {
         }
         self.follow(time + settings.dt, states, work);
         Ok(())
+    }
+
+    /// Which rows a fresh island starts with: a bead that starts off a
+    /// one-sided wire, on the side it pushes toward, starts in flight;
+    /// stick rows start set aside (a bead slides until friction stops it),
+    /// but a bead at rest on a rough wire starts held by static friction.
+    pub(super) fn start_rows(&self, time: f64, states: &[BeadState], work: &mut IslandWork) {
+        let whole = states.len() == self.beads();
+        work.inactive.clear();
+        work.inactive.resize(self.rows(), false);
+        for rough in self.rough.iter().flatten() {
+            if let Some(s) = rough.stick {
+                work.inactive[s] = true;
+            }
+        }
+        for r in 0..self.rows() {
+            let (side, _) = self.sides[r];
+            if side != 0.0
+                && whole
+                && side * self.wire_row(r, states, time).c > OFF_THE_WIRE * self.rows[r].scale()
+            {
+                work.inactive[r] = true;
+            }
+        }
+        // A bead at rest on a rough wire starts held by static friction.
+        for (r, rough) in self.rough.iter().enumerate() {
+            let Some(RoughRow { stick: Some(s), .. }) = rough else {
+                continue;
+            };
+            let bead = self.entry_bead[self.row_start[r]];
+            if work.inactive[r] || self.paths[r].is_some() || !whole {
+                continue;
+            }
+            let row = self.wire_row(r, states, time);
+            if states[bead].velocity == row.wire {
+                let axis = row.tangent();
+                self.place_stick(*s, axis, axis.dot(states[bead].position), work);
+            }
+        }
     }
 
     /// The step of length `settings.dt` as `2^level` equal substeps, from
