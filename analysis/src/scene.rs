@@ -9,7 +9,7 @@ use std::time::Instant;
 use bevy::math::DVec2;
 use bevy::prelude::{Entity, FixedUpdate, IntoScheduleConfigs, Query, Res, ResMut, Resource};
 use wirebead::geometry::{ImplicitCurve, Placed, Pose, WireMotion, WireShape};
-use wirebead::headless::{Headless, run_steps};
+use wirebead::headless::{Headless, idle, run_steps};
 use wirebead::{
     Bead, Diverged, Method, ParamError, SceneLink, ScenePreset, SimClock, SimParams,
     WireBeadPlugin, WireBeadSystems, WireContact,
@@ -205,6 +205,10 @@ fn scene_app(
     let mut app = Headless::new(plugin).single_threaded().build();
     let beads = preset.spawn(&mut app.world_mut().commands());
     app.world_mut().flush();
+    // One update with no step: the islands are built and their initial
+    // velocities projected onto their constraints, so row 0 is the state
+    // the first step starts from.
+    idle(&mut app);
     Ok((app, beads))
 }
 

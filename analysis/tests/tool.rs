@@ -196,3 +196,35 @@ fn compare_scene_holds_rattle_to_rounding_on_the_double_pendulum() {
     let md = analysis::scene_comparison_markdown(&table, &preset, 2.0);
     assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 11);
 }
+
+#[test]
+fn simulate_scene_starts_from_velocities_that_meet_the_constraints() {
+    // A slider-crank whose crank turns while its piston was left at rest:
+    // row 0 is the projected state the first step starts from, so the
+    // energy of row 1 is row 0's to the step's own error.
+    let preset = wirebead::ScenePreset::from_ron(
+        r#"(
+            name: "Slider-crank",
+            params: (integrator: Rattle, timestep: 0.001),
+            wires: [
+                (shape: Circle((radius: 0.5)), beads: [(name: "crank", mass: 1.0,
+                    initial_position: (0.0, 0.5), initial_velocity: (-2.0, 0.0))]),
+                (shape: Line(()), beads: [(name: "piston", mass: 2.0,
+                    initial_position: (1.4142135623730951, 0.0))]),
+            ],
+            constraints: [Rod((a: "crank", b: "piston", length: 1.5))],
+        )"#,
+    )
+    .unwrap();
+    let run = analysis::simulate_scene(&preset, preset.params.clone(), 0.01).unwrap();
+    let (row0, row1) = (&run.rows[0], &run.rows[1]);
+    assert!(row0.velocities[1].x.abs() > 0.5, "the piston starts at rest");
+    let given = 0.5 * 1.0 * 4.0 + 1.0 * 9.81 * 0.5;
+    assert!(row0.energy < given - 0.1, "{} J given, {} J in row 0", given, row0.energy);
+    assert!(
+        (row1.energy - row0.energy).abs() < 1e-6,
+        "row 0 {} J, row 1 {} J",
+        row0.energy,
+        row1.energy
+    );
+}
