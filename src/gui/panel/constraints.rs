@@ -1,0 +1,41 @@
+//! The list of rods and pins with each one's drift and multiplier.
+
+use bevy_egui::egui;
+
+use super::view::PanelView;
+use crate::ConstraintDiagnostics;
+
+/// Every rod and pin with its drift `C` and multiplier λ (a rod under
+/// tension pulls: λ < 0).
+pub(super) fn constraints_section(ui: &mut egui::Ui, view: &PanelView) {
+    if view.rods.is_empty() && view.pins.is_empty() {
+        return;
+    }
+    ui.separator();
+    egui::CollapsingHeader::new("Constraints")
+        .default_open(true)
+        .show(ui, |ui| {
+            egui::Grid::new("constraints")
+                .num_columns(3)
+                .striped(true)
+                .show(ui, |ui| {
+                    ui.strong("");
+                    ui.strong("C");
+                    ui.strong("λ");
+                    ui.end_row();
+                    let mut row = |label: String, d: &ConstraintDiagnostics| {
+                        ui.label(label);
+                        ui.monospace(format!("{:+.2e}", d.c));
+                        ui.monospace(format!("{:+.3e}", d.lambda));
+                        ui.end_row();
+                    };
+                    for (rod, d) in &view.rods {
+                        let [a, b] = rod.beads().map(|e| view.name(e));
+                        row(format!("rod {a}–{b}"), d);
+                    }
+                    for (pin, d) in &view.pins {
+                        row(format!("pin {}", view.name(pin.bead())), d);
+                    }
+                });
+        });
+}

@@ -1,0 +1,85 @@
+//! The egui panel: every parameter of the assignment's panel plus gravity, wire
+//! shape and size, integrator and stabilization; a marker while edits are
+//! pending; live plots of `C`, energy and λ; divergence and scene-file
+//! errors in plain words.
+//!
+//! Edits go through the plugin's validating setters: an invalid value is
+//! refused with the plugin's error message and never reaches the
+//! simulation.
+
+mod constraints;
+mod params;
+mod plots;
+mod view;
+mod window;
+
+use bevy::prelude::*;
+use bevy_egui::EguiPrimaryContextPass;
+
+pub use plots::{PlotHistory, PlotSample, record_history};
+pub use view::{PanelActions, PanelView};
+pub use window::panel;
+
+use crate::gui::drag::SelectedBead;
+use crate::{Bead, WireBeadSystems};
+
+/// The presets the panel offers: `(label, asset path)`.
+#[derive(Resource, Clone, Debug)]
+pub struct PresetCatalog(pub Vec<(String, String)>);
+
+impl Default for PresetCatalog {
+    fn default() -> Self {
+        Self(
+            [
+                (
+                    "The assignment's circle",
+                    "scenes/assignment_circle.scene.ron",
+                ),
+                ("Tilted ellipse", "scenes/ellipse.scene.ron"),
+                ("Sine track", "scenes/sine_track.scene.ron"),
+                ("Many beads", "scenes/multi_bead.scene.ron"),
+                ("Bead at rest", "scenes/resting.scene.ron"),
+                ("Pendulum on a cart", "scenes/pendulum_on_cart.scene.ron"),
+                ("Double pendulum", "scenes/double_pendulum.scene.ron"),
+                ("Rope on a rail", "scenes/rope.scene.ron"),
+                ("Ring of beads on a circle", "scenes/ring.scene.ron"),
+                (
+                    "Two beads and a spring on a track",
+                    "scenes/spring_pair.scene.ron",
+                ),
+                ("Kapitza pendulum", "scenes/kapitza.scene.ron"),
+                ("Bead on a spinning rod", "scenes/spinning_rod.scene.ron"),
+                ("Tautochrone race", "scenes/tautochrone.scene.ron"),
+                ("Roller coaster", "scenes/roller_coaster.scene.ron"),
+            ]
+            .into_iter()
+            .map(|(a, b)| (a.to_owned(), b.to_owned()))
+            .collect(),
+        )
+    }
+}
+
+/// The egui panel and plots.
+#[derive(Default)]
+pub struct PanelPlugin;
+
+impl Plugin for PanelPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<PresetCatalog>()
+            .init_resource::<PlotHistory>()
+            .init_resource::<SelectedBead>()
+            .add_systems(
+                FixedUpdate,
+                record_history.after(WireBeadSystems::Writeback),
+            )
+            .add_systems(Update, keep_selection)
+            .add_systems(EguiPrimaryContextPass, panel);
+    }
+}
+
+/// Selects the first bead when none (or a despawned one) is selected.
+pub fn keep_selection(mut selected: ResMut<SelectedBead>, beads: Query<Entity, With<Bead>>) {
+    if selected.0.is_none_or(|e| !beads.contains(e)) {
+        selected.0 = beads.iter().min();
+    }
+}

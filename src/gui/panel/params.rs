@@ -1,0 +1,255 @@
+//! Editing the parameters: the selected bead's, its wire's shape, and the
+//! solver's, each through the plugin's validating setters.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy_egui::egui;
+
+use super::view::PanelView;
+use crate::geometry::Cycloid;
+use crate::{
+    BeadParams, Integrator, ParamError, PendingBead, PendingParams, PendingWire, PrescribedMotion,
+    Side, Stabilization, Surface, WireContact, WireKind, WireMotion, WireShape, pose_of,
+};
+
+/// The result of an edit: `None` where nothing was edited.
+pub(super) type Edit = Option<Result<(), ParamError>>;
+
+fn number(ui: &mut egui::Ui, label: &str, value: &mut f64, speed: f64) {
+    ui.label(label);
+    ui.add(egui::DragValue::new(value).speed(speed).max_decimals(6));
+    ui.end_row();
+}
+
+/// A menu of `all`, each shown by its `name`.
+fn choice<T: Copy + PartialEq>(
+    ui: &mut egui::Ui,
+    id: &str,
+    value: &mut T,
+    all: &[T],
+    name: fn(T) -> &'static str,
+) {
+    egui::ComboBox::from_id_salt(id)
+        .selected_text(name(*value))
+        .show_ui(ui, |ui| {
+            for &c in all {
+                ui.selectable_value(value, c, name(c));
+            }
+        });
+}
+
+fn vector(ui: &mut egui::Ui, label: &str, value: &mut DVec2, speed: f64) {
+    ui.label(label);
+    ui.horizontal(|ui| {
+        ui.add(egui::DragValue::new(&mut value.x).speed(speed).prefix("x "));
+        ui.add(egui::DragValue::new(&mut value.y).speed(speed).prefix("y "));
+    });
+    ui.end_row();
+}
+
+/// The selected bead's parameters, its wire's shape, and its diagnostics.
+pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) -> Edit {
+    let (entity, bead, diagnostics, on_wire, pending_bead, _) =
+        view.selected.0.and_then(|e| view.beads.get(e).ok())?;
+    ui.separator();
+    ui.strong(format!("Bead {}", view.name(entity)));
+    let mut draft: BeadParams = pending_bead.map_or(*bead.params(), |p| *p.get());
+    let before = draft;
+    egui::Grid::new("bead").num_columns(2).show(ui, |ui| {
+        number(ui, "mass", &mut draft.mass, 0.01);
+        vector(ui, "initial position", &mut draft.initial_position, 0.01);
+        vector(ui, "initial velocity", &mut draft.initial_velocity, 0.01);
+    });
+    let mut outcome = None;
+    if let Some(on_wire) = on_wire
+        && let Ok((wire, transform, pending_wire, motion)) = view.wires.get(on_wire.0)
+    {
+        let shape = pending_wire.map_or_else(|| wire.shape().clone(), |p| p.shape().clone());
+        if let Some(edited) = wire_editor(ui, &shape) {
+            outcome = Some(PendingWire::new(edited.clone()).map(|edit| {
+                commands.entity(on_wire.0).insert(edit);
+                // Start the bead at the new wire's lowest point.
+                let pose = pose_of(transform).unwrap_or_default();
+                draft.initial_position = pose.to_world(edited.bottom());
+            }));
+        }
+        let contact = view.contacts.get(entity).ok();
+        track_lines(
+            ui,
+            wire.surface(),
+            motion.map(PrescribedMotion::motion),
+            contact,
+        );
+    }
+    if draft != before {
+        outcome = Some(PendingBead::new(draft).map(|edit| {
+            commands.entity(entity).insert(edit);
+        }));
+    }
+
+    ui.separator();
+    let clock = &view.clock;
+    egui::Grid::new("values").num_columns(4).show(ui, |ui| {
+        ui.label("C");
+        ui.monospace(format!("{:+.3e}", diagnostics.c));
+        ui.label("Ċ");
+        ui.monospace(format!("{:+.3e}", diagnostics.c_dot));
+        ui.end_row();
+        ui.label("λ");
+        ui.monospace(format!("{:+.3e}", diagnostics.lambda));
+        ui.label("E");
+        ui.monospace(format!("{:+.4}", diagnostics.energy()));
+        ui.end_row();
+        ui.label("t");
+        ui.monospace(format!("{:.2} s", clock.time));
+        ui.label("steps");
+        ui.monospace(format!("{}", clock.steps));
+        ui.end_row();
+        if let Some(island) = view.islands.of(entity).filter(|i| i.rows > 0) {
+            ui.label("island E");
+            ui.monospace(format!("{:+.4}", island.energy));
+            ui.label("beads");
+            ui.monospace(format!("{}", island.beads.len()));
+            ui.end_row();
+        }
+    });
+    outcome
+}
+
+/// What the wire does besides holding the bead, in words: its motion, its
+/// side, restitution, friction and damping, and whether the bead is on it.
+fn track_lines(
+    ui: &mut egui::Ui,
+    surface: &Surface,
+    motion: Option<WireMotion>,
+    contact: Option<&WireContact>,
+) {
+    let moving = match motion {
+        Some(WireMotion::Oscillate(o)) => Some(format!(
+            "oscillates by ({:.2}, {:.2}) at {:.2} Hz",
+            o.amplitude.x, o.amplitude.y, o.frequency
+        )),
+        Some(WireMotion::Spin(s)) => Some(format!("spins at {:.2} rad/s", s.angular_velocity)),
+        _ => None,
+    };
+    let mut lines: Vec<String> = moving.into_iter().collect();
+    if surface.side != Side::Both {
+        lines.push(format!(
+            "pushes one way ({} side), restitution {:.2}",
+            surface.side.name(),
+            surface.restitution
+        ));
+    }
+    if surface.friction.is_some() {
+        lines.push(format!(
+            "friction μs {:.2}, μk {:.2}",
+            surface.friction.static_coefficient, surface.friction.kinetic_coefficient
+        ));
+    }
+    if surface.damping > 0.0 {
+        lines.push(format!("damping {:.2} N·s/m", surface.damping));
+    }
+    if let Some(contact) = contact
+        && (surface.side != Side::Both || !contact.is_on())
+    {
+        lines.push(
+            if contact.is_on() {
+                "on its wire"
+            } else {
+                "in flight"
+            }
+            .to_owned(),
+        );
+    }
+    for line in lines {
+        ui.label(line);
+    }
+}
+
+/// The wire's kind (from [`WireKind::ALL`]) and dimensions; the edited
+/// shape if anything changed.
+fn wire_editor(ui: &mut egui::Ui, shape: &WireShape) -> Option<WireShape> {
+    let mut edited = shape.clone();
+    ui.strong("Wire");
+    egui::Grid::new("wire").num_columns(2).show(ui, |ui| {
+        ui.label("shape");
+        let mut kind = edited.kind();
+        egui::ComboBox::from_id_salt("shape")
+            .selected_text(edited.name())
+            .show_ui(ui, |ui| {
+                for k in WireKind::ALL {
+                    ui.selectable_value(&mut kind, Some(k), k.name());
+                }
+            });
+        ui.end_row();
+        if let Some(kind) = kind.filter(|k| Some(*k) != edited.kind()) {
+            edited = kind.shape(edited.curve().scale());
+        }
+        match &mut edited {
+            WireShape::Circle(c) => number(ui, "radius", &mut c.radius, 0.01),
+            WireShape::Ellipse(e) => {
+                number(ui, "semi-axis a", &mut e.a, 0.01);
+                number(ui, "semi-axis b", &mut e.b, 0.01);
+            }
+            WireShape::Parabola(p) => number(ui, "focal length", &mut p.focal_length, 0.01),
+            WireShape::Sine(s) => {
+                number(ui, "amplitude", &mut s.amplitude, 0.01);
+                number(ui, "wavelength", &mut s.wavelength, 0.01);
+            }
+            WireShape::Cycloid(c) => {
+                let mut radius = c.radius();
+                number(ui, "radius", &mut radius, 0.01);
+                if radius != c.radius() {
+                    *c = Cycloid::new(radius);
+                }
+            }
+            WireShape::Line(_) | WireShape::Spline(_) | WireShape::Custom(_) => {}
+        }
+    });
+    (format!("{edited:?}") != format!("{shape:?}")).then_some(edited)
+}
+
+/// The parameters every bead shares.
+pub(super) fn solver_section(ui: &mut egui::Ui, pending: &mut PendingParams) -> Edit {
+    ui.separator();
+    ui.strong("Solver");
+    let mut draft = pending.get().clone();
+    egui::Grid::new("solver").num_columns(2).show(ui, |ui| {
+        number(ui, "timestep (s)", &mut draft.timestep, 0.0005);
+        number(ui, "spring constant α", &mut draft.alpha, 1.0);
+        number(ui, "damping constant β", &mut draft.beta, 0.1);
+        number(ui, "drag scale k", &mut draft.drag_stiffness, 0.1);
+        vector(ui, "gravity", &mut draft.gravity, 0.01);
+        ui.label("integrator");
+        let mut integrator = draft.method.integrator();
+        choice(
+            ui,
+            "integrator",
+            &mut integrator,
+            Integrator::ALL,
+            Integrator::name,
+        );
+        draft.method = draft.method.with_integrator(integrator);
+        ui.end_row();
+        ui.label("stabilization");
+        match draft.method.stabilization() {
+            Some(mut stabilization) => {
+                let all = Stabilization::ALL;
+                choice(
+                    ui,
+                    "stabilization",
+                    &mut stabilization,
+                    all,
+                    Stabilization::name,
+                );
+                draft.method = draft.method.with_stabilization(stabilization);
+            }
+            None => {
+                ui.label("none: RATTLE holds the wire itself");
+            }
+        }
+        ui.end_row();
+        number(ui, "divergence bound", &mut draft.divergence_bound, 0.01);
+    });
+    (&draft != pending.get()).then(|| pending.set(draft))
+}

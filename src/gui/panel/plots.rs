@@ -1,0 +1,129 @@
+//! The selected bead's last seconds of drift, energy and λ: recorded each
+//! step and plotted with labelled axes.
+
+use std::collections::VecDeque;
+
+use bevy::prelude::*;
+use bevy_egui::egui;
+use egui_plot::{Line, Plot, PlotPoints};
+
+use crate::gui::drag::SelectedBead;
+use crate::{BeadDiagnostics, Islands, SimClock};
+
+/// One plotted sample of the selected bead.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlotSample {
+    /// Simulated time.
+    pub t: f64,
+    /// Drift `C`.
+    pub c: f64,
+    /// Energy.
+    pub energy: f64,
+    /// λ.
+    pub lambda: f64,
+}
+
+/// The last seconds of the selected bead's diagnostics.
+#[derive(Resource, Clone, Debug)]
+pub struct PlotHistory {
+    /// Seconds kept.
+    pub seconds: f64,
+    /// The samples, oldest first.
+    pub samples: VecDeque<PlotSample>,
+    bead: Option<Entity>,
+}
+
+impl Default for PlotHistory {
+    fn default() -> Self {
+        Self {
+            seconds: 10.0,
+            samples: VecDeque::new(),
+            bead: None,
+        }
+    }
+}
+
+/// Appends the selected bead's diagnostics to the plot history; for a
+/// bead joined to others, the energy is its island's (a rod does work on
+/// each of its beads, not on the two together).
+pub fn record_history(
+    selected: Res<SelectedBead>,
+    clock: Res<SimClock>,
+    beads: Query<&BeadDiagnostics>,
+    islands: Res<Islands>,
+    mut history: ResMut<PlotHistory>,
+) {
+    let Some(entity) = selected.0 else { return };
+    let Ok(d) = beads.get(entity) else { return };
+    let t = clock.time;
+    if history.bead != Some(entity) || history.samples.back().is_some_and(|s| s.t > t) {
+        history.samples.clear();
+        history.bead = Some(entity);
+    }
+    let energy = islands
+        .of(entity)
+        .filter(|island| island.rows > 0)
+        .map_or(d.energy(), |island| island.energy);
+    history.samples.push_back(PlotSample {
+        t,
+        c: d.c,
+        energy,
+        lambda: d.lambda,
+    });
+    let horizon = t - history.seconds;
+    while history.samples.front().is_some_and(|s| s.t < horizon) {
+        history.samples.pop_front();
+    }
+}
+
+/// A plot of the last seconds with labelled axes: time in seconds, the
+/// value (its unit is in the heading above) with tick labels in scientific
+/// notation, so that a range of 1e-16 reads as rounding noise and not as a
+/// swing.
+fn plot(
+    ui: &mut egui::Ui,
+    id: &str,
+    name: &str,
+    points: impl Iterator<Item = [f64; 2]>,
+    colour: egui::Color32,
+) {
+    Plot::new(id)
+        .height(90.0)
+        .allow_drag(false)
+        .allow_zoom(false)
+        .allow_scroll(false)
+        .x_axis_label("t (s)")
+        .y_axis_min_width(48.0)
+        .y_axis_formatter(|mark, _| format!("{:.1e}", mark.value))
+        .show(ui, |plot_ui| {
+            plot_ui.line(Line::new(name, points.collect::<PlotPoints>()).color(colour));
+        });
+}
+
+/// Plots of the selected bead's last seconds, each with its axes labelled.
+pub(super) fn plots_section(ui: &mut egui::Ui, history: &PlotHistory) {
+    ui.separator();
+    let samples = &history.samples;
+    for (id, label, unit, colour, value) in [
+        (
+            "plot-c",
+            "drift C",
+            "m",
+            egui::Color32::LIGHT_BLUE,
+            (|s: &PlotSample| s.c) as fn(&PlotSample) -> f64,
+        ),
+        ("plot-e", "energy E", "J", egui::Color32::LIGHT_GREEN, |s| {
+            s.energy
+        }),
+        ("plot-l", "λ", "N", egui::Color32::GOLD, |s| s.lambda),
+    ] {
+        ui.label(format!("{label} ({unit})"));
+        plot(
+            ui,
+            id,
+            label,
+            samples.iter().map(|s| [s.t, value(s)]),
+            colour,
+        );
+    }
+}

@@ -1,0 +1,79 @@
+//! What the panel reads from the world and what its controls write to it,
+//! gathered as system parameters the sections share.
+
+use bevy::ecs::system::SystemParam;
+use bevy::prelude::*;
+
+use super::PresetCatalog;
+use super::plots::PlotHistory;
+use crate::controls::{ControlKeys, StepRequests};
+use crate::gui::drag::SelectedBead;
+use crate::gui::render::SceneStyle;
+use crate::preset::{ActivePreset, LoadPreset};
+use crate::{
+    Bead, BeadDiagnostics, ConstraintDiagnostics, Diverged, Islands, OnWire, PendingBead,
+    PendingParams, PendingWire, Pin, PrescribedMotion, Restart, Rod, SimClock, SimParams, Wire,
+    WireContact,
+};
+
+/// The read-only state the panel shows.
+#[derive(SystemParam)]
+pub struct PanelView<'w, 's> {
+    pub(super) style: Res<'w, SceneStyle>,
+    pub(super) keys: Res<'w, ControlKeys>,
+    pub(super) catalog: Res<'w, PresetCatalog>,
+    pub(super) active: Res<'w, ActivePreset>,
+    pub(super) history: Res<'w, PlotHistory>,
+    pub(super) params: Res<'w, SimParams>,
+    pub(super) selected: Res<'w, SelectedBead>,
+    pub(super) beads: Query<
+        'w,
+        's,
+        (
+            Entity,
+            &'static Bead,
+            &'static BeadDiagnostics,
+            Option<&'static OnWire>,
+            Option<&'static PendingBead>,
+            Option<&'static Diverged>,
+        ),
+    >,
+    pub(super) wires: Query<
+        'w,
+        's,
+        (
+            &'static Wire,
+            &'static Transform,
+            Option<&'static PendingWire>,
+            Option<&'static PrescribedMotion>,
+        ),
+    >,
+    pub(super) contacts: Query<'w, 's, &'static WireContact>,
+    pub(super) rods: Query<'w, 's, (&'static Rod, &'static ConstraintDiagnostics)>,
+    pub(super) pins: Query<'w, 's, (&'static Pin, &'static ConstraintDiagnostics)>,
+    pub(super) names: Query<'w, 's, &'static Name>,
+    pub(super) islands: Res<'w, Islands>,
+    pub(super) pending_beads: Query<'w, 's, (), With<PendingBead>>,
+    pub(super) pending_wires: Query<'w, 's, (), With<PendingWire>>,
+    pub(super) clock: Res<'w, SimClock>,
+}
+
+/// What the panel's controls ask of the world this frame.
+#[derive(SystemParam)]
+pub struct PanelActions<'w, 's> {
+    pub(super) pending: ResMut<'w, PendingParams>,
+    pub(super) time: ResMut<'w, Time<Virtual>>,
+    pub(super) steps: ResMut<'w, StepRequests>,
+    pub(super) restarts: MessageWriter<'w, Restart>,
+    pub(super) loads: MessageWriter<'w, LoadPreset>,
+    pub(super) commands: Commands<'w, 's>,
+}
+
+impl PanelView<'_, '_> {
+    /// A bead's name, or its entity where it has none.
+    pub(super) fn name(&self, bead: Entity) -> String {
+        self.names
+            .get(bead)
+            .map_or_else(|_| bead.to_string(), |n| n.as_str().to_owned())
+    }
+}

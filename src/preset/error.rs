@@ -1,0 +1,104 @@
+//! What is wrong with a scene file, in one line that names the place.
+
+use crate::validate::ParamError;
+
+/// What is wrong with a scene file.
+#[derive(Debug, thiserror::Error)]
+pub enum PresetError {
+    /// The file is not valid RON for a preset.
+    #[error(
+        "malformed scene file at line {}, column {}: {}",
+        .0.span.start.line,
+        .0.span.start.col,
+        .0.code
+    )]
+    Parse(#[from] ron::error::SpannedError),
+    /// A field the format does not have (a misspelt name, or one from a
+    /// later version): refused rather than ignored.
+    #[error(
+        "unknown field `{field}` in {item} at line {line}, column {column}; the file was refused (known fields: {known})"
+    )]
+    UnknownField {
+        /// The field as written.
+        field: String,
+        /// Where it is: `the scene`, `wires[2]`, `wires[0].beads[1]`.
+        item: String,
+        /// The line it is on.
+        line: usize,
+        /// Its column.
+        column: usize,
+        /// The fields that item has.
+        known: String,
+    },
+    /// The file could not be read.
+    #[error("cannot read scene file: {0}")]
+    Io(#[from] std::io::Error),
+    /// The parameters are invalid.
+    #[error("invalid params: {0}")]
+    Params(ParamError),
+    /// A wire is invalid.
+    #[error("wire {index}: {source}")]
+    Wire {
+        /// Its index in `wires`.
+        index: usize,
+        /// What is wrong.
+        source: ParamError,
+    },
+    /// A bead is invalid.
+    #[error("wire {wire}, bead {bead}: {source}")]
+    Bead {
+        /// The wire's index.
+        wire: usize,
+        /// The bead's index on it.
+        bead: usize,
+        /// What is wrong.
+        source: ParamError,
+    },
+    /// A free bead is invalid.
+    #[error("bead {name:?}: {source}")]
+    FreeBead {
+        /// Its name.
+        name: String,
+        /// What is wrong.
+        source: ParamError,
+    },
+    /// Two beads have one name.
+    #[error("two beads are named {0:?}")]
+    DuplicateName(String),
+    /// A constraint or spring is invalid.
+    #[error("{item}: {problem}")]
+    Link {
+        /// Which, in words: `constraint 0 (rod)`, `spring 1`.
+        item: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// The scene has no bead.
+    #[error("the scene has no bead")]
+    Empty,
+}
+
+impl PresetError {
+    /// A parse error at `path` (as `serde_path_to_error` writes it, the
+    /// field last): an unknown field names itself and its item.
+    pub(super) fn at(path: String, error: ron::error::SpannedError) -> Self {
+        match &error.code {
+            ron::Error::NoSuchStructField {
+                expected, found, ..
+            } => {
+                let item = match path.rsplit_once('.') {
+                    Some((item, _)) => item.to_owned(),
+                    None => "the scene".to_owned(),
+                };
+                PresetError::UnknownField {
+                    field: found.clone(),
+                    item,
+                    line: error.span.start.line,
+                    column: error.span.start.col,
+                    known: expected.join(", "),
+                }
+            }
+            _ => PresetError::Parse(error),
+        }
+    }
+}
