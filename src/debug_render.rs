@@ -12,7 +12,7 @@ use bevy::prelude::*;
 
 use crate::dynamics::Rod;
 use crate::dynamics::{
-    Bead, BeadDiagnostics, Diverged, DragTarget, OnWire, Pin, SimParams, Spring, Wire, pose_of,
+    Bead, BeadDiagnostics, Diverged, OnWire, Pin, SimParams, Spring, SpringAnchor, Wire, pose_of,
 };
 use crate::geometry::{ImplicitCurve, Placed, Pose, WireShape};
 
@@ -54,7 +54,7 @@ pub struct DebugRenderStyle {
     pub spring: Color,
     /// The constraint force arrow on a bead on a wire.
     pub constraint_force: Color,
-    /// The drag spring, from a bead to its [`DragTarget`].
+    /// The drag spring, from a bead to its [`SpringAnchor`].
     pub drag: Color,
     /// Whether beads are drawn (off where they have meshes of their own).
     pub beads: bool,
@@ -192,7 +192,7 @@ pub fn draw_forces(
     beads: Query<(
         &Bead,
         Option<&BeadDiagnostics>,
-        Option<&DragTarget>,
+        Option<&SpringAnchor>,
         Has<OnWire>,
     )>,
     params: Res<SimParams>,

@@ -37,10 +37,10 @@
 //! | [`PrescribedMotion`] | a wire that moves ([`WireMotion`]: oscillates or spins), its motion exact in the constraint force; a wire the game moves is followed |
 //! | [`Rod`], [`Pin`], [`Joint`], [`Spring`] | links between beads, each on an entity of its own; [`Constraint`] for a game's own joint |
 //! | [`Islands`], [`ConstraintDiagnostics`] | the beads links join, solved together (`J W Jᵀ λ = …`); each link's `C`, `Ċ`, λ |
-//! | [`SimParams`], [`PendingParams`], [`PendingBead`], [`PendingWire`] | applied and edited parameters; [`Restart`] applies the edits |
+//! | [`SimParams`], [`NextParams`], [`NextBeadParams`], [`NextWireShape`] | applied and edited parameters; [`Restart`] applies the edits |
 //! | [`Method`] | an [`Integrator`] with its [`Stabilization`] (RATTLE takes none) |
 //! | [`KeyboardControlsPlugin`] | Space restarts, P pauses, N steps once: headless-testable |
-//! | [`DragTarget`] | the user's drag: a spring `k (target - x)` while present |
+//! | [`SpringAnchor`] | a point a spring `k (anchor - x)` pulls a bead toward (the assignment's mouse drag) |
 //! | [`BeadDiagnostics`], [`Diverged`], [`BeadDiverged`] | `C`, `Ċ`, λ and energy each step; divergence reports |
 //! | [`SimClock`], [`ParallelStep`] | steps and seconds since the last restart; when the step splits over threads |
 //! | [`ScenePresetPlugin`], [`ScenePreset`] | scenes as RON assets (`*.scene.ron`), hot-reloaded |
@@ -94,9 +94,9 @@ mod validate;
 pub use controls::KeyboardControlsPlugin;
 pub use dynamics::{
     Bead, BeadDiagnostics, BeadDiverged, BeadParams, ConstraintDiagnostics, ContactChanged,
-    Diverged, DivergenceReason, DragTarget, Joint, MAX_TIMESTEP, MIN_TIMESTEP, OnWire, PendingBead,
-    PendingParams, PendingWire, Pin, PrescribedMotion, Rod, SimParams, Spring, Wire, WireBeads,
-    WireContact, pose_of,
+    Diverged, DivergenceReason, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams, NextParams,
+    NextWireShape, OnWire, Pin, PrescribedMotion, Rod, SimParams, Spring, SpringAnchor, Wire,
+    WireBeads, WireContact, pose_of,
 };
 pub use geometry::{
     Friction, ImplicitCurve, Oscillate, Side, Spin, Surface, WireKind, WireMotion, WireShape,
@@ -108,8 +108,21 @@ pub use preset::{ActivePreset, LoadPreset, SceneLink, ScenePreset, ScenePresetPl
 pub use solver::{Constraint, Integrator, Method, Stabilization};
 pub use validate::ParamError;
 
+/// The old name of [`SpringAnchor`].
+#[deprecated(note = "renamed to `SpringAnchor`: a point a spring pulls the bead toward")]
+pub type DragTarget = SpringAnchor;
+/// The old name of [`NextParams`].
+#[deprecated(note = "renamed to `NextParams`: the parameters the next restart applies")]
+pub type PendingParams = NextParams;
+/// The old name of [`NextBeadParams`].
+#[deprecated(note = "renamed to `NextBeadParams`: a bead's parameters for the next restart")]
+pub type PendingBead = NextBeadParams;
+/// The old name of [`NextWireShape`].
+#[deprecated(note = "renamed to `NextWireShape`: a wire's shape for the next restart")]
+pub type PendingWire = NextWireShape;
+
 /// The nouns a game uses: `use wirebead::prelude::*;`. Everything else
-/// is at the crate root (`wirebead::Islands`, `wirebead::PendingParams`, …).
+/// is at the crate root (`wirebead::Islands`, `wirebead::NextParams`, …).
 pub mod prelude {
     pub use crate::{
         Bead, BeadDiagnostics, BeadParams, Diverged, ImplicitCurve, Method, OnWire, Pin,

@@ -15,6 +15,7 @@ use std::process::ExitCode;
 use bevy::math::DVec2;
 use clap::{Args, Parser, Subcommand};
 use wirebead::prelude::*;
+use wirebead::{Integrator, Stabilization, WireKind};
 use wirebead_analysis::{self as analysis, RunConfig};
 
 /// Headless runs, the assignment's figures, and the method comparison.

@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use wirebead::Stabilization;
 use wirebead::prelude::*;
 use wirebead_analysis::{self as analysis, FIGURE_SIZE, RunConfig};
 
@@ -218,9 +219,17 @@ fn simulate_scene_starts_from_velocities_that_meet_the_constraints() {
     .unwrap();
     let run = analysis::simulate_scene(&preset, preset.params.clone(), 0.01).unwrap();
     let (row0, row1) = (&run.rows[0], &run.rows[1]);
-    assert!(row0.velocities[1].x.abs() > 0.5, "the piston starts at rest");
+    assert!(
+        row0.velocities[1].x.abs() > 0.5,
+        "the piston starts at rest"
+    );
     let given = 0.5 * 1.0 * 4.0 + 1.0 * 9.81 * 0.5;
-    assert!(row0.energy < given - 0.1, "{} J given, {} J in row 0", given, row0.energy);
+    assert!(
+        row0.energy < given - 0.1,
+        "{} J given, {} J in row 0",
+        given,
+        row0.energy
+    );
     assert!(
         (row1.energy - row0.energy).abs() < 1e-6,
         "row 0 {} J, row 1 {} J",

@@ -1,5 +1,6 @@
 //! [`Bead`]: a particle's parameters and `f64` state, with the force
-//! accumulated for the next step; its pending edit and the drag target.
+//! accumulated for the next step; its parameters for the next run and the
+//! spring anchor that pulls it.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -166,13 +167,13 @@ impl Bead {
 }
 
 /// Edited [`BeadParams`] for one bead, applied (and removed) by the next
-/// [`Restart`](crate::Restart). Construct it with [`PendingBead::new`] so that
+/// [`Restart`](crate::Restart). Construct it with [`NextBeadParams::new`] so that
 /// an invalid edit never gets into the world.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
 #[reflect(Component)]
-pub struct PendingBead(BeadParams);
+pub struct NextBeadParams(BeadParams);
 
-impl PendingBead {
+impl NextBeadParams {
     /// A pending edit, if `params` is valid.
     pub fn new(params: BeadParams) -> Result<Self, ParamError> {
         params.validate()?;
@@ -190,18 +191,20 @@ impl PendingBead {
     }
 }
 
-/// Where the user is dragging the bead: while present, the drag spring
-/// `k (target - x)` pulls the bead (k is
-/// [`SimParams::drag_stiffness`](crate::SimParams::drag_stiffness)). Insert it
-/// on grab, update it on move, remove it on release.
+/// A point a spring pulls the bead toward while present: the force
+/// `k (anchor - x)`, k being
+/// [`SimParams::drag_stiffness`](crate::SimParams::drag_stiffness). The
+/// assignment's mouse drag is one (the scene inserts it on grab, moves it
+/// with the cursor, removes it on release); a game may pull a bead anywhere
+/// with one.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
 #[reflect(Component)]
-pub struct DragTarget(DVec2);
+pub struct SpringAnchor(DVec2);
 
-impl DragTarget {
-    /// A drag target at `target`, if it is finite.
-    pub fn new(target: DVec2) -> Result<Self, ParamError> {
-        finite_vector("drag target", target).map(Self)
+impl SpringAnchor {
+    /// An anchor at `point`, if it is finite.
+    pub fn new(point: DVec2) -> Result<Self, ParamError> {
+        finite_vector("spring anchor", point).map(Self)
     }
 
     /// Where the spring pulls toward.

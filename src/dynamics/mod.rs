@@ -10,11 +10,11 @@ mod links;
 mod params;
 mod wire;
 
-pub use bead::{Bead, BeadParams, DragTarget, PendingBead};
+pub use bead::{Bead, BeadParams, NextBeadParams, SpringAnchor};
 pub use diagnostics::{BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason};
 pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
-pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, PendingParams, SimParams};
+pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, NextParams, SimParams};
 pub(crate) use wire::WirePose;
 pub use wire::{
-    ContactChanged, OnWire, PendingWire, PrescribedMotion, Wire, WireBeads, WireContact, pose_of,
+    ContactChanged, NextWireShape, OnWire, PrescribedMotion, Wire, WireBeads, WireContact, pose_of,
 };

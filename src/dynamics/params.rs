@@ -1,7 +1,7 @@
 //! Simulation parameters, their validation, and the pending/applied split.
 //!
 //! As in the assignment's panel, edits do not touch the running simulation: they go
-//! to [`PendingParams`] (and a bead's [`PendingBead`](crate::PendingBead))
+//! to [`NextParams`] (and a bead's [`NextBeadParams`](crate::NextBeadParams))
 //! and a [`Restart`](crate::Restart) applies them. Every setter validates and
 //! returns a [`ParamError`] that names the parameter and the value it got,
 //! leaving the previous value in place.
@@ -19,7 +19,7 @@ pub const MIN_TIMESTEP: f64 = 1e-6;
 pub const MAX_TIMESTEP: f64 = 1.0;
 
 /// The parameters shared by every bead: the applied set is this resource,
-/// the edited set is [`PendingParams`].
+/// the edited set is [`NextParams`].
 ///
 /// In a scene file the method is written as its two halves,
 /// `integrator: Rk4, stabilization: Projection`; RATTLE takes no
@@ -184,9 +184,9 @@ pub(crate) fn edit_validated<T: Clone>(
 /// The edited [`SimParams`], applied by the next [`Restart`](crate::Restart).
 #[derive(Resource, Clone, Debug, Default, PartialEq, Reflect)]
 #[reflect(Resource)]
-pub struct PendingParams(SimParams);
+pub struct NextParams(SimParams);
 
-impl PendingParams {
+impl NextParams {
     /// The edited parameters.
     pub fn get(&self) -> &SimParams {
         &self.0
@@ -208,11 +208,11 @@ impl PendingParams {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{BeadParams, PendingBead};
+    use crate::{BeadParams, NextBeadParams};
 
     #[test]
     fn errors_name_the_parameter_and_value() {
-        let mut pending = PendingParams::default();
+        let mut pending = NextParams::default();
         let err = pending.update(|p| p.timestep = 0.0).unwrap_err();
         assert_eq!(
             err.to_string(),
@@ -230,7 +230,7 @@ mod tests {
             &SimParams::default(),
             "a refused edit changes nothing"
         );
-        let err = PendingBead::new(BeadParams {
+        let err = NextBeadParams::new(BeadParams {
             mass: -2.0,
             ..default()
         })

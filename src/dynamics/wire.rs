@@ -50,7 +50,7 @@ impl Wire {
     }
 
     /// The wire with `shape` in place of its own, its surface kept (the
-    /// shape was validated when `shape` was made a [`PendingWire`]).
+    /// shape was validated when `shape` was made a [`NextWireShape`]).
     pub(crate) fn reshaped(&self, shape: &WireShape) -> Self {
         Self {
             shape: shape.clone(),
@@ -170,9 +170,9 @@ pub fn pose_of(transform: &Transform) -> Result<Pose, ParamError> {
 /// An edited shape for a wire, applied (and removed) by the next
 /// [`Restart`](crate::Restart). Built only from a valid shape.
 #[derive(Component, Clone, Debug)]
-pub struct PendingWire(Wire);
+pub struct NextWireShape(Wire);
 
-impl PendingWire {
+impl NextWireShape {
     /// A pending edit, if `shape` is valid.
     pub fn new(shape: WireShape) -> Result<Self, ParamError> {
         Wire::new(shape).map(Self)

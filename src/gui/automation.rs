@@ -15,7 +15,7 @@ use crate::debug_render::{hatch_point, wire_points};
 use crate::geometry::Placed;
 use crate::gui::render::{FramedView, SceneCamera, hatch_length};
 use crate::preset::ActivePreset;
-use crate::{Bead, Diverged, DragTarget, Pin, Rod, Wire, WireContact, pose_of};
+use crate::{Bead, Diverged, Pin, Rod, SpringAnchor, Wire, WireContact, pose_of};
 
 /// Where one bead is.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -143,7 +143,7 @@ struct ReportView<'w, 's> {
         's,
         (
             &'static Bead,
-            Option<&'static DragTarget>,
+            Option<&'static SpringAnchor>,
             Option<&'static Diverged>,
             &'static Transform,
             Option<&'static WireContact>,
@@ -254,7 +254,7 @@ impl ReportView<'_, '_> {
 
 impl AutomationState {
     /// Records the dragged beads' positions and the drag target.
-    fn follow_drag<'a>(&mut self, dragged: impl Iterator<Item = (&'a Bead, &'a DragTarget)>) {
+    fn follow_drag<'a>(&mut self, dragged: impl Iterator<Item = (&'a Bead, &'a SpringAnchor)>) {
         for (bead, target) in dragged {
             self.drag_path.push(bead.position);
             self.drag_target = Some(target.get());

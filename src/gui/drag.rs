@@ -1,4 +1,4 @@
-//! Drag a bead with the mouse: on grab the bead gets a [`DragTarget`] at the
+//! Drag a bead with the mouse: on grab the bead gets a [`SpringAnchor`] at the
 //! cursor, which follows the cursor until release. The simulation turns it
 //! into the assignment's spring force `k (cursor - bead)`. Egui windows block
 //! picking, so a drag over the panel never grabs a bead.
@@ -10,7 +10,7 @@
 use bevy::prelude::*;
 
 use crate::gui::render::{SceneCamera, screen_to_world};
-use crate::{Bead, DragTarget};
+use crate::{Bead, SpringAnchor};
 
 /// The bead the panel shows: the last one grabbed, or the first one.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -40,10 +40,10 @@ type SceneCameras<'w, 's> =
 fn cursor_world(
     location: &bevy::picking::pointer::Location,
     cameras: &SceneCameras,
-) -> Option<DragTarget> {
+) -> Option<SpringAnchor> {
     let (camera, transform) = cameras.iter().next()?;
     let world = screen_to_world(camera, transform, location.position)?;
-    DragTarget::new(world).ok()
+    SpringAnchor::new(world).ok()
 }
 
 /// Grabs a bead: selects it and sets its drag target at the cursor.
@@ -95,7 +95,7 @@ pub fn follow_drag(
     event: On<Pointer<Drag>>,
     cameras: SceneCameras,
     grabbed: Res<Grabbed>,
-    mut targets: Query<&mut DragTarget>,
+    mut targets: Query<&mut SpringAnchor>,
 ) {
     let Some(bead) = grabbed.0 else { return };
     if let (Ok(mut target), Some(next)) = (
@@ -115,6 +115,6 @@ pub fn end_drag(
     if let Some(bead) = grabbed.0.take()
         && let Ok(mut entity) = commands.get_entity(bead)
     {
-        entity.remove::<DragTarget>();
+        entity.remove::<SpringAnchor>();
     }
 }

@@ -1,28 +1,31 @@
-//! [`DragPlugin`]: the force the plugin itself adds in
-//! [`WireBeadSystems::Forces`]: the drag spring. Gravity is added by the
+//! [`SpringAnchorPlugin`]: the force the plugin itself adds in
+//! [`WireBeadSystems::Forces`]: the spring toward a bead's anchor. Gravity is added by the
 //! step.
 
 use bevy::prelude::*;
 
 use super::schedule::WireBeadSystems;
-use crate::dynamics::{Bead, Diverged, DragTarget, SimParams};
+use crate::dynamics::{Bead, Diverged, SimParams, SpringAnchor};
 
-/// Pulls each bead that has a [`DragTarget`] toward it with the
+/// Pulls each bead that has a [`SpringAnchor`] toward it with the
 /// assignment's spring.
 #[derive(Default)]
-pub struct DragPlugin;
+pub struct SpringAnchorPlugin;
 
-impl Plugin for DragPlugin {
+impl Plugin for SpringAnchorPlugin {
     fn build(&self, app: &mut App) {
-        app.register_type::<DragTarget>()
-            .add_systems(FixedUpdate, apply_drag.in_set(WireBeadSystems::Forces));
+        app.register_type::<SpringAnchor>().add_systems(
+            FixedUpdate,
+            apply_anchor_springs.in_set(WireBeadSystems::Forces),
+        );
     }
 }
 
-/// Adds the assignment's drag spring `k (target - x)` to dragged beads.
-fn apply_drag(
+/// Adds the spring `k (anchor - x)` to each bead with a [`SpringAnchor`]
+/// (the assignment's drag spring).
+fn apply_anchor_springs(
     params: Res<SimParams>,
-    mut beads: Query<(&mut Bead, &DragTarget), Without<Diverged>>,
+    mut beads: Query<(&mut Bead, &SpringAnchor), Without<Diverged>>,
 ) {
     for (mut bead, target) in &mut beads {
         bead.add_spring(params.drag_stiffness, target.get());

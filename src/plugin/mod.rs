@@ -6,7 +6,7 @@
 //! | [`ParamsPlugin`] | `params` | [`SimParams`] and the pending edits, the sets' order, [`ParallelStep`], a bead's `Transform` and diagnostics |
 //! | [`ClockPlugin`] | `clock` | [`SimClock`] and the fixed timestep |
 //! | [`WirePosePlugin`] | `wires` | each wire placed for the step: its prescribed motion, or the game's moves |
-//! | [`DragPlugin`] | `forces` | the drag spring toward a [`DragTarget`](crate::DragTarget) |
+//! | [`SpringAnchorPlugin`] | `forces` | the spring toward a bead's [`SpringAnchor`](crate::SpringAnchor) (the assignment's drag) |
 //! | [`BeadStepPlugin`] | `step` | the step of each bead alone on a wire, batched and in parallel |
 //! | [`IslandPlugin`] | `islands` | [`Islands`]: beads joined by rods, pins, joints and springs, stepped together |
 //! | [`RestartPlugin`] | `restart` | [`Restart`]: the pending edits applied, every bead back to its start |
@@ -33,7 +33,7 @@ use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
 
 pub use clock::{ClockPlugin, SimClock};
-pub use forces::DragPlugin;
+pub use forces::SpringAnchorPlugin;
 pub use islands::{IslandPlugin, IslandReport, Islands};
 pub use parallel::{ParallelStep, StepSplit, compute_on_all_cores, use_single_threaded_executors};
 pub use params::ParamsPlugin;
@@ -52,12 +52,12 @@ use crate::dynamics::SimParams;
 ///
 /// ```
 /// use bevy::prelude::*;
-/// use wirebead::plugin::DragPlugin;
+/// use wirebead::plugin::SpringAnchorPlugin;
 /// use wirebead::prelude::*;
 ///
 /// App::new().add_plugins((
 ///     MinimalPlugins,
-///     WireBeadPlugin::default().build().disable::<DragPlugin>(),
+///     WireBeadPlugin::default().build().disable::<SpringAnchorPlugin>(),
 /// ));
 /// ```
 ///
@@ -111,7 +111,7 @@ impl PluginGroup for WireBeadPlugin {
             })
             .add(ClockPlugin)
             .add(WirePosePlugin)
-            .add(DragPlugin)
+            .add(SpringAnchorPlugin)
             .add(BeadStepPlugin)
             .add(IslandPlugin)
             .add(RestartPlugin)

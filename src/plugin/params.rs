@@ -7,10 +7,10 @@ use bevy::prelude::*;
 use super::parallel::{ParallelStep, StepSplit};
 use super::schedule;
 use crate::dynamics::{
-    Bead, BeadDiagnostics, BeadDiverged, ContactChanged, PendingBead, PendingParams, SimParams,
+    Bead, BeadDiagnostics, BeadDiverged, ContactChanged, NextBeadParams, NextParams, SimParams,
 };
 
-/// The parameters ([`SimParams`], [`PendingParams`]), the step's sets in
+/// The parameters ([`SimParams`], [`NextParams`]), the step's sets in
 /// order, [`ParallelStep`], and each bead's `Transform` and
 /// [`BeadDiagnostics`] (unless the beads are lean).
 #[derive(Clone, Debug)]
@@ -46,7 +46,7 @@ impl ParamsPlugin {
             Some(_) => {}
         }
         let applied = app.world().resource::<SimParams>().clone();
-        let mut pending = PendingParams::default();
+        let mut pending = NextParams::default();
         if let Err(err) = pending.set(applied) {
             error!("wirebead: the initial SimParams are invalid ({err}); using the defaults");
             app.insert_resource(SimParams::default());
@@ -76,9 +76,9 @@ impl Plugin for ParamsPlugin {
             .add_message::<ContactChanged>()
             .register_type::<Bead>()
             .register_type::<BeadDiagnostics>()
-            .register_type::<PendingBead>()
+            .register_type::<NextBeadParams>()
             .register_type::<SimParams>()
             .register_type::<ParallelStep>()
-            .register_type::<PendingParams>();
+            .register_type::<NextParams>();
     }
 }

@@ -8,13 +8,13 @@ use super::islands::Islands;
 use super::schedule::WireBeadSystems;
 use super::wires::{prescribed, set_pose};
 use crate::dynamics::{
-    Bead, BeadDiagnostics, Diverged, OnWire, PendingBead, PendingParams, PendingWire,
+    Bead, BeadDiagnostics, Diverged, NextBeadParams, NextParams, NextWireShape, OnWire,
     PrescribedMotion, SimParams, Wire, WireContact, WirePose,
 };
 use crate::geometry::{MovingTrack, Track};
 use crate::solver::constraint_state_on;
 
-/// Restarts the run: applies [`PendingParams`] and every [`PendingBead`],
+/// Restarts the run: applies [`NextParams`] and every [`NextBeadParams`],
 /// returns each bead to its initial state, clears divergence, and sets
 /// `Time<Fixed>` to the timestep. Handled in
 /// [`WireBeadSystems::Restart`](crate::WireBeadSystems::Restart), in
@@ -51,7 +51,7 @@ fn diagnose<T: Track>(track: &T, bead: &Bead, gravity: bevy::math::DVec2) -> Bea
 /// returns every bead to its initial state.
 fn apply_restart(
     mut restarts: MessageReader<Restart>,
-    pending: Res<PendingParams>,
+    pending: Res<NextParams>,
     mut params: ResMut<SimParams>,
     mut time: ResMut<Time<Fixed>>,
     mut clock: ResMut<SimClock>,
@@ -60,7 +60,7 @@ fn apply_restart(
         &mut Wire,
         &mut Transform,
         &mut WirePose,
-        Option<&PendingWire>,
+        Option<&NextWireShape>,
         Option<&PrescribedMotion>,
     )>,
     mut beads: Query<(
@@ -69,7 +69,7 @@ fn apply_restart(
         Option<&mut BeadDiagnostics>,
         Option<&mut WireContact>,
         Option<&OnWire>,
-        Option<&PendingBead>,
+        Option<&NextBeadParams>,
     )>,
     mut islands: ResMut<Islands>,
     mut commands: Commands,
@@ -82,7 +82,7 @@ fn apply_restart(
     for (entity, mut wire, mut transform, mut pose, edit, motion) in &mut wires {
         if let Some(edit) = edit {
             *wire = wire.reshaped(edit.shape());
-            commands.entity(entity).remove::<PendingWire>();
+            commands.entity(entity).remove::<NextWireShape>();
         }
         // A wire on a prescribed motion goes back to its resting pose; one
         // the game moved starts again at rest where it is.
@@ -107,7 +107,9 @@ fn apply_restart(
         if let Some(mut contact) = contact {
             contact.set_if_neq(WireContact::default());
         }
-        commands.entity(entity).remove::<(Diverged, PendingBead)>();
+        commands
+            .entity(entity)
+            .remove::<(Diverged, NextBeadParams)>();
         let wire = on_wire.and_then(|on| wires.get(on.0).ok());
         let Some((_, wire, _, pose, ..)) = wire else {
             if let Some(mut diagnostics) = diagnostics {

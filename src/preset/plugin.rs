@@ -8,7 +8,7 @@ use bevy::prelude::*;
 use super::error::PresetError;
 use super::format::ScenePreset;
 use super::spawn::FromPreset;
-use crate::dynamics::{OnWire, PendingParams};
+use crate::dynamics::{NextParams, OnWire};
 use crate::plugin::{Restart, WireBeadSystems};
 
 /// Loads `*.scene.ron` files as [`ScenePreset`]s, validating them.
@@ -124,7 +124,7 @@ pub fn apply_loaded_preset(
     mut events: MessageReader<AssetEvent<ScenePreset>>,
     presets: Res<Assets<ScenePreset>>,
     mut active: ResMut<ActivePreset>,
-    mut pending: ResMut<PendingParams>,
+    mut pending: ResMut<NextParams>,
     existing: Query<Entity, (With<FromPreset>, Without<OnWire>)>,
     mut restarts: MessageWriter<Restart>,
     mut commands: Commands,

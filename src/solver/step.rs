@@ -136,9 +136,9 @@ pub fn constraint_state_on<T: Track + ?Sized>(track: &T, t: f64, state: BeadStat
 mod tests {
     use super::*;
     use crate::geometry::{Circle, Sine};
-    use crate::solver::test_support::{G, settings};
     use crate::solver::Stabilization;
     use crate::solver::projection::NEWTON_ACCEPT;
+    use crate::solver::test_support::{G, settings};
 
     #[test]
     fn singular_point_is_an_error_not_a_nan() {

@@ -5,7 +5,7 @@ use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::prelude::*;
-use wirebead::{DragTarget, PendingBead, PendingParams, ScenePreset};
+use wirebead::{NextBeadParams, NextParams, ScenePreset, SpringAnchor};
 
 fn scene() -> (App, Entity) {
     let mut app = app(SimParams::default());
@@ -35,17 +35,17 @@ fn leaves_simulation_untouched(bad: impl FnOnce(&mut App, Entity) -> String, exp
         control.world().resource::<SimParams>()
     );
     assert_eq!(
-        app.world().resource::<PendingParams>(),
-        control.world().resource::<PendingParams>()
+        app.world().resource::<NextParams>(),
+        control.world().resource::<NextParams>()
     );
-    assert!(app.world().get::<PendingBead>(bead_entity).is_none());
-    assert!(app.world().get::<DragTarget>(bead_entity).is_none());
+    assert!(app.world().get::<NextBeadParams>(bead_entity).is_none());
+    assert!(app.world().get::<SpringAnchor>(bead_entity).is_none());
 }
 
 fn pending_edit(edit: impl FnOnce(&mut SimParams)) -> impl FnOnce(&mut App, Entity) -> String {
     |app, _| {
         app.world_mut()
-            .resource_mut::<PendingParams>()
+            .resource_mut::<NextParams>()
             .update(edit)
             .unwrap_err()
             .to_string()
@@ -56,7 +56,7 @@ fn bead_edit(edit: impl FnOnce(&mut BeadParams)) -> impl FnOnce(&mut App, Entity
     |_, _| {
         let mut params = BeadParams::default();
         edit(&mut params);
-        PendingBead::new(params).unwrap_err().to_string()
+        NextBeadParams::new(params).unwrap_err().to_string()
     }
 }
 
@@ -144,11 +144,11 @@ fn nan_anywhere_is_refused() {
     );
     leaves_simulation_untouched(
         |_, _| {
-            DragTarget::new(DVec2::new(f64::NAN, 0.0))
+            SpringAnchor::new(DVec2::new(f64::NAN, 0.0))
                 .unwrap_err()
                 .to_string()
         },
-        "drag target must be finite, got (NaN, 0)",
+        "spring anchor must be finite, got (NaN, 0)",
     );
     leaves_simulation_untouched(
         |_, _| Wire::sine(f64::NAN, 1.0).unwrap_err().to_string(),

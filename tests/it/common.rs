@@ -126,3 +126,10 @@ pub fn measured_period(samples: &[Sample]) -> f64 {
     let xs: Vec<(f64, f64)> = samples.iter().map(|s| (s.t, s.position.x)).collect();
     reference::period_from_crossings(&xs).expect("at least two crossings")
 }
+
+/// Whether a step can split over threads here: the `parallel` feature
+/// (Bevy's thread pools) on a machine of more than one core. Where it can,
+/// the parallel tests assert that it did.
+pub fn splits() -> bool {
+    cfg!(feature = "parallel") && bevy::tasks::available_parallelism() > 1
+}

@@ -5,7 +5,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::controls::KeyboardControlsPlugin;
 use wirebead::prelude::*;
-use wirebead::{PendingBead, PendingParams};
+use wirebead::{NextBeadParams, NextParams};
 
 fn press(app: &mut App, key: KeyCode, steps: u32) {
     app.world_mut()
@@ -37,10 +37,10 @@ fn space_restarts_and_applies_pending_params() {
     let (mut app, bead_entity) = scene();
     run_steps(&mut app, 30);
     app.world_mut()
-        .resource_mut::<PendingParams>()
+        .resource_mut::<NextParams>()
         .update(|p| p.alpha = 250.0)
         .unwrap();
-    let edit = PendingBead::new(BeadParams {
+    let edit = NextBeadParams::new(BeadParams {
         mass: 3.0,
         initial_position: DVec2::new(-1.0, 0.0),
         ..default()

@@ -16,7 +16,7 @@ use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use wirebead::headless::{Headless, run_steps};
 use wirebead::prelude::*;
 use wirebead::preset::FromPreset;
-use wirebead::{PendingParams, ScenePreset};
+use wirebead::{NextParams, ScenePreset};
 
 use crate::presets::{SHIPPED, shipped_dir};
 
@@ -147,7 +147,7 @@ fn load_and_step(app: &mut App, text: &str) -> Result<(), TestCaseError> {
         world.despawn(entity);
     }
     world
-        .resource_mut::<PendingParams>()
+        .resource_mut::<NextParams>()
         .set(preset.params.clone())
         .map_err(|e| TestCaseError::fail(format!("validated params refused: {e}")))?;
     preset.spawn(&mut world.commands());

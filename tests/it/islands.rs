@@ -11,7 +11,7 @@ use wirebead::prelude::*;
 use wirebead::solver::{BeadState, Island, IslandRow, IslandWork, LinearForce, RowKind};
 use wirebead::{ConstraintDiagnostics, Islands, ParallelStep, ScenePreset, Stabilization};
 
-use crate::common::{app, bead, params, run_steps};
+use crate::common::{app, bead, params, run_steps, splits};
 
 /// A cart of mass 2 on a horizontal line, a bob of mass 1 on a rod of
 /// length 1, 30° out. Returns (cart, bob, rod).
@@ -272,7 +272,7 @@ fn many_islands_split_over_threads_step_as_on_one() {
                 (0, 1),
                 "{split:?}"
             );
-        } else if bevy::tasks::available_parallelism() > 1 {
+        } else if splits() {
             assert!(
                 split.island_threads > 1 && split.island_chunks > 1,
                 "{split:?}"
@@ -329,7 +329,9 @@ fn slider_crank() -> (App, Entity, Entity) {
         initial_position: DVec2::new(0.0, 0.5),
         initial_velocity: DVec2::new(-2.0, 0.0),
     };
-    let crank = world.spawn((Bead::new(crank).unwrap(), OnWire(circle))).id();
+    let crank = world
+        .spawn((Bead::new(crank).unwrap(), OnWire(circle)))
+        .id();
     let piston = Bead::at_rest(2.0, DVec2::new(2f64.sqrt(), 0.0)).unwrap();
     let piston = world.spawn((piston, OnWire(line))).id();
     world.spawn(Rod::new(crank, piston, 1.5).unwrap());
@@ -353,10 +355,20 @@ fn energy(app: &App, beads: &[Entity]) -> f64 {
 fn assert_velocities_meet_the_constraints(app: &App, crank: Entity, piston: Entity) {
     let (c, p) = (bead(app, crank), bead(app, piston));
     let along_rod = (c.position - p.position).dot(c.velocity - p.velocity);
-    assert!(along_rod.abs() < 1e-12, "the rod stretches at {along_rod:e}");
-    assert!(c.velocity.dot(c.position).abs() < 1e-12, "the crank leaves its circle");
+    assert!(
+        along_rod.abs() < 1e-12,
+        "the rod stretches at {along_rod:e}"
+    );
+    assert!(
+        c.velocity.dot(c.position).abs() < 1e-12,
+        "the crank leaves its circle"
+    );
     assert!(p.velocity.y.abs() < 1e-12, "the piston leaves its line");
-    assert!(p.velocity.x.abs() > 0.5, "the piston does not move: {}", p.velocity);
+    assert!(
+        p.velocity.x.abs() > 0.5,
+        "the piston does not move: {}",
+        p.velocity
+    );
 }
 
 #[test]
@@ -371,7 +383,10 @@ fn initial_velocities_that_break_a_constraint_are_projected_at_spawn_and_restart
     assert!(start < given - 0.1, "{given} J given, {start} J projected");
     run_steps(&mut app, 1);
     let after = energy(&app, &[crank, piston]);
-    assert!((after - start).abs() < 1e-6, "{start} J, then {after} J a step later");
+    assert!(
+        (after - start).abs() < 1e-6,
+        "{start} J, then {after} J a step later"
+    );
     // A restart returns to the initial state and projects it the same way.
     run_steps(&mut app, 200);
     app.world_mut().write_message(Restart);

@@ -364,12 +364,11 @@ impl Crate {
             at = deeper;
             rest = &rest[1..];
         }
-        if let (Some(item), true) = (rest.first(), depth < 16) {
-            if let Some(target) = self.imports.get(&at).and_then(|m| m.get(item)) {
-                if let Some(defined) = self.resolve(&at, target, depth + 1) {
-                    return Some(defined);
-                }
-            }
+        if let (Some(item), true) = (rest.first(), depth < 16)
+            && let Some(target) = self.imports.get(&at).and_then(|m| m.get(item))
+            && let Some(defined) = self.resolve(&at, target, depth + 1)
+        {
+            return Some(defined);
         }
         Some(at)
     }
@@ -388,10 +387,10 @@ impl Crate {
                 let path: Vec<String> = path.into_iter().filter(|s| s != "*").collect();
                 // A module holds its children: its `mod` and re-export of
                 // them is not a use (their use of it is).
-                if let Some(target) = self.resolve(module, &path, 0) {
-                    if !target.starts_with(module) {
-                        targets.insert(target);
-                    }
+                if let Some(target) = self.resolve(module, &path, 0)
+                    && !target.starts_with(module)
+                {
+                    targets.insert(target);
                 }
             }
             edges.insert(module.clone(), targets);

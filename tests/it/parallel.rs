@@ -143,7 +143,7 @@ fn parallel_step_matches_sequential_bit_for_bit() {
     let split = |app: &App| *app.world().resource::<StepSplit>();
     assert_eq!(split(&sequential).bead_threads, 0);
     assert_eq!(split(&sequential).bead_runs, 1);
-    if bevy::tasks::available_parallelism() > 1 {
+    if crate::common::splits() {
         assert!(split(&parallel).bead_threads > 1, "{:?}", split(&parallel));
         assert!(split(&parallel).bead_runs > 1, "{:?}", split(&parallel));
     }

@@ -6,7 +6,7 @@ use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::prelude::*;
-use wirebead::{PendingBead, PendingParams, SimClock, Stabilization};
+use wirebead::{NextBeadParams, NextParams, SimClock, Stabilization};
 
 fn scene() -> (App, Entity) {
     let mut app = app(SimParams::default());
@@ -16,7 +16,7 @@ fn scene() -> (App, Entity) {
 
 fn edit(app: &mut App, bead: Entity) {
     app.world_mut()
-        .resource_mut::<PendingParams>()
+        .resource_mut::<NextParams>()
         .update(|p| {
             p.timestep = 1.0 / 120.0;
             p.alpha = 400.0;
@@ -25,7 +25,7 @@ fn edit(app: &mut App, bead: Entity) {
             p.gravity = DVec2::new(0.0, -3.0);
         })
         .unwrap();
-    let pending = PendingBead::new(BeadParams {
+    let pending = NextBeadParams::new(BeadParams {
         mass: 2.5,
         initial_position: DVec2::new(0.0, -1.0),
         initial_velocity: DVec2::new(2.0, 0.0),
@@ -63,7 +63,7 @@ fn restart_applies_pending_params_and_resets_state() {
     run_steps(&mut app, 0);
 
     let params = app.world().resource::<SimParams>().clone();
-    assert_eq!(&params, app.world().resource::<PendingParams>().get());
+    assert_eq!(&params, app.world().resource::<NextParams>().get());
     assert_eq!(params.method, Method::Rattle);
     assert_eq!(
         app.world().resource::<Time<Fixed>>().timestep(),
@@ -73,7 +73,7 @@ fn restart_applies_pending_params_and_resets_state() {
     assert_eq!(b.mass(), 2.5);
     assert_eq!(b.position, DVec2::new(0.0, -1.0));
     assert_eq!(b.velocity, DVec2::new(2.0, 0.0));
-    assert!(app.world().get::<PendingBead>(bead_entity).is_none());
+    assert!(app.world().get::<NextBeadParams>(bead_entity).is_none());
     let d = diagnostics(&app, bead_entity);
     let clock = *app.world().resource::<SimClock>();
     assert_eq!((clock.steps, clock.time), (0, 0.0));
@@ -90,7 +90,7 @@ fn restart_applies_pending_params_and_resets_state() {
 fn restart_recovers_a_diverged_bead() {
     let (mut app, bead_entity) = scene();
     app.world_mut()
-        .resource_mut::<PendingParams>()
+        .resource_mut::<NextParams>()
         .update(|p| {
             p.method = Method::ExplicitEuler(Stabilization::Baumgarte);
             p.timestep = 0.05;
@@ -102,7 +102,7 @@ fn restart_recovers_a_diverged_bead() {
     assert!(app.world().get::<Diverged>(bead_entity).is_some());
 
     app.world_mut()
-        .resource_mut::<PendingParams>()
+        .resource_mut::<NextParams>()
         .set(SimParams::default())
         .unwrap();
     app.world_mut().write_message(Restart);

@@ -10,7 +10,7 @@ use bevy::prelude::*;
 use wirebead::geometry::{Placed, Pose};
 use wirebead::pose_of;
 use wirebead::prelude::*;
-use wirebead::{DragTarget, Integrator, Stabilization, WireBeads};
+use wirebead::{Integrator, SpringAnchor, Stabilization, WireBeads};
 
 /// A circle written as a game would write its own curve:
 /// `C = (|x|² - r²) / (2r)`.
@@ -176,9 +176,9 @@ fn state_hash(integrator: Integrator) -> u64 {
     let dragged = pairs[0].1;
     app.world_mut()
         .entity_mut(dragged)
-        .insert(DragTarget::new(DVec2::new(1.5, 0.5)).unwrap());
+        .insert(SpringAnchor::new(DVec2::new(1.5, 0.5)).unwrap());
     run_steps(&mut app, 90);
-    app.world_mut().entity_mut(dragged).remove::<DragTarget>();
+    app.world_mut().entity_mut(dragged).remove::<SpringAnchor>();
     run_steps(&mut app, 90);
     let mut hasher = DefaultHasher::new();
     for (_, b) in pairs {
@@ -235,7 +235,7 @@ fn drag_pulls_the_bead_toward_the_target_and_release_stops_it() {
     let target = DVec2::new(1.0, 0.0);
     app.world_mut()
         .entity_mut(b)
-        .insert(DragTarget::new(target).unwrap());
+        .insert(SpringAnchor::new(target).unwrap());
     run_steps(&mut app, 1);
     // The assignment's force, k (target - x), accumulated at the step's start and
     // consumed by the step.
@@ -257,7 +257,7 @@ fn drag_pulls_the_bead_toward_the_target_and_release_stops_it() {
         closest < 0.2 * start,
         "closest approach {closest} from {start}"
     );
-    app.world_mut().entity_mut(b).remove::<DragTarget>();
+    app.world_mut().entity_mut(b).remove::<SpringAnchor>();
     run_steps(&mut app, 1);
     assert_eq!(seen(&app), DVec2::ZERO);
 }

@@ -8,8 +8,9 @@ use bevy_egui::egui;
 use super::view::PanelView;
 use crate::geometry::Cycloid;
 use crate::{
-    BeadParams, Integrator, ParamError, PendingBead, PendingParams, PendingWire, PrescribedMotion,
-    Side, Stabilization, Surface, WireContact, WireKind, WireMotion, WireShape, pose_of,
+    BeadParams, Integrator, NextBeadParams, NextParams, NextWireShape, ParamError,
+    PrescribedMotion, Side, Stabilization, Surface, WireContact, WireKind, WireMotion, WireShape,
+    pose_of,
 };
 
 /// The result of an edit: `None` where nothing was edited.
@@ -66,7 +67,7 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
     {
         let shape = pending_wire.map_or_else(|| wire.shape().clone(), |p| p.shape().clone());
         if let Some(edited) = wire_editor(ui, &shape) {
-            outcome = Some(PendingWire::new(edited.clone()).map(|edit| {
+            outcome = Some(NextWireShape::new(edited.clone()).map(|edit| {
                 commands.entity(on_wire.0).insert(edit);
                 // Start the bead at the new wire's lowest point.
                 let pose = pose_of(transform).unwrap_or_default();
@@ -82,7 +83,7 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
         );
     }
     if draft != before {
-        outcome = Some(PendingBead::new(draft).map(|edit| {
+        outcome = Some(NextBeadParams::new(draft).map(|edit| {
             commands.entity(entity).insert(edit);
         }));
     }
@@ -210,7 +211,7 @@ fn wire_editor(ui: &mut egui::Ui, shape: &WireShape) -> Option<WireShape> {
 }
 
 /// The parameters every bead shares.
-pub(super) fn solver_section(ui: &mut egui::Ui, pending: &mut PendingParams) -> Edit {
+pub(super) fn solver_section(ui: &mut egui::Ui, pending: &mut NextParams) -> Edit {
     ui.separator();
     ui.strong("Solver");
     let mut draft = pending.get().clone();

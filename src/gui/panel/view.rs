@@ -11,8 +11,8 @@ use crate::gui::drag::SelectedBead;
 use crate::gui::render::SceneStyle;
 use crate::preset::{ActivePreset, LoadPreset};
 use crate::{
-    Bead, BeadDiagnostics, ConstraintDiagnostics, Diverged, Islands, OnWire, PendingBead,
-    PendingParams, PendingWire, Pin, PrescribedMotion, Restart, Rod, SimClock, SimParams, Wire,
+    Bead, BeadDiagnostics, ConstraintDiagnostics, Diverged, Islands, NextBeadParams, NextParams,
+    NextWireShape, OnWire, Pin, PrescribedMotion, Restart, Rod, SimClock, SimParams, Wire,
     WireContact,
 };
 
@@ -34,7 +34,7 @@ pub struct PanelView<'w, 's> {
             &'static Bead,
             &'static BeadDiagnostics,
             Option<&'static OnWire>,
-            Option<&'static PendingBead>,
+            Option<&'static NextBeadParams>,
             Option<&'static Diverged>,
         ),
     >,
@@ -44,7 +44,7 @@ pub struct PanelView<'w, 's> {
         (
             &'static Wire,
             &'static Transform,
-            Option<&'static PendingWire>,
+            Option<&'static NextWireShape>,
             Option<&'static PrescribedMotion>,
         ),
     >,
@@ -53,15 +53,15 @@ pub struct PanelView<'w, 's> {
     pub(super) pins: Query<'w, 's, (&'static Pin, &'static ConstraintDiagnostics)>,
     pub(super) names: Query<'w, 's, &'static Name>,
     pub(super) islands: Res<'w, Islands>,
-    pub(super) pending_beads: Query<'w, 's, (), With<PendingBead>>,
-    pub(super) pending_wires: Query<'w, 's, (), With<PendingWire>>,
+    pub(super) pending_beads: Query<'w, 's, (), With<NextBeadParams>>,
+    pub(super) pending_wires: Query<'w, 's, (), With<NextWireShape>>,
     pub(super) clock: Res<'w, SimClock>,
 }
 
 /// What the panel's controls ask of the world this frame.
 #[derive(SystemParam)]
 pub struct PanelActions<'w, 's> {
-    pub(super) pending: ResMut<'w, PendingParams>,
+    pub(super) pending: ResMut<'w, NextParams>,
     pub(super) time: ResMut<'w, Time<Virtual>>,
     pub(super) steps: ResMut<'w, StepRequests>,
     pub(super) restarts: MessageWriter<'w, Restart>,
