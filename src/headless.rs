@@ -1,7 +1,7 @@
-//! The one headless harness: an app with `MinimalPlugins` and the plugin,
-//! stepped by hand, exactly `n` fixed steps at a time. The tests, the
-//! benchmarks, the avian2d comparison and the analysis tool all build their
-//! apps here.
+//! The test harness, not part of the simulation a game adds: an app with
+//! `MinimalPlugins` and the plugin, stepped by hand, exactly `n` fixed
+//! steps at a time. The tests, the benchmarks, the avian2d comparison and
+//! the analysis tool all build their apps here.
 //!
 //! ```
 //! use bevy::math::DVec2;

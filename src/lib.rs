@@ -54,12 +54,12 @@
 //! | module | what it holds |
 //! |---|---|
 //! | [`geometry`] | [`ImplicitCurve`] (`C`, `∇C`, the Hessian), one file per shape, [`Pose`](geometry::Pose) |
-//! | [`reference`](mod@reference) | exact answers: the pendulum's period |
+//! | [`reference`](mod@reference) | reference answers for tests (not the simulation): the pendulum's period |
 //! | [`solver`] | the pure math: eq. (3), the integrators, RATTLE, projection, the batched lanes |
 //! | `dynamics` | the components and resources above (re-exported here) |
 //! | [`plugin`] | the sets, the systems, the plugin |
 //! | [`controls`], [`preset`] | keyboard controls; scene files |
-//! | [`headless`] | the one headless harness the tests, benches and tools build on |
+//! | [`headless`] | the test harness (not the simulation) the tests, benches and tools build on |
 //! | `debug_render` | gizmo drawing of the simulation (feature `debug-render`) |
 //! | `gui` | the windowed scene |
 //!

@@ -1,5 +1,6 @@
-//! Exact answers the simulation is measured against: the period of a bead on
-//! a frictionless vertical circle (a pendulum of length r).
+//! Reference answers for tests and benchmarks, not part of the simulation:
+//! exact results it is measured against, the period of a bead on a
+//! frictionless vertical circle (a pendulum of length r).
 //!
 //! Released from rest at angle θ₀ from the bottom, the period is
 //! `T = 4 sqrt(r/|g|) K(m)`, `m = sin²(θ₀/2)`, with `K` the complete elliptic

@@ -212,3 +212,18 @@ impl SpringAnchor {
         self.0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_spring_anchor_off_the_map_is_refused_in_words() {
+        assert_eq!(
+            SpringAnchor::new(DVec2::new(f64::NAN, 0.0))
+                .unwrap_err()
+                .to_string(),
+            "spring anchor must be finite, got (NaN, 0)"
+        );
+    }
+}

@@ -250,3 +250,68 @@ pub struct ContactChanged {
 #[derive(Component, Debug, Default)]
 #[relationship_target(relationship = OnWire, linked_spawn)]
 pub struct WireBeads(Vec<Entity>);
+
+#[cfg(test)]
+mod tests {
+    use bevy::math::DVec2;
+
+    use super::*;
+    use crate::geometry::{Friction, Oscillate, Surface, WireMotion};
+
+    #[test]
+    fn a_wire_with_no_size_is_refused_in_words() {
+        let refused = |wire: Result<Wire, ParamError>| wire.unwrap_err().to_string();
+        assert_eq!(
+            refused(Wire::circle(0.0)),
+            "radius must be positive and finite, got 0"
+        );
+        assert_eq!(
+            refused(Wire::ellipse(1.0, -1.0)),
+            "semi-axis b must be positive and finite, got -1"
+        );
+        assert_eq!(
+            refused(Wire::sine(f64::NAN, 1.0)),
+            "amplitude must be finite, got NaN"
+        );
+    }
+
+    #[test]
+    fn bad_surfaces_and_motions_are_refused_in_words() {
+        let shake = |amplitude, frequency| {
+            PrescribedMotion::new(WireMotion::Oscillate(Oscillate {
+                amplitude,
+                frequency,
+            }))
+            .unwrap_err()
+            .to_string()
+        };
+        assert_eq!(
+            shake(DVec2::new(f64::NAN, 0.0), 1.0),
+            "oscillation amplitude must be finite, got (NaN, 0)"
+        );
+        assert_eq!(
+            shake(DVec2::Y, 0.0),
+            "oscillation frequency must be positive and finite, got 0"
+        );
+        let surface =
+            |surface: Surface| Wire::line().with_surface(surface).unwrap_err().to_string();
+        assert_eq!(
+            surface(Surface {
+                restitution: 1.5,
+                ..Surface::PLAIN
+            }),
+            "restitution must be between 0 and 1, got 1.5"
+        );
+        assert_eq!(
+            Friction::new(0.2, 0.5).unwrap_err().to_string(),
+            "kinetic friction must not exceed static friction"
+        );
+        assert_eq!(
+            surface(Surface {
+                damping: -1.0,
+                ..Surface::PLAIN
+            }),
+            "damping along the wire must be zero or more and finite, got -1"
+        );
+    }
+}

@@ -316,6 +316,27 @@ mod tests {
         CubicBSpline, CubicCardinalSpline, CubicGenerator, CubicHermite, CyclicCubicGenerator,
     };
 
+    #[test]
+    fn a_spline_without_enough_finite_points_is_refused_in_words() {
+        let spline = |points: Vec<DVec2>| {
+            Spline::new(SplineSpec {
+                kind: SplineKind::CatmullRom,
+                points,
+                closed: false,
+            })
+            .unwrap_err()
+            .to_string()
+        };
+        assert_eq!(
+            spline(vec![DVec2::ZERO]),
+            "a cardinal spline needs two points at least"
+        );
+        assert_eq!(
+            spline(vec![DVec2::ZERO, DVec2::new(f64::NAN, 1.0)]),
+            "a spline's points must be finite"
+        );
+    }
+
     /// Every kind, open and closed, has the coefficients Bevy's own
     /// generator gives (in `f32`), and a scene's points lie on the curve.
     #[test]

@@ -148,3 +148,31 @@ fn bad_links_are_refused_naming_the_item() {
         "bead \"bob\": mass must be positive and finite, got 0"
     );
 }
+
+#[test]
+fn a_broken_file_and_bad_tracks_in_a_file_are_refused_in_words() {
+    assert_eq!(
+        ScenePreset::from_ron("(name: \"broken\", wires: [")
+            .unwrap_err()
+            .to_string(),
+        "malformed scene file at line 1, column 25: Expected opening `(` for struct `WirePreset`"
+    );
+    let scene = |wire: &str| {
+        ScenePreset::from_ron(&format!("(name: \"t\", wires: [({wire}, beads: [()])])"))
+            .unwrap_err()
+            .to_string()
+    };
+    assert_eq!(
+        scene("shape: Line(()), friction: (static: -1.0, kinetic: 0.0)"),
+        "wire 0: static friction must be zero or more and finite, got -1"
+    );
+    assert_eq!(
+        scene("shape: Line(()), motion: Spin((angular_velocity: inf))"),
+        "wire 0: angular velocity must be finite, got inf"
+    );
+    let spline = scene("shape: Spline((points: [(0.0, 0.0)]))");
+    assert!(
+        spline.contains("a cardinal spline needs two points at least"),
+        "{spline}"
+    );
+}

@@ -1,11 +1,13 @@
-//! Every bad input gets its error in words, never a panic, never a NaN in a
-//! `Transform`, and leaves the running simulation as it was.
+//! Every bad input given to a running app gets its error in words, never a
+//! panic, never a NaN in a `Transform`, and leaves the running simulation
+//! as it was. The constructors' own refusals (a wire of zero radius, a bad
+//! spline, a malformed scene file) are unit tests beside them.
 
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::prelude::*;
-use wirebead::{NextBeadParams, NextParams, ScenePreset, SpringAnchor};
+use wirebead::{NextBeadParams, NextParams, SpringAnchor};
 
 fn scene() -> (App, Entity) {
     let mut app = app(SimParams::default());
@@ -85,18 +87,6 @@ fn non_finite_mass_is_refused() {
 }
 
 #[test]
-fn zero_radius_is_refused() {
-    leaves_simulation_untouched(
-        |_, _| Wire::circle(0.0).unwrap_err().to_string(),
-        "radius must be positive and finite, got 0",
-    );
-    leaves_simulation_untouched(
-        |_, _| Wire::ellipse(1.0, -1.0).unwrap_err().to_string(),
-        "semi-axis b must be positive and finite, got -1",
-    );
-}
-
-#[test]
 fn non_positive_timestep_is_refused() {
     leaves_simulation_untouched(
         pending_edit(|p| p.timestep = 0.0),
@@ -141,30 +131,6 @@ fn nan_anywhere_is_refused() {
     leaves_simulation_untouched(
         bead_edit(|b| b.initial_velocity.x = f64::INFINITY),
         "initial velocity must be finite, got (inf, 0)",
-    );
-    leaves_simulation_untouched(
-        |_, _| {
-            SpringAnchor::new(DVec2::new(f64::NAN, 0.0))
-                .unwrap_err()
-                .to_string()
-        },
-        "spring anchor must be finite, got (NaN, 0)",
-    );
-    leaves_simulation_untouched(
-        |_, _| Wire::sine(f64::NAN, 1.0).unwrap_err().to_string(),
-        "amplitude must be finite, got NaN",
-    );
-}
-
-#[test]
-fn malformed_scene_file_is_refused() {
-    leaves_simulation_untouched(
-        |_, _| {
-            ScenePreset::from_ron("(name: \"broken\", wires: [")
-                .unwrap_err()
-                .to_string()
-        },
-        "malformed scene file at line 1, column 25: Expected opening `(` for struct `WirePreset`",
     );
 }
 
@@ -226,83 +192,6 @@ fn nan_written_into_a_bead_is_reported_not_propagated() {
 
 /// Tracks refuse bad numbers in words: a motion, a surface, a spline, and
 /// the same in a scene file (which names the wire).
-#[test]
-fn bad_tracks_are_refused_in_words() {
-    use wirebead::geometry::{Spline, SplineKind, SplineSpec};
-    use wirebead::{Friction, Oscillate, PrescribedMotion, Surface, WireMotion};
-    let shake = |amplitude, frequency| {
-        PrescribedMotion::new(WireMotion::Oscillate(Oscillate {
-            amplitude,
-            frequency,
-        }))
-        .unwrap_err()
-        .to_string()
-    };
-    assert_eq!(
-        shake(DVec2::new(f64::NAN, 0.0), 1.0),
-        "oscillation amplitude must be finite, got (NaN, 0)"
-    );
-    assert_eq!(
-        shake(DVec2::Y, 0.0),
-        "oscillation frequency must be positive and finite, got 0"
-    );
-    let surface = |surface: Surface| Wire::line().with_surface(surface).unwrap_err().to_string();
-    assert_eq!(
-        surface(Surface {
-            restitution: 1.5,
-            ..Surface::PLAIN
-        }),
-        "restitution must be between 0 and 1, got 1.5"
-    );
-    assert_eq!(
-        Friction::new(0.2, 0.5).unwrap_err().to_string(),
-        "kinetic friction must not exceed static friction"
-    );
-    assert_eq!(
-        surface(Surface {
-            damping: -1.0,
-            ..Surface::PLAIN
-        }),
-        "damping along the wire must be zero or more and finite, got -1"
-    );
-    let spline = |points: Vec<DVec2>| {
-        Spline::new(SplineSpec {
-            kind: SplineKind::CatmullRom,
-            points,
-            closed: false,
-        })
-        .unwrap_err()
-        .to_string()
-    };
-    assert_eq!(
-        spline(vec![DVec2::ZERO]),
-        "a cardinal spline needs two points at least"
-    );
-    assert_eq!(
-        spline(vec![DVec2::ZERO, DVec2::new(f64::NAN, 1.0)]),
-        "a spline's points must be finite"
-    );
-    let scene = |wire: &str| {
-        ScenePreset::from_ron(&format!("(name: \"t\", wires: [({wire}, beads: [()])])"))
-            .unwrap_err()
-            .to_string()
-    };
-    assert_eq!(
-        scene("shape: Line(()), friction: (static: -1.0, kinetic: 0.0)"),
-        "wire 0: static friction must be zero or more and finite, got -1"
-    );
-    assert_eq!(
-        scene("shape: Line(()), motion: Spin((angular_velocity: inf))"),
-        "wire 0: angular velocity must be finite, got inf"
-    );
-    assert!(
-        scene("shape: Spline((points: [(0.0, 0.0)]))")
-            .contains("a cardinal spline needs two points at least"),
-        "{}",
-        scene("shape: Spline((points: [(0.0, 0.0)]))")
-    );
-}
-
 /// A bead put exactly on a cycloid's cusp (where the curve has no
 /// tangent) is reported at a singular point; the bead beside it runs on.
 #[test]
