@@ -108,10 +108,7 @@ impl Island {
         }
         if stopped {
             work.time = time;
-            work.x.clear();
-            work.x.extend(states.iter().map(|s| s.position));
-            work.v.clear();
-            work.v.extend(states.iter().map(|s| s.velocity));
+            work.load(states);
             self.evaluate_at_new(work);
             self.project_velocity(work)?;
             for (state, v) in states.iter_mut().zip(&work.v) {
@@ -186,10 +183,7 @@ impl Island {
             // Back on: onto every held row, then the velocities.
             let BeadState { position, velocity } = states[bead];
             work.inactive[r] = false;
-            work.x.clear();
-            work.x.extend(states.iter().map(|s| s.position));
-            work.v.clear();
-            work.v.extend(states.iter().map(|s| s.velocity));
+            work.load(states);
             self.newton(work, Direction::Current)?;
             self.evaluate_at_new(work);
             let nn = normal.length_squared().max(f64::MIN_POSITIVE);

@@ -143,6 +143,15 @@ pub struct IslandWork {
 }
 
 impl IslandWork {
+    /// Takes `states` in as the current positions and velocities
+    /// (`x`, `v`).
+    pub(super) fn load(&mut self, states: &[BeadState]) {
+        self.x.clear();
+        self.x.extend(states.iter().map(|s| s.position));
+        self.v.clear();
+        self.v.extend(states.iter().map(|s| s.velocity));
+    }
+
     /// What the last successful step reported of each row.
     pub fn rows(&self) -> &[RowReport] {
         &self.reports

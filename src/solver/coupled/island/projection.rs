@@ -50,10 +50,7 @@ impl Island {
             *inactive |= self.sides[r].0 != 0.0;
         }
         work.time = time;
-        work.x.clear();
-        work.x.extend(states.iter().map(|s| s.position));
-        work.v.clear();
-        work.v.extend(states.iter().map(|s| s.velocity));
+        work.load(states);
         self.evaluate_at_new(work);
         let projected = self.project_velocity(work);
         work.inactive = held;
