@@ -56,6 +56,7 @@ impl TableWire {
     }
 
     /// The path (a fixed one for a wire that stays put).
+    #[inline]
     pub(super) fn path(&self) -> PosePath {
         match &self.track {
             Some(track) => track.0,
@@ -64,6 +65,7 @@ impl TableWire {
     }
 
     /// The surface.
+    #[inline]
     pub(super) fn surface(&self) -> &Surface {
         self.track.as_deref().map_or(&Surface::PLAIN, |t| &t.1)
     }
@@ -147,6 +149,7 @@ impl WireTable {
     }
 
     /// The wire a bead is on.
+    #[inline]
     pub(super) fn get(&self, on: &OnWire) -> Result<&TableWire, DivergenceReason> {
         match self.place(on.0) {
             Some(k) => self.wires[k].1.as_ref().map_err(Clone::clone),
