@@ -6,7 +6,7 @@ use std::fmt;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::solver::SolveError;
+use crate::solver::{BeadState, RowReport, SolveError};
 
 /// Per-bead diagnostics, updated after every step (on beads that have
 /// them: see [`WireBeadPlugin::lean`](crate::WireBeadPlugin::lean)). The
@@ -32,6 +32,28 @@ pub struct BeadDiagnostics {
 }
 
 impl BeadDiagnostics {
+    /// The diagnostics of a bead of `mass` at `state` under `gravity`: its
+    /// wire row's `C`, `Ċ` and λ (all zero for a bead on no wire) and the
+    /// constraint force on it. The one place the bead step, the island
+    /// step and a restart fill them in.
+    pub(crate) fn of(
+        state: BeadState,
+        mass: f64,
+        gravity: DVec2,
+        row: RowReport,
+        constraint_force: DVec2,
+    ) -> Self {
+        let (kinetic, potential) = state.energy(mass, gravity);
+        Self {
+            c: row.c,
+            c_dot: row.c_dot,
+            lambda: row.lambda,
+            constraint_force,
+            kinetic,
+            potential,
+        }
+    }
+
     /// Kinetic plus potential energy.
     pub fn energy(&self) -> f64 {
         self.kinetic + self.potential

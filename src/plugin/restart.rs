@@ -12,7 +12,7 @@ use crate::dynamics::{
     PrescribedMotion, SimParams, Wire, WireContact, WirePose,
 };
 use crate::geometry::{MovingTrack, Track};
-use crate::solver::constraint_state_on;
+use crate::solver::{RowReport, constraint_state_on};
 
 /// Restarts the run: applies [`NextParams`] and every [`NextBeadParams`],
 /// returns each bead to its initial state, clears divergence, and sets
@@ -34,17 +34,15 @@ impl Plugin for RestartPlugin {
     }
 }
 
-/// The diagnostics of a bead's current state on `curve`, before any step.
+/// The diagnostics of a bead's current state on `track`, before any step.
 fn diagnose<T: Track>(track: &T, bead: &Bead, gravity: bevy::math::DVec2) -> BeadDiagnostics {
     let (c, c_dot) = constraint_state_on(track, 0.0, bead.state());
-    let (kinetic, potential) = bead.state().energy(bead.mass(), gravity);
-    BeadDiagnostics {
+    let row = RowReport {
         c,
         c_dot,
-        kinetic,
-        potential,
-        ..default()
-    }
+        lambda: 0.0,
+    };
+    BeadDiagnostics::of(bead.state(), bead.mass(), gravity, row, default())
 }
 
 /// Handles [`Restart`]: applies the pending wire shapes and parameters and

@@ -145,15 +145,8 @@ pub(super) fn step_islands(
                     .iter()
                     .find(|w| w.0 == i)
                     .map(|w| rows[w.1]);
-                let (kinetic, potential) = state.energy(bead.mass(), gravity);
-                *d = BeadDiagnostics {
-                    c: wire_row.map_or(0.0, |r| r.c),
-                    c_dot: wire_row.map_or(0.0, |r| r.c_dot),
-                    lambda: wire_row.map_or(0.0, |r| r.lambda),
-                    constraint_force: pushed[i],
-                    kinetic,
-                    potential,
-                };
+                let row = wire_row.unwrap_or_default();
+                *d = BeadDiagnostics::of(state, bead.mass(), gravity, row, pushed[i]);
             }
         }
         for link in &cached.links {

@@ -10,7 +10,7 @@ use crate::dynamics::{Bead, BeadDiagnostics, DivergenceReason, OnWire, SimParams
 use crate::geometry::{FixedTrack, MovingTrack, Near, Placed, Surface, Track, WireShape};
 use crate::plugin::report::{FoundDivergences, FoundEvents};
 use crate::plugin::writeback::place;
-use crate::solver::{self, BeadState, Contact, LinearForce, StepOutput, StepSettings};
+use crate::solver::{self, BeadState, Contact, LinearForce, RowReport, StepOutput, StepSettings};
 
 /// How many batches of [`solver::LANES`] beads one call of the batched step
 /// takes.
@@ -200,15 +200,18 @@ impl StepContext<'_> {
         } = outputs;
         bead.advance_to(out.state);
         if let Some(diagnostics) = diagnostics {
-            let (kinetic, potential) = out.state.energy(bead.mass(), self.params.gravity);
-            *diagnostics = BeadDiagnostics {
+            let row = RowReport {
                 c: out.c,
                 c_dot: out.c_dot,
                 lambda: out.lambda,
-                constraint_force: out.constraint_force,
-                kinetic,
-                potential,
             };
+            *diagnostics = BeadDiagnostics::of(
+                out.state,
+                bead.mass(),
+                self.params.gravity,
+                row,
+                out.constraint_force,
+            );
         }
         if let Some(transform) = transform {
             place(transform, out.state.position);
