@@ -30,7 +30,7 @@
 //!
 //! | item | what it is |
 //! |---|---|
-//! | [`WireBeadPlugin`] | the simulation: components, parameters, the step in `FixedUpdate` |
+//! | [`WireBeadPlugin`] | the simulation, a group of small plugins (see [`plugin`]): components, parameters, the step in `FixedUpdate` |
 //! | [`WireBeadSystems`] | the sets: `Restart` in `PreUpdate`; `Prepare → Forces → Step → Writeback` in `FixedUpdate` |
 //! | [`Wire`], [`Bead`], [`OnWire`] | a wire placed by its `Transform`; a bead on it (or free, on none) |
 //! | [`Surface`], [`WireContact`], [`ContactChanged`] | one-sided wires a bead leaves and lands on, restitution, friction; each bead's contact and the message when it changes |
@@ -57,7 +57,7 @@
 //! | [`reference`](mod@reference) | reference answers for tests (not the simulation): the pendulum's period |
 //! | [`solver`] | the pure math: eq. (3), the integrators, RATTLE, projection, the batched lanes |
 //! | `dynamics` | the components and resources above (re-exported here) |
-//! | [`plugin`] | the sets, the systems, the plugin |
+//! | [`plugin`] | the plugin group and its plugins, the sets, the systems |
 //! | [`controls`], [`preset`] | keyboard controls; scene files |
 //! | [`headless`] | the test harness (not the simulation) the tests, benches and tools build on |
 //! | `debug_render` | gizmo drawing of the simulation (feature `debug-render`) |

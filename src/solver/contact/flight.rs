@@ -4,7 +4,7 @@
 
 use bevy::math::DVec2;
 
-use super::{Contact, ContactEvent, MAX_EVENTS, SurfaceStep, Walk};
+use super::{Contact, ContactEvent, MAX_EVENTS, SurfaceStep, Walk, bounces};
 use crate::geometry::Track;
 use crate::lane::V2;
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
@@ -82,9 +82,15 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         let e = self.surface.restitution;
         // A bounce one step of the forces would undo is a landing.
         let normal = self.track.geometry(t + tau, touching.position).normal;
-        let push = (normal.dot(self.force.at(touching.position)) / self.mass).abs()
-            / normal.length().max(f64::MIN_POSITIVE);
-        let bounced = e > 0.0 && e * normal_speed > push * self.settings.dt;
+        let force = self.force.at(touching.position);
+        let bounced = bounces(
+            e,
+            normal_speed,
+            normal,
+            force,
+            self.mass.recip(),
+            self.settings.dt,
+        );
         let event = ContactEvent::Landed {
             time: t + tau,
             position: touching.position,

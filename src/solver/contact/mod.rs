@@ -81,6 +81,23 @@ pub struct SurfaceStep {
 /// the step plainly.
 const MAX_EVENTS: u32 = 4;
 
+/// The bounce rule of eq. (16), for a lone bead and an island alike: a
+/// bead that lands at `normal_speed` across its wire bounces off with
+/// restitution `e` only where one step `dt` of the applied `force`'s push
+/// along the wire's `normal` (on a bead of inverse mass `inverse_mass`)
+/// would not undo the bounce; a slower one lands and stays on.
+pub(crate) fn bounces(
+    e: f64,
+    normal_speed: f64,
+    normal: DVec2,
+    force: DVec2,
+    inverse_mass: f64,
+    dt: f64,
+) -> bool {
+    let push = (normal.dot(force) * inverse_mass).abs() / normal.length().max(f64::MIN_POSITIVE);
+    e > 0.0 && e * normal_speed > push * dt
+}
+
 /// One step of a bead on a wire with a [`Surface`] (see [`step_on`] for
 /// the rest), from `contact`. A plain surface takes [`step_on`] itself.
 ///

@@ -8,7 +8,7 @@ use super::integrators::Stage;
 use super::newton::Direction;
 use super::rows::RowAt;
 use super::{Island, IslandWork, RoughRow};
-use crate::solver::contact::ContactEvent;
+use crate::solver::contact::{ContactEvent, bounces};
 use crate::solver::coupled::constraint::RowKind;
 use crate::solver::settings::Gains;
 use crate::solver::solve::SolveError;
@@ -189,9 +189,9 @@ impl Island {
             let nn = normal.length_squared().max(f64::MIN_POSITIVE);
             let across = normal.dot(velocity - wire);
             let normal_speed = across.abs() / nn.sqrt();
-            let push =
-                (normal.dot(forces[bead].at(position)) * self.inverse_mass[bead]).abs() / nn.sqrt();
-            let bounced = restitution > 0.0 && restitution * normal_speed > push * h;
+            let force = forces[bead].at(position);
+            let w = self.inverse_mass[bead];
+            let bounced = bounces(restitution, normal_speed, normal, force, w, h);
             if bounced {
                 work.bias[r] -= restitution * across;
             }
