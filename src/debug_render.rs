@@ -92,7 +92,7 @@ impl Default for DebugRenderStyle {
 
 /// Where a wire's `Transform` puts it (the identity for a pose that is not
 /// in the plane).
-fn wire_pose(transform: &Transform) -> Pose {
+pub fn wire_pose(transform: &Transform) -> Pose {
     pose_of(transform).unwrap_or_default()
 }
 

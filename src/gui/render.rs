@@ -9,9 +9,11 @@ use bevy::camera::ScalingMode;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::debug_render::{DebugRenderStyle, DebugRenderSystems, WireBeadDebugPlugin, wire_points};
+use crate::debug_render::{
+    DebugRenderStyle, DebugRenderSystems, WireBeadDebugPlugin, wire_points, wire_pose,
+};
 use crate::geometry::{Pose, WireShape};
-use crate::{Bead, OnWire, Restart, Rod, Wire, WireBeadSystems, WireContact, pose_of};
+use crate::{Bead, OnWire, Restart, Rod, Wire, WireBeadSystems, WireContact};
 
 /// Colours and sizes of the scene.
 #[derive(Resource, Clone, Debug)]
@@ -224,10 +226,6 @@ pub fn wire_bounds(shape: &WireShape, pose: &Pose) -> (DVec2, DVec2) {
         (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
         |(lo, hi), p| (lo.min(*p), hi.max(*p)),
     )
-}
-
-fn wire_pose(transform: &Transform) -> Pose {
-    pose_of(transform).unwrap_or_default()
 }
 
 /// Frames every wire (and every bead's start) in the part of the window

@@ -345,7 +345,8 @@ fn energy(app: &App, beads: &[Entity]) -> f64 {
         .iter()
         .map(|&e| {
             let b = bead(app, e);
-            b.state().energy(b.mass(), g).0 + b.state().energy(b.mass(), g).1
+            let (kinetic, potential) = b.state().energy(b.mass(), g);
+            kinetic + potential
         })
         .sum()
 }

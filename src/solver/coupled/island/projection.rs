@@ -10,6 +10,15 @@ use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
 
 impl Island {
+    /// `Σ ½ m |v|²` of the beads' `velocities`.
+    fn kinetic(&self, velocities: impl IntoIterator<Item = DVec2>) -> f64 {
+        velocities
+            .into_iter()
+            .zip(&self.inverse_mass)
+            .map(|(v, w)| 0.5 * v.length_squared() / w)
+            .sum()
+    }
+
     /// Projects the beads' velocities onto the island's two-sided
     /// constraints at `time`: `v ← v − W Jᵀ (J W Jᵀ)⁻¹ (J v − bias)`, the
     /// velocities nearest the given ones in the kinetic-energy norm that
@@ -30,13 +39,7 @@ impl Island {
         states: &mut [BeadState],
         work: &mut IslandWork,
     ) -> Result<(f64, f64), SolveError> {
-        let kinetic = |states: &[BeadState]| -> f64 {
-            states
-                .iter()
-                .zip(&self.inverse_mass)
-                .map(|(s, w)| 0.5 * s.velocity.length_squared() / w)
-                .sum()
-        };
+        let kinetic = |states: &[BeadState]| self.kinetic(states.iter().map(|s| s.velocity));
         let before = kinetic(states);
         if states.len() != self.beads() {
             return Ok((before, before));
@@ -101,12 +104,7 @@ impl Island {
         self.newton(work, Direction::Current)?;
         self.evaluate_at_new(work);
         self.project_velocity(work)?;
-        let kinetic = |v: &[DVec2]| -> f64 {
-            v.iter()
-                .zip(&self.inverse_mass)
-                .map(|(v, w)| 0.5 * v.length_squared() / w)
-                .sum()
-        };
+        let kinetic = |v: &[DVec2]| self.kinetic(v.iter().copied());
         let now = kinetic(&work.v);
         let h = match restore {
             Restore::Nothing => return Ok(()),
