@@ -67,9 +67,9 @@ fn floor_agrees_with_the_plugin(kind: Kind) {
     }
     let world = app.world_mut();
     let plugin: Vec<_> = world
-        .query::<&wirebead::Bead>()
+        .query_filtered::<&wirebead::BeadPosition, With<wirebead::Bead>>()
         .iter(world)
-        .map(|b| b.position)
+        .map(|p| p.0)
         .collect();
     let worst = raw
         .positions()

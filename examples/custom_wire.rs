@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use bevy::math::{DMat2, DVec2};
 use bevy::prelude::*;
 use clap::Parser;
+use wirebead::ImplicitCurve;
 use wirebead::gui::{AutomationPlugin, WireBeadGuiPlugin};
 use wirebead::prelude::*;
 

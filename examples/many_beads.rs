@@ -111,8 +111,12 @@ fn main() -> ExitCode {
         bead_steps / seconds
     );
     println!(
-        "component_bytes: Bead={} BeadDiagnostics={} OnWire={} Transform={} GlobalTransform={}",
-        size_of::<Bead>(),
+        "component_bytes: BeadPosition={} BeadVelocity={} BeadMass={} BeadForce={} BeadParams={} BeadDiagnostics={} OnWire={} Transform={} GlobalTransform={}",
+        size_of::<BeadPosition>(),
+        size_of::<BeadVelocity>(),
+        size_of::<BeadMass>(),
+        size_of::<wirebead::BeadForce>(),
+        size_of::<BeadParams>(),
         size_of::<BeadDiagnostics>(),
         size_of::<OnWire>(),
         size_of::<Transform>(),

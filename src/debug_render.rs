@@ -12,7 +12,8 @@ use bevy::prelude::*;
 
 use crate::dynamics::Rod;
 use crate::dynamics::{
-    Bead, BeadDiagnostics, Diverged, OnWire, Pin, SimParams, Spring, SpringAnchor, Wire, pose_of,
+    BeadDiagnostics, BeadMass, BeadPosition, Diverged, OnWire, Pin, SimParams, Spring,
+    SpringAnchor, Wire, pose_of,
 };
 use crate::geometry::{ImplicitCurve, Placed, Pose, WireShape};
 
@@ -138,7 +139,7 @@ pub fn draw_wires(
 
 /// Draws each bead as a circle, in the diverged colour once it stopped.
 pub fn draw_beads(
-    beads: Query<(&Bead, Has<Diverged>)>,
+    beads: Query<(&BeadPosition, Has<Diverged>)>,
     style: Res<DebugRenderStyle>,
     mut gizmos: Gizmos,
 ) {
@@ -147,7 +148,7 @@ pub fn draw_beads(
     }
     for (bead, diverged) in &beads {
         let colour = if diverged { style.diverged } else { style.bead };
-        let at = Isometry2d::from_translation(bead.position.as_vec2());
+        let at = Isometry2d::from_translation(bead.as_vec2());
         gizmos.circle_2d(at, style.bead_radius, colour);
     }
 }
@@ -155,7 +156,7 @@ pub fn draw_beads(
 /// Draws rods as lines between their beads, pins as small squares at
 /// their points and springs as zigzags.
 pub fn draw_links(
-    beads: Query<&Bead>,
+    beads: Query<&BeadPosition>,
     rods: Query<&Rod>,
     pins: Query<&Pin>,
     transforms: Query<&Transform>,
@@ -163,7 +164,7 @@ pub fn draw_links(
     style: Res<DebugRenderStyle>,
     mut gizmos: Gizmos,
 ) {
-    let at = |e: Entity| beads.get(e).ok().map(|b| b.position.as_vec2());
+    let at = |e: Entity| beads.get(e).ok().map(|b| b.as_vec2());
     for rod in &rods {
         if let (Some(a), Some(b)) = (at(rod.beads()[0]), at(rod.beads()[1])) {
             gizmos.line_2d(a, b, style.rod);
@@ -190,7 +191,8 @@ pub fn draw_links(
 /// bead's weight, and the drag spring.
 pub fn draw_forces(
     beads: Query<(
-        &Bead,
+        &BeadPosition,
+        &BeadMass,
         Option<&BeadDiagnostics>,
         Option<&SpringAnchor>,
         Has<OnWire>,
@@ -200,9 +202,9 @@ pub fn draw_forces(
     mut gizmos: Gizmos,
 ) {
     let g = params.gravity.length().max(1e-3) as f32;
-    for (bead, diagnostics, drag, on_wire) in &beads {
-        let per_newton = style.force_scale / (bead.mass() as f32 * g);
-        let at = bead.position.as_vec2();
+    for (bead, mass, diagnostics, drag, on_wire) in &beads {
+        let per_newton = style.force_scale / (mass.get() as f32 * g);
+        let at = bead.as_vec2();
         let force = diagnostics
             .filter(|_| on_wire)
             .map_or(Vec2::ZERO, |d| d.constraint_force.as_vec2())

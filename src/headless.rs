@@ -13,7 +13,7 @@
 //! let bead = Bead::at_rest(1.0, DVec2::new(1.0, 0.0)).unwrap();
 //! let bead = app.world_mut().spawn((bead, OnWire(wire))).id();
 //! run_steps(&mut app, 30); // half a second: near the bottom
-//! assert!(app.world().get::<Bead>(bead).unwrap().position.y < -0.5);
+//! assert!(app.world().get::<BeadPosition>(bead).unwrap().y < -0.5);
 //! ```
 
 use std::path::PathBuf;
@@ -22,11 +22,12 @@ use std::time::Duration;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 
-use crate::dynamics::SimParams;
+use crate::dynamics::{BeadPosition, BeadVelocity, SimParams};
 use crate::plugin::{
     ParallelStep, WireBeadPlugin, compute_on_all_cores, use_single_threaded_executors,
 };
 use crate::preset::ScenePresetPlugin;
+use crate::solver::BeadState;
 
 /// Builds a headless app: [`Headless::new`], the options, [`Headless::build`].
 #[derive(Clone, Debug)]
@@ -129,4 +130,13 @@ pub fn run_for(app: &mut App, seconds: f64) {
 /// Runs updates with no fixed step (loading assets, handling messages).
 pub fn idle(app: &mut App) {
     run_steps(app, 0);
+}
+
+/// A bead's position and velocity, or `None` if `bead` is not a bead.
+pub fn bead_state(world: &World, bead: Entity) -> Option<BeadState> {
+    let bead = world.get_entity(bead).ok()?;
+    Some(BeadState {
+        position: bead.get::<BeadPosition>()?.0,
+        velocity: bead.get::<BeadVelocity>()?.0,
+    })
 }

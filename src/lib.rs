@@ -33,6 +33,7 @@
 //! | [`WireBeadPlugin`] | the simulation, a group of small plugins (see [`plugin`]): components, parameters, the step in `FixedUpdate` |
 //! | [`WireBeadSystems`] | the sets: `Restart` in `PreUpdate`; `Prepare → Forces → Step → Writeback` in `FixedUpdate` |
 //! | [`Wire`], [`Bead`], [`OnWire`] | a wire placed by its `Transform`; a bead on it (or free, on none) |
+//! | [`BeadPosition`], [`BeadVelocity`], [`BeadMass`], [`BeadForce`], [`BeadParams`] | a bead's columns: its state, mass, the force for the next step (added through [`BeadForces`]) and the state a restart returns to |
 //! | [`Surface`], [`WireContact`], [`ContactChanged`] | one-sided wires a bead leaves and lands on, restitution, friction; each bead's contact and the message when it changes |
 //! | [`PrescribedMotion`] | a wire that moves ([`WireMotion`]: oscillates or spins), its motion exact in the constraint force; a wire the game moves is followed |
 //! | [`Rod`], [`Pin`], [`Joint`], [`Spring`] | links between beads, each on an entity of its own; [`Constraint`] for a game's own joint |
@@ -93,7 +94,8 @@ mod validate;
 
 pub use controls::KeyboardControlsPlugin;
 pub use dynamics::{
-    Bead, BeadDiagnostics, BeadDiverged, BeadParams, ConstraintDiagnostics, ContactChanged,
+    Bead, BeadBundle, BeadDiagnostics, BeadDiverged, BeadForce, BeadForces, BeadForcesItem,
+    BeadMass, BeadParams, BeadPosition, BeadVelocity, ConstraintDiagnostics, ContactChanged,
     Diverged, DivergenceReason, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams, NextParams,
     NextWireShape, OnWire, Pin, PrescribedMotion, Rod, SimParams, Spring, SpringAnchor, Wire,
     WireBeads, WireContact, pose_of,
@@ -125,9 +127,9 @@ pub type PendingWire = NextWireShape;
 /// is at the crate root (`wirebead::Islands`, `wirebead::NextParams`, …).
 pub mod prelude {
     pub use crate::{
-        Bead, BeadDiagnostics, BeadParams, Diverged, ImplicitCurve, Method, OnWire, Pin,
-        PrescribedMotion, Restart, Rod, SimParams, Spring, Surface, Wire, WireBeadPlugin,
-        WireBeadSystems, WireContact, WireMotion, WireShape,
+        Bead, BeadDiagnostics, BeadForces, BeadMass, BeadParams, BeadPosition, BeadVelocity,
+        Diverged, Method, OnWire, Pin, PrescribedMotion, Restart, Rod, SimParams, Spring, Wire,
+        WireBeadPlugin, WireBeadSystems, WireShape,
     };
 }
 

@@ -8,8 +8,8 @@ use bevy::prelude::{FixedUpdate, IntoScheduleConfigs, Query, Res, ResMut, Resour
 use indicatif::{ProgressBar, ProgressStyle};
 use wirebead::headless::{Headless, idle, run_steps};
 use wirebead::{
-    Bead, BeadDiagnostics, BeadParams, Diverged, OnWire, ParamError, Restart, SimClock, SimParams,
-    Wire, WireBeadPlugin, WireBeadSystems, WireShape,
+    Bead, BeadDiagnostics, BeadParams, BeadPosition, BeadVelocity, Diverged, OnWire, ParamError,
+    Restart, SimClock, SimParams, Wire, WireBeadPlugin, WireBeadSystems, WireShape,
 };
 
 use crate::AnalysisResult;
@@ -62,15 +62,15 @@ pub struct RunOutput {
 struct Rows(Vec<Row>);
 
 fn record_rows(
-    beads: Query<(&Bead, &BeadDiagnostics), Without<Diverged>>,
+    beads: Query<(&BeadPosition, &BeadVelocity, &BeadDiagnostics), Without<Diverged>>,
     clock: Res<SimClock>,
     mut rows: ResMut<Rows>,
 ) {
-    for (bead, d) in &beads {
+    for (position, velocity, d) in &beads {
         rows.0.push(Row {
             t: clock.time,
-            position: bead.position,
-            velocity: bead.velocity,
+            position: position.0,
+            velocity: velocity.0,
             c: d.c,
             c_dot: d.c_dot,
             lambda: d.lambda,

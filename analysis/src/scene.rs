@@ -11,8 +11,8 @@ use bevy::prelude::{Entity, FixedUpdate, IntoScheduleConfigs, Query, Res, ResMut
 use wirebead::geometry::{ImplicitCurve, Placed, Pose, WireMotion, WireShape};
 use wirebead::headless::{Headless, idle, run_steps};
 use wirebead::{
-    Bead, Diverged, Method, ParamError, SceneLink, ScenePreset, SimClock, SimParams,
-    WireBeadPlugin, WireBeadSystems, WireContact,
+    BeadPosition, BeadVelocity, Diverged, Method, ParamError, SceneLink, ScenePreset, SimClock,
+    SimParams, WireBeadPlugin, WireBeadSystems, WireContact,
 };
 
 use crate::AnalysisResult;
@@ -161,9 +161,9 @@ impl Recorder {
         let mut on = Vec::with_capacity(self.beads.len());
         for &entity in &self.beads {
             match beads.get(entity) {
-                Ok((bead, contact, None)) => {
-                    x.push(bead.position);
-                    v.push(bead.velocity);
+                Ok((position, velocity, contact, None)) => {
+                    x.push(position.0);
+                    v.push(velocity.0);
                     on.push(contact.is_some_and(WireContact::is_on));
                 }
                 _ => {
@@ -186,7 +186,8 @@ impl Recorder {
 
 /// What the recorder reads of a bead.
 type BeadRecord = (
-    &'static Bead,
+    &'static BeadPosition,
+    &'static BeadVelocity,
     Option<&'static WireContact>,
     Option<&'static Diverged>,
 );

@@ -39,7 +39,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use clap::{Args, ValueEnum};
 use wirebead::SimClock;
-use wirebead::headless::Headless;
+use wirebead::headless::{Headless, bead_state};
 use wirebead::prelude::*;
 use wirebead::solver::BeadState;
 
@@ -147,11 +147,7 @@ fn errors(pendulums: &[Pendulum], state: impl Fn(Entity) -> BeadState, worst: &m
 
 /// A bead's state in our app.
 fn our_state(app: &App, bead: Entity) -> BeadState {
-    let bead = app.world().get::<Bead>(bead).expect("a bead");
-    BeadState {
-        position: bead.position,
-        velocity: bead.velocity,
-    }
+    bead_state(app.world(), bead).expect("a bead")
 }
 
 /// Our `n` pendulums on carts through the plugin, for `steps` steps.

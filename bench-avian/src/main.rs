@@ -39,9 +39,10 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use clap::{Args, Parser, Subcommand};
 use wirebead::SimClock;
-use wirebead::headless::Headless;
+use wirebead::headless::{Headless, bead_state};
 use wirebead::prelude::*;
 use wirebead::reference::{pendulum_period, period_from_crossings};
+use wirebead::solver::BeadState;
 
 /// The circle's radius, metres.
 const RADIUS: f64 = 0.8;
@@ -133,8 +134,8 @@ fn our_app(n: usize, method: Method, dt: f64) -> (App, Entity) {
 /// wall seconds in the stepping loop).
 fn run_ours(n: usize, method: Method, dt: f64, steps: usize) -> (f64, f64, Option<f64>, f64) {
     let (mut app, first) = our_app(n, method, dt);
-    let energy = |b: &Bead| 0.5 * b.velocity.length_squared() + GRAVITY * b.position.y;
-    let e0 = energy(app.world().get::<Bead>(first).expect("bead"));
+    let energy = |b: BeadState| 0.5 * b.velocity.length_squared() + GRAVITY * b.position.y;
+    let e0 = energy(bead_state(app.world(), first).expect("bead"));
     let mut samples = Vec::with_capacity(steps + 1);
     let mut max_radial: f64 = 0.0;
     let mut seconds = 0.0;
@@ -149,7 +150,7 @@ fn run_ours(n: usize, method: Method, dt: f64, steps: usize) -> (f64, f64, Optio
             );
             return (f64::NAN, f64::NAN, None, seconds);
         }
-        let bead = app.world().get::<Bead>(first).expect("bead");
+        let bead = bead_state(app.world(), first).expect("bead");
         let clock = app.world().resource::<SimClock>();
         assert_eq!(
             clock.steps as usize,
@@ -159,7 +160,7 @@ fn run_ours(n: usize, method: Method, dt: f64, steps: usize) -> (f64, f64, Optio
         max_radial = max_radial.max((bead.position.length() - RADIUS).abs());
         samples.push((clock.time, bead.position.x));
     }
-    let bead = app.world().get::<Bead>(first).expect("bead");
+    let bead = bead_state(app.world(), first).expect("bead");
     (
         energy(bead) - e0,
         max_radial,

@@ -1,18 +1,24 @@
-//! [`Bead`]: a particle's parameters and `f64` state, with the force
-//! accumulated for the next step; its parameters for the next run and the
-//! spring anchor that pulls it.
+//! [`Bead`] and its columns: position, velocity, mass, the force
+//! accumulated for the next step and the parameters a restart returns to;
+//! its parameters for the next run and the spring anchor that pulls it.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
+
+use bevy::ecs::lifecycle::HookContext;
+use bevy::ecs::query::QueryData;
+use bevy::ecs::world::DeferredWorld;
 
 use crate::geometry::Twist;
 use crate::solver::{BeadState, LinearForce};
 use crate::validate::{ParamError, finite_vector, positive};
 
 /// The per-bead parameters of the assignment's panel: mass, initial position and
-/// initial velocity.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Reflect)]
+/// initial velocity. On a bead, the state a [`Restart`](crate::Restart)
+/// returns it to.
+#[derive(Component, Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Reflect)]
+#[reflect(Component)]
 #[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct BeadParams {
@@ -41,128 +47,258 @@ impl BeadParams {
         finite_vector("initial position", self.initial_position)?;
         finite_vector("initial velocity", self.initial_velocity).map(drop)
     }
+
+    /// The initial velocity in the world on a wire moving by `twist` at
+    /// t = 0: the initial velocity is relative to the wire's own where the
+    /// bead starts.
+    pub(crate) fn initial_velocity_on(&self, twist: &Twist) -> DVec2 {
+        self.initial_velocity + twist.velocity_at(self.initial_position)
+    }
 }
 
-/// A bead: its applied parameters, its `f64` state and the external force
-/// accumulated for the next step.
+/// A bead: the marker its other components hang on. A bead's state is
+/// split into columns of its own, as a rigid body's is in avian:
 ///
-/// The position and velocity may be written directly (a game teleporting a
-/// bead); the step checks them and marks the bead
-/// [`Diverged`](crate::Diverged) rather than propagate a non-finite value.
+/// | component | what it holds | who writes it |
+/// |---|---|---|
+/// | [`BeadPosition`] | the position, `f64` world coordinates | the step; a game may teleport |
+/// | [`BeadVelocity`] | the velocity | the step; a game may kick |
+/// | [`BeadMass`] | the mass, checked positive and finite | a restart; a game through [`BeadMass::new`] |
+/// | [`BeadForce`] | the force accumulated for the next step | systems in [`WireBeadSystems::Forces`](crate::WireBeadSystems::Forces), through [`BeadForces`]; the step consumes it |
+/// | [`BeadParams`] | mass and initial state a restart returns to | [`Restart`](crate::Restart), from [`NextBeadParams`] |
+///
+/// The step streams only the first four. [`Bead::new`] spawns all five in
+/// one expression; a bare `Bead` gets the others as required components
+/// (at rest at the origin, 1 kg) and remembers the state it was spawned in
+/// as its [`BeadParams`] unless one is given.
+///
+/// A position or velocity written directly is checked by the step, which
+/// marks the bead [`Diverged`](crate::Diverged) rather than propagate a
+/// non-finite value.
 ///
 /// With [`WireBeadPlugin`](crate::WireBeadPlugin)'s defaults a bead also gets
 /// a `Transform` (the plugin writes its position there) and
 /// [`BeadDiagnostics`](crate::BeadDiagnostics);
 /// [`WireBeadPlugin::lean`](crate::WireBeadPlugin::lean) leaves both out for
 /// crowds of beads nobody looks at one by one.
-#[derive(Component, Clone, Debug, PartialEq, Reflect)]
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
 #[reflect(Component)]
-pub struct Bead {
-    params: BeadParams,
-    /// Position in world coordinates.
-    pub position: DVec2,
-    /// Velocity.
-    pub velocity: DVec2,
-    /// The external force accumulated for the next step, gravity not
-    /// included; consumed by the step.
-    force: DVec2,
-    /// The stiffness of that force (the sum of the spring constants in it).
-    force_stiffness: f64,
-}
+#[require(BeadPosition, BeadVelocity, BeadMass, BeadForce)]
+#[component(on_add = remember_start)]
+pub struct Bead;
 
 impl Bead {
     /// A bead at its initial position with its initial velocity, if the
-    /// parameters are valid.
-    pub fn new(params: BeadParams) -> Result<Self, ParamError> {
+    /// parameters are valid: every component of the bead, to spawn in one
+    /// expression.
+    pub fn new(params: BeadParams) -> Result<BeadBundle, ParamError> {
         params.validate()?;
-        Ok(Self::initial(params))
-    }
-
-    fn initial(params: BeadParams) -> Self {
-        Self {
+        Ok((
+            Bead,
+            BeadPosition(params.initial_position),
+            BeadVelocity(params.initial_velocity),
+            BeadMass(params.mass),
             params,
-            position: params.initial_position,
-            velocity: params.initial_velocity,
-            force: DVec2::ZERO,
-            force_stiffness: 0.0,
-        }
+        ))
     }
 
     /// A bead of the given mass at rest at `position`.
-    pub fn at_rest(mass: f64, position: DVec2) -> Result<Self, ParamError> {
+    pub fn at_rest(mass: f64, position: DVec2) -> Result<BeadBundle, ParamError> {
         Self::new(BeadParams {
             mass,
             initial_position: position,
             initial_velocity: DVec2::ZERO,
         })
     }
+}
 
-    /// The applied parameters (what a restart returns to).
-    pub fn params(&self) -> &BeadParams {
-        &self.params
+/// Every component of a bead, as [`Bead::new`] makes them: spawn it, with
+/// an [`OnWire`](crate::OnWire) to put the bead on a wire.
+pub type BeadBundle = (Bead, BeadPosition, BeadVelocity, BeadMass, BeadParams);
+
+/// A bead spawned without [`BeadParams`] restarts where it was spawned.
+fn remember_start(mut world: DeferredWorld, context: HookContext) {
+    let entity = context.entity;
+    if world.get::<BeadParams>(entity).is_some() {
+        return;
+    }
+    let start = world.entity(entity);
+    let params = BeadParams {
+        mass: start.get::<BeadMass>().map_or(1.0, BeadMass::get),
+        initial_position: start.get::<BeadPosition>().map_or(DVec2::ZERO, |p| p.0),
+        initial_velocity: start.get::<BeadVelocity>().map_or(DVec2::ZERO, |v| v.0),
+    };
+    world.commands().entity(entity).insert_if_new(params);
+}
+
+/// A bead's position in `f64` world coordinates. The step writes it; a game
+/// may too (a teleport).
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut, Reflect)]
+#[reflect(Component)]
+pub struct BeadPosition(pub DVec2);
+
+/// A bead's velocity. The step writes it; a game may too (a kick).
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut, Reflect)]
+#[reflect(Component)]
+pub struct BeadVelocity(pub DVec2);
+
+/// A bead's mass in kg, positive and finite: made only by
+/// [`BeadMass::new`], so the step never divides by a bad one. 1 kg by
+/// default.
+#[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Component)]
+pub struct BeadMass(f64);
+
+impl Default for BeadMass {
+    fn default() -> Self {
+        Self(1.0)
+    }
+}
+
+impl BeadMass {
+    /// A mass, if it is positive and finite.
+    pub fn new(mass: f64) -> Result<Self, ParamError> {
+        positive("mass", mass).map(Self)
     }
 
-    /// The mass.
-    pub fn mass(&self) -> f64 {
-        self.params.mass
+    /// The mass in kg.
+    #[inline(always)]
+    pub fn get(&self) -> f64 {
+        self.0
+    }
+}
+
+/// The external force accumulated on a bead for the next step, gravity not
+/// included (the step adds `m g` itself), and its stiffness: the sum of the
+/// spring constants in it. Add to it through [`BeadForces`] from a system
+/// in [`WireBeadSystems::Forces`](crate::WireBeadSystems::Forces); the step
+/// consumes it, so both are zero again after every step.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
+#[reflect(Component)]
+pub struct BeadForce {
+    force: DVec2,
+    stiffness: f64,
+}
+
+impl BeadForce {
+    /// The force added so far, and its stiffness.
+    pub fn get(&self) -> (DVec2, f64) {
+        (self.force, self.stiffness)
     }
 
-    /// Position and velocity.
-    pub fn state(&self) -> BeadState {
-        BeadState {
-            position: self.position,
-            velocity: self.velocity,
+    /// The force of the next step on a bead of mass `mass` at `at`, eq. (5):
+    /// gravity plus the accumulated force, linearized at the bead's
+    /// position.
+    #[inline(always)]
+    pub(crate) fn linear(&self, mass: f64, gravity: DVec2, at: DVec2) -> LinearForce {
+        LinearForce {
+            force: self.force + mass * gravity,
+            stiffness: self.stiffness,
+            at,
         }
     }
 
-    /// Adds a constant force for the next step (call it from a system in
-    /// [`WireBeadSystems::Forces`](crate::WireBeadSystems::Forces)).
+    /// Empties the accumulator (the step has used it).
+    #[inline(always)]
+    pub(crate) fn clear(&mut self) {
+        *self = Self::default();
+    }
+}
+
+/// The query a game adds forces through, in
+/// [`WireBeadSystems::Forces`](crate::WireBeadSystems::Forces):
+/// `Query<BeadForces>`, then [`add_force`](BeadForcesItem::add_force) or
+/// [`add_spring`](BeadForcesItem::add_spring) on each item.
+#[derive(QueryData)]
+#[query_data(mutable)]
+pub struct BeadForces {
+    /// Where the bead is (a spring pulls from here).
+    pub position: &'static BeadPosition,
+    /// The accumulator.
+    pub force: &'static mut BeadForce,
+}
+
+impl BeadForcesItem<'_, '_> {
+    /// Adds a constant force for the next step.
     pub fn add_force(&mut self, force: DVec2) {
-        self.force += force;
+        self.force.force += force;
     }
 
     /// Adds a spring `k (anchor - x)` for the next step.
     pub fn add_spring(&mut self, k: f64, anchor: DVec2) {
-        self.force += k * (anchor - self.position);
-        self.force_stiffness += k;
+        let pull = k * (anchor - self.position.0);
+        self.force.force += pull;
+        self.force.stiffness += k;
     }
 
-    /// The force added for the next step so far (gravity not included;
-    /// the step adds `m g` itself), and its stiffness: the sum of the
-    /// spring constants added. Both are zero again after every step.
-    pub fn accumulated_force(&self) -> (DVec2, f64) {
-        (self.force, self.force_stiffness)
+    /// The force added for the next step so far, and its stiffness.
+    pub fn accumulated(&self) -> (DVec2, f64) {
+        self.force.get()
+    }
+}
+
+/// What the step and a restart read and write of a bead: its state, mass
+/// and force.
+#[derive(QueryData)]
+#[query_data(mutable)]
+pub(crate) struct BeadMotion {
+    pub(crate) position: &'static mut BeadPosition,
+    pub(crate) velocity: &'static mut BeadVelocity,
+    pub(crate) mass: &'static mut BeadMass,
+    pub(crate) force: &'static mut BeadForce,
+}
+
+/// A bead's position and velocity as the solver takes them.
+#[inline(always)]
+fn state_of(position: &BeadPosition, velocity: &BeadVelocity) -> BeadState {
+    BeadState {
+        position: position.0,
+        velocity: velocity.0,
+    }
+}
+
+impl BeadMotionItem<'_, '_> {
+    /// Position and velocity.
+    pub(crate) fn state(&self) -> BeadState {
+        state_of(&self.position, &self.velocity)
     }
 
-    /// The force of the next step, eq. (5): gravity plus the accumulated
-    /// force, linearized at the bead's position.
-    #[inline(always)]
-    pub(crate) fn step_force(&self, gravity: DVec2) -> LinearForce {
-        LinearForce {
-            force: self.force + self.mass() * gravity,
-            stiffness: self.force_stiffness,
-            at: self.position,
-        }
+    /// The mass.
+    pub(crate) fn mass(&self) -> f64 {
+        self.mass.get()
     }
 
     /// Stores a step's new state and clears the consumed force.
-    #[inline(always)]
     pub(crate) fn advance_to(&mut self, state: BeadState) {
-        self.position = state.position;
-        self.velocity = state.velocity;
-        self.force = DVec2::ZERO;
-        self.force_stiffness = 0.0;
+        self.position.0 = state.position;
+        self.velocity.0 = state.velocity;
+        self.force.clear();
     }
 
-    /// Adds the velocity of a moving wire's point where the bead is (its
-    /// initial velocity is relative to its wire at t = 0).
-    pub(crate) fn ride(&mut self, twist: &Twist) {
-        self.velocity += twist.velocity_at(self.position);
+    /// Applies `params`' mass and initial state, the force cleared.
+    pub(crate) fn reset(&mut self, params: &BeadParams) {
+        self.mass.set_if_neq(BeadMass(params.mass));
+        self.advance_to(state_of(
+            &BeadPosition(params.initial_position),
+            &BeadVelocity(params.initial_velocity),
+        ));
+    }
+}
+
+impl BeadMotionReadOnlyItem<'_, '_> {
+    /// Position and velocity.
+    pub(crate) fn state(&self) -> BeadState {
+        state_of(self.position, self.velocity)
     }
 
-    /// Applies `params` and returns the bead to its initial state.
-    pub(crate) fn reset(&mut self, params: BeadParams) {
-        *self = Self::initial(params);
+    /// The mass.
+    pub(crate) fn mass(&self) -> f64 {
+        self.mass.get()
+    }
+
+    /// The force of the next step, eq. (5).
+    pub(crate) fn step_force(&self, gravity: DVec2) -> LinearForce {
+        self.force.linear(self.mass.get(), gravity, self.position.0)
     }
 }
 
@@ -225,5 +361,87 @@ mod tests {
                 .to_string(),
             "spring anchor must be finite, got (NaN, 0)"
         );
+    }
+
+    #[test]
+    fn a_mass_that_is_not_positive_and_finite_is_refused_in_words() {
+        for (mass, words) in [
+            (0.0, "mass must be positive and finite, got 0"),
+            (-2.0, "mass must be positive and finite, got -2"),
+            (f64::NAN, "mass must be positive and finite, got NaN"),
+            (f64::INFINITY, "mass must be positive and finite, got inf"),
+        ] {
+            assert_eq!(BeadMass::new(mass).unwrap_err().to_string(), words);
+        }
+        assert_eq!(BeadMass::new(2.5).unwrap().get(), 2.5);
+    }
+
+    #[test]
+    fn a_bead_spawns_in_one_expression_with_every_column() {
+        let params = BeadParams {
+            mass: 2.0,
+            initial_position: DVec2::new(0.5, -1.0),
+            initial_velocity: DVec2::new(0.0, 3.0),
+        };
+        let mut world = World::new();
+        let bead = world.spawn(Bead::new(params).unwrap()).id();
+        world.flush();
+        let bead = world.entity(bead);
+        assert_eq!(bead.get::<BeadPosition>().unwrap().0, DVec2::new(0.5, -1.0));
+        assert_eq!(bead.get::<BeadVelocity>().unwrap().0, DVec2::new(0.0, 3.0));
+        assert_eq!(bead.get::<BeadMass>().unwrap().get(), 2.0);
+        assert_eq!(bead.get::<BeadForce>().unwrap().get(), (DVec2::ZERO, 0.0));
+        assert_eq!(bead.get::<BeadParams>(), Some(&params));
+    }
+
+    #[test]
+    fn a_bare_bead_remembers_the_state_it_was_spawned_in() {
+        let mut world = World::new();
+        let (p, v) = (DVec2::new(1.0, 2.0), DVec2::new(-3.0, 0.25));
+        let bead = world
+            .spawn((
+                Bead,
+                BeadPosition(p),
+                BeadVelocity(v),
+                BeadMass::new(4.0).unwrap(),
+            ))
+            .id();
+        let plain = world.spawn(Bead).id();
+        world.flush();
+        let expected = BeadParams {
+            mass: 4.0,
+            initial_position: p,
+            initial_velocity: v,
+        };
+        assert_eq!(world.get::<BeadParams>(bead), Some(&expected));
+        let plain = world.entity(plain);
+        assert_eq!(plain.get::<BeadMass>().unwrap().get(), 1.0);
+        assert_eq!(plain.get::<BeadPosition>().unwrap().0, DVec2::ZERO);
+        assert_eq!(
+            plain.get::<BeadParams>().unwrap().initial_position,
+            DVec2::ZERO
+        );
+    }
+
+    #[test]
+    fn forces_accumulate_and_a_spring_pulls_from_where_the_bead_is() {
+        let mut world = World::new();
+        let at = DVec2::new(1.0, -1.0);
+        let bead = world.spawn(Bead::at_rest(1.0, at).unwrap()).id();
+        let mut query = world.query::<BeadForces>();
+        let mut forces = query.get_mut(&mut world, bead).unwrap();
+        forces.add_force(DVec2::new(0.5, 0.0));
+        forces.add_spring(20.0, DVec2::new(2.0, 1.0));
+        forces.add_spring(5.0, at);
+        let (force, stiffness) = forces.accumulated();
+        assert_eq!(force, DVec2::new(0.5 + 20.0, 40.0));
+        assert_eq!(stiffness, 25.0);
+        // The force of the step adds the weight and is linear about `at`.
+        let step = world
+            .get::<BeadForce>(bead)
+            .unwrap()
+            .linear(2.0, DVec2::new(0.0, -10.0), at);
+        assert_eq!(step.force, DVec2::new(20.5, 20.0));
+        assert_eq!((step.stiffness, step.at), (25.0, at));
     }
 }

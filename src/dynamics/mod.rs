@@ -10,7 +10,11 @@ mod links;
 mod params;
 mod wire;
 
-pub use bead::{Bead, BeadParams, NextBeadParams, SpringAnchor};
+pub use bead::{
+    Bead, BeadBundle, BeadForce, BeadForces, BeadForcesItem, BeadMass, BeadParams, BeadPosition,
+    BeadVelocity, NextBeadParams, SpringAnchor,
+};
+pub(crate) use bead::{BeadMotion, BeadMotionItem};
 pub use diagnostics::{BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason};
 pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
 pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, NextParams, SimParams};

@@ -15,7 +15,7 @@ use crate::debug_render::{hatch_point, wire_points};
 use crate::geometry::Placed;
 use crate::gui::render::{FramedView, SceneCamera, hatch_length};
 use crate::preset::ActivePreset;
-use crate::{Bead, Diverged, Pin, Rod, SpringAnchor, Wire, WireContact, pose_of};
+use crate::{BeadPosition, Diverged, Pin, Rod, SpringAnchor, Wire, WireContact, pose_of};
 
 /// Where one bead is.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -142,7 +142,7 @@ struct ReportView<'w, 's> {
         'w,
         's,
         (
-            &'static Bead,
+            &'static BeadPosition,
             Option<&'static SpringAnchor>,
             Option<&'static Diverged>,
             &'static Transform,
@@ -183,8 +183,8 @@ impl ReportView<'_, '_> {
                 .iter()
                 .filter_map(|(bead, _, diverged, transform, contact)| {
                     Some(BeadReport {
-                        world: bead.position.to_array(),
-                        pixel: to_pixel(bead.position)?,
+                        world: bead.to_array(),
+                        pixel: to_pixel(bead.0)?,
                         radius_px: transform.scale.x / self.view.size.y.max(1e-9) * size[1] as f32,
                         diverged: diverged.map(|d| d.reason.to_string()),
                         in_flight: contact.is_some_and(|c| !c.is_on()),
@@ -234,7 +234,7 @@ impl ReportView<'_, '_> {
                 .filter_map(|rod| {
                     let end = |i: usize| {
                         let (bead, ..) = self.beads.get(rod.beads()[i]).ok()?;
-                        to_pixel(bead.position)
+                        to_pixel(bead.0)
                     };
                     Some([end(0)?, end(1)?])
                 })
@@ -254,9 +254,12 @@ impl ReportView<'_, '_> {
 
 impl AutomationState {
     /// Records the dragged beads' positions and the drag target.
-    fn follow_drag<'a>(&mut self, dragged: impl Iterator<Item = (&'a Bead, &'a SpringAnchor)>) {
+    fn follow_drag<'a>(
+        &mut self,
+        dragged: impl Iterator<Item = (&'a BeadPosition, &'a SpringAnchor)>,
+    ) {
         for (bead, target) in dragged {
-            self.drag_path.push(bead.position);
+            self.drag_path.push(bead.0);
             self.drag_target = Some(target.get());
         }
     }

@@ -10,7 +10,7 @@
 use bevy::prelude::*;
 
 use crate::gui::render::{SceneCamera, screen_to_world};
-use crate::{Bead, SpringAnchor};
+use crate::{BeadPosition, SpringAnchor};
 
 /// The bead the panel shows: the last one grabbed, or the first one.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -49,7 +49,7 @@ fn cursor_world(
 /// Grabs a bead: selects it and sets its drag target at the cursor.
 pub fn start_drag(
     event: On<Pointer<DragStart>>,
-    beads: Query<(Entity, &Bead, &Transform)>,
+    beads: Query<(Entity, &BeadPosition, &Transform)>,
     windows: Query<(), With<Window>>,
     cameras: SceneCameras,
     mut grabbed: ResMut<Grabbed>,
@@ -76,7 +76,7 @@ pub fn start_drag(
             .map(|(e, b, t)| {
                 (
                     e,
-                    (b.position - target.get()).length() / f64::from(t.scale.x.max(1e-6)),
+                    (b.0 - target.get()).length() / f64::from(t.scale.x.max(1e-6)),
                 )
             })
             .filter(|(_, d)| *d <= 1.5)

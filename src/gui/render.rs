@@ -13,7 +13,9 @@ use crate::debug_render::{
     DebugRenderStyle, DebugRenderSystems, WireBeadDebugPlugin, wire_points, wire_pose,
 };
 use crate::geometry::{Pose, WireShape};
-use crate::{Bead, OnWire, Restart, Rod, Wire, WireBeadSystems, WireContact};
+use crate::{
+    Bead, BeadParams, BeadPosition, OnWire, Restart, Rod, Wire, WireBeadSystems, WireContact,
+};
 
 /// Colours and sizes of the scene.
 #[derive(Resource, Clone, Debug)]
@@ -198,12 +200,12 @@ pub fn add_bead_visuals(
 pub fn record_trails(
     params: Res<crate::SimParams>,
     style: Res<SceneStyle>,
-    mut beads: Query<(&Bead, &mut Trail, Option<&WireContact>)>,
+    mut beads: Query<(&BeadPosition, &mut Trail, Option<&WireContact>)>,
 ) {
     let keep = (style.trail_seconds / params.timestep).ceil() as usize;
     for (bead, mut trail, contact) in &mut beads {
         let flying = contact.is_some_and(|c| !c.is_on());
-        trail.0.push_back((bead.position.as_vec2(), flying));
+        trail.0.push_back((bead.as_vec2(), flying));
         while trail.0.len() > keep.max(2) {
             trail.0.pop_front();
         }
@@ -232,7 +234,7 @@ pub fn wire_bounds(shape: &WireShape, pose: &Pose) -> (DVec2, DVec2) {
 /// left of the panel, whatever their size.
 pub fn frame_camera(
     wires: Query<(&Wire, &Transform)>,
-    beads: Query<&Bead>,
+    beads: Query<&BeadParams>,
     rods: Query<&Rod>,
     on_wire: Query<(), With<OnWire>>,
     windows: Query<&Window>,
@@ -248,8 +250,8 @@ pub fn frame_camera(
         hi = hi.max(b);
     }
     for bead in &beads {
-        lo = lo.min(bead.params().initial_position);
-        hi = hi.max(bead.params().initial_position);
+        lo = lo.min(bead.initial_position);
+        hi = hi.max(bead.initial_position);
     }
     // Beads hanging on rods swing out as far as the rods reach: a rod
     // with a bead on no wire widens the view by its length.

@@ -5,7 +5,7 @@
 use bevy::prelude::*;
 
 use super::schedule::WireBeadSystems;
-use crate::dynamics::{Bead, Diverged, SimParams, SpringAnchor};
+use crate::dynamics::{BeadForces, Diverged, SimParams, SpringAnchor};
 
 /// Pulls each bead that has a [`SpringAnchor`] toward it with the
 /// assignment's spring.
@@ -25,7 +25,7 @@ impl Plugin for SpringAnchorPlugin {
 /// (the assignment's drag spring).
 fn apply_anchor_springs(
     params: Res<SimParams>,
-    mut beads: Query<(&mut Bead, &SpringAnchor), Without<Diverged>>,
+    mut beads: Query<(BeadForces, &SpringAnchor), Without<Diverged>>,
 ) {
     for (mut bead, target) in &mut beads {
         bead.add_spring(params.drag_stiffness, target.get());

@@ -7,7 +7,8 @@ use bevy::prelude::*;
 use super::parallel::{ParallelStep, StepSplit};
 use super::schedule;
 use crate::dynamics::{
-    Bead, BeadDiagnostics, BeadDiverged, ContactChanged, NextBeadParams, NextParams, SimParams,
+    Bead, BeadDiagnostics, BeadDiverged, BeadForce, BeadMass, BeadParams, BeadPosition,
+    BeadVelocity, ContactChanged, NextBeadParams, NextParams, SimParams,
 };
 
 /// The parameters ([`SimParams`], [`NextParams`]), the step's sets in
@@ -75,6 +76,11 @@ impl Plugin for ParamsPlugin {
             .add_message::<BeadDiverged>()
             .add_message::<ContactChanged>()
             .register_type::<Bead>()
+            .register_type::<BeadPosition>()
+            .register_type::<BeadVelocity>()
+            .register_type::<BeadMass>()
+            .register_type::<BeadForce>()
+            .register_type::<BeadParams>()
             .register_type::<BeadDiagnostics>()
             .register_type::<NextBeadParams>()
             .register_type::<SimParams>()

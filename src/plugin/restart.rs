@@ -8,8 +8,8 @@ use super::islands::Islands;
 use super::schedule::WireBeadSystems;
 use super::wires::{prescribed, set_pose};
 use crate::dynamics::{
-    Bead, BeadDiagnostics, Diverged, NextBeadParams, NextParams, NextWireShape, OnWire,
-    PrescribedMotion, SimParams, Wire, WireContact, WirePose,
+    BeadDiagnostics, BeadMotion, BeadMotionItem, BeadParams, Diverged, NextBeadParams, NextParams,
+    NextWireShape, OnWire, PrescribedMotion, SimParams, Wire, WireContact, WirePose,
 };
 use crate::geometry::{MovingTrack, Track};
 use crate::solver::{RowReport, constraint_state_on};
@@ -35,7 +35,11 @@ impl Plugin for RestartPlugin {
 }
 
 /// The diagnostics of a bead's current state on `track`, before any step.
-fn diagnose<T: Track>(track: &T, bead: &Bead, gravity: bevy::math::DVec2) -> BeadDiagnostics {
+fn diagnose<T: Track>(
+    track: &T,
+    bead: &BeadMotionItem,
+    gravity: bevy::math::DVec2,
+) -> BeadDiagnostics {
     let (c, c_dot) = constraint_state_on(track, 0.0, bead.state());
     let row = RowReport {
         c,
@@ -63,7 +67,8 @@ fn apply_restart(
     )>,
     mut beads: Query<(
         Entity,
-        &mut Bead,
+        BeadMotion,
+        &mut BeadParams,
         Option<&mut BeadDiagnostics>,
         Option<&mut WireContact>,
         Option<&OnWire>,
@@ -99,9 +104,11 @@ fn apply_restart(
     let overstep = time.overstep();
     time.discard_overstep(overstep);
     *clock = SimClock::default();
-    for (entity, mut bead, diagnostics, contact, on_wire, edit) in &mut beads {
-        let bead_params = edit.map_or(*bead.params(), |p| *p.get());
-        bead.reset(bead_params);
+    for (entity, mut bead, mut bead_params, diagnostics, contact, on_wire, edit) in &mut beads {
+        if let Some(edit) = edit {
+            bead_params.set_if_neq(*edit.get());
+        }
+        bead.reset(&bead_params);
         if let Some(mut contact) = contact {
             contact.set_if_neq(WireContact::default());
         }
@@ -117,7 +124,7 @@ fn apply_restart(
         };
         let Ok(path) = pose.get() else { continue };
         // The initial velocity is relative to the wire's own at t = 0.
-        bead.ride(&path.at(0.0).1);
+        bead.velocity.0 = bead_params.initial_velocity_on(&path.at(0.0).1);
         if let Some(mut diagnostics) = diagnostics {
             let track = MovingTrack {
                 curve: wire.shape().curve(),

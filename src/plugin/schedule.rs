@@ -8,8 +8,9 @@ use bevy::prelude::*;
 ///
 /// A game adds its own forces with
 /// `app.add_systems(FixedUpdate, my_force.in_set(WireBeadSystems::Forces))`,
-/// calling [`Bead::add_force`](crate::Bead::add_force) or
-/// [`Bead::add_spring`](crate::Bead::add_spring).
+/// adding to each bead through the [`BeadForces`](crate::BeadForces)
+/// query: [`add_force`](crate::BeadForcesItem::add_force) or
+/// [`add_spring`](crate::BeadForcesItem::add_spring).
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum WireBeadSystems {
     /// [`PreUpdate`]: handles [`Restart`](crate::Restart), applying the

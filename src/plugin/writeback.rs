@@ -7,7 +7,7 @@ use bevy::prelude::*;
 
 use super::parallel::ParallelStep;
 use super::schedule::WireBeadSystems;
-use crate::dynamics::Bead;
+use crate::dynamics::BeadPosition;
 
 /// Keeps each bead's `Transform` at its position where the step did not
 /// write it itself (a restart, a game's own edit).
@@ -35,13 +35,13 @@ pub(crate) struct LastStep(pub(crate) Tick);
 fn write_transforms(
     parallel: Res<ParallelStep>,
     stepped: Res<LastStep>,
-    mut beads: Query<(Ref<Bead>, &mut Transform), Changed<Bead>>,
+    mut beads: Query<(Ref<BeadPosition>, &mut Transform), Changed<BeadPosition>>,
 ) {
-    let write = |(bead, mut transform): (Ref<Bead>, Mut<Transform>)| {
+    let write = |(position, mut transform): (Ref<BeadPosition>, Mut<Transform>)| {
         // The step wrote the ones it changed last (without reading them
         // again here).
-        if bead.last_changed() != stepped.0 {
-            place(&mut transform, bead.position);
+        if position.last_changed() != stepped.0 {
+            place(&mut transform, position.0);
         }
     };
     if beads.iter().size_hint().1.unwrap_or(usize::MAX) >= parallel.threshold {

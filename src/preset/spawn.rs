@@ -4,7 +4,7 @@
 use bevy::prelude::*;
 
 use super::format::{BeadPreset, SceneLink, ScenePreset};
-use crate::dynamics::{Bead, OnWire, Pin, PrescribedMotion, Rod, Spring, Wire};
+use crate::dynamics::{Bead, BeadVelocity, OnWire, Pin, PrescribedMotion, Rod, Spring, Wire};
 use crate::geometry::{Pose, Twist};
 
 /// Marks the wires and beads spawned from a preset, which the next preset
@@ -22,18 +22,15 @@ impl ScenePreset {
         let mut spawn_bead =
             |preset: &BeadPreset, wire: Option<(Entity, Twist)>, commands: &mut Commands| {
                 let name = Name::new(names[beads.len()].clone());
-                let Ok(mut bead) = Bead::new(preset.params()) else {
+                let params = preset.params();
+                let Ok(bead) = Bead::new(params) else {
                     beads.push(Entity::PLACEHOLDER);
                     return;
                 };
-                // The initial velocity is relative to the wire's own at
-                // t = 0, as a restart makes it.
-                if let Some((_, twist)) = &wire {
-                    bead.ride(twist);
-                }
                 let mut entity = commands.spawn((bead, name, FromPreset));
-                if let Some((wire, _)) = wire {
-                    entity.insert(OnWire(wire));
+                if let Some((wire, twist)) = wire {
+                    let velocity = BeadVelocity(params.initial_velocity_on(&twist));
+                    entity.insert((OnWire(wire), velocity));
                 }
                 beads.push(entity.id());
             };

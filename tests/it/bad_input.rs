@@ -177,9 +177,8 @@ fn nan_written_into_a_bead_is_reported_not_propagated() {
     let (mut app, bead_entity) = scene();
     let before = *app.world().get::<Transform>(bead_entity).unwrap();
     app.world_mut()
-        .get_mut::<Bead>(bead_entity)
+        .get_mut::<BeadVelocity>(bead_entity)
         .unwrap()
-        .velocity
         .x = f64::NAN;
     run_steps(&mut app, 5);
     let diverged = app.world().get::<Diverged>(bead_entity).expect("reported");

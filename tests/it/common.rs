@@ -4,11 +4,13 @@
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
+use wirebead::BeadForce;
 use wirebead::SimClock;
-use wirebead::headless::Headless;
+use wirebead::headless::{Headless, bead_state};
 pub use wirebead::headless::{run_for, run_steps};
 use wirebead::prelude::*;
 use wirebead::reference;
+use wirebead::solver::BeadState;
 
 /// One recorded step of one bead.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -34,17 +36,17 @@ impl Recording {
 }
 
 fn record(
-    beads: Query<(Entity, &Bead, &BeadDiagnostics)>,
+    beads: Query<(Entity, &BeadPosition, &BeadVelocity, &BeadDiagnostics)>,
     clock: Res<SimClock>,
     mut recording: ResMut<Recording>,
 ) {
-    for (entity, bead, diagnostics) in &beads {
+    for (entity, position, velocity, diagnostics) in &beads {
         recording.0.push((
             entity,
             Sample {
                 t: clock.time,
-                position: bead.position,
-                velocity: bead.velocity,
+                position: position.0,
+                velocity: velocity.0,
                 diagnostics: *diagnostics,
             },
         ));
@@ -92,8 +94,35 @@ pub fn pendulum(app: &mut App, r: f64, theta0: f64) -> Entity {
     circle_bead(app, r, reference::point_on_circle(r, theta0), DVec2::ZERO)
 }
 
-pub fn bead(app: &App, bead: Entity) -> Bead {
-    app.world().get::<Bead>(bead).expect("bead").clone()
+/// What a test reads of a bead: its columns, copied out.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BeadNow {
+    pub position: DVec2,
+    pub velocity: DVec2,
+    pub mass: f64,
+    pub params: BeadParams,
+    pub force: (DVec2, f64),
+}
+
+impl BeadNow {
+    pub fn state(&self) -> BeadState {
+        BeadState {
+            position: self.position,
+            velocity: self.velocity,
+        }
+    }
+}
+
+pub fn bead(app: &App, bead: Entity) -> BeadNow {
+    let world = app.world();
+    let state = bead_state(world, bead).expect("bead");
+    BeadNow {
+        position: state.position,
+        velocity: state.velocity,
+        mass: world.get::<BeadMass>(bead).expect("bead").get(),
+        params: *world.get::<BeadParams>(bead).expect("bead"),
+        force: world.get::<BeadForce>(bead).expect("bead").get(),
+    }
 }
 
 pub fn diagnostics(app: &App, bead: Entity) -> BeadDiagnostics {

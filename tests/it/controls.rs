@@ -58,7 +58,7 @@ fn space_restarts_and_applies_pending_params() {
     assert_eq!(app.world().resource::<SimParams>().alpha, 250.0);
     let b = bead(&app, bead_entity);
     assert_eq!(
-        (b.mass(), b.position, b.velocity),
+        (b.mass, b.position, b.velocity),
         (3.0, DVec2::new(-1.0, 0.0), DVec2::ZERO)
     );
     assert_eq!(steps(&app), 0);

@@ -345,7 +345,7 @@ fn energy(app: &App, beads: &[Entity]) -> f64 {
         .iter()
         .map(|&e| {
             let b = bead(app, e);
-            let (kinetic, potential) = b.state().energy(b.mass(), g);
+            let (kinetic, potential) = b.state().energy(b.mass, g);
             kinetic + potential
         })
         .sum()

@@ -8,6 +8,8 @@ use wirebead::plugin::StepSplit;
 use wirebead::prelude::*;
 use wirebead::{ParallelStep, SimClock};
 
+use crate::common::bead;
+
 const BEADS_PER_WIRE: usize = 1500;
 
 /// Four wires of different shapes, moved and rotated, 1,500 beads on each
@@ -96,10 +98,7 @@ fn assert_same_beads(a: (&App, &[Entity]), b: (&App, &[Entity])) -> usize {
     let mut diverged = 0;
     let mut moved = 0;
     for (&ea, &eb) in a.1.iter().zip(b.1) {
-        let (ba, bb) = (
-            a.0.world().get::<Bead>(ea).unwrap(),
-            b.0.world().get::<Bead>(eb).unwrap(),
-        );
+        let (ba, bb) = (bead(a.0, ea), bead(b.0, eb));
         for (va, vb) in [(ba.position, bb.position), (ba.velocity, bb.velocity)] {
             assert_eq!(
                 va.to_array().map(f64::to_bits),
@@ -116,7 +115,7 @@ fn assert_same_beads(a: (&App, &[Entity]), b: (&App, &[Entity])) -> usize {
         );
         assert_eq!(ra, rb, "the same beads diverge for the same reason");
         diverged += usize::from(ra.is_some());
-        moved += usize::from(ba.position != ba.params().initial_position);
+        moved += usize::from(ba.position != ba.params.initial_position);
     }
     assert!(moved > 4 * BEADS_PER_WIRE - 10, "{moved} beads moved");
     diverged
@@ -171,7 +170,7 @@ fn lean_beads_step_like_full_ones_without_their_extras() {
         assert!(!entity.contains::<Transform>() && !entity.contains::<GlobalTransform>());
         assert!(!entity.contains::<BeadDiagnostics>());
     }
-    let position = lean.world().get::<Bead>(watched).unwrap().position;
+    let position = lean.world().get::<BeadPosition>(watched).unwrap().0;
     let written = lean.world().get::<Transform>(watched).unwrap().translation;
     assert_eq!(
         (written.x, written.y),

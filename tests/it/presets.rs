@@ -11,6 +11,8 @@ use wirebead::prelude::*;
 use wirebead::preset::{ActivePreset, FromPreset};
 use wirebead::{ConstraintDiagnostics, Islands, LoadPreset, ScenePreset};
 
+use crate::common::{BeadNow, bead};
+
 pub(crate) const SHIPPED: &[&str] = &[
     "assignment_circle.scene.ron",
     "ellipse.scene.ron",
@@ -151,14 +153,13 @@ fn wait_for(app: &mut App, done: impl Fn(&ActivePreset) -> bool) {
     panic!("timed out: {:?}", app.world().resource::<ActivePreset>());
 }
 
-fn beads(app: &mut App) -> Vec<(Entity, Bead)> {
+fn beads(app: &mut App) -> Vec<(Entity, BeadNow)> {
     let mut query = app
         .world_mut()
-        .query_filtered::<(Entity, &Bead), With<FromPreset>>();
-    let mut beads: Vec<(Entity, Bead)> = query
-        .iter(app.world())
-        .map(|(e, b)| (e, b.clone()))
-        .collect();
+        .query_filtered::<Entity, (With<Bead>, With<FromPreset>)>();
+    let entities: Vec<Entity> = query.iter(app.world()).collect();
+    let mut beads: Vec<(Entity, BeadNow)> =
+        entities.into_iter().map(|e| (e, bead(app, e))).collect();
     beads.sort_by_key(|(e, _)| *e);
     beads
 }

@@ -70,7 +70,7 @@ fn restart_applies_pending_params_and_resets_state() {
         Duration::from_secs_f64(1.0 / 120.0)
     );
     let b = bead(&app, bead_entity);
-    assert_eq!(b.mass(), 2.5);
+    assert_eq!(b.mass, 2.5);
     assert_eq!(b.position, DVec2::new(0.0, -1.0));
     assert_eq!(b.velocity, DVec2::new(2.0, 0.0));
     assert!(app.world().get::<NextBeadParams>(bead_entity).is_none());

@@ -10,7 +10,7 @@ use bevy::prelude::*;
 use wirebead::geometry::{Placed, Pose};
 use wirebead::pose_of;
 use wirebead::prelude::*;
-use wirebead::{Integrator, SpringAnchor, Stabilization, WireBeads};
+use wirebead::{BeadForce, ImplicitCurve, Integrator, SpringAnchor, Stabilization, WireBeads};
 
 /// A circle written as a game would write its own curve:
 /// `C = (|x|² - r²) / (2r)`.
@@ -126,7 +126,7 @@ fn each_bead_stays_on_its_own_moved_and_rotated_wire() {
                 wire.shape().name()
             );
             // It moved: gravity pulled it along its wire.
-            assert!((b.position - b.params().initial_position).length() > 1e-3);
+            assert!((b.position - b.params.initial_position).length() > 1e-3);
             // Its Transform is its f64 position, rounded to f32.
             let t = app
                 .world()
@@ -207,8 +207,8 @@ fn same_inputs_give_bit_identical_state() {
 #[derive(Resource, Default)]
 struct ForceAtStepStart(Vec<DVec2>);
 
-fn record_force(beads: Query<&Bead>, mut seen: ResMut<ForceAtStepStart>) {
-    seen.0.extend(beads.iter().map(|b| b.accumulated_force().0));
+fn record_force(beads: Query<&BeadForce>, mut seen: ResMut<ForceAtStepStart>) {
+    seen.0.extend(beads.iter().map(|b| b.get().0));
 }
 
 #[test]
@@ -242,7 +242,7 @@ fn drag_pulls_the_bead_toward_the_target_and_release_stops_it() {
     let k = app.world().resource::<SimParams>().drag_stiffness;
     let seen = |app: &App| *app.world().resource::<ForceAtStepStart>().0.last().unwrap();
     assert_eq!(seen(&app), k * (target - DVec2::new(0.0, -1.0)));
-    assert_eq!(bead(&app, b).accumulated_force(), (DVec2::ZERO, 0.0));
+    assert_eq!(bead(&app, b).force, (DVec2::ZERO, 0.0));
     run_steps(&mut app, 60);
     // With no friction it swings about the target; it comes close to it.
     let start = (DVec2::new(0.0, -1.0) - target).length();
@@ -324,9 +324,9 @@ fn a_wire_moved_reshaped_or_taken_away_between_steps_is_what_its_beads_see() {
 }
 
 /// Moves every bead to (0.25, -0.5) after the step, before the writeback.
-fn move_after_step(mut beads: Query<&mut Bead>) {
-    for mut bead in &mut beads {
-        bead.position = DVec2::new(0.25, -0.5);
+fn move_after_step(mut beads: Query<&mut BeadPosition>) {
+    for mut position in &mut beads {
+        position.0 = DVec2::new(0.25, -0.5);
     }
 }
 
@@ -355,7 +355,7 @@ fn a_bead_put_where_it_cannot_step_shows_where_it_was_put() {
     let b = pendulum(&mut app, 1.0, 0.5);
     run_steps(&mut app, 5);
     // The centre of its circle, where the constraint has no normal.
-    app.world_mut().get_mut::<Bead>(b).unwrap().position = DVec2::ZERO;
+    app.world_mut().get_mut::<BeadPosition>(b).unwrap().0 = DVec2::ZERO;
     run_steps(&mut app, 1);
     let diverged = app.world().get::<Diverged>(b).expect("diverged");
     assert!(

@@ -6,8 +6,8 @@ use std::f64::consts::TAU;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::prelude::*;
-use wirebead::{ContactChanged, Side, SimClock, Stabilization};
-use wirebead::{Oscillate, ScenePreset};
+use wirebead::{ContactChanged, Side, SimClock, Stabilization, Surface, WireContact};
+use wirebead::{Oscillate, ScenePreset, WireMotion};
 
 use crate::common::{Recording, app, run_for, spawn_bead, spawn_wire};
 
@@ -142,7 +142,7 @@ fn shaken_pendulum(dt: f64, by_game: bool) -> DVec2 {
     let bead = app.world_mut().spawn((bead, OnWire(wire))).id();
     run_for(&mut app, 2.0);
     assert!(app.world().get::<Diverged>(bead).is_none());
-    app.world().get::<Bead>(bead).unwrap().position
+    app.world().get::<BeadPosition>(bead).unwrap().0
 }
 
 /// A game writing a wire's `Transform` each step gives the trajectory of
@@ -413,7 +413,7 @@ fn a_bead_rides_a_self_crossing_spline_loop_on_its_branch() {
     for _ in 0..2000 {
         crate::common::run_steps(&mut app, 1);
         let along = app.world().get::<WireContact>(bead).unwrap().along();
-        let y = app.world().get::<Bead>(bead).unwrap().position.y;
+        let y = app.world().get::<BeadPosition>(bead).unwrap().0.y;
         let c = crate::common::diagnostics(&app, bead).c.abs();
         if along >= segments - 0.05 {
             break;
@@ -470,7 +470,7 @@ fn a_two_bead_cart_rides_the_roller_coaster_and_flies_off_its_hill() {
     let (mut stretch, mut off, mut top) = (0.0f64, 0.0f64, f64::MIN);
     for _ in 0..4000 {
         crate::common::run_steps(&mut app, 1);
-        let at = |b: Entity| app.world().get::<Bead>(b).unwrap().position;
+        let at = |b: Entity| app.world().get::<BeadPosition>(b).unwrap().0;
         stretch = stretch.max(((at(beads[0]) - at(beads[1])).length() - length).abs());
         for &b in &beads {
             assert!(app.world().get::<Diverged>(b).is_none());
@@ -523,7 +523,7 @@ fn a_scene_with_a_rough_wire_stops_lone_beads_and_carts_at_the_coulomb_distance(
     run_for(&mut app, 3.0);
     let expected = 9.0 / (2.0 * 0.3 * 9.81);
     for (bead, start) in [(beads[0], 0.0), (beads[2], 0.0)] {
-        let b = app.world().get::<Bead>(bead).unwrap();
+        let b = crate::common::bead(&app, bead);
         let error = ((b.position.x - start) - expected).abs() / expected;
         eprintln!(
             "rough scene: stopped after {:.6} m (relative error {error:.2e})",
@@ -567,7 +567,7 @@ fn a_wire_moved_once_then_left_holds_its_bead_where_it_now_is() {
     let mut transform = app.world_mut().get_mut::<Transform>(wire).unwrap();
     transform.translation.x = 0.05;
     steps(&mut app, 120);
-    let p = app.world().get::<Bead>(bead).unwrap().position;
+    let p = app.world().get::<BeadPosition>(bead).unwrap().0;
     let off = ((p - DVec2::new(f64::from(0.05f32), 0.0)).length() - 1.0).abs();
     eprintln!("moved once, then left: the bead is {off:.1e} m off the wire after 2 s");
     assert!(

@@ -54,7 +54,7 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
         view.selected.0.and_then(|e| view.beads.get(e).ok())?;
     ui.separator();
     ui.strong(format!("Bead {}", view.name(entity)));
-    let mut draft: BeadParams = pending_bead.map_or(*bead.params(), |p| *p.get());
+    let mut draft: BeadParams = pending_bead.map_or(*bead, |p| *p.get());
     let before = draft;
     egui::Grid::new("bead").num_columns(2).show(ui, |ui| {
         number(ui, "mass", &mut draft.mass, 0.01);

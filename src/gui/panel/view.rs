@@ -11,9 +11,9 @@ use crate::gui::drag::SelectedBead;
 use crate::gui::render::SceneStyle;
 use crate::preset::{ActivePreset, LoadPreset};
 use crate::{
-    Bead, BeadDiagnostics, ConstraintDiagnostics, Diverged, Islands, NextBeadParams, NextParams,
-    NextWireShape, OnWire, Pin, PrescribedMotion, Restart, Rod, SimClock, SimParams, Wire,
-    WireContact,
+    BeadDiagnostics, BeadParams, ConstraintDiagnostics, Diverged, Islands, NextBeadParams,
+    NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, Restart, Rod, SimClock, SimParams,
+    Wire, WireContact,
 };
 
 /// The read-only state the panel shows.
@@ -31,7 +31,7 @@ pub struct PanelView<'w, 's> {
         's,
         (
             Entity,
-            &'static Bead,
+            &'static BeadParams,
             &'static BeadDiagnostics,
             Option<&'static OnWire>,
             Option<&'static NextBeadParams>,

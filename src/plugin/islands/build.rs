@@ -8,7 +8,9 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::{CachedIsland, InIsland, IslandReport, Islands, LinkRows};
-use crate::dynamics::{Bead, DivergenceReason, Joint, OnWire, Pin, Rod, Spring, Wire, WirePose};
+use crate::dynamics::{
+    BeadMotion, DivergenceReason, Joint, OnWire, Pin, Rod, Spring, Wire, WirePose,
+};
 use crate::plugin::clock::SimClock;
 use crate::plugin::report::Divergences;
 use crate::solver::{self, BeadState, Island, IslandRow, IslandWork, RowKind, SpringLink};
@@ -48,7 +50,7 @@ fn pin_rows(at: DVec2) -> Vec<IslandRow> {
 pub(super) fn prepare_islands(
     mut islands: ResMut<Islands>,
     links: Links,
-    mut beads: Query<(Entity, &mut Bead, Option<&OnWire>, Has<InIsland>)>,
+    mut beads: Query<(Entity, BeadMotion, Option<&OnWire>, Has<InIsland>)>,
     wires: Query<(&Wire, &WirePose)>,
     transforms: Query<&Transform>,
     mut commands: Commands,
@@ -324,7 +326,7 @@ fn start_island(
     entities: &[Entity],
     wire_rows: &[(usize, usize, Entity)],
     wires: &Query<(&Wire, &WirePose)>,
-    beads: &mut Query<(Entity, &mut Bead, Option<&OnWire>, Has<InIsland>)>,
+    beads: &mut Query<(Entity, BeadMotion, Option<&OnWire>, Has<InIsland>)>,
     clock: &SimClock,
 ) -> IslandWork {
     for &(_, row, wire) in wire_rows {
@@ -350,12 +352,12 @@ fn start_island(
     let mut changed = Vec::new();
     for (&entity, state) in entities.iter().zip(&states) {
         if let Ok((_, mut bead, ..)) = beads.get_mut(entity) {
-            let change = (state.velocity - bead.velocity).length();
+            let change = (state.velocity - bead.velocity.0).length();
             if change > 1e-9 * bead.velocity.length().max(1.0) {
                 changed.push(entity.to_string());
             }
-            if bead.velocity != state.velocity {
-                bead.velocity = state.velocity;
+            if bead.velocity.0 != state.velocity {
+                bead.velocity.0 = state.velocity;
             }
         }
     }

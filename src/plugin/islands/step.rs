@@ -6,8 +6,8 @@ use bevy::prelude::*;
 
 use super::{CachedIsland, InIsland, Islands, LinkRows};
 use crate::dynamics::{
-    Bead, BeadDiagnostics, ConstraintDiagnostics, Diverged, DivergenceReason, Pin, SimParams, Wire,
-    WireContact, WirePose,
+    BeadDiagnostics, BeadMotion, ConstraintDiagnostics, Diverged, DivergenceReason, Pin, SimParams,
+    Wire, WireContact, WirePose,
 };
 use crate::plugin::clock::SimClock;
 use crate::plugin::parallel::{ParallelStep, StepSplit};
@@ -27,7 +27,7 @@ pub(super) fn step_islands(
     mut islands: ResMut<Islands>,
     mut beads: Query<
         (
-            &mut Bead,
+            BeadMotion,
             Option<&mut BeadDiagnostics>,
             Option<&mut Transform>,
             Option<&mut WireContact>,

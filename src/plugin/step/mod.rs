@@ -21,7 +21,8 @@ use super::report::{ContactReports, Divergences, FoundDivergences, FoundEvents};
 use super::schedule::WireBeadSystems;
 use super::writeback::LastStep;
 use crate::dynamics::{
-    Bead, BeadDiagnostics, Diverged, OnWire, SimParams, Wire, WireContact, WirePose,
+    BeadDiagnostics, BeadForce, BeadMass, BeadPosition, BeadVelocity, Diverged, OnWire, SimParams,
+    Wire, WireContact, WirePose,
 };
 use run::{StepContext, split_table};
 use table::WireTable;
@@ -53,7 +54,10 @@ fn step_beads(
     mut beads: Query<
         (
             Entity,
-            &mut Bead,
+            &mut BeadPosition,
+            &mut BeadVelocity,
+            &BeadMass,
+            &mut BeadForce,
             &OnWire,
             Option<&mut BeadDiagnostics>,
             Option<&mut Transform>,

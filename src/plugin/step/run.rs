@@ -3,10 +3,14 @@
 //! the rest, the outputs written in the same pass.
 
 use bevy::ecs::change_detection::ContiguousMut;
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::table::{TableWire, WireTable, with_curve};
-use crate::dynamics::{Bead, BeadDiagnostics, DivergenceReason, OnWire, SimParams, WireContact};
+use crate::dynamics::{
+    BeadDiagnostics, BeadForce, BeadMass, BeadPosition, BeadVelocity, DivergenceReason, OnWire,
+    SimParams, WireContact,
+};
 use crate::geometry::{FixedTrack, MovingTrack, Near, Placed, Surface, Track, WireShape};
 use crate::plugin::report::{FoundDivergences, FoundEvents};
 use crate::plugin::writeback::place;
@@ -36,14 +40,14 @@ impl StepContext<'_> {
         let mut outs = [solver::CircleSteps::default(); BATCHES];
         let mut waiting = [0; BATCHES * solver::LANES];
         let mut queued = 0;
-        for i in 0..run.beads.len() {
+        for i in 0..run.entities.len() {
             if let Some((centre, radius)) = self.wires.circle(&run.on_wires[i]) {
-                let bead = &run.beads[i];
+                let bead = run.bead(i);
                 lanes[queued / solver::LANES].set(
                     queued % solver::LANES,
-                    bead.state(),
-                    &bead.step_force(self.params.gravity),
-                    bead.mass(),
+                    bead.state,
+                    &bead.force(self.params.gravity),
+                    bead.mass,
                     centre,
                     radius,
                 );
@@ -82,24 +86,24 @@ impl StepContext<'_> {
 
     /// Bead `i` of `run` through [`solver::step`]; a failure is recorded.
     fn step_one(&self, run: &mut BeadRun, i: usize) {
+        let bead = run.bead(i);
         let contact = run.contacts.as_deref_mut().map(|c| &mut c[i]);
-        let bead = &run.beads[i];
         let result = match self.wires.get(&run.on_wires[i]) {
             Err(reason) => Err(reason),
             Ok(wire) if !wire.surface().is_plain() || wire.shape.is_traced() => {
-                self.step_on_surface(wire, bead, run.entities[i], contact)
+                self.step_on_surface(wire, &bead, run.entities[i], contact)
             }
             Ok(TableWire {
                 shape,
                 pose,
                 track: None,
             }) => with_curve!(shape, curve => {
-                self.step_bead(&FixedTrack(&Placed { curve, pose: *pose }), bead)
+                self.step_bead(&FixedTrack(&Placed { curve, pose: *pose }), &bead)
             }),
             Ok(wire) => {
                 let path = &wire.path();
                 with_curve!(&wire.shape, curve => {
-                    self.step_bead(&MovingTrack { curve, path }, bead)
+                    self.step_bead(&MovingTrack { curve, path }, &bead)
                 })
             }
         };
@@ -107,9 +111,8 @@ impl StepContext<'_> {
             Ok(out) => self.finish(run.outputs(i), out),
             Err(reason) => {
                 // The bead keeps its state; its `Transform` shows it.
-                let outputs = run.outputs(i);
-                if let Some(transform) = outputs.transform {
-                    place(transform, outputs.bead.position);
+                if let Some(transform) = run.outputs(i).transform {
+                    place(transform, bead.state.position);
                 }
                 self.found.push(run.entities[i], reason, self.time);
             }
@@ -121,10 +124,10 @@ impl StepContext<'_> {
     fn step_bead<T: Track + ?Sized>(
         &self,
         track: &T,
-        bead: &Bead,
+        bead: &BeadInputs,
     ) -> Result<StepOutput, DivergenceReason> {
         let (state, force, start) = self.start(bead)?;
-        solver::step_on(track, start, state, &force, bead.mass(), &self.settings)
+        solver::step_on(track, start, state, &force, bead.mass, &self.settings)
             .map_err(DivergenceReason::Solve)
     }
 
@@ -132,12 +135,12 @@ impl StepContext<'_> {
     fn surface_step<T: Track + ?Sized>(
         &self,
         track: &T,
-        bead: &Bead,
+        bead: &BeadInputs,
         surface: &Surface,
         contact: Contact,
     ) -> Result<solver::SurfaceStep, DivergenceReason> {
         let (state, force, start) = self.start(bead)?;
-        let (mass, settings) = (bead.mass(), &self.settings);
+        let (mass, settings) = (bead.mass, &self.settings);
         solver::step_surface(
             track, start, state, &force, mass, settings, surface, contact,
         )
@@ -146,13 +149,12 @@ impl StepContext<'_> {
 
     /// A bead's state (checked finite), the force on it and the time the
     /// step starts.
-    fn start(&self, bead: &Bead) -> Result<(BeadState, LinearForce, f64), DivergenceReason> {
-        let state = bead.state();
-        if !state.is_finite() {
+    fn start(&self, bead: &BeadInputs) -> Result<(BeadState, LinearForce, f64), DivergenceReason> {
+        if !bead.state.is_finite() {
             return Err(DivergenceReason::NonFiniteState);
         }
-        let force = bead.step_force(self.params.gravity);
-        Ok((state, force, self.time - self.settings.dt))
+        let force = bead.force(self.params.gravity);
+        Ok((bead.state, force, self.time - self.settings.dt))
     }
 
     /// One bead on a wire with a surface (one-sided, rough or damped):
@@ -161,7 +163,7 @@ impl StepContext<'_> {
     fn step_on_surface(
         &self,
         wire: &TableWire,
-        bead: &Bead,
+        bead: &BeadInputs,
         entity: Entity,
         contact: Option<&mut WireContact>,
     ) -> Result<StepOutput, DivergenceReason> {
@@ -194,11 +196,17 @@ impl StepContext<'_> {
     #[inline(always)]
     fn finish(&self, outputs: BeadOutputs, out: StepOutput) {
         let BeadOutputs {
-            bead,
+            position,
+            velocity,
+            force,
+            mass,
             diagnostics,
             transform,
         } = outputs;
-        bead.advance_to(out.state);
+        (position.0, velocity.0) = (out.state.position, out.state.velocity);
+        if *force != BeadForce::default() {
+            force.clear();
+        }
         if let Some(diagnostics) = diagnostics {
             let row = RowReport {
                 c: out.c,
@@ -207,7 +215,7 @@ impl StepContext<'_> {
             };
             *diagnostics = BeadDiagnostics::of(
                 out.state,
-                bead.mass(),
+                mass,
                 self.params.gravity,
                 row,
                 out.constraint_force,
@@ -219,29 +227,66 @@ impl StepContext<'_> {
     }
 }
 
-/// A run of beads stored side by side: their entities, states and wires,
-/// and, when they have them, their diagnostics and transforms.
+/// A run of beads stored side by side: their entities, the columns of
+/// their state, mass, force and wire, and, when they have them, their
+/// diagnostics, transforms and contacts.
 pub(super) struct BeadRun<'w> {
     entities: &'w [Entity],
-    beads: &'w mut [Bead],
+    positions: &'w mut [BeadPosition],
+    velocities: &'w mut [BeadVelocity],
+    masses: &'w [BeadMass],
+    forces: &'w mut [BeadForce],
     on_wires: &'w [OnWire],
     diagnostics: Option<&'w mut [BeadDiagnostics]>,
     transforms: Option<&'w mut [Transform]>,
     contacts: Option<&'w mut [WireContact]>,
 }
 
+/// What one bead's step reads.
+struct BeadInputs {
+    state: BeadState,
+    mass: f64,
+    force: BeadForce,
+}
+
+impl BeadInputs {
+    /// The force of the step, eq. (5).
+    #[inline(always)]
+    fn force(&self, gravity: DVec2) -> LinearForce {
+        self.force.linear(self.mass, gravity, self.state.position)
+    }
+}
+
 /// What one bead's step writes.
 struct BeadOutputs<'a> {
-    bead: &'a mut Bead,
+    position: &'a mut BeadPosition,
+    velocity: &'a mut BeadVelocity,
+    force: &'a mut BeadForce,
+    mass: f64,
     diagnostics: Option<&'a mut BeadDiagnostics>,
     transform: Option<&'a mut Transform>,
 }
 
 impl BeadRun<'_> {
     #[inline(always)]
+    fn bead(&self, i: usize) -> BeadInputs {
+        BeadInputs {
+            state: BeadState {
+                position: self.positions[i].0,
+                velocity: self.velocities[i].0,
+            },
+            mass: self.masses[i].get(),
+            force: self.forces[i],
+        }
+    }
+
+    #[inline(always)]
     fn outputs(&mut self, i: usize) -> BeadOutputs<'_> {
         BeadOutputs {
-            bead: &mut self.beads[i],
+            position: &mut self.positions[i],
+            velocity: &mut self.velocities[i],
+            force: &mut self.forces[i],
+            mass: self.masses[i].get(),
             diagnostics: self.diagnostics.as_deref_mut().map(|d| &mut d[i]),
             transform: self.transforms.as_deref_mut().map(|t| &mut t[i]),
         }
@@ -251,7 +296,10 @@ impl BeadRun<'_> {
 /// The columns of one table of beads, as the step's query hands them out.
 pub(super) type BeadTable<'w> = (
     &'w [Entity],
-    ContiguousMut<'w, Bead>,
+    ContiguousMut<'w, BeadPosition>,
+    ContiguousMut<'w, BeadVelocity>,
+    &'w [BeadMass],
+    ContiguousMut<'w, BeadForce>,
     &'w [OnWire],
     Option<ContiguousMut<'w, BeadDiagnostics>>,
     Option<ContiguousMut<'w, Transform>>,
@@ -289,29 +337,39 @@ fn contact_runs<'w>(
 
 /// Cuts one table's beads into runs: one for a single thread, else about a
 /// quarter of each thread's share, so a slow thread does not hold the
-/// others up. Marks the beads, diagnostics and transforms changed.
+/// others up. Marks the positions, velocities, diagnostics and transforms
+/// changed; not the forces, which the step only empties.
 pub(super) fn split_table<'w>(
-    (entities, beads, on_wires, diagnostics, transforms, contacts): BeadTable<'w>,
+    (entities, positions, velocities, masses, forces, on_wires, diagnostics, transforms, contacts): BeadTable<'w>,
     threads: usize,
 ) -> Vec<BeadRun<'w>> {
     let runs = if threads > 1 { 4 * threads } else { 1 };
     let n = entities.len().div_ceil(runs).max(1);
-    let beads = ContiguousMut::split(beads).0;
+    let mut positions = ContiguousMut::split(positions).0.chunks_mut(n);
+    let mut velocities = ContiguousMut::split(velocities).0.chunks_mut(n);
+    let mut masses = masses.chunks(n);
+    let mut forces = ContiguousMut::bypass_change_detection_split(forces)
+        .0
+        .chunks_mut(n);
     entities
         .chunks(n)
-        .zip(beads.chunks_mut(n))
         .zip(on_wires.chunks(n))
         .zip(column_runs(diagnostics, n))
         .zip(column_runs(transforms, n))
         .zip(contact_runs(contacts, n))
-        .map(
-            |(((((entities, beads), on_wires), diagnostics), transforms), contacts)| BeadRun {
-                entities,
-                beads,
-                on_wires,
-                diagnostics,
-                transforms,
-                contacts,
+        .filter_map(
+            |((((entities, on_wires), diagnostics), transforms), contacts)| {
+                Some(BeadRun {
+                    entities,
+                    positions: positions.next()?,
+                    velocities: velocities.next()?,
+                    masses: masses.next()?,
+                    forces: forces.next()?,
+                    on_wires,
+                    diagnostics,
+                    transforms,
+                    contacts,
+                })
             },
         )
         .collect()
