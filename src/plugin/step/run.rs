@@ -40,7 +40,27 @@ impl StepContext<'_> {
         let mut outs = [solver::CircleSteps::default(); BATCHES];
         let mut waiting = [0; BATCHES * solver::LANES];
         let mut queued = 0;
-        for i in 0..run.entities.len() {
+        let mut i = 0;
+        while i < run.entities.len() {
+            // A block of beads side by side, each on a plain circle: into
+            // one batch column by column.
+            if queued % solver::LANES == 0
+                && self.fill_block(&run, i, &mut lanes[queued / solver::LANES])
+            {
+                for (lane, wait) in waiting[queued..][..solver::LANES].iter_mut().enumerate() {
+                    *wait = i + lane;
+                }
+                queued += solver::LANES;
+                i += solver::LANES;
+                if queued == waiting.len() {
+                    solver::step_on_circle_batches(&lanes, &self.settings, &mut outs);
+                    self.finish_batches(&mut run, &outs, &waiting);
+                    queued = 0;
+                }
+                continue;
+            }
+            i += 1;
+            let i = i - 1;
             if let Some((centre, radius)) = self.wires.circle(&run.on_wires[i]) {
                 let bead = run.bead(i);
                 lanes[queued / solver::LANES].set(
@@ -76,10 +96,85 @@ impl StepContext<'_> {
     /// each); a lane the batch did not finish goes through
     /// [`StepContext::step_one`].
     fn finish_batches(&self, run: &mut BeadRun, outs: &[solver::CircleSteps], waiting: &[usize]) {
-        for (k, &j) in waiting.iter().enumerate() {
-            match outs[k / solver::LANES].lane(k % solver::LANES) {
-                Some(out) => self.finish(run.outputs(j), out),
-                None => self.step_one(run, j),
+        for (out, waiting) in outs.iter().zip(waiting.chunks_exact(solver::LANES)) {
+            let first = waiting[0];
+            if out.done == [true; solver::LANES] && waiting[solver::LANES - 1] == first + solver::LANES - 1 {
+                self.finish_block(run, out, first);
+                continue;
+            }
+            for (lane, &j) in waiting.iter().enumerate() {
+                match out.lane(lane) {
+                    Some(out) => self.finish(run.outputs(j), out),
+                    None => self.step_one(run, j),
+                }
+            }
+        }
+    }
+
+    /// Puts the [`solver::LANES`] beads from `first` on into `lanes`, column
+    /// by column, if each is on a plain circle; else leaves `lanes` as it
+    /// was and returns false.
+    #[inline(always)]
+    fn fill_block(&self, run: &BeadRun, first: usize, lanes: &mut solver::CircleLanes) -> bool {
+        const N: usize = solver::LANES;
+        let Some(on_wires) = run.on_wires.get(first..first + N) else {
+            return false;
+        };
+        let mut circles = [(DVec2::ZERO, 0.0); N];
+        for (circle, on) in circles.iter_mut().zip(on_wires) {
+            match self.wires.circle(on) {
+                Some(found) => *circle = found,
+                None => return false,
+            }
+        }
+        let gravity = self.params.gravity;
+        let positions = &run.positions[first..first + N];
+        let velocities = &run.velocities[first..first + N];
+        let masses = &run.masses[first..first + N];
+        let forces = &run.forces[first..first + N];
+        for j in 0..N {
+            let (p, v, m) = (positions[j].0, velocities[j].0, masses[j].get());
+            let force = forces[j].linear(m, gravity, p);
+            (lanes.x[j], lanes.y[j]) = (p.x, p.y);
+            (lanes.vx[j], lanes.vy[j]) = (v.x, v.y);
+            (lanes.fx[j], lanes.fy[j]) = (force.force.x, force.force.y);
+            lanes.stiffness[j] = force.stiffness;
+            (lanes.at_x[j], lanes.at_y[j]) = (p.x, p.y);
+            lanes.mass[j] = m;
+            let (centre, radius) = circles[j];
+            (lanes.ox[j], lanes.oy[j]) = (centre.x, centre.y);
+            lanes.radius[j] = radius;
+        }
+        true
+    }
+
+    /// Stores a finished batch whose beads lie side by side from `first`
+    /// on, column by column.
+    #[inline(always)]
+    fn finish_block(&self, run: &mut BeadRun, out: &solver::CircleSteps, first: usize) {
+        const N: usize = solver::LANES;
+        let range = first..first + N;
+        for (j, p) in run.positions[range.clone()].iter_mut().enumerate() {
+            p.0 = DVec2::new(out.x[j], out.y[j]);
+        }
+        for (j, v) in run.velocities[range.clone()].iter_mut().enumerate() {
+            v.0 = DVec2::new(out.vx[j], out.vy[j]);
+        }
+        for force in &mut run.forces[range.clone()] {
+            if *force != BeadForce::default() {
+                force.clear();
+            }
+        }
+        if let Some(diagnostics) = run.diagnostics.as_deref_mut() {
+            let masses = &run.masses[range.clone()];
+            for (j, d) in diagnostics[range.clone()].iter_mut().enumerate() {
+                let out = out.lane_unchecked(j);
+                *d = self.diagnose(&out, masses[j].get());
+            }
+        }
+        if let Some(transforms) = run.transforms.as_deref_mut() {
+            for (j, t) in transforms[range].iter_mut().enumerate() {
+                place(t, DVec2::new(out.x[j], out.y[j]));
             }
         }
     }
@@ -208,22 +303,30 @@ impl StepContext<'_> {
             force.clear();
         }
         if let Some(diagnostics) = diagnostics {
-            let row = RowReport {
-                c: out.c,
-                c_dot: out.c_dot,
-                lambda: out.lambda,
-            };
-            *diagnostics = BeadDiagnostics::of(
-                out.state,
-                mass,
-                self.params.gravity,
-                row,
-                out.constraint_force,
-            );
+            *diagnostics = self.diagnose(&out, mass);
         }
         if let Some(transform) = transform {
             place(transform, out.state.position);
         }
+    }
+}
+
+impl StepContext<'_> {
+    /// The diagnostics of a bead of mass `mass` after step `out`.
+    #[inline(always)]
+    fn diagnose(&self, out: &StepOutput, mass: f64) -> BeadDiagnostics {
+        let row = RowReport {
+            c: out.c,
+            c_dot: out.c_dot,
+            lambda: out.lambda,
+        };
+        BeadDiagnostics::of(
+            out.state,
+            mass,
+            self.params.gravity,
+            row,
+            out.constraint_force,
+        )
     }
 }
 

@@ -122,7 +122,14 @@ impl CircleSteps {
     /// bead must go through [`step`].
     #[inline(always)]
     pub fn lane(&self, i: usize) -> Option<StepOutput> {
-        self.done[i].then(|| StepOutput {
+        self.done[i].then(|| self.lane_unchecked(i))
+    }
+
+    /// Lane `i`'s entries as a [`StepOutput`], whether or not the lane
+    /// finished (check [`done`](Self::done) first).
+    #[inline(always)]
+    pub fn lane_unchecked(&self, i: usize) -> StepOutput {
+        StepOutput {
             state: BeadState {
                 position: DVec2::new(self.x[i], self.y[i]),
                 velocity: DVec2::new(self.vx[i], self.vy[i]),
@@ -131,7 +138,7 @@ impl CircleSteps {
             constraint_force: DVec2::new(self.fx[i], self.fy[i]),
             c: self.c[i],
             c_dot: self.c_dot[i],
-        })
+        }
     }
 }
 
