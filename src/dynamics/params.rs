@@ -208,7 +208,7 @@ impl NextParams {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{BeadParams, NextBeadParams};
+    use crate::dynamics::{BeadParams, NextBeadParams};
 
     #[test]
     fn errors_name_the_parameter_and_value() {

@@ -81,7 +81,7 @@ impl Default for WireBeadPlugin {
 
 impl WireBeadPlugin {
     /// The plugin with the given initial parameters, if they are valid.
-    pub fn new(params: SimParams) -> Result<Self, crate::ParamError> {
+    pub fn new(params: SimParams) -> Result<Self, crate::validate::ParamError> {
         params.validate()?;
         Ok(Self {
             params,

@@ -17,7 +17,7 @@ const GOOD: &str = r#"(
 fn a_preset_parses_with_defaults_filled_in() {
     let preset = ScenePreset::from_ron(GOOD).unwrap();
     assert_eq!(preset.params.alpha, 50.0);
-    assert_eq!(preset.params.method, crate::Method::Rattle);
+    assert_eq!(preset.params.method, crate::solver::Method::Rattle);
     assert_eq!(preset.params.beta, SimParams::default().beta);
     assert_eq!(preset.wires[1].beads[0].params(), BeadParams::default());
     assert_eq!(preset.wires[0].angle_degrees, 30.0);
