@@ -108,6 +108,13 @@ fn apply_restart(
         if let Some(edit) = edit {
             bead_params.set_if_neq(*edit.get());
         }
+        if let Err(err) = bead_params.validate() {
+            // Written directly, not through `NextBeadParams`.
+            warn!(
+                "wirebead: bead {entity} was not restarted: its BeadParams are invalid ({err}); it keeps its state"
+            );
+            continue;
+        }
         bead.reset(&bead_params);
         if let Some(mut contact) = contact {
             contact.set_if_neq(WireContact::default());

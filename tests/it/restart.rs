@@ -112,3 +112,25 @@ fn restart_recovers_a_diverged_bead() {
     assert!(app.world().get::<Diverged>(bead_entity).is_none());
     assert_eq!(steps(&app), 60);
 }
+
+#[test]
+fn a_restart_keeps_the_state_of_a_bead_whose_params_were_written_invalid() {
+    let (mut app, b) = scene();
+    run_steps(&mut app, 30);
+    let before = bead(&app, b);
+    app.world_mut().get_mut::<BeadParams>(b).unwrap().mass = -1.0;
+    app.world_mut().write_message(Restart);
+    run_steps(&mut app, 0);
+    let after = bead(&app, b);
+    assert_eq!(
+        (after.position, after.velocity),
+        (before.position, before.velocity)
+    );
+    assert_eq!(after.mass, 1.0, "the mass stays the valid one");
+    // It steps on from where it was, as if no restart had come.
+    run_steps(&mut app, 30);
+    let (mut control, c) = scene();
+    run_steps(&mut control, 60);
+    assert_eq!(bead(&app, b).state(), bead(&control, c).state());
+    assert!(app.world().get::<Diverged>(b).is_none());
+}

@@ -98,7 +98,9 @@ impl StepContext<'_> {
     fn finish_batches(&self, run: &mut BeadRun, outs: &[solver::CircleSteps], waiting: &[usize]) {
         for (out, waiting) in outs.iter().zip(waiting.chunks_exact(solver::LANES)) {
             let first = waiting[0];
-            if out.done == [true; solver::LANES] && waiting[solver::LANES - 1] == first + solver::LANES - 1 {
+            if out.done == [true; solver::LANES]
+                && waiting[solver::LANES - 1] == first + solver::LANES - 1
+            {
                 self.finish_block(run, out, first);
                 continue;
             }
