@@ -8,6 +8,8 @@
 //! | `settings` | [`StepSettings`]: what is the same for every bead in a step |
 //! | `state` | [`BeadState`], [`LinearForce`] |
 //! | `solve` | λ of eq. (3) in closed form |
+//! | `friction` | friction and damping along a wire, eq. (17) |
+//! | `wire_normal` | when the wire's normal is usable, and a vector split along and across the wire |
 //! | `euler`, `rk4`, `rattle`, `projection` | the integrators and post-stabilization, eqs. (6)–(11) |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
 //! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eqs. (16)–(17): on the wire, in flight, where an event falls |
@@ -21,6 +23,7 @@
 mod contact;
 mod coupled;
 mod euler;
+mod friction;
 mod lanes;
 mod method;
 mod projection;
@@ -30,6 +33,7 @@ mod settings;
 mod solve;
 mod state;
 mod step;
+mod wire_normal;
 
 pub use contact::{Contact, ContactEvent, SurfaceStep, free_step, step_surface};
 pub use coupled::{

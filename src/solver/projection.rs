@@ -7,6 +7,7 @@ use bevy::math::DVec2;
 use super::settings::Gains;
 use super::solve::{SolveError, normal_length_squared, resistance, solve_on};
 use super::state::BeadState;
+use super::wire_normal::{along, usable};
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
 
 /// Tolerance on `|C|` for the Newton solves (RATTLE, projection), in units
@@ -62,7 +63,7 @@ pub(crate) fn newton_along<T: Track + ?Sized>(
             break;
         }
         let slope = g.normal.dot(dir);
-        if !(slope.is_finite() && slope.abs() > 1e-300) {
+        if !usable(slope.abs()) {
             return Err(SolveError::Singular { x: p.x, y: p.y });
         }
         s -= g.c / slope;
@@ -143,13 +144,13 @@ fn tangential<T: Track + ?Sized>(
     let n = track.geometry(t, x).normal;
     let nn = normal_length_squared(n, x)?;
     let w = wire_velocity(track, t, x);
-    Ok(v - (n.dot(v - w) / nn) * n)
+    Ok(v - DVec2::from(super::wire_normal::across(n.into(), nn, (v - w).into())))
 }
 
 /// `a` without its component along `n`.
 fn along_wire(n: DVec2, a: DVec2, x: DVec2) -> Result<DVec2, SolveError> {
     let nn = normal_length_squared(n, x)?;
-    Ok(a - (n.dot(a) / nn) * n)
+    Ok(along(n.into(), nn, a.into()).into())
 }
 
 /// Eq. (10): the factor that scales a projected velocity of kinetic

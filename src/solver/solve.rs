@@ -3,8 +3,10 @@
 
 use bevy::math::DVec2;
 
+use super::friction;
 use super::settings::Gains;
 use super::state::{BeadState, LinearForce};
+use super::wire_normal::{along, usable};
 use crate::geometry::{FixedTrack, Geometry, ImplicitCurve, Surface, Track};
 use crate::lane::{Lane, V2};
 
@@ -71,7 +73,7 @@ pub struct Solved {
 #[inline(always)]
 pub(crate) fn normal_length_squared(normal: DVec2, x: DVec2) -> Result<f64, SolveError> {
     let nn = normal.length_squared();
-    if nn.is_finite() && nn > 1e-24 {
+    if usable(nn) {
         Ok(nn)
     } else {
         Err(SolveError::Singular { x: x.x, y: x.y })
@@ -226,21 +228,20 @@ pub(crate) fn resistance(
     lambda: f64,
 ) -> DVec2 {
     let nn = normal.length_squared();
-    let along = |a: DVec2| a - normal * (normal.dot(a) / nn);
-    let press = lambda.abs() * nn.sqrt();
-    let kinetic = surface.friction.kinetic_coefficient * press;
-    let damping = -surface.damping * along(relative);
+    let along = |a: DVec2| along(normal.into(), nn, a.into());
+    let press = friction::press(lambda, nn);
+    let damping = friction::damping(surface.damping, along(relative));
     let direction = along(sliding);
-    let speed = direction.length();
+    let speed = direction.dot(direction).sqrt();
     if speed > 0.0 {
-        return damping - (kinetic / speed) * direction;
+        return (damping + friction::kinetic(&surface.friction, press, direction, speed)).into();
     }
     let pull = along(applied);
-    let strength = pull.length();
-    if strength <= surface.friction.static_coefficient * press {
-        -pull
+    let strength = pull.dot(pull).sqrt();
+    if friction::holds(&surface.friction, strength, press) {
+        -DVec2::from(pull)
     } else {
-        -(kinetic / strength) * pull
+        friction::kinetic(&surface.friction, press, pull, strength).into()
     }
 }
 

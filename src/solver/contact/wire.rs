@@ -6,10 +6,12 @@ use bevy::math::DVec2;
 
 use super::{Contact, MAX_EVENTS, SurfaceStep, Walk};
 use crate::geometry::Track;
+use crate::solver::friction;
 use crate::solver::settings::Gains;
 use crate::solver::solve::{SolveError, Solved, solve_on};
 use crate::solver::state::BeadState;
 use crate::solver::step::StepOutput;
+use crate::solver::wire_normal::along;
 
 impl<T: Track + ?Sized> Walk<'_, T> {
     /// A part of length `h` on the wire from `state` at `t`.
@@ -87,9 +89,9 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         let normal = self.track.geometry(t, state.position).normal;
         let nn = normal.length_squared();
         let applied = self.force.at(state.position) - self.mass * frame;
-        let pull = applied - normal * (normal.dot(applied) / nn);
-        let press = solved.lambda.abs() * nn.sqrt();
-        Ok((pull.length() <= self.surface.friction.static_coefficient * press).then_some(solved))
+        let pull = DVec2::from(along(normal.into(), nn, applied.into()));
+        let press = friction::press(solved.lambda, nn);
+        Ok(friction::holds(&self.surface.friction, pull.length(), press).then_some(solved))
     }
 
     /// A part of length `h` in which static friction holds the bead still

@@ -13,6 +13,7 @@ use crate::solver::rk4::Stages;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::{ConstraintForce, constraint_force};
 use crate::solver::state::LinearForceLanes;
+use crate::solver::wire_normal::{across, along, usable};
 
 /// Eqs. (3)–(4) on each lane's circle: the geometry, the solve and whether
 /// its normal is usable.
@@ -31,7 +32,7 @@ pub(super) fn solve_on_circles<T: Lane>(
     let hv = g.hessian.apply(v);
     let solved = constraint_force(g.normal, hv, g.c, v, force.at(p), m, settings.gains());
     let nn = solved.nn;
-    let regular = g.len.is_nonzero() & nn.is_finite() & nn.gt(nn.splat(1e-24));
+    let regular = g.len.is_nonzero() & usable(nn);
     (solved, g.normal, regular)
 }
 
@@ -135,10 +136,7 @@ impl<T: Lane> OnCircles<T> {
     #[inline(always)]
     fn normal_length_squared(self, at: At<T>) -> (T, T::Mask) {
         let nn = at.normal.dot(at.normal);
-        (
-            nn,
-            at.len.is_nonzero() & nn.is_finite() & nn.gt(nn.splat(1e-24)),
-        )
+        (nn, at.len.is_nonzero() & usable(nn))
     }
 
     /// Whether a Newton solve at the point `at` is done at residual `|c|`
@@ -192,7 +190,7 @@ impl<T: Lane> OnCircles<T> {
                 break;
             }
             let slope = g.normal.dot(dir);
-            active = active & slope.is_finite() & !slope.abs_le(slope.splat(1e-300));
+            active = active & usable(slope.abs());
             s = T::select(active, s - g.c / slope, s);
         }
         (s, root, found)
@@ -245,9 +243,8 @@ impl<T: Lane> OnCircles<T> {
     #[inline(always)]
     fn tangential(self, at: At<T>, v: V2<T>) -> (V2<T>, T::Mask) {
         let zero = V2::new(at.c.splat(0.0), at.c.splat(0.0));
-        let n = at.normal;
         let (nn, ok) = self.normal_length_squared(at);
-        (v - n.scale(n.dot(v - zero) / nn), ok)
+        (v - across(at.normal, nn, v - zero), ok)
     }
 
     /// `project` from `x`, where the circle is `start`: Newton steps along
@@ -306,7 +303,7 @@ impl<T: Lane> OnCircles<T> {
         let zero = V2::new(m.splat(0.0), m.splat(0.0));
         let relative = v0 - zero;
         let applied = force.at(x0).div(m);
-        let kick = applied - n0.scale(n0.dot(applied) / n0.dot(n0));
+        let kick = along(n0, n0.dot(n0), applied);
         let moved = relative.plus(h, kick);
         let target = moved.dot(moved);
         let now = vp - zero;
