@@ -17,6 +17,49 @@ pub(crate) trait Stages<T> {
     fn acceleration(&mut self, x: V2<T>, v: V2<T>, at: f64) -> Result<V2<T>, Self::Error>;
 }
 
+/// The later stages of eq. (7): where each is taken (a fraction of the
+/// step after its start, along the previous stage's derivative) and the
+/// weight of its derivative in the step's sum (the first stage's is 1).
+pub(crate) const RK4_STAGES: [(f64, f64); 3] = [(0.5, 2.0), (0.5, 2.0), (1.0, 1.0)];
+
+/// A later stage's state: `(x + τ h ẋ, v + τ h v̇)` from the step's start
+/// `(x, v)`, the previous stage's derivative `(dx, dv)` and the stage's
+/// fraction `at` (`τ`) of the step `h`.
+#[inline(always)]
+pub(crate) fn rk4_stage<T: Lane>(
+    (x, v): (V2<T>, V2<T>),
+    (dx, dv): (V2<T>, V2<T>),
+    at: f64,
+    h: T,
+) -> (V2<T>, V2<T>) {
+    let advance = h.splat(at) * h;
+    (x.plus(advance, dx), v.plus(advance, dv))
+}
+
+/// The step's sum of derivatives with a later stage's `(dx, dv)` added at
+/// its `weight`.
+#[inline(always)]
+pub(crate) fn rk4_add<T: Lane>(
+    (sx, sv): (V2<T>, V2<T>),
+    (dx, dv): (V2<T>, V2<T>),
+    weight: f64,
+) -> (V2<T>, V2<T>) {
+    let weight = dx.x.splat(weight);
+    (sx + dx.scale(weight), sv + dv.scale(weight))
+}
+
+/// The step's end: `(x, v) + h/6 · (sx, sv)`, the sum of the stages'
+/// weighted derivatives.
+#[inline(always)]
+pub(crate) fn rk4_end<T: Lane>(
+    (x, v): (V2<T>, V2<T>),
+    (sx, sv): (V2<T>, V2<T>),
+    h: T,
+) -> (V2<T>, V2<T>) {
+    let sixth = h / h.splat(6.0);
+    (x.plus(sixth, sx), v.plus(sixth, sv))
+}
+
 /// Eq. (7) on lanes: one step of length `h` from `(x, v)` with `a` the
 /// acceleration there; `stages` gives the acceleration at each later stage,
 /// or stops the step with its error.
@@ -28,18 +71,14 @@ pub(crate) fn rk4_lanes<T: Lane, S: Stages<T>>(
     h: T,
     stages: &mut S,
 ) -> Result<(V2<T>, V2<T>), S::Error> {
-    let half = h.splat(0.5) * h;
-    let v2 = v.plus(half, a);
-    let a2 = stages.acceleration(x.plus(half, v), v2, 0.5)?;
-    let v3 = v.plus(half, a2);
-    let a3 = stages.acceleration(x.plus(half, v2), v3, 0.5)?;
-    let v4 = v.plus(h, a3);
-    let a4 = stages.acceleration(x.plus(h, v3), v4, 1.0)?;
-    let (two, sixth) = (h.splat(2.0), h / h.splat(6.0));
-    Ok((
-        x.plus(sixth, v + v2.scale(two) + v3.scale(two) + v4),
-        v.plus(sixth, a + a2.scale(two) + a3.scale(two) + a4),
-    ))
+    let mut derivative = (v, a);
+    let mut sum = derivative;
+    for (at, weight) in RK4_STAGES {
+        let (xs, vs) = rk4_stage((x, v), derivative, at, h);
+        derivative = (vs, stages.acceleration(xs, vs, at)?);
+        sum = rk4_add(sum, derivative, weight);
+    }
+    Ok(rk4_end((x, v), sum, h))
 }
 
 /// One RK4 step of length `h` from `state`, given `first`, the solve at

@@ -3,6 +3,10 @@
 
 use super::newton::Direction;
 use super::{Island, IslandWork, RowReport};
+use bevy::math::DVec2;
+
+use crate::lane::V2;
+use crate::solver::rk4::{RK4_STAGES, rk4_add, rk4_end, rk4_stage};
 use crate::solver::settings::Gains;
 use crate::solver::solve::SolveError;
 use crate::solver::state::LinearForce;
@@ -98,27 +102,32 @@ impl Island {
         self.keep_lambda(work);
         let n = self.beads();
         let start = work.time;
+        let pair = |x: &[DVec2], v: &[DVec2], i: usize| (V2::from(x[i]), V2::from(v[i]));
         work.x_sum.clone_from(&work.v0);
         work.v_sum.clone_from(&work.acceleration);
-        for (weight, advance) in [(2.0, 0.5 * h), (2.0, 0.5 * h), (1.0, h)] {
+        for (at, weight) in RK4_STAGES {
             // The stage's state from the previous stage's derivative, which
             // is (work.v, work.acceleration).
             for i in 0..n {
-                let (dx, dv) = (work.v[i], work.acceleration[i]);
-                work.x[i] = work.x0[i] + advance * dx;
-                work.v[i] = work.v0[i] + advance * dv;
+                let derivative = pair(&work.v, &work.acceleration, i);
+                let (x, v) = rk4_stage(pair(&work.x0, &work.v0, i), derivative, at, h);
+                (work.x[i], work.v[i]) = (x.into(), v.into());
             }
-            work.time = start + advance;
+            work.time = start + at * h;
             self.accelerate(forces, gains, work, Stage::Later)?;
             for i in 0..n {
-                work.x_sum[i] += weight * work.v[i];
-                work.v_sum[i] += weight * work.acceleration[i];
+                let derivative = pair(&work.v, &work.acceleration, i);
+                let (x, v) = rk4_add(pair(&work.x_sum, &work.v_sum, i), derivative, weight);
+                (work.x_sum[i], work.v_sum[i]) = (x.into(), v.into());
             }
         }
-        let sixth = h / 6.0;
         for i in 0..n {
-            work.x[i] = work.x0[i] + sixth * work.x_sum[i];
-            work.v[i] = work.v0[i] + sixth * work.v_sum[i];
+            let (x, v) = rk4_end(
+                pair(&work.x0, &work.v0, i),
+                pair(&work.x_sum, &work.v_sum, i),
+                h,
+            );
+            (work.x[i], work.v[i]) = (x.into(), v.into());
         }
         Ok(())
     }

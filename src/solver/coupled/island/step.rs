@@ -7,6 +7,7 @@ use bevy::math::DVec2;
 use super::integrators::Stage;
 use super::projection::Restore;
 use super::{CALM_STEPS, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow};
+use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use crate::solver::method::Method;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::SolveError;
@@ -197,12 +198,15 @@ impl Island {
             Method::Rattle => self.rattle(forces, h, work)?,
             Method::ExplicitEuler(_) | Method::SemiImplicitEuler(_) => {
                 self.accelerate(forces, gains, work, Stage::Start)?;
-                let semi = matches!(settings.method, Method::SemiImplicitEuler(_));
+                let euler = if matches!(settings.method, Method::SemiImplicitEuler(_)) {
+                    semi_implicit_euler_lanes
+                } else {
+                    explicit_euler_lanes
+                };
                 for i in 0..n {
                     let (x, v, a) = (work.x0[i], work.v0[i], work.acceleration[i]);
-                    let v1 = v + h * a;
-                    work.x[i] = x + h * if semi { v1 } else { v };
-                    work.v[i] = v1;
+                    let (x1, v1) = euler(x.into(), v.into(), a.into(), h);
+                    (work.x[i], work.v[i]) = (x1.into(), v1.into());
                 }
                 self.keep_lambda(work);
             }
