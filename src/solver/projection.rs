@@ -9,6 +9,7 @@ use super::solve::{SolveError, normal_length_squared, resistance, solve_on};
 use super::state::BeadState;
 use super::wire_normal::{along, usable};
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
+use crate::lane::{Lane, V2};
 
 /// Tolerance on `|C|` for the Newton solves (RATTLE, projection), in units
 /// of the wire's scale or of the point's largest coordinate, whichever is
@@ -24,20 +25,50 @@ pub const NEWTON_ACCEPT: f64 = 1e-10;
 /// The most Newton iterations a solve takes before it gives up.
 pub(crate) const NEWTON_MAX_ITERATIONS: u32 = 20;
 
-/// Whether a Newton solve is done at a point whose largest coordinate is
-/// `reach` in size: `|C|` within the tolerance of the wire's scale or of
-/// the point's coordinates (rounding keeps `C` from going below a few ulps
-/// of them), or within [`NEWTON_ACCEPT`] and stalled (no smaller than half
-/// the `previous` residual) or at the last iteration.
-pub(crate) fn newton_done(
-    residual: f64,
-    previous: f64,
-    scale: f64,
-    reach: f64,
+/// The size of a point's largest coordinate: how far from the origin
+/// rounding its coordinates reaches.
+#[inline(always)]
+pub(crate) fn reach<T: Lane>(p: V2<T>) -> T {
+    p.x.abs().max(p.y.abs())
+}
+
+/// Whether the residual `|C|` of a Newton solve is within
+/// [`NEWTON_TOLERANCE`] of the constraint's `scale` or of the `reach` of
+/// the point it is evaluated at (rounding keeps `C` from going below a few
+/// ulps of them).
+#[inline(always)]
+pub(crate) fn newton_within<T: Lane>(residual: T, scale: T, reach: T) -> T::Mask {
+    residual.abs_le(residual.splat(NEWTON_TOLERANCE) * scale.max(reach))
+}
+
+/// Whether a Newton solve that has not reached [`newton_within`] takes
+/// its residual `|C|` anyway: within [`NEWTON_ACCEPT`] of the constraint's
+/// `scale` and stalled (no smaller than half the `previous` residual), or
+/// at the `last` iteration.
+#[inline(always)]
+pub(crate) fn newton_accepted<T: Lane>(residual: T, previous: T, scale: T, last: bool) -> T::Mask {
+    let accepted = residual.abs_le(residual.splat(NEWTON_ACCEPT) * scale);
+    if last {
+        accepted
+    } else {
+        accepted & residual.gt(residual.splat(0.5) * previous)
+    }
+}
+
+/// Whether a Newton solve on one constraint is done at residual `|C|`,
+/// after the `previous` residual, at a point of the given `reach`:
+/// [`newton_within`] or [`newton_accepted`]. An island, with a residual
+/// for each row, asks [`newton_within`] of every row and
+/// [`newton_accepted`] of its worst row relative to that row's scale.
+#[inline(always)]
+pub(crate) fn newton_done<T: Lane>(
+    residual: T,
+    previous: T,
+    scale: T,
+    reach: T,
     last: bool,
-) -> bool {
-    residual <= NEWTON_TOLERANCE * scale.max(reach)
-        || (residual <= NEWTON_ACCEPT * scale && (last || residual > 0.5 * previous))
+) -> T::Mask {
+    newton_within(residual, scale, reach) | newton_accepted(residual, previous, scale, last)
 }
 
 /// Newton's method on `s ↦ C(base + s dir, t)`: the root `s`.
@@ -55,8 +86,8 @@ pub(crate) fn newton_along<T: Track + ?Sized>(
         let g = track.geometry(t, p);
         let previous = residual;
         residual = g.c.abs();
-        let reach = p.abs().max_element();
-        if newton_done(residual, previous, scale, reach, i == NEWTON_MAX_ITERATIONS) {
+        let last = i == NEWTON_MAX_ITERATIONS;
+        if newton_done(residual, previous, scale, reach(p.into()), last) {
             return Ok(s);
         }
         if i == NEWTON_MAX_ITERATIONS {
@@ -99,8 +130,8 @@ pub(crate) fn project_on<T: Track + ?Sized>(
         let g = track.geometry(t, x);
         let previous = residual;
         residual = g.c.abs();
-        let reach = x.abs().max_element();
-        if newton_done(residual, previous, scale, reach, i == NEWTON_MAX_ITERATIONS) {
+        let last = i == NEWTON_MAX_ITERATIONS;
+        if newton_done(residual, previous, scale, reach(x.into()), last) {
             converged = true;
             break;
         }

@@ -7,7 +7,7 @@ use std::convert::Infallible;
 use crate::geometry::circle_geometry;
 use crate::lane::{Lane, Mask, V2};
 use crate::solver::projection::{
-    ENERGY_CORRECTION_LIMIT, NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE,
+    ENERGY_CORRECTION_LIMIT, NEWTON_MAX_ITERATIONS, newton_done, reach,
 };
 use crate::solver::rk4::Stages;
 use crate::solver::settings::StepSettings;
@@ -140,19 +140,10 @@ impl<T: Lane> OnCircles<T> {
     }
 
     /// Whether a Newton solve at the point `at` is done at residual `|c|`
-    /// after `previous`, as `newton_done` says.
+    /// after `previous` (`newton_done`, the circle's scale its radius).
     #[inline(always)]
     fn converged(self, c: T, previous: T, at: V2<T>, last: bool) -> T::Mask {
-        let r = self.radius;
-        let residual = c.abs();
-        let reach = at.x.abs().max(at.y.abs());
-        let within = residual.abs_le(r.splat(NEWTON_TOLERANCE) * r.max(reach));
-        let accepted = residual.abs_le(r.splat(NEWTON_ACCEPT) * r);
-        if last {
-            within | accepted
-        } else {
-            within | (accepted & residual.gt(r.splat(0.5) * previous))
-        }
+        newton_done(c.abs(), previous, self.radius, reach(at), last)
     }
 
     /// The lanes whose scale is the radius itself (`scale().max(MIN_POSITIVE)`).
