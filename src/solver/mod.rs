@@ -10,7 +10,7 @@
 //! | `solve` | λ of eq. (3) in closed form |
 //! | `friction` | friction and damping along a wire, eq. (17) |
 //! | `wire_normal` | when the wire's normal is usable, and a vector split along and across the wire |
-//! | `euler`, `rk4`, `rattle`, `projection` | the integrators and post-stabilization, eqs. (6)–(11) |
+//! | `euler`, `rk4`, `rattle`, `projection`, `restore` | the integrators and post-stabilization, eqs. (6)–(11) |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
 //! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eqs. (16)–(17): on the wire, in flight, where an event falls |
 //! | `lanes/` (`circle`) | the batched step: eight beads on circles at once, bit for bit [`step`](fn@step), many such batches in one call; the solves on each lane's circle (crate-private) |
@@ -28,6 +28,7 @@ mod lanes;
 mod method;
 mod projection;
 mod rattle;
+mod restore;
 mod rk4;
 mod settings;
 mod solve;

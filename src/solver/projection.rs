@@ -1,11 +1,11 @@
 //! Newton's method on `C`, shared by RATTLE's position solve and
-//! post-stabilization projection, eq. (9), and the energy-restoring
-//! velocity scale that completes the projection, eq. (10).
+//! post-stabilization projection, eq. (9), with its stopping test, and the
+//! velocity's normal part removed after it. The restores that complete the
+//! projection, eqs. (10) and (11), are in `restore`.
 
 use bevy::math::DVec2;
 
-use super::settings::Gains;
-use super::solve::{SolveError, normal_length_squared, resistance, solve_on};
+use super::solve::{SolveError, normal_length_squared};
 use super::state::BeadState;
 use super::wire_normal::{along, usable};
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
@@ -156,7 +156,7 @@ pub(crate) fn project_on<T: Track + ?Sized>(
 /// The velocity of the wire's point at `x` at time `t` (zero on a fixed
 /// wire).
 #[inline(always)]
-fn wire_velocity<T: Track + ?Sized>(track: &T, t: f64, x: DVec2) -> DVec2 {
+pub(super) fn wire_velocity<T: Track + ?Sized>(track: &T, t: f64, x: DVec2) -> DVec2 {
     if T::MOVES {
         track.twist(t).velocity_at(x)
     } else {
@@ -166,7 +166,7 @@ fn wire_velocity<T: Track + ?Sized>(track: &T, t: f64, x: DVec2) -> DVec2 {
 
 /// `v` without the part of its normal component that the wire does not
 /// share: `∇C·(v − w) = 0` afterwards.
-fn tangential<T: Track + ?Sized>(
+pub(super) fn tangential<T: Track + ?Sized>(
     track: &T,
     t: f64,
     x: DVec2,
@@ -179,100 +179,7 @@ fn tangential<T: Track + ?Sized>(
 }
 
 /// `a` without its component along `n`.
-fn along_wire(n: DVec2, a: DVec2, x: DVec2) -> Result<DVec2, SolveError> {
+pub(super) fn along_wire(n: DVec2, a: DVec2, x: DVec2) -> Result<DVec2, SolveError> {
     let nn = normal_length_squared(n, x)?;
     Ok(along(n.into(), nn, a.into()).into())
-}
-
-/// Eq. (10): the factor that scales a projected velocity of kinetic
-/// energy `kinetic_now` to the kinetic energy `kinetic_target`; 1 where
-/// either is zero or not finite (nothing to scale, or nothing to scale to).
-pub(crate) fn kinetic_scale(kinetic_target: f64, kinetic_now: f64) -> f64 {
-    let ratio = kinetic_target / kinetic_now;
-    if ratio.is_finite() && ratio > 0.0 {
-        ratio.sqrt()
-    } else {
-        1.0
-    }
-}
-
-/// Eq. (10) for one bead after an Euler step of length `h` from `start`
-/// at time `t`: `projected`'s velocity scaled to the speed of
-/// `v₀ + h a_t`, the start velocity plus the step's kick without its
-/// normal part (`a_t` the applied acceleration's component along the wire
-/// at `x₀`), and its normal component, which the scale multiplies from
-/// rounding, removed again. On a moving wire the same holds in the wire's
-/// frame: relative velocities, and the frame's acceleration `a_w` taken
-/// from the applied one.
-pub(crate) fn restore_speed<T: Track + ?Sized>(
-    track: &T,
-    t: f64,
-    start: BeadState,
-    projected: BeadState,
-    force: &super::state::LinearForce,
-    mass: f64,
-    h: f64,
-) -> Result<BeadState, SolveError> {
-    let (x0, x1, t1) = (start.position, projected.position, t + h);
-    let (w0, w1) = (wire_velocity(track, t, x0), wire_velocity(track, t1, x1));
-    let relative = start.velocity - w0;
-    let mut applied = force.at(x0) / mass;
-    if T::MOVES {
-        applied -= track.twist(t).acceleration_at(x0, relative);
-    }
-    let normal = track.geometry(t, x0).normal;
-    if let Some((surface, sliding)) = track.surface() {
-        // Friction and damping are part of the kick: the speed they take
-        // away stays away.
-        let lambda = solve_on(track, t, start, force, mass, Gains::NONE)?.lambda;
-        applied += resistance(surface, sliding, normal, relative, mass * applied, lambda) / mass;
-    }
-    let kick = along_wire(normal, applied, x0)?;
-    let target = (relative + h * kick).length_squared();
-    let now = projected.velocity - w1;
-    let scale = kinetic_scale(target, now.length_squared());
-    Ok(BeadState {
-        velocity: tangential(track, t1, x1, w1 + scale * now)?,
-        ..projected
-    })
-}
-
-/// The largest relative change of speed eq. (11) makes: a fourth-order
-/// step's energy error is far below it; a larger mismatch means a bead at
-/// a turning point or at rest, where the ratio of two near-zero kinetic
-/// energies says nothing, and the velocity is left as projected.
-pub const ENERGY_CORRECTION_LIMIT: f64 = 1e-3;
-
-/// Eq. (11): the factor that brings a projected velocity of kinetic energy
-/// `kinetic_now` to the energy balance `kinetic_target` of a conservative
-/// system, or 1 where the change would exceed
-/// [`ENERGY_CORRECTION_LIMIT`].
-pub(crate) fn energy_scale(kinetic_target: f64, kinetic_now: f64) -> f64 {
-    let scale = kinetic_scale(kinetic_target, kinetic_now);
-    if (scale - 1.0).abs() <= ENERGY_CORRECTION_LIMIT {
-        scale
-    } else {
-        1.0
-    }
-}
-
-/// Eq. (11) for one bead after an RK4 step from `start`: `projected`'s
-/// velocity scaled so that the energy is the start's, kinetic plus the
-/// potential of the linear force of eq. (5) (gravity and the drag spring),
-/// and its normal component removed again.
-pub(crate) fn restore_energy<T: Track + ?Sized>(
-    track: &T,
-    t: f64,
-    start: BeadState,
-    projected: BeadState,
-    force: &super::state::LinearForce,
-    mass: f64,
-) -> Result<BeadState, SolveError> {
-    let target = 0.5 * mass * start.velocity.length_squared() + force.potential(start.position)
-        - force.potential(projected.position);
-    let scale = energy_scale(target, 0.5 * mass * projected.velocity.length_squared());
-    Ok(BeadState {
-        velocity: tangential(track, t, projected.position, scale * projected.velocity)?,
-        ..projected
-    })
 }

@@ -6,8 +6,9 @@ use bevy::math::DVec2;
 
 use super::euler::{explicit_euler, semi_implicit_euler};
 use super::method::Method;
-use super::projection::{project_on, restore_energy, restore_speed};
+use super::projection::project_on;
 use super::rattle::rattle_on;
+use super::restore::{restore_energy, restore_speed};
 use super::rk4::rk4_on;
 use super::settings::StepSettings;
 use super::solve::{SolveError, solve_on};

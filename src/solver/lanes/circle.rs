@@ -6,9 +6,8 @@ use std::convert::Infallible;
 
 use crate::geometry::circle_geometry;
 use crate::lane::{Lane, Mask, V2};
-use crate::solver::projection::{
-    ENERGY_CORRECTION_LIMIT, NEWTON_MAX_ITERATIONS, newton_done, reach,
-};
+use crate::solver::projection::{NEWTON_MAX_ITERATIONS, newton_done, reach};
+use crate::solver::restore::{bead_energy_scale, speed_scale};
 use crate::solver::rk4::Stages;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::{ConstraintForce, constraint_force};
@@ -295,16 +294,8 @@ impl<T: Lane> OnCircles<T> {
         let relative = v0 - zero;
         let applied = force.at(x0).div(m);
         let kick = along(n0, n0.dot(n0), applied);
-        let moved = relative.plus(h, kick);
-        let target = moved.dot(moved);
         let now = vp - zero;
-        // `kinetic_scale`.
-        let ratio = target / now.dot(now);
-        let scale = T::select(
-            ratio.is_finite() & ratio.gt(m.splat(0.0)),
-            ratio.sqrt(),
-            m.splat(1.0),
-        );
+        let scale = speed_scale(relative, kick, h, now);
         self.tangential(at, zero + now.scale(scale))
     }
 
@@ -323,26 +314,7 @@ impl<T: Lane> OnCircles<T> {
         force: &LinearForceLanes<T>,
         m: T,
     ) -> (V2<T>, T::Mask) {
-        let half = m.splat(0.5);
-        let potential = |x: V2<T>| {
-            let d = x - force.at;
-            -force.force.dot(d) + half * force.stiffness * d.dot(d)
-        };
-        let target = half * m * v0.dot(v0) + potential(x0) - potential(xp);
-        let now = half * m * vp.dot(vp);
-        let one = m.splat(1.0);
-        // `kinetic_scale`, then `energy_scale`'s limit.
-        let ratio = target / now;
-        let scale = T::select(
-            ratio.is_finite() & ratio.gt(m.splat(0.0)),
-            ratio.sqrt(),
-            one,
-        );
-        let scale = T::select(
-            (scale - one).abs_le(m.splat(ENERGY_CORRECTION_LIMIT)),
-            scale,
-            one,
-        );
+        let scale = bead_energy_scale(force, m, (x0, v0), (xp, vp));
         self.tangential(at, vp.scale(scale))
     }
 }

@@ -5,7 +5,7 @@ use bevy::math::DVec2;
 
 use super::newton::Direction;
 use super::{Island, IslandWork};
-use crate::solver::projection::{energy_scale, kinetic_scale};
+use crate::solver::restore::{energy_scale, kinetic_scale};
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
 
