@@ -14,6 +14,7 @@ use super::settings::StepSettings;
 use super::solve::{SolveError, solve_on};
 use super::state::{BeadState, LinearForce};
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
+use crate::lane::Lane;
 
 /// The result of one step.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -82,8 +83,8 @@ pub fn step_on<T: Track + ?Sized>(
         return Err(SolveError::NonFinite);
     }
     let g = track.geometry(t1, advance.state.position);
-    let bound = settings.drift_bound * track.scale();
-    if g.c.is_nan() || g.c.abs() > bound {
+    let (bound, within) = drift_check(settings, g.c, track.scale());
+    if !within {
         return Err(SolveError::DriftExceeded { c: g.c, bound });
     }
     let (state, (c, c_dot)) = if settings.method.projects() {
@@ -113,6 +114,15 @@ pub fn step_on<T: Track + ?Sized>(
         c,
         c_dot,
     })
+}
+
+/// The divergence check, for a lone bead, the lanes and each row of an
+/// island: the drift bound of a constraint of size `scale`, and whether
+/// the `C` a step left is within it (not where `C` or the bound is NaN).
+#[inline(always)]
+pub(crate) fn drift_check<T: Lane>(settings: &StepSettings, c: T, scale: T) -> (T, T::Mask) {
+    let bound = scale.splat(settings.drift_bound) * scale;
+    (bound, c.abs_le(bound))
 }
 
 /// `C` and `Ċ = N·ẋ` at a state: how far off its wire the bead is, and how

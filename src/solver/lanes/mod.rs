@@ -21,6 +21,8 @@ use super::settings::StepSettings;
 use super::state::LinearForceLanes;
 use super::state::{BeadState, LinearForce};
 use super::step::StepOutput;
+#[cfg(target_arch = "x86_64")]
+use super::step::drift_check;
 #[cfg(doc)]
 use super::step::step;
 pub use crate::lane::LANES;
@@ -276,14 +278,14 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut Circ
         start_normal,
         mut regular,
     } = advanced;
-    let bound = m.splat(settings.drift_bound) * radius;
+    let (_, within) = drift_check(settings, end.c, radius);
     regular = regular
         & x.is_finite()
         & v.is_finite()
         & x1.is_finite()
         & v1.is_finite()
         & end.len.is_nonzero()
-        & end.c.abs_le(bound);
+        & within;
     let (x1, v1, end) = if settings.method.projects() {
         // Eq. (9), then the speed of eq. (10) after an Euler step, the
         // energy of eq. (11) after RK4.

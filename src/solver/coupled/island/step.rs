@@ -12,6 +12,7 @@ use crate::solver::method::Method;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
+use crate::solver::step::drift_check;
 
 impl Island {
     /// One step of every bead of the island under `settings`: `states`
@@ -218,9 +219,9 @@ impl Island {
         work.time = time + h;
         self.evaluate_at_new(work);
         for r in 0..self.rows() {
-            let bound = settings.drift_bound * self.rows[r].scale();
             let c = work.c[r];
-            if c.is_nan() || c.abs() > bound {
+            let (bound, within) = drift_check(settings, c, self.rows[r].scale());
+            if !within {
                 return Err(SolveError::DriftExceeded { c, bound });
             }
         }
