@@ -11,6 +11,7 @@
 //! | `friction` | friction and damping along a wire, eq. (17) |
 //! | `wire_normal` | when the wire's normal is usable, and a vector split along and across the wire |
 //! | `euler`, `rk4`, `rattle`, `projection`, `restore` | the integrators and post-stabilization, eqs. (6)–(11) |
+//! | `newton` | Newton's method on `C` and its stopping test, for RATTLE and projection |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
 //! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eqs. (16)–(17): on the wire, in flight, where an event falls |
 //! | `lanes/` (`circle`) | the batched step: eight beads on circles at once, bit for bit [`step`](fn@step), many such batches in one call; the solves on each lane's circle (crate-private) |
@@ -26,6 +27,7 @@ mod euler;
 mod friction;
 mod lanes;
 mod method;
+mod newton;
 mod projection;
 mod rattle;
 mod restore;

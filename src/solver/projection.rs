@@ -1,108 +1,73 @@
-//! Newton's method on `C`, shared by RATTLE's position solve and
-//! post-stabilization projection, eq. (9), with its stopping test, and the
+//! Post-stabilization, eq. (9), for one bead on a wire that may move: the
+//! Newton iteration of `newton` run on the wire at one time, and the
 //! velocity's normal part removed after it. The restores that complete the
 //! projection, eqs. (10) and (11), are in `restore`.
 
 use bevy::math::DVec2;
 
+use super::newton::{Root, WireAt, newton_onto, tangential as tangential_on};
 use super::solve::{SolveError, normal_length_squared};
 use super::state::BeadState;
-use super::wire_normal::{along, usable};
-use crate::geometry::{FixedTrack, ImplicitCurve, Track};
-use crate::lane::{Lane, V2};
+use super::wire_normal::along;
+use crate::geometry::{FixedTrack, Geometry, ImplicitCurve, Track};
+use crate::lane::V2;
 
-/// Tolerance on `|C|` for the Newton solves (RATTLE, projection), in units
-/// of the wire's scale or of the point's largest coordinate, whichever is
-/// larger: a few ulps, which Newton's quadratic convergence reaches in two
-/// or three iterations, and below which rounding the coordinates keeps `C`
-/// from going.
-pub const NEWTON_TOLERANCE: f64 = 4.0 * f64::EPSILON;
-/// Where rounding keeps `|C|` from reaching [`NEWTON_TOLERANCE`] (a bead
-/// far from the origin beside its wire's scale), a residual below this (in
-/// wire scales) is accepted once an iteration no longer halves it, or after
-/// the last iteration.
-pub const NEWTON_ACCEPT: f64 = 1e-10;
-/// The most Newton iterations a solve takes before it gives up.
-pub(crate) const NEWTON_MAX_ITERATIONS: u32 = 20;
-
-/// The size of a point's largest coordinate: how far from the origin
-/// rounding its coordinates reaches.
-#[inline(always)]
-pub(crate) fn reach<T: Lane>(p: V2<T>) -> T {
-    p.x.abs().max(p.y.abs())
+/// A [`Track`] at time `t`, as the Newton iterations of `newton` see a
+/// wire.
+pub(crate) struct TrackAt<'a, T: ?Sized> {
+    /// The wire.
+    pub(crate) track: &'a T,
+    /// The time it is taken at.
+    pub(crate) t: f64,
 }
 
-/// Whether the residual `|C|` of a Newton solve is within
-/// [`NEWTON_TOLERANCE`] of the constraint's `scale` or of the `reach` of
-/// the point it is evaluated at (rounding keeps `C` from going below a few
-/// ulps of them).
-#[inline(always)]
-pub(crate) fn newton_within<T: Lane>(residual: T, scale: T, reach: T) -> T::Mask {
-    residual.abs_le(residual.splat(NEWTON_TOLERANCE) * scale.max(reach))
+impl<T: Track + ?Sized> TrackAt<'_, T> {
+    /// The wire's scale, as the Newton solves take it (never zero).
+    #[inline(always)]
+    pub(crate) fn scale(&self) -> f64 {
+        self.track.scale().max(f64::MIN_POSITIVE)
+    }
 }
 
-/// Whether a Newton solve that has not reached [`newton_within`] takes
-/// its residual `|C|` anyway: within [`NEWTON_ACCEPT`] of the constraint's
-/// `scale` and stalled (no smaller than half the `previous` residual), or
-/// at the `last` iteration.
-#[inline(always)]
-pub(crate) fn newton_accepted<T: Lane>(residual: T, previous: T, scale: T, last: bool) -> T::Mask {
-    let accepted = residual.abs_le(residual.splat(NEWTON_ACCEPT) * scale);
-    if last {
-        accepted
+impl<T: Track + ?Sized> WireAt<f64> for TrackAt<'_, T> {
+    type At = Geometry;
+    #[inline(always)]
+    fn at(&self, p: V2<f64>) -> Geometry {
+        self.track.geometry(self.t, p.into())
+    }
+    #[inline(always)]
+    fn c(at: &Geometry) -> f64 {
+        at.c
+    }
+    #[inline(always)]
+    fn normal(at: &Geometry) -> V2<f64> {
+        at.normal.into()
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: Geometry, b: Geometry) -> Geometry {
+        if mask { a } else { b }
+    }
+    #[inline(always)]
+    fn velocity(&self, p: V2<f64>) -> V2<f64> {
+        wire_velocity(self.track, self.t, p.into()).into()
+    }
+}
+
+/// Why a Newton iteration on one bead did not find its root (`point` the
+/// last point it reached): it ran out of iterations, or it met a singular
+/// point there.
+pub(crate) fn newton_error<P, A>(root: &Root<f64, P, A>, point: DVec2) -> SolveError {
+    if root.running {
+        SolveError::NoConvergence {
+            iterations: super::newton::NEWTON_MAX_ITERATIONS,
+            residual: root.residual,
+        }
     } else {
-        accepted & residual.gt(residual.splat(0.5) * previous)
+        SolveError::Singular {
+            x: point.x,
+            y: point.y,
+        }
     }
-}
-
-/// Whether a Newton solve on one constraint is done at residual `|C|`,
-/// after the `previous` residual, at a point of the given `reach`:
-/// [`newton_within`] or [`newton_accepted`]. An island, with a residual
-/// for each row, asks [`newton_within`] of every row and
-/// [`newton_accepted`] of its worst row relative to that row's scale.
-#[inline(always)]
-pub(crate) fn newton_done<T: Lane>(
-    residual: T,
-    previous: T,
-    scale: T,
-    reach: T,
-    last: bool,
-) -> T::Mask {
-    newton_within(residual, scale, reach) | newton_accepted(residual, previous, scale, last)
-}
-
-/// Newton's method on `s ↦ C(base + s dir, t)`: the root `s`.
-pub(crate) fn newton_along<T: Track + ?Sized>(
-    track: &T,
-    t: f64,
-    base: DVec2,
-    dir: DVec2,
-) -> Result<f64, SolveError> {
-    let scale = track.scale().max(f64::MIN_POSITIVE);
-    let mut s = 0.0;
-    let mut residual = f64::INFINITY;
-    for i in 0..=NEWTON_MAX_ITERATIONS {
-        let p = base + s * dir;
-        let g = track.geometry(t, p);
-        let previous = residual;
-        residual = g.c.abs();
-        let last = i == NEWTON_MAX_ITERATIONS;
-        if newton_done(residual, previous, scale, reach(p.into()), last) {
-            return Ok(s);
-        }
-        if i == NEWTON_MAX_ITERATIONS {
-            break;
-        }
-        let slope = g.normal.dot(dir);
-        if !usable(slope.abs()) {
-            return Err(SolveError::Singular { x: p.x, y: p.y });
-        }
-        s -= g.c / slope;
-    }
-    Err(SolveError::NoConvergence {
-        iterations: NEWTON_MAX_ITERATIONS,
-        residual,
-    })
 }
 
 /// Post-stabilization, eq. (9): moves the position onto `C = 0` by Newton
@@ -122,34 +87,23 @@ pub(crate) fn project_on<T: Track + ?Sized>(
     t: f64,
     state: BeadState,
 ) -> Result<BeadState, SolveError> {
-    let scale = track.scale().max(f64::MIN_POSITIVE);
-    let mut x = state.position;
-    let mut converged = false;
-    let mut residual = f64::INFINITY;
-    for i in 0..=NEWTON_MAX_ITERATIONS {
-        let g = track.geometry(t, x);
-        let previous = residual;
-        residual = g.c.abs();
-        let last = i == NEWTON_MAX_ITERATIONS;
-        if newton_done(residual, previous, scale, reach(x.into()), last) {
-            converged = true;
-            break;
-        }
-        if i == NEWTON_MAX_ITERATIONS {
-            break;
-        }
-        let nn = normal_length_squared(g.normal, x)?;
-        x -= (g.c / nn) * g.normal;
+    let wire = TrackAt { track, t };
+    let x = V2::from(state.position);
+    let onto = newton_onto(&wire, x, wire.at(x), wire.scale(), true);
+    let position = DVec2::from(onto.root);
+    if !onto.found {
+        return Err(newton_error(&onto, position));
     }
-    if !converged {
-        return Err(SolveError::NoConvergence {
-            iterations: NEWTON_MAX_ITERATIONS,
-            residual,
+    let (velocity, usable) = tangential_on(&wire, &onto.at, onto.root, state.velocity.into());
+    if !usable {
+        return Err(SolveError::Singular {
+            x: position.x,
+            y: position.y,
         });
     }
     Ok(BeadState {
-        position: x,
-        velocity: tangential(track, t, x, state.velocity)?,
+        position,
+        velocity: velocity.into(),
     })
 }
 
@@ -172,10 +126,13 @@ pub(super) fn tangential<T: Track + ?Sized>(
     x: DVec2,
     v: DVec2,
 ) -> Result<DVec2, SolveError> {
-    let n = track.geometry(t, x).normal;
-    let nn = normal_length_squared(n, x)?;
-    let w = wire_velocity(track, t, x);
-    Ok(v - DVec2::from(super::wire_normal::across(n.into(), nn, (v - w).into())))
+    let wire = TrackAt { track, t };
+    let (v, usable) = tangential_on(&wire, &wire.at(x.into()), x.into(), v.into());
+    if usable {
+        Ok(v.into())
+    } else {
+        Err(SolveError::Singular { x: x.x, y: x.y })
+    }
 }
 
 /// `a` without its component along `n`.

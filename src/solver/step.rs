@@ -148,7 +148,7 @@ mod tests {
     use super::*;
     use crate::geometry::{Circle, Sine};
     use crate::solver::Stabilization;
-    use crate::solver::projection::NEWTON_ACCEPT;
+    use crate::solver::newton::NEWTON_ACCEPT;
     use crate::solver::test_support::{G, settings};
 
     #[test]

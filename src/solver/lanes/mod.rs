@@ -15,6 +15,8 @@ use super::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 #[cfg(target_arch = "x86_64")]
 use super::method::Method;
 #[cfg(target_arch = "x86_64")]
+use super::newton::WireAt;
+#[cfg(target_arch = "x86_64")]
 use super::rk4::rk4_lanes;
 use super::settings::StepSettings;
 #[cfg(target_arch = "x86_64")]
@@ -291,7 +293,7 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut Circ
         // energy of eq. (11) after RK4.
         let (xp, vp, at, projected) = circle.project(x1, v1, end);
         let (vr, restored) = if settings.method.is_euler() {
-            circle.restore_speed(x, v, start_normal, vp, at, &force, m, h)
+            circle.restore_speed(x, v, start_normal, xp, vp, at, &force, m, h)
         } else {
             circle.restore_energy(x, v, xp, vp, at, &force, m)
         };

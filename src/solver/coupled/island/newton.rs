@@ -4,7 +4,7 @@
 use super::{EXACT_STEPS, Island, IslandWork};
 use bevy::math::DVec2;
 
-use crate::solver::projection::{NEWTON_MAX_ITERATIONS, newton_accepted, newton_within, reach};
+use crate::solver::newton::{NEWTON_MAX_ITERATIONS, newton_accepted, newton_within, reach};
 use crate::solver::solve::SolveError;
 
 impl Island {
