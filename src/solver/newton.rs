@@ -114,6 +114,97 @@ pub(crate) struct Root<T: Lane, P, A> {
     pub(crate) residual: T,
 }
 
+/// What a Newton iteration moves, and how it moves it.
+trait Walk<T: Lane, W: WireAt<T>> {
+    /// The point the wire is evaluated at.
+    fn point(&self) -> V2<T>;
+    /// One Newton step from the point, where the wire is `g` and `C` is
+    /// `c`, in the lanes `active`; returns the lanes it could take it in
+    /// (the others stay where they are).
+    fn step(&mut self, g: &W::At, c: T, active: T::Mask) -> T::Mask;
+}
+
+/// Newton's method on `C` from `walk`'s point, where the wire is `start`,
+/// in the lanes `active` at the start, for a wire of size `scale`, until
+/// [`newton_done`]: the wire where each lane stopped and why.
+#[inline(always)]
+fn newton<T: Lane, W: WireAt<T>, K: Walk<T, W>>(
+    wire: &W,
+    mut walk: K,
+    start: W::At,
+    scale: T,
+    active: T::Mask,
+) -> Root<T, K, W::At> {
+    let mut active = active;
+    let mut found = active & !active;
+    let mut previous = scale.splat(f64::INFINITY);
+    let mut p = walk.point();
+    let mut g = start;
+    let mut end = start;
+    for i in 0..=NEWTON_MAX_ITERATIONS {
+        let c = W::c(&g);
+        let last = i == NEWTON_MAX_ITERATIONS;
+        let done = active & newton_done(c.abs(), previous, scale, reach(p), last);
+        previous = c.abs();
+        end = W::select(done, g, end);
+        found = found | done;
+        active = active & !done;
+        if last || !active.any() {
+            break;
+        }
+        active = walk.step(&g, c, active);
+        p = walk.point();
+        g = wire.at(p);
+    }
+    Root {
+        root: walk,
+        at: end,
+        found,
+        running: active,
+        residual: previous,
+    }
+}
+
+/// The walk of [`newton_along`]: `base + s dir`.
+struct Along<T> {
+    base: V2<T>,
+    dir: V2<T>,
+    s: T,
+}
+
+impl<T: Lane, W: WireAt<T>> Walk<T, W> for Along<T> {
+    #[inline(always)]
+    fn point(&self) -> V2<T> {
+        self.base.plus(self.s, self.dir)
+    }
+    #[inline(always)]
+    fn step(&mut self, g: &W::At, c: T, active: T::Mask) -> T::Mask {
+        let slope = W::normal(g).dot(self.dir);
+        let active = active & usable(slope.abs());
+        self.s = T::select(active, self.s - c / slope, self.s);
+        active
+    }
+}
+
+/// The walk of [`newton_onto`]: along the local gradient.
+struct Onto<T> {
+    x: V2<T>,
+}
+
+impl<T: Lane, W: WireAt<T>> Walk<T, W> for Onto<T> {
+    #[inline(always)]
+    fn point(&self) -> V2<T> {
+        self.x
+    }
+    #[inline(always)]
+    fn step(&mut self, g: &W::At, c: T, active: T::Mask) -> T::Mask {
+        let (nn, usable) = W::normal_length_squared(g);
+        let active = active & usable;
+        self.x = V2::select(active, self.x - W::normal(g).scale(c / nn), self.x);
+        active
+    }
+}
+
 /// Newton's method on `s ↦ C(base + s dir)`: the root `s`, in the lanes
 /// `active` at the start, for a wire of size `scale`. A lane stops where
 /// the slope `∇C·dir` is not usable; its point is then `base + s dir`.
@@ -125,38 +216,21 @@ pub(crate) fn newton_along<T: Lane, W: WireAt<T>>(
     scale: T,
     active: T::Mask,
 ) -> Root<T, T, W::At> {
-    let mut s = scale.splat(0.0);
-    let mut active = active;
-    let mut found = active & !active;
-    let mut previous = s.splat(f64::INFINITY);
+    let walk = Along {
+        base,
+        dir,
+        s: scale.splat(0.0),
+    };
     // At s = 0 too the point is `base + 0 dir` (a zero's sign can differ
     // from `base`'s).
-    let mut p = base.plus(s, dir);
-    let mut g = wire.at(p);
-    let mut root = g;
-    for i in 0..=NEWTON_MAX_ITERATIONS {
-        let c = W::c(&g);
-        let last = i == NEWTON_MAX_ITERATIONS;
-        let done = active & newton_done(c.abs(), previous, scale, reach(p), last);
-        previous = c.abs();
-        root = W::select(done, g, root);
-        found = found | done;
-        active = active & !done;
-        if last || !active.any() {
-            break;
-        }
-        let slope = W::normal(&g).dot(dir);
-        active = active & usable(slope.abs());
-        s = T::select(active, s - c / slope, s);
-        p = base.plus(s, dir);
-        g = wire.at(p);
-    }
+    let start = wire.at(Walk::<T, W>::point(&walk));
+    let r = newton(wire, walk, start, scale, active);
     Root {
-        root: s,
-        at: root,
-        found,
-        running: active,
-        residual: previous,
+        root: r.root.s,
+        at: r.at,
+        found: r.found,
+        running: r.running,
+        residual: r.residual,
     }
 }
 
@@ -172,34 +246,13 @@ pub(crate) fn newton_onto<T: Lane, W: WireAt<T>>(
     scale: T,
     active: T::Mask,
 ) -> Root<T, V2<T>, W::At> {
-    let mut x = x;
-    let mut active = active;
-    let mut found = active & !active;
-    let mut previous = scale.splat(f64::INFINITY);
-    let mut g = start;
-    let mut end = start;
-    for i in 0..=NEWTON_MAX_ITERATIONS {
-        let c = W::c(&g);
-        let last = i == NEWTON_MAX_ITERATIONS;
-        let done = active & newton_done(c.abs(), previous, scale, reach(x), last);
-        previous = c.abs();
-        end = W::select(done, g, end);
-        found = found | done;
-        active = active & !done;
-        if last || !active.any() {
-            break;
-        }
-        let (nn, usable) = W::normal_length_squared(&g);
-        active = active & usable;
-        x = V2::select(active, x - W::normal(&g).scale(c / nn), x);
-        g = wire.at(x);
-    }
+    let r = newton(wire, Onto { x }, start, scale, active);
     Root {
-        root: x,
-        at: end,
-        found,
-        running: active,
-        residual: previous,
+        root: r.root.x,
+        at: r.at,
+        found: r.found,
+        running: r.running,
+        residual: r.residual,
     }
 }
 

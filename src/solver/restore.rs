@@ -65,66 +65,68 @@ pub(crate) fn bead_energy_scale<T: Lane>(
     energy_scale(target, half * m * vp.dot(vp))
 }
 
-/// Eq. (10) for one bead after an Euler step of length `h` from `start`
-/// at time `t`: `projected`'s velocity scaled to the speed of
-/// `v₀ + h a_t`, the start velocity plus the step's kick without its
-/// normal part (`a_t` the applied acceleration's component along the wire
-/// at `x₀`), and its normal component, which the scale multiplies from
-/// rounding, removed again. On a moving wire the same holds in the wire's
+/// What completes one bead's projection after a step of length `h` from
+/// `start` at time `t`, `projected` being where the projection put it.
+///
+/// After an Euler step (`euler`), eq. (10): `projected`'s velocity scaled
+/// to the speed of `v₀ + h a_t`, the start velocity plus the step's kick
+/// without its normal part (`a_t` the applied acceleration's component
+/// along the wire at `x₀`, friction and damping included: the speed they
+/// take away stays away). On a moving wire the same holds in the wire's
 /// frame: relative velocities, and the frame's acceleration `a_w` taken
 /// from the applied one.
-pub(crate) fn restore_speed<T: Track + ?Sized>(
+///
+/// After RK4, eq. (11): `projected`'s velocity scaled so that the energy
+/// is the start's, kinetic plus the potential of the linear force of
+/// eq. (5) (gravity and the drag spring). It keeps a conservative
+/// system's energy: on a moving wire (which does work on the bead) or with
+/// friction or damping (which take energy away) the projection is left as
+/// it is.
+///
+/// Either way the velocity's normal component, which the scale multiplies
+/// from rounding, is removed again.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn restore<T: Track + ?Sized>(
     track: &T,
     t: f64,
+    h: f64,
+    euler: bool,
     start: BeadState,
     projected: BeadState,
     force: &LinearForce,
     mass: f64,
-    h: f64,
 ) -> Result<BeadState, SolveError> {
     let (x0, x1, t1) = (start.position, projected.position, t + h);
-    let (w0, w1) = (wire_velocity(track, t, x0), wire_velocity(track, t1, x1));
-    let relative = start.velocity - w0;
-    let mut applied = force.at(x0) / mass;
-    if T::MOVES {
-        applied -= track.twist(t).acceleration_at(x0, relative);
-    }
-    let normal = track.geometry(t, x0).normal;
-    if let Some((surface, sliding)) = track.surface() {
-        // Friction and damping are part of the kick: the speed they take
-        // away stays away.
-        let lambda = solve_on(track, t, start, force, mass, Gains::NONE)?.lambda;
-        applied += resistance(surface, sliding, normal, relative, mass * applied, lambda) / mass;
-    }
-    let kick = along_wire(normal, applied, x0)?;
-    let now = projected.velocity - w1;
-    let scale = speed_scale(relative.into(), kick.into(), h, now.into());
+    let velocity = if euler {
+        let (w0, w1) = (wire_velocity(track, t, x0), wire_velocity(track, t1, x1));
+        let relative = start.velocity - w0;
+        let mut applied = force.at(x0) / mass;
+        if T::MOVES {
+            applied -= track.twist(t).acceleration_at(x0, relative);
+        }
+        let normal = track.geometry(t, x0).normal;
+        if let Some((surface, sliding)) = track.surface() {
+            let lambda = solve_on(track, t, start, force, mass, Gains::NONE)?.lambda;
+            let resisted = resistance(surface, sliding, normal, relative, mass * applied, lambda);
+            applied += resisted / mass;
+        }
+        let kick = along_wire(normal, applied, x0)?;
+        let now = projected.velocity - w1;
+        let scale = speed_scale(relative.into(), kick.into(), h, now.into());
+        w1 + scale * now
+    } else if T::MOVES || track.surface().is_some_and(|(s, _)| s.resists()) {
+        return Ok(projected);
+    } else {
+        let scale = bead_energy_scale(
+            &force.lanes(),
+            mass,
+            (x0.into(), start.velocity.into()),
+            (x1.into(), projected.velocity.into()),
+        );
+        scale * projected.velocity
+    };
     Ok(BeadState {
-        velocity: tangential(track, t1, x1, w1 + scale * now)?,
-        ..projected
-    })
-}
-
-/// Eq. (11) for one bead after an RK4 step from `start`: `projected`'s
-/// velocity scaled so that the energy is the start's, kinetic plus the
-/// potential of the linear force of eq. (5) (gravity and the drag spring),
-/// and its normal component removed again.
-pub(crate) fn restore_energy<T: Track + ?Sized>(
-    track: &T,
-    t: f64,
-    start: BeadState,
-    projected: BeadState,
-    force: &LinearForce,
-    mass: f64,
-) -> Result<BeadState, SolveError> {
-    let scale = bead_energy_scale(
-        &force.lanes(),
-        mass,
-        (start.position.into(), start.velocity.into()),
-        (projected.position.into(), projected.velocity.into()),
-    );
-    Ok(BeadState {
-        velocity: tangential(track, t, projected.position, scale * projected.velocity)?,
+        velocity: tangential(track, t1, x1, velocity)?,
         ..projected
     })
 }

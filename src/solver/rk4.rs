@@ -22,42 +22,17 @@ pub(crate) trait Stages<T> {
 /// weight of its derivative in the step's sum (the first stage's is 1).
 pub(crate) const RK4_STAGES: [(f64, f64); 3] = [(0.5, 2.0), (0.5, 2.0), (1.0, 1.0)];
 
-/// A later stage's state: `(x + τ h ẋ, v + τ h v̇)` from the step's start
-/// `(x, v)`, the previous stage's derivative `(dx, dv)` and the stage's
-/// fraction `at` (`τ`) of the step `h`.
+/// `(x, v) + t (dx, dv)`: a stage's state from the step's start and the
+/// previous stage's derivative (`t` the stage's fraction of the step
+/// times `h`), a stage's derivative added to the sum at its weight, and
+/// the step's end from the sum (`t = h/6`).
 #[inline(always)]
-pub(crate) fn rk4_stage<T: Lane>(
+pub(crate) fn rk4_plus<T: Lane>(
     (x, v): (V2<T>, V2<T>),
+    t: T,
     (dx, dv): (V2<T>, V2<T>),
-    at: f64,
-    h: T,
 ) -> (V2<T>, V2<T>) {
-    let advance = h.splat(at) * h;
-    (x.plus(advance, dx), v.plus(advance, dv))
-}
-
-/// The step's sum of derivatives with a later stage's `(dx, dv)` added at
-/// its `weight`.
-#[inline(always)]
-pub(crate) fn rk4_add<T: Lane>(
-    (sx, sv): (V2<T>, V2<T>),
-    (dx, dv): (V2<T>, V2<T>),
-    weight: f64,
-) -> (V2<T>, V2<T>) {
-    let weight = dx.x.splat(weight);
-    (sx + dx.scale(weight), sv + dv.scale(weight))
-}
-
-/// The step's end: `(x, v) + h/6 · (sx, sv)`, the sum of the stages'
-/// weighted derivatives.
-#[inline(always)]
-pub(crate) fn rk4_end<T: Lane>(
-    (x, v): (V2<T>, V2<T>),
-    (sx, sv): (V2<T>, V2<T>),
-    h: T,
-) -> (V2<T>, V2<T>) {
-    let sixth = h / h.splat(6.0);
-    (x.plus(sixth, sx), v.plus(sixth, sv))
+    (x.plus(t, dx), v.plus(t, dv))
 }
 
 /// Eq. (7) on lanes: one step of length `h` from `(x, v)` with `a` the
@@ -74,11 +49,11 @@ pub(crate) fn rk4_lanes<T: Lane, S: Stages<T>>(
     let mut derivative = (v, a);
     let mut sum = derivative;
     for (at, weight) in RK4_STAGES {
-        let (xs, vs) = rk4_stage((x, v), derivative, at, h);
+        let (xs, vs) = rk4_plus((x, v), h.splat(at) * h, derivative);
         derivative = (vs, stages.acceleration(xs, vs, at)?);
-        sum = rk4_add(sum, derivative, weight);
+        sum = rk4_plus(sum, h.splat(weight), derivative);
     }
-    Ok(rk4_end((x, v), sum, h))
+    Ok(rk4_plus((x, v), h / h.splat(6.0), sum))
 }
 
 /// One RK4 step of length `h` from `state`, given `first`, the solve at

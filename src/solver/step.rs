@@ -8,7 +8,7 @@ use super::euler::{explicit_euler, semi_implicit_euler};
 use super::method::Method;
 use super::projection::project_on;
 use super::rattle::rattle_on;
-use super::restore::{restore_energy, restore_speed};
+use super::restore::restore;
 use super::rk4::rk4_on;
 use super::settings::StepSettings;
 use super::solve::{SolveError, solve_on};
@@ -89,15 +89,8 @@ pub fn step_on<T: Track + ?Sized>(
     }
     let (state, (c, c_dot)) = if settings.method.projects() {
         let projected = project_on(track, t1, advance.state)?;
-        let projected = if settings.method.is_euler() {
-            restore_speed(track, t, state, projected, force, mass, h)?
-        } else if T::MOVES || track.surface().is_some_and(|(s, _)| s.resists()) {
-            // Eq. (11) keeps a conservative system's energy: a moving wire
-            // does work, friction and damping take it away.
-            projected
-        } else {
-            restore_energy(track, t1, state, projected, force, mass)?
-        };
+        let euler = settings.method.is_euler();
+        let projected = restore(track, t, h, euler, state, projected, force, mass)?;
         (projected, constraint_state_on(track, t1, projected))
     } else {
         let relative = if T::MOVES {

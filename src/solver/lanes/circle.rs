@@ -1,6 +1,8 @@
-//! The solves on each lane's unrotated circle, operation for operation as
-//! the single-bead step takes them: eq. (3), the RK4 stages, RATTLE,
-//! projection and the restores of eq. (9).
+//! The solves on each lane's unrotated circle: eq. (3), the RK4 stages,
+//! RATTLE, projection and the restores of eqs. (10) and (11). Each runs
+//! the function the single-bead step runs (in `solve`, `rk4`, `rattle`,
+//! `newton`, `restore`), written over [`Lane`], on the circle as a
+//! [`WireAt`].
 
 use std::convert::Infallible;
 
@@ -105,12 +107,11 @@ pub(super) struct Advanced<T: Lane> {
 }
 
 /// Each lane's unrotated circle, for the steps that solve on it: RATTLE,
-/// projection and the energy restore, written as
+/// projection and the restores, by the functions that
 /// [`rattle`](fn@crate::solver::rattle), [`project`](crate::solver::project)
-/// and eq. (11) compute them for one bead (on a fixed wire, with no
-/// surface), operation for operation, so each lane returns their bits.
-/// Each also returns the lanes where the scalar function would have
-/// succeeded; the others mean nothing.
+/// and the restores run for one bead (on a fixed wire, with no surface),
+/// so each lane returns their bits. Each also returns the lanes where the
+/// scalar function would have succeeded; the others mean nothing.
 #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 #[derive(Clone, Copy)]
 pub(super) struct OnCircles<T: Lane> {
@@ -216,7 +217,7 @@ impl<T: Lane> OnCircles<T> {
         (onto.root, v, onto.at, onto.found & ok)
     }
 
-    /// Eq. (10) (`restore_speed`) after an Euler step of length `h` from
+    /// Eq. (10) (as `restore` takes it) after an Euler step of length `h` from
     /// `(x0, v0)`, where `∇C` was `n0` (usable, as the step's `regular`
     /// lanes hold): the projected velocity `vp` at `xp` (where the circle
     /// is `at`) scaled to the speed of `v0 + h a_t`, `a_t` the applied
@@ -245,7 +246,7 @@ impl<T: Lane> OnCircles<T> {
         tangential(&self, &at, xp, w1 + now.scale(scale))
     }
 
-    /// Eq. (11) (`restore_energy`): the projected velocity `vp` at `xp`
+    /// Eq. (11) (as `restore` takes it): the projected velocity `vp` at `xp`
     /// (where the circle is `at`) scaled so the energy is that of
     /// `(x0, v0)`, and its normal component removed again.
     #[inline(always)]

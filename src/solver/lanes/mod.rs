@@ -6,7 +6,7 @@
 //! | file | what it holds |
 //! |---|---|
 //! | `mod` | the lanes' layout ([`CircleLanes`], [`CircleSteps`]), the entry points and the step's outline on the lanes |
-//! | `circle` | the solves on each lane's circle: eq. (3), the RK4 stages, RATTLE, projection and the restores of eq. (9) |
+//! | `circle` | the solves on each lane's circle: eq. (3), the RK4 stages, RATTLE, projection and the restores of eqs. (10) and (11) |
 
 #[cfg(target_arch = "x86_64")]
 use self::circle::{Advanced, CircleStages, OnCircles, solve_on_circles};

@@ -6,7 +6,7 @@ use super::{Island, IslandWork, RowReport};
 use bevy::math::DVec2;
 
 use crate::lane::V2;
-use crate::solver::rk4::{RK4_STAGES, rk4_add, rk4_end, rk4_stage};
+use crate::solver::rk4::{RK4_STAGES, rk4_plus};
 use crate::solver::settings::Gains;
 use crate::solver::solve::SolveError;
 use crate::solver::state::LinearForce;
@@ -110,23 +110,21 @@ impl Island {
             // is (work.v, work.acceleration).
             for i in 0..n {
                 let derivative = pair(&work.v, &work.acceleration, i);
-                let (x, v) = rk4_stage(pair(&work.x0, &work.v0, i), derivative, at, h);
+                let (x, v) = rk4_plus(pair(&work.x0, &work.v0, i), at * h, derivative);
                 (work.x[i], work.v[i]) = (x.into(), v.into());
             }
             work.time = start + at * h;
             self.accelerate(forces, gains, work, Stage::Later)?;
             for i in 0..n {
                 let derivative = pair(&work.v, &work.acceleration, i);
-                let (x, v) = rk4_add(pair(&work.x_sum, &work.v_sum, i), derivative, weight);
+                let (x, v) = rk4_plus(pair(&work.x_sum, &work.v_sum, i), weight, derivative);
                 (work.x_sum[i], work.v_sum[i]) = (x.into(), v.into());
             }
         }
+        let sixth = h / 6.0;
         for i in 0..n {
-            let (x, v) = rk4_end(
-                pair(&work.x0, &work.v0, i),
-                pair(&work.x_sum, &work.v_sum, i),
-                h,
-            );
+            let sum = pair(&work.x_sum, &work.v_sum, i);
+            let (x, v) = rk4_plus(pair(&work.x0, &work.v0, i), sixth, sum);
             (work.x[i], work.v[i]) = (x.into(), v.into());
         }
         Ok(())
