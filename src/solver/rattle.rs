@@ -102,6 +102,23 @@ pub(crate) struct Rattled<T: Lane, A> {
     pub(crate) end_usable: T::Mask,
 }
 
+/// RATTLE's unconstrained position, eq. (8): `x₀ + h v₀ + h²/(2m) f₀`
+/// from `(x0, v0)` for a bead of mass `m` under the force `f0`; for a
+/// lone bead, the lanes and each bead of an island.
+#[inline(always)]
+pub(crate) fn rattle_drift<T: Lane>((x0, v0): (V2<T>, V2<T>), f0: V2<T>, m: T, h: T) -> V2<T> {
+    x0.plus(h, v0).plus(h * h / (m.splat(2.0) * m), f0)
+}
+
+/// RATTLE's second half kick, eq. (8): `v + h/(2m) f₁` on the mean
+/// velocity `v = (x₁ − x₀)/h` of a bead of mass `m` under the force `f1`
+/// at the new position, before the velocity solve; for a lone bead, the
+/// lanes and each bead of an island.
+#[inline(always)]
+pub(crate) fn rattle_half_kick<T: Lane>(v: V2<T>, f1: V2<T>, m: T, h: T) -> V2<T> {
+    v.plus(h / (m.splat(2.0) * m), f1)
+}
+
 /// Eq. (8) on lanes, for one bead and for the batched lanes: from
 /// `(x0, v0)`, where the normal is `n0`, a step of length `h` for a bead
 /// of mass `m` under `force` and the force `resisted` along the wire (held
@@ -123,7 +140,7 @@ pub(crate) fn rattle_lanes<T: Lane, W: WireAt<T>>(
     active: T::Mask,
 ) -> Rattled<T, W::At> {
     let two_m = m.splat(2.0) * m;
-    let free = x0.plus(h, v0).plus(h * h / two_m, force.at(x0) + resisted);
+    let free = rattle_drift((x0, v0), force.at(x0) + resisted, m, h);
     // Newton's last point is `free + s n0`, the new position.
     let root = newton_along(wire, free, n0, scale, active);
     let s = root.root;
@@ -132,7 +149,7 @@ pub(crate) fn rattle_lanes<T: Lane, W: WireAt<T>>(
     let v_half = (x1 - x0).div(h);
     let n1 = W::normal(&root.at);
     let (nn1, end_usable) = W::normal_length_squared(&root.at);
-    let w = v_half.plus(h / two_m, force.at(x1) + resisted);
+    let w = rattle_half_kick(v_half, force.at(x1) + resisted, m, h);
     let mu_scaled = -n1.dot(w - wire.velocity(x1)) / nn1;
     let v1 = w.plus(mu_scaled, n1);
     let mu = two_m * mu_scaled / h;

@@ -1,11 +1,16 @@
 //! Eq. (12) on an island (λ and the accelerations, from `J W Jᵀ`
-//! factored), and the RK4 and RATTLE steps built on it.
+//! factored), and the RK4 and RATTLE steps built on it. Each bead moves
+//! by the lone bead's formulas (RK4's stages and sum, RATTLE's drift and
+//! half kick); what is the island's own is the matrix solve for the
+//! multipliers, in eq. (12), in RATTLE's Newton position solve and in its
+//! velocity solve.
 
 use super::newton::Direction;
 use super::{Island, IslandWork, RowReport};
 use bevy::math::DVec2;
 
 use crate::lane::V2;
+use crate::solver::rattle::{rattle_drift, rattle_half_kick};
 use crate::solver::rk4::{RK4_STAGES, rk4_plus};
 use crate::solver::settings::Gains;
 use crate::solver::solve::SolveError;
@@ -147,9 +152,10 @@ impl Island {
         work.x.clear();
         work.v.clear();
         for i in 0..n {
-            let w = self.inverse_mass[i];
+            let start = (work.x0[i].into(), work.v0[i].into());
+            let m = self.inverse_mass[i].recip();
             work.x
-                .push(work.x0[i] + h * work.v0[i] + (0.5 * h * h * w) * work.force[i]);
+                .push(rattle_drift(start, work.force[i].into(), m, h).into());
             work.v.push(work.v0[i]);
         }
         work.time += h;
@@ -166,7 +172,8 @@ impl Island {
         }
         self.applied(forces, &work.x, &work.v, &mut work.force);
         for i in 0..n {
-            work.v[i] += (0.5 * h * self.inverse_mass[i]) * work.force[i];
+            let m = self.inverse_mass[i].recip();
+            work.v[i] = rattle_half_kick(work.v[i].into(), work.force[i].into(), m, h).into();
         }
         self.evaluate_at_new(work);
         self.project_velocity(work)?;
