@@ -1,5 +1,9 @@
 //! The Newton position solve of RATTLE and of projection, and its check
-//! that the root it found continues the step's start.
+//! that the root it found continues the step's start. Where a lone bead's
+//! Newton step divides by one slope, an island's solves a matrix for all
+//! its rows' multipliers, so the iteration is the island's own; it stops
+//! by the lone bead's test, each row within its tolerance or the worst
+//! row accepted.
 
 use super::{EXACT_STEPS, Island, IslandWork};
 use bevy::math::DVec2;

@@ -1,5 +1,8 @@
 //! Post-stabilization on an island, eq. (13): positions back onto the
 //! constraints, velocities onto `J v = 0`, and the energy or speed kept.
+//! Where a lone bead removes one normal component, an island solves
+//! `J W Jᵀ` for all its rows at once; the speed and energy are restored by
+//! the lone bead's scale factors, with targets summed over the island.
 
 use bevy::math::DVec2;
 
