@@ -205,6 +205,20 @@ impl<T: Lane, W: WireAt<T>> Walk<T, W> for Onto<T> {
     }
 }
 
+impl<T: Lane, P, A> Root<T, P, A> {
+    /// The same ending with `root` as its root.
+    #[inline(always)]
+    fn with<Q>(self, root: Q) -> Root<T, Q, A> {
+        Root {
+            root,
+            at: self.at,
+            found: self.found,
+            running: self.running,
+            residual: self.residual,
+        }
+    }
+}
+
 /// Newton's method on `s ↦ C(base + s dir)`: the root `s`, in the lanes
 /// `active` at the start, for a wire of size `scale`. A lane stops where
 /// the slope `∇C·dir` is not usable; its point is then `base + s dir`.
@@ -225,13 +239,8 @@ pub(crate) fn newton_along<T: Lane, W: WireAt<T>>(
     // from `base`'s).
     let start = wire.at(Walk::<T, W>::point(&walk));
     let r = newton(wire, walk, start, scale, active);
-    Root {
-        root: r.root.s,
-        at: r.at,
-        found: r.found,
-        running: r.running,
-        residual: r.residual,
-    }
+    let s = r.root.s;
+    r.with(s)
 }
 
 /// Newton steps along the local gradient from `x` (where the wire is
@@ -247,13 +256,8 @@ pub(crate) fn newton_onto<T: Lane, W: WireAt<T>>(
     active: T::Mask,
 ) -> Root<T, V2<T>, W::At> {
     let r = newton(wire, Onto { x }, start, scale, active);
-    Root {
-        root: r.root.x,
-        at: r.at,
-        found: r.found,
-        running: r.running,
-        residual: r.residual,
-    }
+    let x = r.root.x;
+    r.with(x)
 }
 
 /// `v` at `p` (where the wire is `at`) without the part of its normal

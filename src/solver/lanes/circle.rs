@@ -33,8 +33,9 @@ pub(super) fn solve_on_circles<T: Lane>(
     let g = circle_geometry(p - centre, radius);
     let hv = g.hessian.apply(v);
     let solved = constraint_force(g.normal, hv, g.c, v, force.at(p), m, settings.gains());
-    let nn = solved.nn;
-    let regular = g.len.is_nonzero() & usable(nn);
+    // The normal's usability as `WireAt::normal_length_squared` has it,
+    // from the `|N|²` the solve computed.
+    let regular = g.len.is_nonzero() & usable(solved.nn);
     (solved, g.normal, regular)
 }
 
