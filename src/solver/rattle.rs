@@ -8,7 +8,7 @@ use bevy::math::DVec2;
 use super::newton::{Root, WireAt, newton_along};
 use super::projection::{TrackAt, newton_error};
 use super::settings::Gains;
-use super::solve::{SolveError, normal_length_squared, resistance, solve_on};
+use super::solve::{InFrame, SolveError, in_frame, normal_length_squared, resistance, solve_on};
 use super::state::{Advance, BeadState, LinearForce, LinearForceLanes};
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
 use crate::lane::{Lane, V2};
@@ -48,9 +48,9 @@ pub(crate) fn rattle_on<T: Track + ?Sized>(
     // through the step (eq. 17).
     let resisted = match track.surface() {
         Some((surface, sliding)) => {
-            let twist = track.twist(t);
-            let relative = v0 - twist.velocity_at(x0);
-            let applied = force.at(x0) - mass * twist.acceleration_at(x0, relative);
+            let InFrame {
+                relative, applied, ..
+            } = in_frame(track, t, state, force.at(x0), mass);
             let lambda = solve_on(track, t, state, force, mass, Gains::NONE)?.lambda;
             resistance(surface, sliding, n0, relative, applied, lambda)
         }

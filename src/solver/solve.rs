@@ -190,14 +190,15 @@ pub(crate) fn solve_on<T: Track + ?Sized>(
             acceleration: solved.acceleration.into(),
         });
     }
-    let twist = track.twist(t);
-    let relative = state.velocity - twist.velocity_at(state.position);
-    let frame = twist.acceleration_at(state.position, relative);
+    let InFrame {
+        relative,
+        frame,
+        applied,
+    } = in_frame(track, t, state, f, mass);
     let seen = BeadState {
         velocity: relative,
         ..state
     };
-    let applied = f - mass * frame;
     let solved = constraint_force_at(&g, seen, applied, mass, gains)?;
     let mut acceleration = DVec2::from(solved.acceleration) + frame;
     if let Some((surface, sliding)) = track.surface() {
@@ -209,6 +210,38 @@ pub(crate) fn solve_on<T: Track + ?Sized>(
         constraint_force: solved.lambda * g.normal,
         acceleration,
     })
+}
+
+/// A bead of mass `m` under the force `f`, seen from its wire's frame (see
+/// [`in_frame`]).
+pub(crate) struct InFrame {
+    /// The bead's velocity relative to the wire, `v_r = ẋ − w(x)`.
+    pub(crate) relative: DVec2,
+    /// The frame's acceleration `a_w` where the bead is.
+    pub(crate) frame: DVec2,
+    /// The force the bead feels in the frame, `f − m a_w`.
+    pub(crate) applied: DVec2,
+}
+
+/// `state` of a bead of mass `mass` under the force `f`, seen from its
+/// wire's frame at time `t`: for eq. (3) on a moving wire, RATTLE's and
+/// static friction's force along the wire.
+#[inline(always)]
+pub(crate) fn in_frame<T: Track + ?Sized>(
+    track: &T,
+    t: f64,
+    state: BeadState,
+    f: DVec2,
+    mass: f64,
+) -> InFrame {
+    let twist = track.twist(t);
+    let relative = state.velocity - twist.velocity_at(state.position);
+    let frame = twist.acceleration_at(state.position, relative);
+    InFrame {
+        relative,
+        frame,
+        applied: f - mass * frame,
+    }
 }
 
 /// Eq. (17): the force along the wire that friction and damping put on a
