@@ -8,7 +8,10 @@
 //! | `settings` | [`StepSettings`]: what is the same for every bead in a step |
 //! | `state` | [`BeadState`], [`LinearForce`] |
 //! | `solve` | λ of eq. (3) in closed form |
-//! | `euler`, `rk4`, `rattle`, `projection` | the integrators and post-stabilization, eqs. (6)–(11) |
+//! | `friction` | friction and damping along a wire, eq. (17) |
+//! | `wire_normal` | when the wire's normal is usable, and a vector split along and across the wire |
+//! | `euler`, `rk4`, `rattle`, `projection`, `restore` | the integrators and post-stabilization, eqs. (6)–(11) |
+//! | `newton` | Newton's method on `C` and its stopping test, for RATTLE and projection |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
 //! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eqs. (16)–(17): on the wire, in flight, where an event falls |
 //! | `lanes/` (`circle`) | the batched step: eight beads on circles at once, bit for bit [`step`](fn@step), many such batches in one call; the solves on each lane's circle (crate-private) |
@@ -21,15 +24,19 @@
 mod contact;
 mod coupled;
 mod euler;
+mod friction;
 mod lanes;
 mod method;
+mod newton;
 mod projection;
 mod rattle;
+mod restore;
 mod rk4;
 mod settings;
 mod solve;
 mod state;
 mod step;
+mod wire_normal;
 
 pub use contact::{Contact, ContactEvent, SurfaceStep, free_step, step_surface};
 pub use coupled::{

@@ -1,12 +1,17 @@
-//! RATTLE for one bead on one wire, eq. (8).
+//! RATTLE for one bead on one wire, eq. (8), written once over [`Lane`]
+//! for one bead and for the batched lanes. An island's RATTLE solves for
+//! all its rows' multipliers at once (a matrix solve in each Newton step
+//! and in the velocity solve), so its step is its own.
 
-use super::projection::newton_along;
-use super::settings::Gains;
-use super::solve::{SolveError, normal_length_squared, resistance, solve_on};
-use super::state::{Advance, BeadState, LinearForce};
 use bevy::math::DVec2;
 
+use super::newton::{Root, WireAt, newton_along};
+use super::projection::{TrackAt, newton_error};
+use super::settings::Gains;
+use super::solve::{InFrame, SolveError, in_frame, normal_length_squared, resistance, solve_on};
+use super::state::{Advance, BeadState, LinearForce, LinearForceLanes};
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
+use crate::lane::{Lane, V2};
 
 /// One RATTLE step of length `h`: the position solve by Newton along
 /// `N₀`, then the velocity solve, linear in μ. λ reported is the mean of
@@ -37,43 +42,124 @@ pub(crate) fn rattle_on<T: Track + ?Sized>(
         position: x0,
         velocity: v0,
     } = state;
-    let t1 = t + h;
     let n0 = track.geometry(t, x0).normal;
     normal_length_squared(n0, x0)?;
     // Friction and damping along the wire, held at their start value
     // through the step (eq. 17).
     let resisted = match track.surface() {
         Some((surface, sliding)) => {
-            let twist = track.twist(t);
-            let relative = v0 - twist.velocity_at(x0);
-            let applied = force.at(x0) - mass * twist.acceleration_at(x0, relative);
+            let InFrame {
+                relative, applied, ..
+            } = in_frame(track, t, state, force.at(x0), mass);
             let lambda = solve_on(track, t, state, force, mass, Gains::NONE)?.lambda;
             resistance(surface, sliding, n0, relative, applied, lambda)
         }
         None => DVec2::ZERO,
     };
-    let free = x0 + h * v0 + (h * h / (2.0 * mass)) * (force.at(x0) + resisted);
-    let s = newton_along(track, t1, free, n0)?;
-    let x1 = free + s * n0;
-    let lambda = 2.0 * mass * s / (h * h);
-    let v_half = (x1 - x0) / h;
-    let n1 = track.geometry(t1, x1).normal;
-    let nn1 = normal_length_squared(n1, x1)?;
-    let w = v_half + (h / (2.0 * mass)) * (force.at(x1) + resisted);
-    let wire = if T::MOVES {
-        track.twist(t1).velocity_at(x1)
-    } else {
-        DVec2::ZERO
-    };
-    let mu_scaled = -n1.dot(w - wire) / nn1;
-    let v1 = w + mu_scaled * n1;
-    let mu = 2.0 * mass * mu_scaled / h;
+    let wire = TrackAt { track, t: t + h };
+    let step = rattle_lanes(
+        &wire,
+        (x0.into(), v0.into()),
+        n0.into(),
+        &force.lanes(),
+        resisted.into(),
+        mass,
+        h,
+        wire.scale(),
+        true,
+    );
+    let x1 = DVec2::from(step.x);
+    if !step.root.found {
+        return Err(newton_error(&step.root, x1));
+    }
+    if !step.end_usable {
+        return Err(SolveError::Singular { x: x1.x, y: x1.y });
+    }
     Ok(Advance {
         state: BeadState {
             position: x1,
-            velocity: v1,
+            velocity: step.v.into(),
         },
-        lambda: 0.5 * (lambda + mu),
-        constraint_force: 0.5 * (lambda * n0 + mu * n1),
+        lambda: step.lambda,
+        constraint_force: step.constraint_force.into(),
     })
+}
+
+/// What [`rattle_lanes`] returns in each lane.
+pub(crate) struct Rattled<T: Lane, A> {
+    /// The new position.
+    pub(crate) x: V2<T>,
+    /// The new velocity.
+    pub(crate) v: V2<T>,
+    /// The mean of the position and velocity multipliers.
+    pub(crate) lambda: T,
+    /// The mean of their forces.
+    pub(crate) constraint_force: V2<T>,
+    /// The position solve: found where the new position meets the wire,
+    /// and the wire there.
+    pub(crate) root: Root<T, T, A>,
+    /// The lanes where the normal at the new position is usable.
+    pub(crate) end_usable: T::Mask,
+}
+
+/// RATTLE's unconstrained position, eq. (8): `x₀ + h v₀ + h²/(2m) f₀`
+/// from `(x0, v0)` for a bead of mass `m` under the force `f0`; for a
+/// lone bead, the lanes and each bead of an island.
+#[inline(always)]
+pub(crate) fn rattle_drift<T: Lane>((x0, v0): (V2<T>, V2<T>), f0: V2<T>, m: T, h: T) -> V2<T> {
+    x0.plus(h, v0).plus(h * h / (m.splat(2.0) * m), f0)
+}
+
+/// RATTLE's second half kick, eq. (8): `v + h/(2m) f₁` on the mean
+/// velocity `v = (x₁ − x₀)/h` of a bead of mass `m` under the force `f1`
+/// at the new position, before the velocity solve; for a lone bead, the
+/// lanes and each bead of an island.
+#[inline(always)]
+pub(crate) fn rattle_half_kick<T: Lane>(v: V2<T>, f1: V2<T>, m: T, h: T) -> V2<T> {
+    v.plus(h / (m.splat(2.0) * m), f1)
+}
+
+/// Eq. (8) on lanes, for one bead and for the batched lanes: from
+/// `(x0, v0)`, where the normal is `n0`, a step of length `h` for a bead
+/// of mass `m` under `force` and the force `resisted` along the wire (held
+/// through the step) onto `wire` at the step's end, of size `scale`, in
+/// the lanes `active`. The position solve is Newton along `n0` from the
+/// unconstrained point; the velocity solve is linear in μ, relative to the
+/// wire's own velocity.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn rattle_lanes<T: Lane, W: WireAt<T>>(
+    wire: &W,
+    (x0, v0): (V2<T>, V2<T>),
+    n0: V2<T>,
+    force: &LinearForceLanes<T>,
+    resisted: V2<T>,
+    m: T,
+    h: T,
+    scale: T,
+    active: T::Mask,
+) -> Rattled<T, W::At> {
+    let two_m = m.splat(2.0) * m;
+    let free = rattle_drift((x0, v0), force.at(x0) + resisted, m, h);
+    // Newton's last point is `free + s n0`, the new position.
+    let root = newton_along(wire, free, n0, scale, active);
+    let s = root.root;
+    let x1 = free.plus(s, n0);
+    let lambda = two_m * s / (h * h);
+    let v_half = (x1 - x0).div(h);
+    let n1 = W::normal(&root.at);
+    let (nn1, end_usable) = W::normal_length_squared(&root.at);
+    let w = rattle_half_kick(v_half, force.at(x1) + resisted, m, h);
+    let mu_scaled = -n1.dot(w - wire.velocity(x1)) / nn1;
+    let v1 = w.plus(mu_scaled, n1);
+    let mu = two_m * mu_scaled / h;
+    let half = m.splat(0.5);
+    Rattled {
+        x: x1,
+        v: v1,
+        lambda: half * (lambda + mu),
+        constraint_force: (n0.scale(lambda) + n1.scale(mu)).scale(half),
+        root,
+        end_usable,
+    }
 }

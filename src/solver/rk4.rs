@@ -17,6 +17,24 @@ pub(crate) trait Stages<T> {
     fn acceleration(&mut self, x: V2<T>, v: V2<T>, at: f64) -> Result<V2<T>, Self::Error>;
 }
 
+/// The later stages of eq. (7): where each is taken (a fraction of the
+/// step after its start, along the previous stage's derivative) and the
+/// weight of its derivative in the step's sum (the first stage's is 1).
+pub(crate) const RK4_STAGES: [(f64, f64); 3] = [(0.5, 2.0), (0.5, 2.0), (1.0, 1.0)];
+
+/// `(x, v) + t (dx, dv)`: a stage's state from the step's start and the
+/// previous stage's derivative (`t` the stage's fraction of the step
+/// times `h`), a stage's derivative added to the sum at its weight, and
+/// the step's end from the sum (`t = h/6`).
+#[inline(always)]
+pub(crate) fn rk4_plus<T: Lane>(
+    (x, v): (V2<T>, V2<T>),
+    t: T,
+    (dx, dv): (V2<T>, V2<T>),
+) -> (V2<T>, V2<T>) {
+    (x.plus(t, dx), v.plus(t, dv))
+}
+
 /// Eq. (7) on lanes: one step of length `h` from `(x, v)` with `a` the
 /// acceleration there; `stages` gives the acceleration at each later stage,
 /// or stops the step with its error.
@@ -28,18 +46,19 @@ pub(crate) fn rk4_lanes<T: Lane, S: Stages<T>>(
     h: T,
     stages: &mut S,
 ) -> Result<(V2<T>, V2<T>), S::Error> {
-    let half = h.splat(0.5) * h;
-    let v2 = v.plus(half, a);
-    let a2 = stages.acceleration(x.plus(half, v), v2, 0.5)?;
-    let v3 = v.plus(half, a2);
-    let a3 = stages.acceleration(x.plus(half, v2), v3, 0.5)?;
-    let v4 = v.plus(h, a3);
-    let a4 = stages.acceleration(x.plus(h, v3), v4, 1.0)?;
-    let (two, sixth) = (h.splat(2.0), h / h.splat(6.0));
-    Ok((
-        x.plus(sixth, v + v2.scale(two) + v3.scale(two) + v4),
-        v.plus(sixth, a + a2.scale(two) + a3.scale(two) + a4),
-    ))
+    // The stages written out: the batched step runs faster so than with a
+    // loop over them.
+    let [(at2, w2), (at3, w3), (at4, w4)] = RK4_STAGES;
+    let (x2, v2) = rk4_plus((x, v), h.splat(at2) * h, (v, a));
+    let a2 = stages.acceleration(x2, v2, at2)?;
+    let (x3, v3) = rk4_plus((x, v), h.splat(at3) * h, (v2, a2));
+    let a3 = stages.acceleration(x3, v3, at3)?;
+    let (x4, v4) = rk4_plus((x, v), h.splat(at4) * h, (v3, a3));
+    let a4 = stages.acceleration(x4, v4, at4)?;
+    let sum = rk4_plus((v, a), h.splat(w2), (v2, a2));
+    let sum = rk4_plus(sum, h.splat(w3), (v3, a3));
+    let sum = rk4_plus(sum, h.splat(w4), (v4, a4));
+    Ok(rk4_plus((x, v), h / h.splat(6.0), sum))
 }
 
 /// One RK4 step of length `h` from `state`, given `first`, the solve at

@@ -3,8 +3,10 @@
 
 use bevy::math::DVec2;
 
+use super::friction;
 use super::settings::Gains;
 use super::state::{BeadState, LinearForce};
+use super::wire_normal::{along, usable};
 use crate::geometry::{FixedTrack, Geometry, ImplicitCurve, Surface, Track};
 use crate::lane::{Lane, V2};
 
@@ -71,7 +73,7 @@ pub struct Solved {
 #[inline(always)]
 pub(crate) fn normal_length_squared(normal: DVec2, x: DVec2) -> Result<f64, SolveError> {
     let nn = normal.length_squared();
-    if nn.is_finite() && nn > 1e-24 {
+    if usable(nn) {
         Ok(nn)
     } else {
         Err(SolveError::Singular { x: x.x, y: x.y })
@@ -188,14 +190,15 @@ pub(crate) fn solve_on<T: Track + ?Sized>(
             acceleration: solved.acceleration.into(),
         });
     }
-    let twist = track.twist(t);
-    let relative = state.velocity - twist.velocity_at(state.position);
-    let frame = twist.acceleration_at(state.position, relative);
+    let InFrame {
+        relative,
+        frame,
+        applied,
+    } = in_frame(track, t, state, f, mass);
     let seen = BeadState {
         velocity: relative,
         ..state
     };
-    let applied = f - mass * frame;
     let solved = constraint_force_at(&g, seen, applied, mass, gains)?;
     let mut acceleration = DVec2::from(solved.acceleration) + frame;
     if let Some((surface, sliding)) = track.surface() {
@@ -207,6 +210,38 @@ pub(crate) fn solve_on<T: Track + ?Sized>(
         constraint_force: solved.lambda * g.normal,
         acceleration,
     })
+}
+
+/// A bead of mass `m` under the force `f`, seen from its wire's frame (see
+/// [`in_frame`]).
+pub(crate) struct InFrame {
+    /// The bead's velocity relative to the wire, `v_r = ẋ − w(x)`.
+    pub(crate) relative: DVec2,
+    /// The frame's acceleration `a_w` where the bead is.
+    pub(crate) frame: DVec2,
+    /// The force the bead feels in the frame, `f − m a_w`.
+    pub(crate) applied: DVec2,
+}
+
+/// `state` of a bead of mass `mass` under the force `f`, seen from its
+/// wire's frame at time `t`: for eq. (3) on a moving wire, RATTLE's and
+/// static friction's force along the wire.
+#[inline(always)]
+pub(crate) fn in_frame<T: Track + ?Sized>(
+    track: &T,
+    t: f64,
+    state: BeadState,
+    f: DVec2,
+    mass: f64,
+) -> InFrame {
+    let twist = track.twist(t);
+    let relative = state.velocity - twist.velocity_at(state.position);
+    let frame = twist.acceleration_at(state.position, relative);
+    InFrame {
+        relative,
+        frame,
+        applied: f - mass * frame,
+    }
 }
 
 /// Eq. (17): the force along the wire that friction and damping put on a
@@ -226,21 +261,20 @@ pub(crate) fn resistance(
     lambda: f64,
 ) -> DVec2 {
     let nn = normal.length_squared();
-    let along = |a: DVec2| a - normal * (normal.dot(a) / nn);
-    let press = lambda.abs() * nn.sqrt();
-    let kinetic = surface.friction.kinetic_coefficient * press;
-    let damping = -surface.damping * along(relative);
+    let along = |a: DVec2| along(normal.into(), nn, a.into());
+    let press = friction::press(lambda, nn);
+    let damping = friction::damping(surface.damping, along(relative));
     let direction = along(sliding);
-    let speed = direction.length();
+    let speed = direction.dot(direction).sqrt();
     if speed > 0.0 {
-        return damping - (kinetic / speed) * direction;
+        return (damping + friction::kinetic(&surface.friction, press, direction, speed)).into();
     }
     let pull = along(applied);
-    let strength = pull.length();
-    if strength <= surface.friction.static_coefficient * press {
-        -pull
+    let strength = pull.dot(pull).sqrt();
+    if friction::holds(&surface.friction, strength, press) {
+        -DVec2::from(pull)
     } else {
-        -(kinetic / strength) * pull
+        friction::kinetic(&surface.friction, press, pull, strength).into()
     }
 }
 

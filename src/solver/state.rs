@@ -53,20 +53,23 @@ impl LinearForce {
     /// The potential of the force, `U(x) = −force·(x − at) + ½ S |x − at|²`
     /// (so `f = −∇U`), zero at `at`: the force of eq. (5) is conservative.
     pub fn potential(&self, x: DVec2) -> f64 {
-        let d = x - self.at;
-        -self.force.dot(d) + 0.5 * self.stiffness * d.length_squared()
+        self.lanes().potential(x.into())
     }
 
     /// `f(x)`.
     #[inline]
     pub fn at(&self, x: DVec2) -> DVec2 {
+        self.lanes().at(x.into()).into()
+    }
+
+    /// The force as the formulas over lanes take it.
+    #[inline(always)]
+    pub(crate) fn lanes(&self) -> LinearForceLanes<f64> {
         LinearForceLanes {
             force: self.force.into(),
             stiffness: self.stiffness,
             at: self.at.into(),
         }
-        .at(x.into())
-        .into()
     }
 }
 
@@ -83,6 +86,13 @@ impl<T: Lane> LinearForceLanes<T> {
     #[inline(always)]
     pub(crate) fn at(&self, x: V2<T>) -> V2<T> {
         self.force - (x - self.at).scale(self.stiffness)
+    }
+
+    /// The potential of eq. (5)'s force (see [`LinearForce::potential`]).
+    #[inline(always)]
+    pub(crate) fn potential(&self, x: V2<T>) -> T {
+        let d = x - self.at;
+        -self.force.dot(d) + d.x.splat(0.5) * self.stiffness * d.dot(d)
     }
 }
 

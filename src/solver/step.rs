@@ -6,13 +6,15 @@ use bevy::math::DVec2;
 
 use super::euler::{explicit_euler, semi_implicit_euler};
 use super::method::Method;
-use super::projection::{project_on, restore_energy, restore_speed};
+use super::projection::project_on;
 use super::rattle::rattle_on;
+use super::restore::restore;
 use super::rk4::rk4_on;
 use super::settings::StepSettings;
 use super::solve::{SolveError, solve_on};
 use super::state::{BeadState, LinearForce};
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
+use crate::lane::Lane;
 
 /// The result of one step.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -81,21 +83,14 @@ pub fn step_on<T: Track + ?Sized>(
         return Err(SolveError::NonFinite);
     }
     let g = track.geometry(t1, advance.state.position);
-    let bound = settings.drift_bound * track.scale();
-    if g.c.is_nan() || g.c.abs() > bound {
+    let (bound, within) = drift_check(settings, g.c, track.scale());
+    if !within {
         return Err(SolveError::DriftExceeded { c: g.c, bound });
     }
     let (state, (c, c_dot)) = if settings.method.projects() {
         let projected = project_on(track, t1, advance.state)?;
-        let projected = if settings.method.is_euler() {
-            restore_speed(track, t, state, projected, force, mass, h)?
-        } else if T::MOVES || track.surface().is_some_and(|(s, _)| s.resists()) {
-            // Eq. (11) keeps a conservative system's energy: a moving wire
-            // does work, friction and damping take it away.
-            projected
-        } else {
-            restore_energy(track, t1, state, projected, force, mass)?
-        };
+        let euler = settings.method.is_euler();
+        let projected = restore(track, t, h, euler, state, projected, force, mass)?;
         (projected, constraint_state_on(track, t1, projected))
     } else {
         let relative = if T::MOVES {
@@ -112,6 +107,15 @@ pub fn step_on<T: Track + ?Sized>(
         c,
         c_dot,
     })
+}
+
+/// The divergence check, for a lone bead, the lanes and each row of an
+/// island: the drift bound of a constraint of size `scale`, and whether
+/// the `C` a step left is within it (not where `C` or the bound is NaN).
+#[inline(always)]
+pub(crate) fn drift_check<T: Lane>(settings: &StepSettings, c: T, scale: T) -> (T, T::Mask) {
+    let bound = scale.splat(settings.drift_bound) * scale;
+    (bound, c.abs_le(bound))
 }
 
 /// `C` and `Ċ = N·ẋ` at a state: how far off its wire the bead is, and how
@@ -137,7 +141,7 @@ mod tests {
     use super::*;
     use crate::geometry::{Circle, Sine};
     use crate::solver::Stabilization;
-    use crate::solver::projection::NEWTON_ACCEPT;
+    use crate::solver::newton::NEWTON_ACCEPT;
     use crate::solver::test_support::{G, settings};
 
     #[test]

@@ -21,6 +21,7 @@ use super::settings::{Gains, StepSettings};
 use super::solve::{SolveError, normal_length_squared, solve_on};
 use super::state::{BeadState, LinearForce};
 use super::step::{StepOutput, step_on};
+use super::wire_normal::across;
 use crate::geometry::{Rough, Surface, Track};
 
 mod flight;
@@ -189,7 +190,7 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         let nn = normal_length_squared(normal, state.position)?;
         let wire = self.track.twist(t).velocity_at(state.position);
         let relative = state.velocity - wire;
-        let across = normal * (normal.dot(relative) / nn);
+        let across = DVec2::from(across(normal.into(), nn, relative.into()));
         Ok((wire, relative - across, across))
     }
 }

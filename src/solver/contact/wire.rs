@@ -6,10 +6,12 @@ use bevy::math::DVec2;
 
 use super::{Contact, MAX_EVENTS, SurfaceStep, Walk};
 use crate::geometry::Track;
+use crate::solver::friction;
 use crate::solver::settings::Gains;
-use crate::solver::solve::{SolveError, Solved, solve_on};
+use crate::solver::solve::{SolveError, Solved, in_frame, solve_on};
 use crate::solver::state::BeadState;
 use crate::solver::step::StepOutput;
+use crate::solver::wire_normal::along;
 
 impl<T: Track + ?Sized> Walk<'_, T> {
     /// A part of length `h` on the wire from `state` at `t`.
@@ -81,15 +83,13 @@ impl<T: Track + ?Sized> Walk<'_, T> {
     /// slides.
     fn sticks(&self, t: f64, state: BeadState) -> Result<Option<Solved>, SolveError> {
         let solved = solve_on(self.track, t, state, self.force, self.mass, Gains::NONE)?;
-        let twist = self.track.twist(t);
-        let relative = state.velocity - twist.velocity_at(state.position);
-        let frame = twist.acceleration_at(state.position, relative);
+        let f = self.force.at(state.position);
+        let applied = in_frame(self.track, t, state, f, self.mass).applied;
         let normal = self.track.geometry(t, state.position).normal;
         let nn = normal.length_squared();
-        let applied = self.force.at(state.position) - self.mass * frame;
-        let pull = applied - normal * (normal.dot(applied) / nn);
-        let press = solved.lambda.abs() * nn.sqrt();
-        Ok((pull.length() <= self.surface.friction.static_coefficient * press).then_some(solved))
+        let pull = DVec2::from(along(normal.into(), nn, applied.into()));
+        let press = friction::press(solved.lambda, nn);
+        Ok(friction::holds(&self.surface.friction, pull.length(), press).then_some(solved))
     }
 
     /// A part of length `h` in which static friction holds the bead still

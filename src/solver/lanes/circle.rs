@@ -1,18 +1,21 @@
-//! The solves on each lane's unrotated circle, operation for operation as
-//! the single-bead step takes them: eq. (3), the RK4 stages, RATTLE,
-//! projection and the restores of eq. (9).
+//! The solves on each lane's unrotated circle: eq. (3), the RK4 stages,
+//! RATTLE, projection and the restores of eqs. (10) and (11). Each runs
+//! the function the single-bead step runs (in `solve`, `rk4`, `rattle`,
+//! `newton`, `restore`), written over [`Lane`], on the circle as a
+//! [`WireAt`].
 
 use std::convert::Infallible;
 
 use crate::geometry::circle_geometry;
-use crate::lane::{Lane, Mask, V2};
-use crate::solver::projection::{
-    ENERGY_CORRECTION_LIMIT, NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE,
-};
+use crate::lane::{Lane, V2};
+use crate::solver::newton::{WireAt, newton_onto, tangential};
+use crate::solver::rattle::rattle_lanes;
+use crate::solver::restore::{bead_energy_scale, speed_scale};
 use crate::solver::rk4::Stages;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::{ConstraintForce, constraint_force};
 use crate::solver::state::LinearForceLanes;
+use crate::solver::wire_normal::{along, usable};
 
 /// Eqs. (3)–(4) on each lane's circle: the geometry, the solve and whether
 /// its normal is usable.
@@ -30,8 +33,9 @@ pub(super) fn solve_on_circles<T: Lane>(
     let g = circle_geometry(p - centre, radius);
     let hv = g.hessian.apply(v);
     let solved = constraint_force(g.normal, hv, g.c, v, force.at(p), m, settings.gains());
-    let nn = solved.nn;
-    let regular = g.len.is_nonzero() & nn.is_finite() & nn.gt(nn.splat(1e-24));
+    // The normal's usability as `WireAt::normal_length_squared` has it,
+    // from the `|N|²` the solve computed.
+    let regular = g.len.is_nonzero() & usable(solved.nn);
     (solved, g.normal, regular)
 }
 
@@ -104,12 +108,11 @@ pub(super) struct Advanced<T: Lane> {
 }
 
 /// Each lane's unrotated circle, for the steps that solve on it: RATTLE,
-/// projection and the energy restore, written as
+/// projection and the restores, by the functions that
 /// [`rattle`](fn@crate::solver::rattle), [`project`](crate::solver::project)
-/// and eq. (11) compute them for one bead (on a fixed wire, with no
-/// surface), operation for operation, so each lane returns their bits.
-/// Each also returns the lanes where the scalar function would have
-/// succeeded; the others mean nothing.
+/// and the restores run for one bead (on a fixed wire, with no surface),
+/// so each lane returns their bits. Each also returns the lanes where the
+/// scalar function would have succeeded; the others mean nothing.
 #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 #[derive(Clone, Copy)]
 pub(super) struct OnCircles<T: Lane> {
@@ -117,85 +120,51 @@ pub(super) struct OnCircles<T: Lane> {
     pub(super) radius: T,
 }
 
-#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-impl<T: Lane> OnCircles<T> {
-    /// The circle at `x`.
+impl<T: Lane> WireAt<T> for OnCircles<T> {
+    type At = At<T>;
+    /// The circle at `p`.
     #[inline(always)]
-    pub(super) fn at(self, x: V2<T>) -> At<T> {
-        let g = circle_geometry(x - self.centre, self.radius);
+    fn at(&self, p: V2<T>) -> At<T> {
+        let g = circle_geometry(p - self.centre, self.radius);
         At {
             len: g.len,
             c: g.c,
             normal: g.normal,
         }
     }
-
+    #[inline(always)]
+    fn c(at: &At<T>) -> T {
+        at.c
+    }
+    #[inline(always)]
+    fn normal(at: &At<T>) -> V2<T> {
+        at.normal
+    }
     /// `|N|²` where the normal is usable (the scalar step's
     /// `normal_length_squared`): not at the centre, finite, not vanishing.
     #[inline(always)]
-    fn normal_length_squared(self, at: At<T>) -> (T, T::Mask) {
+    fn normal_length_squared(at: &At<T>) -> (T, T::Mask) {
         let nn = at.normal.dot(at.normal);
-        (
-            nn,
-            at.len.is_nonzero() & nn.is_finite() & nn.gt(nn.splat(1e-24)),
-        )
+        (nn, at.len.is_nonzero() & usable(nn))
     }
-
-    /// Whether a Newton solve at the point `at` is done at residual `|c|`
-    /// after `previous`, as `newton_done` says.
     #[inline(always)]
-    fn converged(self, c: T, previous: T, at: V2<T>, last: bool) -> T::Mask {
-        let r = self.radius;
-        let residual = c.abs();
-        let reach = at.x.abs().max(at.y.abs());
-        let within = residual.abs_le(r.splat(NEWTON_TOLERANCE) * r.max(reach));
-        let accepted = residual.abs_le(r.splat(NEWTON_ACCEPT) * r);
-        if last {
-            within | accepted
-        } else {
-            within | (accepted & residual.gt(r.splat(0.5) * previous))
-        }
+    fn select(mask: T::Mask, a: At<T>, b: At<T>) -> At<T> {
+        At::select(mask, a, b)
     }
+    /// A fixed wire's: zero.
+    #[inline(always)]
+    fn velocity(&self, p: V2<T>) -> V2<T> {
+        let zero = p.x.splat(0.0);
+        V2::new(zero, zero)
+    }
+}
 
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+impl<T: Lane> OnCircles<T> {
     /// The lanes whose scale is the radius itself (`scale().max(MIN_POSITIVE)`).
     #[inline(always)]
     fn sized(self) -> T::Mask {
         self.radius.gt(self.radius.splat(f64::MIN_POSITIVE))
-    }
-
-    /// `newton_along`: the root `s` of `C(base + s dir) = 0`, and the
-    /// circle at `base + s dir`.
-    #[inline(always)]
-    fn newton_along(self, base: V2<T>, dir: V2<T>) -> (T, At<T>, T::Mask) {
-        let mut s = self.radius.splat(0.0);
-        let mut active = self.sized();
-        let mut found = active & !active;
-        let mut previous = s.splat(f64::INFINITY);
-        // Set in each lane where it is done.
-        let mut root = At {
-            len: s,
-            c: s,
-            normal: V2::new(s, s),
-        };
-        for i in 0..=NEWTON_MAX_ITERATIONS {
-            // At s = 0 too the point is `base + 0 dir`, as the scalar solve
-            // evaluates it (a zero's sign can differ from `base`'s).
-            let p = base.plus(s, dir);
-            let g = self.at(p);
-            let last = i == NEWTON_MAX_ITERATIONS;
-            let done = active & self.converged(g.c, previous, p, last);
-            previous = g.c.abs();
-            root = At::select(done, g, root);
-            found = found | done;
-            active = active & !done;
-            if last || !active.any() {
-                break;
-            }
-            let slope = g.normal.dot(dir);
-            active = active & slope.is_finite() & !slope.abs_le(slope.splat(1e-300));
-            s = T::select(active, s - g.c / slope, s);
-        }
-        (s, root, found)
     }
 
     /// `rattle` on a fixed wire.
@@ -208,46 +177,30 @@ impl<T: Lane> OnCircles<T> {
         m: T,
         h: T,
     ) -> Advanced<T> {
-        let zero = V2::new(m.splat(0.0), m.splat(0.0));
         let g0 = self.at(x0);
-        let n0 = g0.normal;
-        let (_, mut ok) = self.normal_length_squared(g0);
-        let two_m = m.splat(2.0) * m;
+        let (_, ok) = Self::normal_length_squared(&g0);
         // No friction on the batched wires: the resisting force is zero.
-        let free = x0.plus(h, v0).plus(h * h / two_m, force.at(x0) + zero);
-        // Newton's last point is `free + s n0`, the new position.
-        let (s, g1, found) = self.newton_along(free, n0);
-        let x1 = free.plus(s, n0);
-        let lambda = two_m * s / (h * h);
-        let v_half = (x1 - x0).div(h);
-        let n1 = g1.normal;
-        let (nn1, usable) = self.normal_length_squared(g1);
-        ok = ok & found & usable;
-        let w = v_half.plus(h / two_m, force.at(x1) + zero);
-        let mu_scaled = -n1.dot(w - zero) / nn1;
-        let v1 = w.plus(mu_scaled, n1);
-        let mu = two_m * mu_scaled / h;
-        let half = m.splat(0.5);
-        let constraint_force = (n0.scale(lambda) + n1.scale(mu)).scale(half);
+        let zero = self.velocity(x0);
+        let step = rattle_lanes(
+            &self,
+            (x0, v0),
+            g0.normal,
+            force,
+            zero,
+            m,
+            h,
+            self.radius,
+            self.sized(),
+        );
         Advanced {
-            x: x1,
-            v: v1,
-            lambda: half * (lambda + mu),
-            constraint_force,
-            end: g1,
-            start_normal: n0,
-            regular: ok,
+            x: step.x,
+            v: step.v,
+            lambda: step.lambda,
+            constraint_force: step.constraint_force,
+            end: step.root.at,
+            start_normal: g0.normal,
+            regular: ok & step.root.found & step.end_usable,
         }
-    }
-
-    /// `v` without its normal component at the point where the circle is
-    /// `at` (`tangential`).
-    #[inline(always)]
-    fn tangential(self, at: At<T>, v: V2<T>) -> (V2<T>, T::Mask) {
-        let zero = V2::new(at.c.splat(0.0), at.c.splat(0.0));
-        let n = at.normal;
-        let (nn, ok) = self.normal_length_squared(at);
-        (v - n.scale(n.dot(v - zero) / nn), ok)
     }
 
     /// `project` from `x`, where the circle is `start`: Newton steps along
@@ -260,35 +213,17 @@ impl<T: Lane> OnCircles<T> {
         v: V2<T>,
         start: At<T>,
     ) -> (V2<T>, V2<T>, At<T>, T::Mask) {
-        let mut x = x;
-        let mut active = self.sized();
-        let mut found = active & !active;
-        let mut end = start;
-        let mut previous = start.c.splat(f64::INFINITY);
-        for i in 0..=NEWTON_MAX_ITERATIONS {
-            let g = if i == 0 { start } else { self.at(x) };
-            let last = i == NEWTON_MAX_ITERATIONS;
-            let done = active & self.converged(g.c, previous, x, last);
-            previous = g.c.abs();
-            end = At::select(done, g, end);
-            found = found | done;
-            active = active & !done;
-            if last || !active.any() {
-                break;
-            }
-            let (nn, usable) = self.normal_length_squared(g);
-            active = active & usable;
-            x = V2::select(active, x - g.normal.scale(g.c / nn), x);
-        }
-        let (v, ok) = self.tangential(end, v);
-        (x, v, end, found & ok)
+        let onto = newton_onto(&self, x, start, self.radius, self.sized());
+        let (v, ok) = tangential(&self, &onto.at, onto.root, v);
+        (onto.root, v, onto.at, onto.found & ok)
     }
 
-    /// Eq. (10) (`restore_speed`) after an Euler step of length `h` from
+    /// Eq. (10) (as `restore` takes it) after an Euler step of length `h` from
     /// `(x0, v0)`, where `∇C` was `n0` (usable, as the step's `regular`
-    /// lanes hold): the projected velocity `vp` (where the circle is `at`)
-    /// scaled to the speed of `v0 + h a_t`, `a_t` the applied acceleration
-    /// along the wire at `x0`, and its normal component removed again.
+    /// lanes hold): the projected velocity `vp` at `xp` (where the circle
+    /// is `at`) scaled to the speed of `v0 + h a_t`, `a_t` the applied
+    /// acceleration along the wire at `x0`, and its normal component
+    /// removed again.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub(super) fn restore_speed(
@@ -296,31 +231,23 @@ impl<T: Lane> OnCircles<T> {
         x0: V2<T>,
         v0: V2<T>,
         n0: V2<T>,
+        xp: V2<T>,
         vp: V2<T>,
         at: At<T>,
         force: &LinearForceLanes<T>,
         m: T,
         h: T,
     ) -> (V2<T>, T::Mask) {
-        // A fixed wire: its velocity is zero at both ends of the step.
-        let zero = V2::new(m.splat(0.0), m.splat(0.0));
-        let relative = v0 - zero;
+        let (w0, w1) = (self.velocity(x0), self.velocity(xp));
+        let relative = v0 - w0;
         let applied = force.at(x0).div(m);
-        let kick = applied - n0.scale(n0.dot(applied) / n0.dot(n0));
-        let moved = relative.plus(h, kick);
-        let target = moved.dot(moved);
-        let now = vp - zero;
-        // `kinetic_scale`.
-        let ratio = target / now.dot(now);
-        let scale = T::select(
-            ratio.is_finite() & ratio.gt(m.splat(0.0)),
-            ratio.sqrt(),
-            m.splat(1.0),
-        );
-        self.tangential(at, zero + now.scale(scale))
+        let kick = along(n0, n0.dot(n0), applied);
+        let now = vp - w1;
+        let scale = speed_scale(relative, kick, h, now);
+        tangential(&self, &at, xp, w1 + now.scale(scale))
     }
 
-    /// Eq. (11) (`restore_energy`): the projected velocity `vp` at `xp`
+    /// Eq. (11) (as `restore` takes it): the projected velocity `vp` at `xp`
     /// (where the circle is `at`) scaled so the energy is that of
     /// `(x0, v0)`, and its normal component removed again.
     #[inline(always)]
@@ -335,26 +262,7 @@ impl<T: Lane> OnCircles<T> {
         force: &LinearForceLanes<T>,
         m: T,
     ) -> (V2<T>, T::Mask) {
-        let half = m.splat(0.5);
-        let potential = |x: V2<T>| {
-            let d = x - force.at;
-            -force.force.dot(d) + half * force.stiffness * d.dot(d)
-        };
-        let target = half * m * v0.dot(v0) + potential(x0) - potential(xp);
-        let now = half * m * vp.dot(vp);
-        let one = m.splat(1.0);
-        // `kinetic_scale`, then `energy_scale`'s limit.
-        let ratio = target / now;
-        let scale = T::select(
-            ratio.is_finite() & ratio.gt(m.splat(0.0)),
-            ratio.sqrt(),
-            one,
-        );
-        let scale = T::select(
-            (scale - one).abs_le(m.splat(ENERGY_CORRECTION_LIMIT)),
-            scale,
-            one,
-        );
-        self.tangential(at, vp.scale(scale))
+        let scale = bead_energy_scale(force, m, (x0, v0), (xp, vp));
+        tangential(&self, &at, xp, vp.scale(scale))
     }
 }

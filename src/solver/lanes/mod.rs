@@ -6,7 +6,7 @@
 //! | file | what it holds |
 //! |---|---|
 //! | `mod` | the lanes' layout ([`CircleLanes`], [`CircleSteps`]), the entry points and the step's outline on the lanes |
-//! | `circle` | the solves on each lane's circle: eq. (3), the RK4 stages, RATTLE, projection and the restores of eq. (9) |
+//! | `circle` | the solves on each lane's circle: eq. (3), the RK4 stages, RATTLE, projection and the restores of eqs. (10) and (11) |
 
 #[cfg(target_arch = "x86_64")]
 use self::circle::{Advanced, CircleStages, OnCircles, solve_on_circles};
@@ -15,12 +15,16 @@ use super::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 #[cfg(target_arch = "x86_64")]
 use super::method::Method;
 #[cfg(target_arch = "x86_64")]
+use super::newton::WireAt;
+#[cfg(target_arch = "x86_64")]
 use super::rk4::rk4_lanes;
 use super::settings::StepSettings;
 #[cfg(target_arch = "x86_64")]
 use super::state::LinearForceLanes;
 use super::state::{BeadState, LinearForce};
 use super::step::StepOutput;
+#[cfg(target_arch = "x86_64")]
+use super::step::drift_check;
 #[cfg(doc)]
 use super::step::step;
 pub use crate::lane::LANES;
@@ -283,20 +287,20 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut Circ
         start_normal,
         mut regular,
     } = advanced;
-    let bound = m.splat(settings.drift_bound) * radius;
+    let (_, within) = drift_check(settings, end.c, radius);
     regular = regular
         & x.is_finite()
         & v.is_finite()
         & x1.is_finite()
         & v1.is_finite()
         & end.len.is_nonzero()
-        & end.c.abs_le(bound);
+        & within;
     let (x1, v1, end) = if settings.method.projects() {
         // Eq. (9), then the speed of eq. (10) after an Euler step, the
         // energy of eq. (11) after RK4.
         let (xp, vp, at, projected) = circle.project(x1, v1, end);
         let (vr, restored) = if settings.method.is_euler() {
-            circle.restore_speed(x, v, start_normal, vp, at, &force, m, h)
+            circle.restore_speed(x, v, start_normal, xp, vp, at, &force, m, h)
         } else {
             circle.restore_energy(x, v, xp, vp, at, &force, m)
         };

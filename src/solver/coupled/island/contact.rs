@@ -10,9 +10,11 @@ use super::rows::RowAt;
 use super::{Island, IslandWork, RoughRow};
 use crate::solver::contact::{ContactEvent, bounces};
 use crate::solver::coupled::constraint::RowKind;
+use crate::solver::friction;
 use crate::solver::settings::Gains;
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
+use crate::solver::wire_normal::usable;
 
 impl Island {
     /// Eq. (17) on the island at the step's start (λ from
@@ -40,17 +42,17 @@ impl Island {
             }
             let row = self.wire_row(r, states, time);
             let nn = row.normal.length_squared();
-            if nn.is_nan() || nn <= 0.0 {
+            if !usable(nn) {
                 continue;
             }
-            let press = work.lambda[r].abs() * nn.sqrt();
+            let press = friction::press(work.lambda[r], nn);
             let sliding = row.sliding(states[bead].velocity);
             let mut direction = sliding;
             if let Some(s) = rough.stick
                 && !work.inactive[s]
             {
                 let hold = work.lambda[s];
-                if hold.abs() <= rough.friction.static_coefficient * press {
+                if friction::holds(&rough.friction, hold.abs(), press) {
                     continue; // held still
                 }
                 // It gives way: it slides toward the pull, against λ's push.
@@ -61,10 +63,10 @@ impl Island {
             }
             let speed = direction.length();
             if speed > 0.0 {
-                forces[bead].force -=
-                    (rough.friction.kinetic_coefficient * press / speed) * direction;
+                let kinetic = friction::kinetic(&rough.friction, press, direction.into(), speed);
+                forces[bead].force += DVec2::from(kinetic);
             }
-            forces[bead].force -= rough.damping * sliding;
+            forces[bead].force += DVec2::from(friction::damping(rough.damping, sliding.into()));
             slides.push((r, bead, sliding));
         }
         slides

@@ -1,8 +1,17 @@
 //! Eq. (12) on an island (λ and the accelerations, from `J W Jᵀ`
-//! factored), and the RK4 and RATTLE steps built on it.
+//! factored), and the RK4 and RATTLE steps built on it. Each bead moves
+//! by the lone bead's formulas (RK4's stages and sum, RATTLE's drift and
+//! half kick); what is the island's own is the matrix solve for the
+//! multipliers, in eq. (12), in RATTLE's Newton position solve and in its
+//! velocity solve.
 
 use super::newton::Direction;
 use super::{Island, IslandWork, RowReport};
+use bevy::math::DVec2;
+
+use crate::lane::V2;
+use crate::solver::rattle::{rattle_drift, rattle_half_kick};
+use crate::solver::rk4::{RK4_STAGES, rk4_plus};
 use crate::solver::settings::Gains;
 use crate::solver::solve::SolveError;
 use crate::solver::state::LinearForce;
@@ -98,27 +107,30 @@ impl Island {
         self.keep_lambda(work);
         let n = self.beads();
         let start = work.time;
+        let pair = |x: &[DVec2], v: &[DVec2], i: usize| (V2::from(x[i]), V2::from(v[i]));
         work.x_sum.clone_from(&work.v0);
         work.v_sum.clone_from(&work.acceleration);
-        for (weight, advance) in [(2.0, 0.5 * h), (2.0, 0.5 * h), (1.0, h)] {
+        for (at, weight) in RK4_STAGES {
             // The stage's state from the previous stage's derivative, which
             // is (work.v, work.acceleration).
             for i in 0..n {
-                let (dx, dv) = (work.v[i], work.acceleration[i]);
-                work.x[i] = work.x0[i] + advance * dx;
-                work.v[i] = work.v0[i] + advance * dv;
+                let derivative = pair(&work.v, &work.acceleration, i);
+                let (x, v) = rk4_plus(pair(&work.x0, &work.v0, i), at * h, derivative);
+                (work.x[i], work.v[i]) = (x.into(), v.into());
             }
-            work.time = start + advance;
+            work.time = start + at * h;
             self.accelerate(forces, gains, work, Stage::Later)?;
             for i in 0..n {
-                work.x_sum[i] += weight * work.v[i];
-                work.v_sum[i] += weight * work.acceleration[i];
+                let derivative = pair(&work.v, &work.acceleration, i);
+                let (x, v) = rk4_plus(pair(&work.x_sum, &work.v_sum, i), weight, derivative);
+                (work.x_sum[i], work.v_sum[i]) = (x.into(), v.into());
             }
         }
         let sixth = h / 6.0;
         for i in 0..n {
-            work.x[i] = work.x0[i] + sixth * work.x_sum[i];
-            work.v[i] = work.v0[i] + sixth * work.v_sum[i];
+            let sum = pair(&work.x_sum, &work.v_sum, i);
+            let (x, v) = rk4_plus(pair(&work.x0, &work.v0, i), sixth, sum);
+            (work.x[i], work.v[i]) = (x.into(), v.into());
         }
         Ok(())
     }
@@ -140,9 +152,10 @@ impl Island {
         work.x.clear();
         work.v.clear();
         for i in 0..n {
-            let w = self.inverse_mass[i];
+            let start = (work.x0[i].into(), work.v0[i].into());
+            let m = self.inverse_mass[i].recip();
             work.x
-                .push(work.x0[i] + h * work.v0[i] + (0.5 * h * h * w) * work.force[i]);
+                .push(rattle_drift(start, work.force[i].into(), m, h).into());
             work.v.push(work.v0[i]);
         }
         work.time += h;
@@ -159,7 +172,8 @@ impl Island {
         }
         self.applied(forces, &work.x, &work.v, &mut work.force);
         for i in 0..n {
-            work.v[i] += (0.5 * h * self.inverse_mass[i]) * work.force[i];
+            let m = self.inverse_mass[i].recip();
+            work.v[i] = rattle_half_kick(work.v[i].into(), work.force[i].into(), m, h).into();
         }
         self.evaluate_at_new(work);
         self.project_velocity(work)?;

@@ -7,11 +7,11 @@
 //! | `mod` | [`Island`] and what may change between steps (wires, axes, sides, friction), [`IslandWork`], [`RowReport`] |
 //! | `build` | [`Island::new`]: the rows and springs checked and laid out, [`IslandRow`], [`IslandError`] |
 //! | `rows` | each row's `C`, gradient, `J̇q̇` and bias (eq. 15 for a moving wire), and the products with `J` |
-//! | `step` | [`Island::step`]: the step's outline, the Euler steps, the drift check, substeps and halvings |
-//! | `integrators` | eq. (12) on an island (λ and the accelerations), RK4, RATTLE |
-//! | `newton` | the Newton position solve and its check that the root continues the start |
+//! | `step` | [`Island::step`]: the step's outline, the Euler steps and the drift check (the lone bead's, bead by bead and row by row), substeps and halvings |
+//! | `integrators` | eq. (12) on an island (λ and the accelerations), RK4, RATTLE: each bead by the lone bead's formulas, the multipliers by matrix solves |
+//! | `newton` | the Newton position solve (a matrix solve for the multipliers at each step, stopped by the lone bead's test row by row) and its check that the root continues the start |
 //! | `projection` | post-stabilization, eq. (13), and the velocity projection |
-//! | `contact` | one-sided rows (leaving, landing, bouncing) and friction (sliding, stopping, sticking) |
+//! | `contact` | one-sided rows (leaving, landing, bouncing by the lone bead's rule) and friction (sliding, stopping, sticking: the lone bead's friction, with a stick row's multiplier for the pull) |
 
 use bevy::math::DVec2;
 

@@ -1,8 +1,14 @@
 //! The Newton position solve of RATTLE and of projection, and its check
-//! that the root it found continues the step's start.
+//! that the root it found continues the step's start. Where a lone bead's
+//! Newton step divides by one slope, an island's solves a matrix for all
+//! its rows' multipliers, so the iteration is the island's own; it stops
+//! by the lone bead's test, each row within its tolerance or the worst
+//! row accepted.
 
 use super::{EXACT_STEPS, Island, IslandWork};
-use crate::solver::projection::{NEWTON_ACCEPT, NEWTON_MAX_ITERATIONS, NEWTON_TOLERANCE};
+use bevy::math::DVec2;
+
+use crate::solver::newton::{NEWTON_MAX_ITERATIONS, newton_accepted, newton_within, reach};
 use crate::solver::solve::SolveError;
 
 impl Island {
@@ -37,23 +43,17 @@ impl Island {
         loop {
             self.evaluate_positions(work);
             let last = i == NEWTON_MAX_ITERATIONS;
-            let tolerance = if last {
-                NEWTON_ACCEPT
-            } else {
-                NEWTON_TOLERANCE
-            };
-            let mut done = true;
+            // Every row within the tolerance, as one bead's solve asks of
+            // its wire; or the worst row, relative to its scale, accepted.
+            let mut within = true;
             let mut worst = 0.0f64;
             for r in 0..rows {
                 let scale = self.rows[r].scale().max(f64::MIN_POSITIVE);
                 let residual = work.c[r].abs();
                 worst = worst.max(residual / scale);
-                done &= residual <= tolerance * scale;
+                within &= newton_within(residual, scale, self.reach(r, &work.x));
             }
-            // Rounding keeps C from the tolerance where coordinates are
-            // large beside a row's scale: stop once it no longer shrinks.
-            let stalled = worst <= NEWTON_ACCEPT && worst > 0.5 * previous;
-            if done || stalled {
+            if within || newton_accepted(worst, previous, 1.0, last) {
                 return self.same_branch(work, direction, worst);
             }
             if last || !worst.is_finite() {
@@ -118,6 +118,14 @@ impl Island {
             self.push(along, &work.rhs, &mut work.x);
             i += 1;
         }
+    }
+
+    /// The largest coordinate of row `r`'s beads at `x`: how far rounding
+    /// the coordinates its `C` is computed from reaches.
+    fn reach(&self, r: usize, x: &[DVec2]) -> f64 {
+        (self.row_start[r]..self.row_start[r + 1])
+            .map(|e| reach(x[self.entry_bead[e]].into()))
+            .fold(0.0, f64::max)
     }
 
     /// Checks that a Newton solution is the continuation of the start: no

@@ -1,11 +1,14 @@
 //! Post-stabilization on an island, eq. (13): positions back onto the
 //! constraints, velocities onto `J v = 0`, and the energy or speed kept.
+//! Where a lone bead removes one normal component, an island solves
+//! `J W Jᵀ` for all its rows at once; the speed and energy are restored by
+//! the lone bead's scale factors, with targets summed over the island.
 
 use bevy::math::DVec2;
 
 use super::newton::Direction;
 use super::{Island, IslandWork};
-use crate::solver::projection::{energy_scale, kinetic_scale};
+use crate::solver::restore::{energy_scale, kinetic_scale};
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
 

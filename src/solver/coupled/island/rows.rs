@@ -8,6 +8,7 @@ use super::{Island, IslandWork};
 use crate::geometry::{ImplicitCurve, Near, Placed, Pose, Twist, WireShape};
 use crate::solver::coupled::constraint::RowKind;
 use crate::solver::state::{BeadState, LinearForce};
+use crate::solver::wire_normal::along;
 
 impl Island {
     /// Wire row `r` where its bead is in `states` at `time`, whether the
@@ -265,7 +266,7 @@ impl RowAt {
     pub(super) fn sliding(&self, velocity: DVec2) -> DVec2 {
         let relative = velocity - self.wire;
         let nn = self.normal.length_squared();
-        relative - self.normal * (self.normal.dot(relative) / nn)
+        along(self.normal.into(), nn, relative.into()).into()
     }
 
     /// The unit direction along the wire: a stick row's axis.

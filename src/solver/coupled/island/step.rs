@@ -7,10 +7,12 @@ use bevy::math::DVec2;
 use super::integrators::Stage;
 use super::projection::Restore;
 use super::{CALM_STEPS, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow};
+use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use crate::solver::method::Method;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
+use crate::solver::step::drift_check;
 
 impl Island {
     /// One step of every bead of the island under `settings`: `states`
@@ -197,12 +199,15 @@ impl Island {
             Method::Rattle => self.rattle(forces, h, work)?,
             Method::ExplicitEuler(_) | Method::SemiImplicitEuler(_) => {
                 self.accelerate(forces, gains, work, Stage::Start)?;
-                let semi = matches!(settings.method, Method::SemiImplicitEuler(_));
+                let euler = if matches!(settings.method, Method::SemiImplicitEuler(_)) {
+                    semi_implicit_euler_lanes
+                } else {
+                    explicit_euler_lanes
+                };
                 for i in 0..n {
                     let (x, v, a) = (work.x0[i], work.v0[i], work.acceleration[i]);
-                    let v1 = v + h * a;
-                    work.x[i] = x + h * if semi { v1 } else { v };
-                    work.v[i] = v1;
+                    let (x1, v1) = euler(x.into(), v.into(), a.into(), h);
+                    (work.x[i], work.v[i]) = (x1.into(), v1.into());
                 }
                 self.keep_lambda(work);
             }
@@ -214,9 +219,9 @@ impl Island {
         work.time = time + h;
         self.evaluate_at_new(work);
         for r in 0..self.rows() {
-            let bound = settings.drift_bound * self.rows[r].scale();
             let c = work.c[r];
-            if c.is_nan() || c.abs() > bound {
+            let (bound, within) = drift_check(settings, c, self.rows[r].scale());
+            if !within {
                 return Err(SolveError::DriftExceeded { c, bound });
             }
         }
