@@ -4,6 +4,7 @@
 
 use bevy::math::DVec2;
 
+use super::locate::locate;
 use super::{Contact, ContactEvent, MAX_EVENTS, SurfaceStep, Walk, bounces};
 use crate::geometry::Track;
 use crate::lane::V2;
@@ -68,7 +69,7 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         }
         // It crosses the wire within the part: land where it does.
         let before = side * self.track.geometry(t, state.position).c;
-        let tau = self.locate(h, before, |tau| {
+        let tau = locate(h, before, |tau| {
             let part = free_step(self.settings.method, state, self.force, self.mass, tau);
             Ok(side * self.track.geometry(t + tau, part.position).c)
         })?;

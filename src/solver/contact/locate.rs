@@ -1,5 +1,6 @@
 //! Where within a part of a step an event falls (a leaving, a landing, a
-//! stop): regula falsi on the part's length.
+//! stop): regula falsi on the part's length, for a lone bead and an
+//! island alike.
 
 use bevy::math::DVec2;
 
@@ -21,52 +22,51 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         g0: f64,
         g: impl Fn(f64, BeadState) -> Result<f64, SolveError>,
     ) -> Result<(f64, BeadState), SolveError> {
-        let tau = self.locate(h, g0, |tau| {
+        let tau = locate(h, g0, |tau| {
             g(tau, self.slide(t, tau, state, sliding)?.state)
         })?;
         Ok((t + tau, self.slide(t, tau, state, sliding)?.state))
     }
+}
 
-    /// The sub-step length in `(0, h]` where `g` (`g0` at 0, positive;
-    /// not positive at `h`) reaches zero: regula falsi with the Illinois
-    /// modification, to a relative width of 1e-13 of `h`.
-    pub(super) fn locate(
-        &self,
-        h: f64,
-        g0: f64,
-        mut g: impl FnMut(f64) -> Result<f64, SolveError>,
-    ) -> Result<f64, SolveError> {
-        let (mut a, mut b) = (0.0, h);
-        let (mut ga, mut gb) = (g0, g(h)?);
-        if ga.is_nan() || ga <= 0.0 {
-            return Ok(0.0);
-        }
-        let mut last = 0;
-        for _ in 0..100 {
-            if b - a <= 1e-13 * h || gb == 0.0 {
-                break;
-            }
-            let mut m = b - gb * (b - a) / (gb - ga);
-            if !(m > a && m < b) {
-                m = 0.5 * (a + b);
-            }
-            let gm = g(m)?;
-            if gm > 0.0 {
-                a = m;
-                ga = gm;
-                if last == 1 {
-                    gb *= 0.5;
-                }
-                last = 1;
-            } else {
-                b = m;
-                gb = gm;
-                if last == -1 {
-                    ga *= 0.5;
-                }
-                last = -1;
-            }
-        }
-        Ok(b)
+/// The sub-step length in `(0, h]` where `g` (`g0` at 0, positive;
+/// not positive at `h`) reaches zero: regula falsi with the Illinois
+/// modification, to a relative width of 1e-13 of `h`.
+pub(crate) fn locate(
+    h: f64,
+    g0: f64,
+    mut g: impl FnMut(f64) -> Result<f64, SolveError>,
+) -> Result<f64, SolveError> {
+    let (mut a, mut b) = (0.0, h);
+    let (mut ga, mut gb) = (g0, g(h)?);
+    if ga.is_nan() || ga <= 0.0 {
+        return Ok(0.0);
     }
+    let mut last = 0;
+    for _ in 0..100 {
+        if b - a <= 1e-13 * h || gb == 0.0 {
+            break;
+        }
+        let mut m = b - gb * (b - a) / (gb - ga);
+        if !(m > a && m < b) {
+            m = 0.5 * (a + b);
+        }
+        let gm = g(m)?;
+        if gm > 0.0 {
+            a = m;
+            ga = gm;
+            if last == 1 {
+                gb *= 0.5;
+            }
+            last = 1;
+        } else {
+            b = m;
+            gb = gm;
+            if last == -1 {
+                ga *= 0.5;
+            }
+            last = -1;
+        }
+    }
+    Ok(b)
 }

@@ -31,6 +31,7 @@ mod tests;
 mod wire;
 
 pub use flight::free_step;
+pub(crate) use locate::locate;
 
 /// Whether a bead is on its wire or flying off it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

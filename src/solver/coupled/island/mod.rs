@@ -233,11 +233,11 @@ impl Island {
     /// [`Side`](crate::geometry::Side)) with restitution `restitution`:
     /// where λ takes the sign the wire cannot push with at a step's start,
     /// the row is set aside and its bead flies with the rest of the island;
-    /// where the bead crosses the wire again by a step's end, it lands
-    /// there (the island projected onto it, the bead's normal velocity
-    /// reversed and scaled by the restitution, the row kept aside if it
-    /// bounced). Events fall on step boundaries here, so their timing is
-    /// first order in the step (a lone bead's are located within the step).
+    /// where the bead crosses the wire again within a step, it lands where
+    /// it crosses, located as a lone bead's landing is (the island
+    /// projected onto it, the bead's normal velocity reversed and scaled
+    /// by the restitution, the row kept aside if it bounced), and the step
+    /// goes on from there. A leaving falls on a step's start.
     pub fn set_side(&mut self, row: usize, side: Side, restitution: f64) {
         if let (Some(RowKind::Wire { .. }), Some(slot)) =
             (self.rows.get(row), self.sides.get_mut(row))

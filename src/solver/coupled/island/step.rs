@@ -7,12 +7,26 @@ use bevy::math::DVec2;
 use super::integrators::Stage;
 use super::projection::Restore;
 use super::{CALM_STEPS, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow};
+use crate::solver::contact::locate;
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use crate::solver::method::Method;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
 use crate::solver::step::drift_check;
+
+/// A step's flight, as [`Island::land_within`] takes it again: where and
+/// when it started, its forces and settings, the substep level it started
+/// at, and the rows it may land on.
+struct Flight<'a> {
+    time: f64,
+    start: &'a [BeadState],
+    forces: &'a [LinearForce],
+    settings: &'a StepSettings,
+    level: u32,
+    calm: u32,
+    rows: &'a [usize],
+}
 
 impl Island {
     /// One step of every bead of the island under `settings`: `states`
@@ -67,14 +81,114 @@ impl Island {
             Vec::new()
         };
         let forces = if rough { &resisted[..] } else { forces };
+        let flying = if one_sided {
+            self.flying(time, states, work)
+        } else {
+            Vec::new()
+        };
+        let start = (!flying.is_empty()).then(|| (states.to_vec(), work.level, work.calm));
         self.substeps(time, states, forces, settings, work)?;
+        if let Some((start, level, calm)) = start
+            && self.crossing(time + settings.dt, states, &flying) <= 0.0
+        {
+            let flight = Flight {
+                time,
+                start: &start,
+                forces,
+                settings,
+                level,
+                calm,
+                rows: &flying,
+            };
+            self.land_within(&flight, states, work)?;
+        }
         if one_sided {
+            // A landing the located one left (another row, or a bounce
+            // that came back), at the step's end.
             self.land(time + settings.dt, states, forces, settings.dt, work)?;
         }
         if rough {
             self.stop(time + settings.dt, states, &slides, work)?;
         }
         self.follow(time + settings.dt, states, work);
+        Ok(())
+    }
+
+    /// The one-sided rows set aside whose beads are off their wires on the
+    /// side they push toward: the rows a flight may land on within the
+    /// step.
+    fn flying(&self, time: f64, states: &[BeadState], work: &IslandWork) -> Vec<usize> {
+        if states.len() != self.beads() {
+            return Vec::new();
+        }
+        (0..self.rows())
+            .filter(|&r| self.sides[r].0 != 0.0 && work.inactive[r])
+            .filter(|&r| self.sides[r].0 * self.wire_row(r, states, time).c > 0.0)
+            .collect()
+    }
+
+    /// How far the nearest of `rows` is from crossing its wire at `time`:
+    /// the least `side · C` (not positive once one has crossed).
+    fn crossing(&self, time: f64, states: &[BeadState], rows: &[usize]) -> f64 {
+        rows.iter()
+            .map(|&r| self.sides[r].0 * self.wire_row(r, states, time).c)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// A flight that crossed a wire within the step lands where it does,
+    /// as a lone bead's does ([`locate`]): the step is taken again to the
+    /// crossing, the bead lands there ([`Island::land`]), and the rest of
+    /// the step follows from the landing. Each trial step starts from the
+    /// same substep level. If a trial step fails, the step is kept as it
+    /// was taken whole, to land at its end.
+    fn land_within(
+        &self,
+        flight: &Flight,
+        states: &mut [BeadState],
+        work: &mut IslandWork,
+    ) -> Result<(), SolveError> {
+        let Flight {
+            time,
+            start,
+            forces,
+            settings,
+            ..
+        } = *flight;
+        let whole = states.to_vec();
+        let (level, calm, events) = (work.level, work.calm, work.events.len());
+        let trial = |tau: f64, states: &mut [BeadState], work: &mut IslandWork| {
+            states.copy_from_slice(start);
+            (work.level, work.calm) = (flight.level, flight.calm);
+            let part = StepSettings {
+                dt: tau,
+                ..*settings
+            };
+            self.substeps(time, states, forces, &part, work)
+        };
+        let mut probe = start.to_vec();
+        let g0 = self.crossing(time, start, flight.rows);
+        let located = locate(settings.dt, g0, |tau| {
+            trial(tau, &mut probe, work)?;
+            Ok(self.crossing(time + tau, &probe, flight.rows))
+        });
+        let landed = located.and_then(|tau| {
+            trial(tau, states, work)?;
+            self.land(time + tau, states, forces, settings.dt, work)?;
+            let rest = settings.dt - tau;
+            if rest > 1e-13 * settings.dt {
+                let part = StepSettings {
+                    dt: rest,
+                    ..*settings
+                };
+                self.substeps(time + tau, states, forces, &part, work)?;
+            }
+            Ok(())
+        });
+        if landed.is_err() {
+            states.copy_from_slice(&whole);
+            (work.level, work.calm) = (level, calm);
+            work.events.truncate(events);
+        }
         Ok(())
     }
 
