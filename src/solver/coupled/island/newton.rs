@@ -51,7 +51,8 @@ impl Island {
                 let scale = self.rows[r].scale().max(f64::MIN_POSITIVE);
                 let residual = work.c[r].abs();
                 worst = worst.max(residual / scale);
-                within &= newton_within(residual, scale, self.reach(r, &work.x));
+                // The reach only while every row so far is within.
+                within = within && newton_within(residual, scale, self.reach(r, &work.x));
             }
             if within || newton_accepted(worst, previous, 1.0, last) {
                 return self.same_branch(work, direction, worst);
