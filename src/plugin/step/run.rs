@@ -35,7 +35,27 @@ impl StepContext<'_> {
     /// go through the batched step, [`solver::LANES`] at a time, up to
     /// [`BATCHES`] batches per call; the others, and the lanes it hands
     /// back, one by one.
-    pub(super) fn step_run(&self, mut run: BeadRun) {
+    pub(super) fn step_run(&self, run: BeadRun) {
+        // Compiled for AVX2 where the processor has it, so that filling
+        // and storing the batches inlines with the batched step.
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = crate::lane::avx2() {
+            struct Run<'c, 'w>(&'c StepContext<'c>, BeadRun<'w>);
+            impl pulp::NullaryFnOnce for Run<'_, '_> {
+                type Output = ();
+                #[inline(always)]
+                fn call(self) {
+                    self.0.step_run_here(self.1);
+                }
+            }
+            return simd.vectorize(Run(self, run));
+        }
+        self.step_run_here(run);
+    }
+
+    /// [`StepContext::step_run`] in whatever code it is compiled into.
+    #[inline(always)]
+    fn step_run_here(&self, mut run: BeadRun) {
         let mut lanes = [solver::CircleLanes::default(); BATCHES];
         let mut outs = [solver::CircleSteps::default(); BATCHES];
         let mut waiting = [0; BATCHES * solver::LANES];
@@ -95,6 +115,7 @@ impl StepContext<'_> {
     /// Stores the batched steps of the beads `waiting` (in order, one lane
     /// each); a lane the batch did not finish goes through
     /// [`StepContext::step_one`].
+    #[inline(always)]
     fn finish_batches(&self, run: &mut BeadRun, outs: &[solver::CircleSteps], waiting: &[usize]) {
         for (out, waiting) in outs.iter().zip(waiting.chunks_exact(solver::LANES)) {
             let first = waiting[0];
