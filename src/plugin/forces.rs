@@ -16,7 +16,10 @@ impl Plugin for SpringAnchorPlugin {
     fn build(&self, app: &mut App) {
         app.register_type::<SpringAnchor>().add_systems(
             FixedUpdate,
-            apply_anchor_springs.in_set(WireBeadSystems::Forces),
+            // Skipped, not run empty, while no bead has an anchor.
+            apply_anchor_springs
+                .run_if(any_with_component::<SpringAnchor>)
+                .in_set(WireBeadSystems::Forces),
         );
     }
 }

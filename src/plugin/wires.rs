@@ -19,13 +19,32 @@ pub struct WirePosePlugin;
 
 impl Plugin for WirePosePlugin {
     fn build(&self, app: &mut App) {
-        app.add_observer(wire_added).add_systems(
-            FixedUpdate,
-            place_wires
-                .before(advance_clock)
-                .in_set(WireBeadSystems::Prepare),
-        );
+        app.init_resource::<MovingWires>()
+            .add_observer(wire_added)
+            .add_systems(
+                FixedUpdate,
+                place_wires
+                    .run_if(wires_to_place)
+                    .before(advance_clock)
+                    .in_set(WireBeadSystems::Prepare),
+            );
     }
+}
+
+/// The wires a game moved that have not come to rest: placed again each
+/// step until they do.
+#[derive(Resource, Default)]
+pub(crate) struct MovingWires(EntityHashSet);
+
+/// Whether any wire needs placing: one on a prescribed motion, one whose
+/// `Transform` changed, or one still moving. Where none does (every wire
+/// at rest) the step skips [`place_wires`] altogether.
+fn wires_to_place(
+    driven: Query<(), With<PrescribedMotion>>,
+    moved: Query<(), (With<Wire>, Without<PrescribedMotion>, Changed<Transform>)>,
+    moving: Res<MovingWires>,
+) -> bool {
+    !driven.is_empty() || !moving.0.is_empty() || !moved.is_empty()
 }
 
 /// Places every wire for the coming step, from [`SimClock::time`] to one
@@ -36,7 +55,7 @@ pub(crate) fn place_wires(
     mut driven: Query<(&PrescribedMotion, &mut Transform, &mut WirePose)>,
     mut followed: Query<(Ref<Transform>, &mut WirePose), (With<Wire>, Without<PrescribedMotion>)>,
     moved: Query<Entity, (With<Wire>, Without<PrescribedMotion>, Changed<Transform>)>,
-    mut moving: Local<EntityHashSet>,
+    mut moving: ResMut<MovingWires>,
 ) {
     let (start, h) = (clock.time, params.timestep);
     let end = start + h;
@@ -50,7 +69,7 @@ pub(crate) fn place_wires(
     // Only the wires whose `Transform` changed, and the ones that were
     // still moving: the rest stay where they are, unvisited.
     let mut still_moving = EntityHashSet::default();
-    let before = moving.iter().copied().filter(|&e| !moved.contains(e));
+    let before = moving.0.iter().copied().filter(|&e| !moved.contains(e));
     for entity in moved.iter().chain(before) {
         let Ok((transform, mut pose)) = followed.get_mut(entity) else {
             continue;
@@ -75,7 +94,7 @@ pub(crate) fn place_wires(
         };
         pose.set_if_neq(WirePose::on(path));
     }
-    *moving = still_moving;
+    moving.0 = still_moving;
 }
 
 /// Places a wire where its `Transform` puts it the moment it is added, so
