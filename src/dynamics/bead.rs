@@ -268,11 +268,14 @@ impl BeadMotionItem<'_, '_> {
         self.mass.get()
     }
 
-    /// Stores a step's new state and clears the consumed force.
+    /// Stores a step's new state and clears the consumed force (touching
+    /// the force only where one was added).
     pub(crate) fn advance_to(&mut self, state: BeadState) {
         self.position.0 = state.position;
         self.velocity.0 = state.velocity;
-        self.force.clear();
+        if *self.force != BeadForce::default() {
+            self.force.clear();
+        }
     }
 
     /// Applies `params`' mass and initial state, the force cleared.
@@ -294,11 +297,6 @@ impl BeadMotionReadOnlyItem<'_, '_> {
     /// The mass.
     pub(crate) fn mass(&self) -> f64 {
         self.mass.get()
-    }
-
-    /// The force of the next step, eq. (5).
-    pub(crate) fn step_force(&self, gravity: DVec2) -> LinearForce {
-        self.force.linear(self.mass.get(), gravity, self.position.0)
     }
 }
 

@@ -291,6 +291,7 @@ pub(super) fn prepare_islands(
                     work,
                     states: Vec::with_capacity(group.len()),
                     forces: Vec::with_capacity(group.len()),
+                    masses: masses.clone(),
                     links: link_rows,
                     wire_rows,
                     anchored,

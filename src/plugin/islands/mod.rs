@@ -109,6 +109,9 @@ struct CachedIsland {
     work: IslandWork,
     states: Vec<BeadState>,
     forces: Vec<LinearForce>,
+    /// Each bead's mass, as the island was built with it (a restart or a
+    /// change of links builds it again).
+    masses: Vec<f64>,
     links: Vec<LinkRows>,
     /// The wire row of each bead on a wire: (bead, row, wire entity).
     wire_rows: Vec<(usize, usize, Entity)>,

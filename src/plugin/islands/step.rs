@@ -53,8 +53,12 @@ pub(super) fn step_islands(
             let Ok((bead, ..)) = beads.get(entity) else {
                 continue 'gather; // a bead of it stopped: so does the island
             };
-            cached.states.push(bead.state());
-            cached.forces.push(bead.step_force(gravity));
+            let state = bead.state();
+            let mass = cached.masses[cached.states.len()];
+            cached.states.push(state);
+            cached
+                .forces
+                .push(bead.force.linear(mass, gravity, state.position));
         }
         for &(_, row, wire) in &cached.wire_rows {
             let Ok((wire, pose)) = wires.get(wire) else {
@@ -146,7 +150,7 @@ pub(super) fn step_islands(
                     .find(|w| w.0 == i)
                     .map(|w| rows[w.1]);
                 let row = wire_row.unwrap_or_default();
-                *d = BeadDiagnostics::of(state, bead.mass(), gravity, row, pushed[i]);
+                *d = BeadDiagnostics::of(state, cached.masses[i], gravity, row, pushed[i]);
             }
         }
         for link in &cached.links {
