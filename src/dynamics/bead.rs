@@ -198,10 +198,13 @@ impl BeadForce {
         }
     }
 
-    /// Empties the accumulator (the step has used it).
+    /// Empties the accumulator (the step has used it), writing only where
+    /// a force was added.
     #[inline(always)]
     pub(crate) fn clear(&mut self) {
-        *self = Self::default();
+        if *self != Self::default() {
+            *self = Self::default();
+        }
     }
 }
 
@@ -273,9 +276,8 @@ impl BeadMotionItem<'_, '_> {
     pub(crate) fn advance_to(&mut self, state: BeadState) {
         self.position.0 = state.position;
         self.velocity.0 = state.velocity;
-        if *self.force != BeadForce::default() {
-            self.force.clear();
-        }
+        // Marked changed only where a force was added.
+        self.force.set_if_neq(BeadForce::default());
     }
 
     /// Applies `params`' mass and initial state, the force cleared.

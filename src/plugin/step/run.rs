@@ -62,6 +62,11 @@ impl StepContext<'_> {
         let mut queued = 0;
         let mut i = 0;
         while i < run.entities.len() {
+            if queued == waiting.len() {
+                solver::step_on_circle_batches(&lanes, &self.settings, &mut outs);
+                self.finish_batches(&mut run, &outs, &waiting);
+                queued = 0;
+            }
             // A block of beads side by side, each on a plain circle: into
             // one batch column by column.
             if queued % solver::LANES == 0
@@ -72,37 +77,27 @@ impl StepContext<'_> {
                 }
                 queued += solver::LANES;
                 i += solver::LANES;
-                if queued == waiting.len() {
-                    solver::step_on_circle_batches(&lanes, &self.settings, &mut outs);
-                    self.finish_batches(&mut run, &outs, &waiting);
-                    queued = 0;
-                }
                 continue;
+            }
+            match self.wires.circle(&run.on_wires[i]) {
+                Some((centre, radius)) => {
+                    let bead = run.bead(i);
+                    lanes[queued / solver::LANES].set(
+                        queued % solver::LANES,
+                        bead.state,
+                        &bead.force(self.params.gravity),
+                        bead.mass,
+                        centre,
+                        radius,
+                    );
+                    waiting[queued] = i;
+                    queued += 1;
+                }
+                None => self.step_one(&mut run, i),
             }
             i += 1;
-            let i = i - 1;
-            if let Some((centre, radius)) = self.wires.circle(&run.on_wires[i]) {
-                let bead = run.bead(i);
-                lanes[queued / solver::LANES].set(
-                    queued % solver::LANES,
-                    bead.state,
-                    &bead.force(self.params.gravity),
-                    bead.mass,
-                    centre,
-                    radius,
-                );
-                waiting[queued] = i;
-                queued += 1;
-                if queued == waiting.len() {
-                    solver::step_on_circle_batches(&lanes, &self.settings, &mut outs);
-                    self.finish_batches(&mut run, &outs, &waiting);
-                    queued = 0;
-                }
-                continue;
-            }
-            self.step_one(&mut run, i);
         }
-        // The last, partial batches: full ones batched, the rest one by one.
+        // The last batches: full ones batched, the rest one by one.
         let whole = queued / solver::LANES;
         solver::step_on_circle_batches(&lanes[..whole], &self.settings, &mut outs[..whole]);
         let batched = whole * solver::LANES;
@@ -155,18 +150,20 @@ impl StepContext<'_> {
         let velocities = &run.velocities[first..first + N];
         let masses = &run.masses[first..first + N];
         let forces = &run.forces[first..first + N];
-        for j in 0..N {
-            let (p, v, m) = (positions[j].0, velocities[j].0, masses[j].get());
-            let force = forces[j].linear(m, gravity, p);
-            (lanes.x[j], lanes.y[j]) = (p.x, p.y);
-            (lanes.vx[j], lanes.vy[j]) = (v.x, v.y);
-            (lanes.fx[j], lanes.fy[j]) = (force.force.x, force.force.y);
-            lanes.stiffness[j] = force.stiffness;
-            (lanes.at_x[j], lanes.at_y[j]) = (p.x, p.y);
-            lanes.mass[j] = m;
-            let (centre, radius) = circles[j];
-            (lanes.ox[j], lanes.oy[j]) = (centre.x, centre.y);
-            lanes.radius[j] = radius;
+        for (j, (centre, radius)) in circles.into_iter().enumerate() {
+            let (p, m) = (positions[j].0, masses[j].get());
+            let state = BeadState {
+                position: p,
+                velocity: velocities[j].0,
+            };
+            lanes.set(
+                j,
+                state,
+                &forces[j].linear(m, gravity, p),
+                m,
+                centre,
+                radius,
+            );
         }
         true
     }
@@ -184,9 +181,7 @@ impl StepContext<'_> {
             v.0 = DVec2::new(out.vx[j], out.vy[j]);
         }
         for force in &mut run.forces[range.clone()] {
-            if *force != BeadForce::default() {
-                force.clear();
-            }
+            force.clear();
         }
         if let Some(diagnostics) = run.diagnostics.as_deref_mut() {
             let masses = &run.masses[range.clone()];
@@ -322,9 +317,7 @@ impl StepContext<'_> {
             transform,
         } = outputs;
         (position.0, velocity.0) = (out.state.position, out.state.velocity);
-        if *force != BeadForce::default() {
-            force.clear();
-        }
+        force.clear();
         if let Some(diagnostics) = diagnostics {
             *diagnostics = self.diagnose(&out, mass);
         }
