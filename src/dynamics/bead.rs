@@ -273,6 +273,7 @@ impl BeadMotionItem<'_, '_> {
 
     /// Stores a step's new state and clears the consumed force (touching
     /// the force only where one was added).
+    #[inline]
     pub(crate) fn advance_to(&mut self, state: BeadState) {
         self.position.0 = state.position;
         self.velocity.0 = state.velocity;

@@ -6,14 +6,18 @@ use bevy::prelude::*;
 
 use super::{CachedIsland, InIsland, Islands, LinkRows};
 use crate::dynamics::{
-    BeadDiagnostics, BeadMotion, ConstraintDiagnostics, Diverged, DivergenceReason, Pin, SimParams,
-    Wire, WireContact, WirePose,
+    BeadDiagnostics, BeadForce, BeadMotion, BeadPosition, BeadVelocity, ConstraintDiagnostics,
+    Diverged, DivergenceReason, Pin, SimParams, Wire, WireContact, WirePose,
 };
 use crate::plugin::clock::SimClock;
 use crate::plugin::parallel::{ParallelStep, StepSplit};
 use crate::plugin::report::{ContactReports, Divergences};
 use crate::plugin::writeback::place;
-use crate::solver::{Contact, StepSettings};
+use crate::solver::{BeadState, Contact, StepSettings};
+
+/// The beads [`step_islands`] steps: those in an island that have not
+/// stopped.
+type Stepped = (With<InIsland>, Without<Diverged>);
 
 /// Steps every island whose beads have not diverged: gathers their states
 /// and forces, calls [`Island::step`] (the islands split over the compute
@@ -25,15 +29,18 @@ pub(super) fn step_islands(
     clock: Res<SimClock>,
     parallel: Res<ParallelStep>,
     mut islands: ResMut<Islands>,
-    mut beads: Query<
-        (
-            BeadMotion,
-            Option<&mut BeadDiagnostics>,
-            Option<&mut Transform>,
-            Option<&mut WireContact>,
-        ),
-        (With<InIsland>, Without<Diverged>),
-    >,
+    mut beads: ParamSet<(
+        Query<(&BeadPosition, &BeadVelocity, &BeadForce), Stepped>,
+        Query<
+            (
+                BeadMotion,
+                Option<&mut BeadDiagnostics>,
+                Option<&mut Transform>,
+                Option<&mut WireContact>,
+            ),
+            Stepped,
+        >,
+    )>,
     mut changes: ContactReports,
     wires: Query<(Ref<Wire>, &WirePose)>,
     pins: Query<&Pin>,
@@ -45,20 +52,26 @@ pub(super) fn step_islands(
     let settings = params.step_settings();
     let gravity = params.gravity;
     let mut stepped_beads = 0;
+    // The gather looks up the three columns it reads, not every column
+    // the write-back needs.
+    let motion = beads.p0();
     'gather: for cached in &mut islands.cached {
         cached.outcome = None;
         cached.states.clear();
         cached.forces.clear();
         for &entity in &cached.report.beads {
-            let Ok((bead, ..)) = beads.get(entity) else {
+            let Ok((position, velocity, force)) = motion.get(entity) else {
                 continue 'gather; // a bead of it stopped: so does the island
             };
-            let state = bead.state();
+            let state = BeadState {
+                position: position.0,
+                velocity: velocity.0,
+            };
             let mass = cached.masses[cached.states.len()];
             cached.states.push(state);
             cached
                 .forces
-                .push(bead.force.linear(mass, gravity, state.position));
+                .push(force.linear(mass, gravity, state.position));
         }
         for &(_, row, wire) in &cached.wire_rows {
             let Ok((wire, pose)) = wires.get(wire) else {
@@ -122,8 +135,20 @@ pub(super) fn step_islands(
             let bead = cached.report.beads[local];
             changes.report(bead, event);
         }
-        for &(local, row, _) in &cached.wire_rows {
-            if let Ok((.., Some(mut contact))) = beads.get_mut(cached.report.beads[local]) {
+        // One lookup per bead writes all it has.
+        let mut written = beads.p1();
+        for (i, &entity) in cached.report.beads.iter().enumerate() {
+            let Ok((mut bead, bead_diagnostics, transform, contact)) = written.get_mut(entity)
+            else {
+                continue;
+            };
+            let state = cached.states[i];
+            bead.advance_to(state);
+            if let Some(mut transform) = transform {
+                place(&mut transform, state.position);
+            }
+            let wire_row = cached.wire_rows.iter().find(|w| w.0 == i).map(|w| w.1);
+            if let (Some(mut contact), Some(row)) = (contact, wire_row) {
                 let held = if cached.work.holds(row) {
                     Contact::OnWire
                 } else {
@@ -133,23 +158,8 @@ pub(super) fn step_islands(
                     contact.contact = held;
                 }
             }
-        }
-        for (i, &entity) in cached.report.beads.iter().enumerate() {
-            let Ok((mut bead, bead_diagnostics, transform, _)) = beads.get_mut(entity) else {
-                continue;
-            };
-            let state = cached.states[i];
-            bead.advance_to(state);
-            if let Some(mut transform) = transform {
-                place(&mut transform, state.position);
-            }
             if let Some(mut d) = bead_diagnostics {
-                let wire_row = cached
-                    .wire_rows
-                    .iter()
-                    .find(|w| w.0 == i)
-                    .map(|w| rows[w.1]);
-                let row = wire_row.unwrap_or_default();
+                let row = wire_row.map(|r| rows[r]).unwrap_or_default();
                 *d = BeadDiagnostics::of(state, cached.masses[i], gravity, row, pushed[i]);
             }
         }
