@@ -4,7 +4,7 @@ use bevy::math::{DMat2, DVec2};
 use serde::{Deserialize, Serialize};
 
 use super::{Geometry, ImplicitCurve};
-use crate::lane::{Lane, Sym2, V2};
+use crate::lane::{Lane, Sym2, V2, Vector};
 
 /// A circle of radius `r` about the local origin: `C = |x| - r`, the assignment's
 /// wire. Singular at the centre.

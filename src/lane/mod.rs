@@ -113,6 +113,28 @@ impl Lane for f64 {
 /// How many beads the batched step takes at once.
 pub const LANES: usize = 8;
 
+/// A vector of lanes in the plane or in space: what the step's formulas
+/// take positions, velocities, forces and normals as, so that each is
+/// written once for both dimensions. [`V2`] and [`V3`] implement it; every
+/// operation is componentwise or a sum in the order glam sums it.
+pub(crate) trait Vector<T: Lane>: Copy + Add<Output = Self> + Sub<Output = Self> {
+    /// `self · other`, as glam's `dot` sums it.
+    fn dot(self, other: Self) -> T;
+    /// `t self`.
+    fn scale(self, t: T) -> Self;
+    /// `self + t d`, as glam evaluates `a + t * d`.
+    fn plus(self, t: T, d: Self) -> Self;
+    /// `self / t`, as glam divides a vector by a number.
+    fn div(self, t: T) -> Self;
+    /// `a` in the lanes where `mask` holds, `b` in the others.
+    fn select(mask: T::Mask, a: Self, b: Self) -> Self;
+    /// Every component finite.
+    fn is_finite(self) -> T::Mask;
+    /// The size of the largest component: how far from the origin
+    /// rounding the coordinates reaches.
+    fn reach(self) -> T;
+}
+
 /// A 2-vector of lanes: `x` and `y` of one bead, or of eight.
 #[derive(Clone, Copy)]
 pub(crate) struct V2<T> {
@@ -126,41 +148,36 @@ impl<T: Lane> V2<T> {
     pub(crate) fn new(x: T, y: T) -> Self {
         Self { x, y }
     }
+}
 
-    /// `self · other`, as glam's `dot` sums it.
+impl<T: Lane> Vector<T> for V2<T> {
     #[inline(always)]
-    pub(crate) fn dot(self, other: Self) -> T {
+    fn dot(self, other: Self) -> T {
         self.x * other.x + self.y * other.y
     }
-
-    /// `t self`.
     #[inline(always)]
-    pub(crate) fn scale(self, t: T) -> Self {
+    fn scale(self, t: T) -> Self {
         Self::new(t * self.x, t * self.y)
     }
-
-    /// `self + t d`, as glam evaluates `a + t * d`.
     #[inline(always)]
-    pub(crate) fn plus(self, t: T, d: Self) -> Self {
+    fn plus(self, t: T, d: Self) -> Self {
         Self::new(self.x + t * d.x, self.y + t * d.y)
     }
-
-    /// `self / t`, as glam divides a vector by a number.
     #[inline(always)]
-    pub(crate) fn div(self, t: T) -> Self {
+    fn div(self, t: T) -> Self {
         Self::new(self.x / t, self.y / t)
     }
-
-    /// `a` in the lanes where `mask` holds, `b` in the others.
     #[inline(always)]
-    pub(crate) fn select(mask: T::Mask, a: Self, b: Self) -> Self {
+    fn select(mask: T::Mask, a: Self, b: Self) -> Self {
         Self::new(T::select(mask, a.x, b.x), T::select(mask, a.y, b.y))
     }
-
-    /// Both components finite.
     #[inline(always)]
-    pub(crate) fn is_finite(self) -> T::Mask {
+    fn is_finite(self) -> T::Mask {
         self.x.is_finite() & self.y.is_finite()
+    }
+    #[inline(always)]
+    fn reach(self) -> T {
+        self.x.abs().max(self.y.abs())
     }
 }
 
@@ -191,6 +208,128 @@ impl From<V2<f64>> for bevy::math::DVec2 {
     #[inline(always)]
     fn from(v: V2<f64>) -> Self {
         Self::new(v.x, v.y)
+    }
+}
+
+/// glam's vectors are vectors of one lane: the scalar paths pass them to
+/// the formulas as they are. Each operation is glam's own, which sums and
+/// rounds as [`V2`] and [`V3`] do.
+macro_rules! glam_vector {
+    ($($v:ty),*) => {$(
+        impl Vector<f64> for $v {
+            #[inline(always)]
+            fn dot(self, other: Self) -> f64 {
+                <$v>::dot(self, other)
+            }
+            #[inline(always)]
+            fn scale(self, t: f64) -> Self {
+                t * self
+            }
+            #[inline(always)]
+            fn plus(self, t: f64, d: Self) -> Self {
+                self + t * d
+            }
+            #[inline(always)]
+            fn div(self, t: f64) -> Self {
+                self / t
+            }
+            #[inline(always)]
+            fn select(mask: bool, a: Self, b: Self) -> Self {
+                if mask { a } else { b }
+            }
+            #[inline(always)]
+            fn is_finite(self) -> bool {
+                <$v>::is_finite(self)
+            }
+            #[inline(always)]
+            fn reach(self) -> f64 {
+                self.abs().max_element()
+            }
+        }
+    )*};
+}
+
+glam_vector!(bevy::math::DVec2, bevy::math::DVec3);
+
+/// A 3-vector of lanes: `x`, `y` and `z` of one bead in space, or of
+/// eight.
+#[derive(Clone, Copy)]
+pub(crate) struct V3<T> {
+    pub(crate) x: T,
+    pub(crate) y: T,
+    pub(crate) z: T,
+}
+
+impl<T: Lane> V3<T> {
+    /// `(x, y, z)`.
+    #[inline(always)]
+    pub(crate) fn new(x: T, y: T, z: T) -> Self {
+        Self { x, y, z }
+    }
+}
+
+impl<T: Lane> Vector<T> for V3<T> {
+    #[inline(always)]
+    fn dot(self, other: Self) -> T {
+        self.x * other.x + self.y * other.y + self.z * other.z
+    }
+    #[inline(always)]
+    fn scale(self, t: T) -> Self {
+        Self::new(t * self.x, t * self.y, t * self.z)
+    }
+    #[inline(always)]
+    fn plus(self, t: T, d: Self) -> Self {
+        Self::new(self.x + t * d.x, self.y + t * d.y, self.z + t * d.z)
+    }
+    #[inline(always)]
+    fn div(self, t: T) -> Self {
+        Self::new(self.x / t, self.y / t, self.z / t)
+    }
+    #[inline(always)]
+    fn select(mask: T::Mask, a: Self, b: Self) -> Self {
+        Self::new(
+            T::select(mask, a.x, b.x),
+            T::select(mask, a.y, b.y),
+            T::select(mask, a.z, b.z),
+        )
+    }
+    #[inline(always)]
+    fn is_finite(self) -> T::Mask {
+        self.x.is_finite() & self.y.is_finite() & self.z.is_finite()
+    }
+    #[inline(always)]
+    fn reach(self) -> T {
+        self.x.abs().max(self.y.abs()).max(self.z.abs())
+    }
+}
+
+impl<T: Lane> Add for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        Self::new(self.x + o.x, self.y + o.y, self.z + o.z)
+    }
+}
+
+impl<T: Lane> Sub for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        Self::new(self.x - o.x, self.y - o.y, self.z - o.z)
+    }
+}
+
+impl From<bevy::math::DVec3> for V3<f64> {
+    #[inline(always)]
+    fn from(v: bevy::math::DVec3) -> Self {
+        Self::new(v.x, v.y, v.z)
+    }
+}
+
+impl From<V3<f64>> for bevy::math::DVec3 {
+    #[inline(always)]
+    fn from(v: V3<f64>) -> Self {
+        Self::new(v.x, v.y, v.z)
     }
 }
 

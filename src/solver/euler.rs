@@ -3,23 +3,18 @@
 
 use super::solve::Solved;
 use super::state::{Advance, BeadState};
-use crate::lane::{Lane, V2};
+use crate::lane::{Lane, V2, Vector};
 
 /// Explicit Euler on lanes: `x₁ = x₀ + h v₀`, `v₁ = v₀ + h a₀`.
 #[inline(always)]
-pub(crate) fn explicit_euler_lanes<T: Lane>(x: V2<T>, v: V2<T>, a: V2<T>, h: T) -> (V2<T>, V2<T>) {
+pub(crate) fn explicit_euler_lanes<T: Lane, V: Vector<T>>(x: V, v: V, a: V, h: T) -> (V, V) {
     (x.plus(h, v), v.plus(h, a))
 }
 
 /// Semi-implicit (symplectic) Euler on lanes: `v₁ = v₀ + h a₀`,
 /// `x₁ = x₀ + h v₁`.
 #[inline(always)]
-pub(crate) fn semi_implicit_euler_lanes<T: Lane>(
-    x: V2<T>,
-    v: V2<T>,
-    a: V2<T>,
-    h: T,
-) -> (V2<T>, V2<T>) {
+pub(crate) fn semi_implicit_euler_lanes<T: Lane, V: Vector<T>>(x: V, v: V, a: V, h: T) -> (V, V) {
     let v1 = v.plus(h, a);
     (x.plus(h, v1), v1)
 }

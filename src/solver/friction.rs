@@ -10,7 +10,7 @@
 //! [`holds`].
 
 use crate::geometry::Friction;
-use crate::lane::{Lane, V2};
+use crate::lane::{Lane, Vector};
 
 /// `|λ ∇C|`: how hard a wire of normal `∇C` (of squared length `nn`)
 /// presses on its bead under the multiplier `lambda`.
@@ -29,12 +29,13 @@ pub(crate) fn holds(friction: &Friction, pull: f64, press: f64) -> bool {
 /// Kinetic friction `−μk press d / |d|` against the direction `d` (of
 /// length `length`, not zero) a bead slides or is pulled in.
 #[inline(always)]
-pub(crate) fn kinetic<T: Lane>(friction: &Friction, press: T, d: V2<T>, length: T) -> V2<T> {
+pub(crate) fn kinetic<T: Lane, V: Vector<T>>(friction: &Friction, press: T, d: V, length: T) -> V {
     d.scale(-(press.splat(friction.kinetic_coefficient) * press / length))
 }
 
 /// Viscous damping `−c v_t` on the velocity `sliding` along the wire.
 #[inline(always)]
-pub(crate) fn damping<T: Lane>(c: f64, sliding: V2<T>) -> V2<T> {
-    sliding.scale(sliding.x.splat(-c))
+pub(crate) fn damping<T: Lane, V: Vector<T>>(c: f64, sliding: V) -> V {
+    let speed_squared = sliding.dot(sliding);
+    sliding.scale(speed_squared.splat(-c))
 }

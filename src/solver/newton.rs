@@ -9,7 +9,7 @@
 //! so its iteration is its own; it stops by the same [`newton_within`] and
 //! [`newton_accepted`].
 
-use crate::lane::{Lane, Mask, V2};
+use crate::lane::{Lane, Mask, Vector};
 
 use super::wire_normal::{across, usable};
 
@@ -26,13 +26,6 @@ pub const NEWTON_TOLERANCE: f64 = 4.0 * f64::EPSILON;
 pub const NEWTON_ACCEPT: f64 = 1e-10;
 /// The most Newton iterations a solve takes before it gives up.
 pub(crate) const NEWTON_MAX_ITERATIONS: u32 = 20;
-
-/// The size of a point's largest coordinate: how far from the origin
-/// rounding its coordinates reaches.
-#[inline(always)]
-pub(crate) fn reach<T: Lane>(p: V2<T>) -> T {
-    p.x.abs().max(p.y.abs())
-}
 
 /// Whether the residual `|C|` of a Newton solve is within
 /// [`NEWTON_TOLERANCE`] of the constraint's `scale` or of the `reach` of
@@ -77,14 +70,16 @@ pub(crate) fn newton_done<T: Lane>(
 /// `∇C` at a point, whether its normal is usable there, and its own
 /// velocity.
 pub(crate) trait WireAt<T: Lane> {
+    /// The vectors it takes and gives: in the plane or in space.
+    type V: Vector<T>;
     /// The wire at a point: `C`, `∇C`, and what a caller reuses.
     type At: Copy;
     /// The wire at `p`.
-    fn at(&self, p: V2<T>) -> Self::At;
+    fn at(&self, p: Self::V) -> Self::At;
     /// `C` at a point.
     fn c(at: &Self::At) -> T;
     /// `∇C` at a point.
-    fn normal(at: &Self::At) -> V2<T>;
+    fn normal(at: &Self::At) -> Self::V;
     /// `|∇C|²` at a point, and whether the normal there is usable.
     fn normal_length_squared(at: &Self::At) -> (T, T::Mask) {
         let n = Self::normal(at);
@@ -94,7 +89,7 @@ pub(crate) trait WireAt<T: Lane> {
     /// `a` in the lanes where `mask` holds, `b` in the others.
     fn select(mask: T::Mask, a: Self::At, b: Self::At) -> Self::At;
     /// The velocity of the wire's point at `p` (zero on a fixed wire).
-    fn velocity(&self, p: V2<T>) -> V2<T>;
+    fn velocity(&self, p: Self::V) -> Self::V;
 }
 
 /// Where a Newton iteration ended, in each lane.
@@ -117,7 +112,7 @@ pub(crate) struct Root<T: Lane, P, A> {
 /// What a Newton iteration moves, and how it moves it.
 trait Walk<T: Lane, W: WireAt<T>> {
     /// The point the wire is evaluated at.
-    fn point(&self) -> V2<T>;
+    fn point(&self) -> W::V;
     /// One Newton step from the point, where the wire is `g` and `C` is
     /// `c`, in the lanes `active`; returns the lanes it could take it in
     /// (the others stay where they are).
@@ -144,7 +139,7 @@ fn newton<T: Lane, W: WireAt<T>, K: Walk<T, W>>(
     for i in 0..=NEWTON_MAX_ITERATIONS {
         let c = W::c(&g);
         let last = i == NEWTON_MAX_ITERATIONS;
-        let done = active & newton_done(c.abs(), previous, scale, reach(p), last);
+        let done = active & newton_done(c.abs(), previous, scale, p.reach(), last);
         previous = c.abs();
         end = W::select(done, g, end);
         found = found | done;
@@ -166,15 +161,15 @@ fn newton<T: Lane, W: WireAt<T>, K: Walk<T, W>>(
 }
 
 /// The walk of [`newton_along`]: `base + s dir`.
-struct Along<T> {
-    base: V2<T>,
-    dir: V2<T>,
+struct Along<V, T> {
+    base: V,
+    dir: V,
     s: T,
 }
 
-impl<T: Lane, W: WireAt<T>> Walk<T, W> for Along<T> {
+impl<T: Lane, W: WireAt<T>> Walk<T, W> for Along<W::V, T> {
     #[inline(always)]
-    fn point(&self) -> V2<T> {
+    fn point(&self) -> W::V {
         self.base.plus(self.s, self.dir)
     }
     #[inline(always)]
@@ -187,20 +182,20 @@ impl<T: Lane, W: WireAt<T>> Walk<T, W> for Along<T> {
 }
 
 /// The walk of [`newton_onto`]: along the local gradient.
-struct Onto<T> {
-    x: V2<T>,
+struct Onto<V> {
+    x: V,
 }
 
-impl<T: Lane, W: WireAt<T>> Walk<T, W> for Onto<T> {
+impl<T: Lane, W: WireAt<T>> Walk<T, W> for Onto<W::V> {
     #[inline(always)]
-    fn point(&self) -> V2<T> {
+    fn point(&self) -> W::V {
         self.x
     }
     #[inline(always)]
     fn step(&mut self, g: &W::At, c: T, active: T::Mask) -> T::Mask {
         let (nn, usable) = W::normal_length_squared(g);
         let active = active & usable;
-        self.x = V2::select(active, self.x - W::normal(g).scale(c / nn), self.x);
+        self.x = W::V::select(active, self.x - W::normal(g).scale(c / nn), self.x);
         active
     }
 }
@@ -225,8 +220,8 @@ impl<T: Lane, P, A> Root<T, P, A> {
 #[inline(always)]
 pub(crate) fn newton_along<T: Lane, W: WireAt<T>>(
     wire: &W,
-    base: V2<T>,
-    dir: V2<T>,
+    base: W::V,
+    dir: W::V,
     scale: T,
     active: T::Mask,
 ) -> Root<T, T, W::At> {
@@ -250,11 +245,11 @@ pub(crate) fn newton_along<T: Lane, W: WireAt<T>>(
 #[inline(always)]
 pub(crate) fn newton_onto<T: Lane, W: WireAt<T>>(
     wire: &W,
-    x: V2<T>,
+    x: W::V,
     start: W::At,
     scale: T,
     active: T::Mask,
-) -> Root<T, V2<T>, W::At> {
+) -> Root<T, W::V, W::At> {
     let r = newton(wire, Onto { x }, start, scale, active);
     let x = r.root.x;
     r.with(x)
@@ -267,9 +262,9 @@ pub(crate) fn newton_onto<T: Lane, W: WireAt<T>>(
 pub(crate) fn tangential<T: Lane, W: WireAt<T>>(
     wire: &W,
     at: &W::At,
-    p: V2<T>,
-    v: V2<T>,
-) -> (V2<T>, T::Mask) {
+    p: W::V,
+    v: W::V,
+) -> (W::V, T::Mask) {
     let (nn, ok) = W::normal_length_squared(at);
     let w = wire.velocity(p);
     (v - across(W::normal(at), nn, v - w), ok)

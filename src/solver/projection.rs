@@ -30,6 +30,7 @@ impl<T: Track + ?Sized> TrackAt<'_, T> {
 }
 
 impl<T: Track + ?Sized> WireAt<f64> for TrackAt<'_, T> {
+    type V = V2<f64>;
     type At = Geometry;
     #[inline(always)]
     fn at(&self, p: V2<f64>) -> Geometry {
@@ -138,5 +139,5 @@ pub(super) fn tangential<T: Track + ?Sized>(
 /// `a` without its component along `n`.
 pub(super) fn along_wire(n: DVec2, a: DVec2, x: DVec2) -> Result<DVec2, SolveError> {
     let nn = normal_length_squared(n, x)?;
-    Ok(along(n.into(), nn, a.into()).into())
+    Ok(along(n, nn, a))
 }

@@ -11,7 +11,7 @@ use super::settings::Gains;
 use super::solve::{InFrame, SolveError, in_frame, normal_length_squared, resistance, solve_on};
 use super::state::{Advance, BeadState, LinearForce, LinearForceLanes};
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
-use crate::lane::{Lane, V2};
+use crate::lane::{Lane, Vector};
 
 /// One RATTLE step of length `h`: the position solve by Newton along
 /// `N₀`, then the velocity solve, linear in μ. λ reported is the mean of
@@ -86,15 +86,15 @@ pub(crate) fn rattle_on<T: Track + ?Sized>(
 }
 
 /// What [`rattle_lanes`] returns in each lane.
-pub(crate) struct Rattled<T: Lane, A> {
+pub(crate) struct Rattled<T: Lane, V, A> {
     /// The new position.
-    pub(crate) x: V2<T>,
+    pub(crate) x: V,
     /// The new velocity.
-    pub(crate) v: V2<T>,
+    pub(crate) v: V,
     /// The mean of the position and velocity multipliers.
     pub(crate) lambda: T,
     /// The mean of their forces.
-    pub(crate) constraint_force: V2<T>,
+    pub(crate) constraint_force: V,
     /// The position solve: found where the new position meets the wire,
     /// and the wire there.
     pub(crate) root: Root<T, T, A>,
@@ -106,7 +106,7 @@ pub(crate) struct Rattled<T: Lane, A> {
 /// from `(x0, v0)` for a bead of mass `m` under the force `f0`; for a
 /// lone bead, the lanes and each bead of an island.
 #[inline(always)]
-pub(crate) fn rattle_drift<T: Lane>((x0, v0): (V2<T>, V2<T>), f0: V2<T>, m: T, h: T) -> V2<T> {
+pub(crate) fn rattle_drift<T: Lane, V: Vector<T>>((x0, v0): (V, V), f0: V, m: T, h: T) -> V {
     x0.plus(h, v0).plus(h * h / (m.splat(2.0) * m), f0)
 }
 
@@ -115,7 +115,7 @@ pub(crate) fn rattle_drift<T: Lane>((x0, v0): (V2<T>, V2<T>), f0: V2<T>, m: T, h
 /// at the new position, before the velocity solve; for a lone bead, the
 /// lanes and each bead of an island.
 #[inline(always)]
-pub(crate) fn rattle_half_kick<T: Lane>(v: V2<T>, f1: V2<T>, m: T, h: T) -> V2<T> {
+pub(crate) fn rattle_half_kick<T: Lane, V: Vector<T>>(v: V, f1: V, m: T, h: T) -> V {
     v.plus(h / (m.splat(2.0) * m), f1)
 }
 
@@ -130,15 +130,15 @@ pub(crate) fn rattle_half_kick<T: Lane>(v: V2<T>, f1: V2<T>, m: T, h: T) -> V2<T
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn rattle_lanes<T: Lane, W: WireAt<T>>(
     wire: &W,
-    (x0, v0): (V2<T>, V2<T>),
-    n0: V2<T>,
-    force: &LinearForceLanes<T>,
-    resisted: V2<T>,
+    (x0, v0): (W::V, W::V),
+    n0: W::V,
+    force: &LinearForceLanes<T, W::V>,
+    resisted: W::V,
     m: T,
     h: T,
     scale: T,
     active: T::Mask,
-) -> Rattled<T, W::At> {
+) -> Rattled<T, W::V, W::At> {
     let two_m = m.splat(2.0) * m;
     let free = rattle_drift((x0, v0), force.at(x0) + resisted, m, h);
     // Newton's last point is `free + s n0`, the new position.

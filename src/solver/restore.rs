@@ -11,7 +11,7 @@ use super::settings::Gains;
 use super::solve::{SolveError, resistance, solve_on};
 use super::state::{BeadState, LinearForce, LinearForceLanes};
 use crate::geometry::Track;
-use crate::lane::{Lane, V2};
+use crate::lane::{Lane, Vector};
 
 /// The largest relative change of speed eq. (11) makes: a fourth-order
 /// step's energy error is far below it; a larger mismatch means a bead at
@@ -45,7 +45,7 @@ pub(crate) fn energy_scale<T: Lane>(kinetic_target: T, kinetic_now: T) -> T {
 /// `now` (relative to the wire) the speed of `relative + h kick`, the
 /// start's velocity relative to the wire plus the step's kick along it.
 #[inline(always)]
-pub(crate) fn speed_scale<T: Lane>(relative: V2<T>, kick: V2<T>, h: T, now: V2<T>) -> T {
+pub(crate) fn speed_scale<T: Lane, V: Vector<T>>(relative: V, kick: V, h: T, now: V) -> T {
     let moved = relative.plus(h, kick);
     kinetic_scale(moved.dot(moved), now.dot(now))
 }
@@ -54,11 +54,11 @@ pub(crate) fn speed_scale<T: Lane>(relative: V2<T>, kick: V2<T>, h: T, now: V2<T
 /// the projected state `(xp, vp)` the energy of the start `(x0, v0)`,
 /// kinetic plus the potential of the linear force of eq. (5).
 #[inline(always)]
-pub(crate) fn bead_energy_scale<T: Lane>(
-    force: &LinearForceLanes<T>,
+pub(crate) fn bead_energy_scale<T: Lane, V: Vector<T>>(
+    force: &LinearForceLanes<T, V>,
     m: T,
-    (x0, v0): (V2<T>, V2<T>),
-    (xp, vp): (V2<T>, V2<T>),
+    (x0, v0): (V, V),
+    (xp, vp): (V, V),
 ) -> T {
     let half = m.splat(0.5);
     let target = half * m * v0.dot(v0) + force.potential(x0) - force.potential(xp);
@@ -112,7 +112,7 @@ pub(crate) fn restore<T: Track + ?Sized>(
         }
         let kick = along_wire(normal, applied, x0)?;
         let now = projected.velocity - w1;
-        let scale = speed_scale(relative.into(), kick.into(), h, now.into());
+        let scale = speed_scale(relative, kick, h, now);
         w1 + scale * now
     } else if T::MOVES || track.surface().is_some_and(|(s, _)| s.resists()) {
         return Ok(projected);

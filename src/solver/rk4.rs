@@ -4,17 +4,17 @@ use super::settings::Gains;
 use super::solve::{SolveError, Solved, solve_on};
 use super::state::{Advance, BeadState, LinearForce};
 use crate::geometry::{FixedTrack, ImplicitCurve, Track};
-use crate::lane::{Lane, V2};
+use crate::lane::{Lane, V2, Vector};
 
 /// The acceleration at each later stage of eq. (7): eq. (4) solved afresh.
 /// A trait rather than a closure, so that the batched step's stages are
 /// inlined into its AVX2 function.
-pub(crate) trait Stages<T> {
+pub(crate) trait Stages<T, V = V2<T>> {
     /// Why a stage cannot be solved.
     type Error;
     /// The acceleration at `(x, v)`, a fraction `at` of the step after its
     /// start (½, ½, then 1).
-    fn acceleration(&mut self, x: V2<T>, v: V2<T>, at: f64) -> Result<V2<T>, Self::Error>;
+    fn acceleration(&mut self, x: V, v: V, at: f64) -> Result<V, Self::Error>;
 }
 
 /// The later stages of eq. (7): where each is taken (a fraction of the
@@ -27,11 +27,7 @@ pub(crate) const RK4_STAGES: [(f64, f64); 3] = [(0.5, 2.0), (0.5, 2.0), (1.0, 1.
 /// times `h`), a stage's derivative added to the sum at its weight, and
 /// the step's end from the sum (`t = h/6`).
 #[inline(always)]
-pub(crate) fn rk4_plus<T: Lane>(
-    (x, v): (V2<T>, V2<T>),
-    t: T,
-    (dx, dv): (V2<T>, V2<T>),
-) -> (V2<T>, V2<T>) {
+pub(crate) fn rk4_plus<T: Lane, V: Vector<T>>((x, v): (V, V), t: T, (dx, dv): (V, V)) -> (V, V) {
     (x.plus(t, dx), v.plus(t, dv))
 }
 
@@ -39,13 +35,13 @@ pub(crate) fn rk4_plus<T: Lane>(
 /// acceleration there; `stages` gives the acceleration at each later stage,
 /// or stops the step with its error.
 #[inline(always)]
-pub(crate) fn rk4_lanes<T: Lane, S: Stages<T>>(
-    x: V2<T>,
-    v: V2<T>,
-    a: V2<T>,
+pub(crate) fn rk4_lanes<T: Lane, V: Vector<T>, S: Stages<T, V>>(
+    x: V,
+    v: V,
+    a: V,
     h: T,
     stages: &mut S,
-) -> Result<(V2<T>, V2<T>), S::Error> {
+) -> Result<(V, V), S::Error> {
     // The stages written out: the batched step runs faster so than with a
     // loop over them.
     let [(at2, w2), (at3, w3), (at4, w4)] = RK4_STAGES;

@@ -8,7 +8,7 @@ use super::settings::Gains;
 use super::state::{BeadState, LinearForce};
 use super::wire_normal::{along, usable};
 use crate::geometry::{FixedTrack, Geometry, ImplicitCurve, Surface, Track};
-use crate::lane::{Lane, V2};
+use crate::lane::{Lane, V2, Vector};
 
 /// Why a step could not be taken.
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
@@ -82,13 +82,13 @@ pub(crate) fn normal_length_squared(normal: DVec2, x: DVec2) -> Result<f64, Solv
 
 /// Eqs. (3) and (4) on lanes: what [`constraint_force`] returns.
 #[derive(Clone, Copy)]
-pub(crate) struct ConstraintForce<T> {
+pub(crate) struct ConstraintForce<T, V = V2<T>> {
     /// `|N|²`.
     pub(crate) nn: T,
     /// λ.
     pub(crate) lambda: T,
     /// `(f + λN) / m`.
-    pub(crate) acceleration: V2<T>,
+    pub(crate) acceleration: V,
 }
 
 /// λ of eq. (3) and the acceleration of eq. (4), written once for one
@@ -96,15 +96,15 @@ pub(crate) struct ConstraintForce<T> {
 /// `c` is `C`, all where the bead is; `v` its velocity, `f` the force on
 /// it, `m` its mass. The caller checks `nn` (a vanishing normal).
 #[inline(always)]
-pub(crate) fn constraint_force<T: Lane>(
-    n: V2<T>,
-    hv: V2<T>,
+pub(crate) fn constraint_force<T: Lane, V: Vector<T>>(
+    n: V,
+    hv: V,
     c: T,
-    v: V2<T>,
-    f: V2<T>,
+    v: V,
+    f: V,
     m: T,
     gains: Gains,
-) -> ConstraintForce<T> {
+) -> ConstraintForce<T, V> {
     let vhv = v.dot(hv);
     let (alpha, beta) = (m.splat(gains.alpha), m.splat(gains.beta));
     let nn = n.dot(n);
@@ -261,20 +261,20 @@ pub(crate) fn resistance(
     lambda: f64,
 ) -> DVec2 {
     let nn = normal.length_squared();
-    let along = |a: DVec2| along(normal.into(), nn, a.into());
+    let along = |a: DVec2| along(normal, nn, a);
     let press = friction::press(lambda, nn);
     let damping = friction::damping(surface.damping, along(relative));
     let direction = along(sliding);
     let speed = direction.dot(direction).sqrt();
     if speed > 0.0 {
-        return (damping + friction::kinetic(&surface.friction, press, direction, speed)).into();
+        return damping + friction::kinetic(&surface.friction, press, direction, speed);
     }
     let pull = along(applied);
     let strength = pull.dot(pull).sqrt();
     if friction::holds(&surface.friction, strength, press) {
-        -DVec2::from(pull)
+        -pull
     } else {
-        friction::kinetic(&surface.friction, press, pull, strength).into()
+        friction::kinetic(&surface.friction, press, pull, strength)
     }
 }
 

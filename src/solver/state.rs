@@ -3,7 +3,7 @@
 
 use bevy::math::DVec2;
 
-use crate::lane::{Lane, V2};
+use crate::lane::{Lane, V2, Vector};
 
 /// Position and velocity of one bead.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -73,26 +73,26 @@ impl LinearForce {
     }
 }
 
-/// [`LinearForce`] on lanes.
+/// [`LinearForce`] on lanes, in the plane or in space.
 #[derive(Clone, Copy)]
-pub(crate) struct LinearForceLanes<T> {
-    pub(crate) force: V2<T>,
+pub(crate) struct LinearForceLanes<T, V = V2<T>> {
+    pub(crate) force: V,
     pub(crate) stiffness: T,
-    pub(crate) at: V2<T>,
+    pub(crate) at: V,
 }
 
-impl<T: Lane> LinearForceLanes<T> {
+impl<T: Lane, V: Vector<T>> LinearForceLanes<T, V> {
     /// Eq. (5): `f(x) = force - stiffness (x - at)`.
     #[inline(always)]
-    pub(crate) fn at(&self, x: V2<T>) -> V2<T> {
+    pub(crate) fn at(&self, x: V) -> V {
         self.force - (x - self.at).scale(self.stiffness)
     }
 
     /// The potential of eq. (5)'s force (see [`LinearForce::potential`]).
     #[inline(always)]
-    pub(crate) fn potential(&self, x: V2<T>) -> T {
+    pub(crate) fn potential(&self, x: V) -> T {
         let d = x - self.at;
-        -self.force.dot(d) + d.x.splat(0.5) * self.stiffness * d.dot(d)
+        -self.force.dot(d) + self.stiffness.splat(0.5) * self.stiffness * d.dot(d)
     }
 }
 

@@ -3,7 +3,7 @@
 //! along the wire. Written once over [`Lane`], for one bead, for the
 //! batched lanes and for an island's rows.
 
-use crate::lane::{Lane, V2};
+use crate::lane::{Lane, Vector};
 
 /// The smallest `|N|²` a solve divides by: below it (or where it is not
 /// finite) the normal vanishes and the bead is at a singular point of its
@@ -22,13 +22,13 @@ pub(crate) fn usable<T: Lane>(nn: T) -> T::Mask {
 /// The part of `v` across the wire: its component along `n`, whose
 /// squared length is `nn`.
 #[inline(always)]
-pub(crate) fn across<T: Lane>(n: V2<T>, nn: T, v: V2<T>) -> V2<T> {
+pub(crate) fn across<T: Lane, V: Vector<T>>(n: V, nn: T, v: V) -> V {
     n.scale(n.dot(v) / nn)
 }
 
 /// The part of `v` along the wire: `v` without its component along `n`,
 /// whose squared length is `nn`.
 #[inline(always)]
-pub(crate) fn along<T: Lane>(n: V2<T>, nn: T, v: V2<T>) -> V2<T> {
+pub(crate) fn along<T: Lane, V: Vector<T>>(n: V, nn: T, v: V) -> V {
     v - across(n, nn, v)
 }

@@ -191,7 +191,7 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         let nn = normal_length_squared(normal, state.position)?;
         let wire = self.track.twist(t).velocity_at(state.position);
         let relative = state.velocity - wire;
-        let across = DVec2::from(across(normal.into(), nn, relative.into()));
+        let across = across(normal, nn, relative);
         Ok((wire, relative - across, across))
     }
 }

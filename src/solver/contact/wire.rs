@@ -87,7 +87,7 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         let applied = in_frame(self.track, t, state, f, self.mass).applied;
         let normal = self.track.geometry(t, state.position).normal;
         let nn = normal.length_squared();
-        let pull = DVec2::from(along(normal.into(), nn, applied.into()));
+        let pull = along(normal, nn, applied);
         let press = friction::press(solved.lambda, nn);
         Ok(friction::holds(&self.surface.friction, pull.length(), press).then_some(solved))
     }

@@ -7,7 +7,7 @@
 use std::convert::Infallible;
 
 use crate::geometry::circle_geometry;
-use crate::lane::{Lane, V2};
+use crate::lane::{Lane, V2, Vector};
 use crate::solver::newton::{WireAt, newton_onto, tangential};
 use crate::solver::rattle::rattle_lanes;
 use crate::solver::restore::{bead_energy_scale, speed_scale};
@@ -121,6 +121,7 @@ pub(super) struct OnCircles<T: Lane> {
 }
 
 impl<T: Lane> WireAt<T> for OnCircles<T> {
+    type V = V2<T>;
     type At = At<T>;
     /// The circle at `p`.
     #[inline(always)]

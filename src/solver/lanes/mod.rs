@@ -29,7 +29,7 @@ use super::step::drift_check;
 use super::step::step;
 pub use crate::lane::LANES;
 #[cfg(target_arch = "x86_64")]
-use crate::lane::{F64x8, Lane, V2, avx2};
+use crate::lane::{F64x8, Lane, V2, Vector, avx2};
 use bevy::math::DVec2;
 #[cfg(target_arch = "x86_64")]
 use pulp::x86::V3;

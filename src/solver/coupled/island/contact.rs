@@ -63,10 +63,9 @@ impl Island {
             }
             let speed = direction.length();
             if speed > 0.0 {
-                let kinetic = friction::kinetic(&rough.friction, press, direction.into(), speed);
-                forces[bead].force += DVec2::from(kinetic);
+                forces[bead].force += friction::kinetic(&rough.friction, press, direction, speed);
             }
-            forces[bead].force += DVec2::from(friction::damping(rough.damping, sliding.into()));
+            forces[bead].force += friction::damping(rough.damping, sliding);
             slides.push((r, bead, sliding));
         }
         slides

@@ -152,10 +152,9 @@ impl Island {
         work.x.clear();
         work.v.clear();
         for i in 0..n {
-            let start = (work.x0[i].into(), work.v0[i].into());
+            let start = (work.x0[i], work.v0[i]);
             let m = self.inverse_mass[i].recip();
-            work.x
-                .push(rattle_drift(start, work.force[i].into(), m, h).into());
+            work.x.push(rattle_drift(start, work.force[i], m, h));
             work.v.push(work.v0[i]);
         }
         work.time += h;
@@ -173,7 +172,7 @@ impl Island {
         self.applied(forces, &work.x, &work.v, &mut work.force);
         for i in 0..n {
             let m = self.inverse_mass[i].recip();
-            work.v[i] = rattle_half_kick(work.v[i].into(), work.force[i].into(), m, h).into();
+            work.v[i] = rattle_half_kick(work.v[i], work.force[i], m, h);
         }
         self.evaluate_at_new(work);
         self.project_velocity(work)?;

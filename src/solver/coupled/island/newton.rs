@@ -8,7 +8,8 @@
 use super::{EXACT_STEPS, Island, IslandWork};
 use bevy::math::DVec2;
 
-use crate::solver::newton::{NEWTON_MAX_ITERATIONS, newton_accepted, newton_within, reach};
+use crate::lane::Vector;
+use crate::solver::newton::{NEWTON_MAX_ITERATIONS, newton_accepted, newton_within};
 use crate::solver::solve::SolveError;
 
 impl Island {
@@ -125,7 +126,7 @@ impl Island {
     /// the coordinates its `C` is computed from reaches.
     fn reach(&self, r: usize, x: &[DVec2]) -> f64 {
         (self.row_start[r]..self.row_start[r + 1])
-            .map(|e| reach(x[self.entry_bead[e]].into()))
+            .map(|e| x[self.entry_bead[e]].reach())
             .fold(0.0, f64::max)
     }
 

@@ -266,7 +266,7 @@ impl RowAt {
     pub(super) fn sliding(&self, velocity: DVec2) -> DVec2 {
         let relative = velocity - self.wire;
         let nn = self.normal.length_squared();
-        along(self.normal.into(), nn, relative.into()).into()
+        along(self.normal, nn, relative)
     }
 
     /// The unit direction along the wire: a stick row's axis.

@@ -320,8 +320,7 @@ impl Island {
                 };
                 for i in 0..n {
                     let (x, v, a) = (work.x0[i], work.v0[i], work.acceleration[i]);
-                    let (x1, v1) = euler(x.into(), v.into(), a.into(), h);
-                    (work.x[i], work.v[i]) = (x1.into(), v1.into());
+                    (work.x[i], work.v[i]) = euler(x, v, a, h);
                 }
                 self.keep_lambda(work);
             }
