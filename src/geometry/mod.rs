@@ -19,6 +19,7 @@
 //! This module knows nothing of the ECS: plain values and `bevy_math` only.
 
 mod circle;
+mod coordinates;
 mod cycloid;
 mod ellipse;
 mod line;
@@ -35,6 +36,7 @@ use bevy::math::{DMat2, DVec2};
 
 pub use circle::Circle;
 pub(crate) use circle::circle_geometry;
+pub use coordinates::Coordinates;
 pub use cycloid::{Cycloid, CycloidArch};
 pub use ellipse::Ellipse;
 pub use line::Line;
@@ -52,13 +54,13 @@ pub use traced::{HINT_WINDOW, Parametric, Traced};
 
 /// The value, gradient and Hessian of a constraint at one point.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Geometry {
+pub struct Geometry<V: Coordinates = DVec2> {
     /// The constraint value `C(x)`: zero on the wire.
     pub c: f64,
     /// The gradient `N = ∇C(x)`.
-    pub normal: DVec2,
+    pub normal: V,
     /// The Hessian `H(x)` of `C`, so that `Ṅ = H ẋ`.
-    pub hessian: DMat2,
+    pub hessian: V::Hessian,
 }
 
 /// A curve in the plane given implicitly by `C(x) = 0`.

@@ -24,48 +24,45 @@ use std::f64::consts::TAU;
 use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
 
-use super::{Geometry, ImplicitCurve, Placed, Pose, Surface};
+use super::{Coordinates, Geometry, ImplicitCurve, Placed, Pose, Surface};
 use crate::validate::{ParamError, finite, finite_vector, positive};
 
-/// The quarter turn `J d = (−d.y, d.x)`.
-#[inline(always)]
-fn perp(d: DVec2) -> DVec2 {
-    DVec2::new(-d.y, d.x)
-}
-
-/// A rigid motion of the plane at one instant: the velocity and
-/// acceleration of a reference point and the angular velocity and
+/// A rigid motion at one instant, in the plane or in space: the velocity
+/// and acceleration of a reference point and the angular velocity and
 /// acceleration about it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Twist {
+pub struct Twist<V: Coordinates = DVec2> {
     /// The reference point (the wire's origin `p`).
-    pub origin: DVec2,
+    pub origin: V,
     /// `ṗ`.
-    pub velocity: DVec2,
-    /// `ω`, counter-clockwise positive.
-    pub angular_velocity: f64,
+    pub velocity: V,
+    /// `ω`: counter-clockwise positive in the plane, along the axis
+    /// (right-handed) in space.
+    pub angular_velocity: V::Angular,
     /// `p̈`.
-    pub acceleration: DVec2,
+    pub acceleration: V,
     /// `ω̇`.
-    pub angular_acceleration: f64,
+    pub angular_acceleration: V::Angular,
 }
 
-impl Twist {
-    /// The velocity `w(x) = ṗ + ω J(x − p)` of the moving frame's point at `x`.
+impl<V: Coordinates> Twist<V> {
+    /// The velocity `w(x) = ṗ + ω × (x − p)` of the moving frame's point
+    /// at `x` (`ω J (x − p)` in the plane).
     #[inline]
-    pub fn velocity_at(&self, x: DVec2) -> DVec2 {
-        self.velocity + self.angular_velocity * perp(x - self.origin)
+    pub fn velocity_at(&self, x: V) -> V {
+        self.velocity + V::turn(self.angular_velocity, x - self.origin)
     }
 
-    /// `a_w = p̈ + ω̇ J r − ω² r + 2ω J v_r` (`r = x − p`): the acceleration
-    /// of the frame's point at `x` plus the Coriolis term for a body moving
-    /// at `relative_velocity` in the frame.
+    /// `a_w = p̈ + ω̇ × r + ω × (ω × r) + 2ω × v_r` (`r = x − p`; in the
+    /// plane `p̈ + ω̇ J r − ω² r + 2ω J v_r`): the acceleration of the
+    /// frame's point at `x` plus the Coriolis term for a body moving at
+    /// `relative_velocity` in the frame.
     #[inline]
-    pub fn acceleration_at(&self, x: DVec2, relative_velocity: DVec2) -> DVec2 {
+    pub fn acceleration_at(&self, x: V, relative_velocity: V) -> V {
         let r = x - self.origin;
         let w = self.angular_velocity;
-        self.acceleration + self.angular_acceleration * perp(r) - w * w * r
-            + 2.0 * w * perp(relative_velocity)
+        self.acceleration + V::turn(self.angular_acceleration, r) - V::centripetal(w, r)
+            + V::turn(V::twice(w), relative_velocity)
     }
 }
 
@@ -316,29 +313,30 @@ impl PosePath {
 }
 
 /// A wire over time, as the solver asks for it: its geometry where a bead
-/// is at time `t`, and the velocity and acceleration of its points.
-pub trait Track {
+/// is at time `t`, and the velocity and acceleration of its points. `V`
+/// is the plane's [`DVec2`] (a curve) or space's `DVec3` (a surface).
+pub trait Track<V: Coordinates = DVec2> {
     /// Whether the wire may move. When false, `velocity_at` and
     /// `acceleration_at` are zero and the solver skips them.
     const MOVES: bool;
     /// `C`, `∇C` and the Hessian at `x` at time `t`.
-    fn geometry(&self, t: f64, x: DVec2) -> Geometry;
+    fn geometry(&self, t: f64, x: V) -> Geometry<V>;
     /// A characteristic length (see [`ImplicitCurve::scale`]).
     fn scale(&self) -> f64;
     /// The wire's twist at time `t`.
-    fn twist(&self, t: f64) -> Twist;
+    fn twist(&self, t: f64) -> Twist<V>;
     /// Whether the wire ends (see [`ImplicitCurve::has_ends`]).
     fn has_ends(&self) -> bool;
     /// How far past an end the point nearest `x` is at time `t` (see
     /// [`ImplicitCurve::past_end`]).
-    fn past_end(&self, t: f64, x: DVec2) -> f64;
+    fn past_end(&self, t: f64, x: V) -> f64;
     /// Where the point of the wire that is at `x` at time `from` is at time
     /// `to` (a bead held still on the wire is carried there).
-    fn carry(&self, x: DVec2, from: f64, to: f64) -> DVec2;
+    fn carry(&self, x: V, from: f64, to: f64) -> V;
     /// Friction and damping along the wire, if it has any, and the
     /// direction the bead slid in at the step's start (see [`Rough`]).
     #[inline(always)]
-    fn surface(&self) -> Option<(&Surface, DVec2)> {
+    fn surface(&self) -> Option<(&Surface, V)> {
         None
     }
 }
@@ -348,38 +346,38 @@ pub trait Track {
 /// start (zero if it was at rest). Kinetic friction keeps opposing that
 /// direction through the step, so that a bead friction stops within a step
 /// reverses rather than chatters, and the step is cut where it stops.
-pub struct Rough<'a, T: Track + ?Sized> {
+pub struct Rough<'a, T: ?Sized, V: Coordinates = DVec2> {
     /// The wire.
     pub track: &'a T,
     /// What resists sliding on it.
     pub surface: &'a Surface,
     /// The bead's velocity along the wire (relative to it) at the step's
     /// start.
-    pub sliding: DVec2,
+    pub sliding: V,
 }
 
-impl<T: Track + ?Sized> Track for Rough<'_, T> {
+impl<V: Coordinates, T: Track<V> + ?Sized> Track<V> for Rough<'_, T, V> {
     const MOVES: bool = T::MOVES;
     #[inline(always)]
-    fn geometry(&self, t: f64, x: DVec2) -> Geometry {
+    fn geometry(&self, t: f64, x: V) -> Geometry<V> {
         self.track.geometry(t, x)
     }
     fn scale(&self) -> f64 {
         self.track.scale()
     }
-    fn twist(&self, t: f64) -> Twist {
+    fn twist(&self, t: f64) -> Twist<V> {
         self.track.twist(t)
     }
-    fn carry(&self, x: DVec2, from: f64, to: f64) -> DVec2 {
+    fn carry(&self, x: V, from: f64, to: f64) -> V {
         self.track.carry(x, from, to)
     }
     fn has_ends(&self) -> bool {
         self.track.has_ends()
     }
-    fn past_end(&self, t: f64, x: DVec2) -> f64 {
+    fn past_end(&self, t: f64, x: V) -> f64 {
         self.track.past_end(t, x)
     }
-    fn surface(&self) -> Option<(&Surface, DVec2)> {
+    fn surface(&self) -> Option<(&Surface, V)> {
         Some((self.surface, self.sliding))
     }
 }

@@ -18,7 +18,7 @@ mod avx2;
 pub(crate) use avx2::{F64x8, avx2};
 
 /// A number or a vector of numbers the step's formulas run on.
-pub(crate) trait Lane:
+pub trait Lane:
     Copy
     + Add<Output = Self>
     + Sub<Output = Self>
@@ -52,9 +52,7 @@ pub(crate) trait Lane:
 }
 
 /// Per-lane truth values: `bool` for one bead, a mask for eight.
-pub(crate) trait Mask:
-    Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self>
-{
+pub trait Mask: Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self> {
     /// Whether any lane holds.
     fn any(self) -> bool;
 }
@@ -117,7 +115,7 @@ pub const LANES: usize = 8;
 /// take positions, velocities, forces and normals as, so that each is
 /// written once for both dimensions. [`V2`] and [`V3`] implement it; every
 /// operation is componentwise or a sum in the order glam sums it.
-pub(crate) trait Vector<T: Lane>: Copy + Add<Output = Self> + Sub<Output = Self> {
+pub trait Vector<T: Lane>: Copy + Add<Output = Self> + Sub<Output = Self> {
     /// `self · other`, as glam's `dot` sums it.
     fn dot(self, other: Self) -> T;
     /// `t self`.

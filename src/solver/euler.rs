@@ -3,7 +3,8 @@
 
 use super::solve::Solved;
 use super::state::{Advance, BeadState};
-use crate::lane::{Lane, V2, Vector};
+use crate::geometry::Coordinates;
+use crate::lane::{Lane, Vector};
 
 /// Explicit Euler on lanes: `x₁ = x₀ + h v₀`, `v₁ = v₀ + h a₀`.
 #[inline(always)]
@@ -19,14 +20,11 @@ pub(crate) fn semi_implicit_euler_lanes<T: Lane, V: Vector<T>>(x: V, v: V, a: V,
     (x.plus(h, v1), v1)
 }
 
-/// Wraps a step on one lane as an [`Advance`].
+/// Wraps a step of one bead as an [`Advance`].
 #[inline(always)]
-fn advance(first: &Solved, (x, v): (V2<f64>, V2<f64>)) -> Advance {
+fn advance<V: Coordinates>(first: &Solved<V>, (position, velocity): (V, V)) -> Advance<V> {
     Advance {
-        state: BeadState {
-            position: x.into(),
-            velocity: v.into(),
-        },
+        state: BeadState { position, velocity },
         lambda: first.lambda,
         constraint_force: first.constraint_force,
     }
@@ -34,17 +32,22 @@ fn advance(first: &Solved, (x, v): (V2<f64>, V2<f64>)) -> Advance {
 
 /// Explicit Euler: `x₁ = x₀ + h v₀`, `v₁ = v₀ + h a₀`.
 #[inline(always)]
-pub fn explicit_euler(state: BeadState, first: &Solved, h: f64) -> Advance {
+pub fn explicit_euler<V: Coordinates>(
+    state: BeadState<V>,
+    first: &Solved<V>,
+    h: f64,
+) -> Advance<V> {
     let (x, v, a) = (state.position, state.velocity, first.acceleration);
-    advance(first, explicit_euler_lanes(x.into(), v.into(), a.into(), h))
+    advance(first, explicit_euler_lanes(x, v, a, h))
 }
 
 /// Semi-implicit (symplectic) Euler: `v₁ = v₀ + h a₀`, `x₁ = x₀ + h v₁`.
 #[inline(always)]
-pub fn semi_implicit_euler(state: BeadState, first: &Solved, h: f64) -> Advance {
+pub fn semi_implicit_euler<V: Coordinates>(
+    state: BeadState<V>,
+    first: &Solved<V>,
+    h: f64,
+) -> Advance<V> {
     let (x, v, a) = (state.position, state.velocity, first.acceleration);
-    advance(
-        first,
-        semi_implicit_euler_lanes(x.into(), v.into(), a.into(), h),
-    )
+    advance(first, semi_implicit_euler_lanes(x, v, a, h))
 }

@@ -3,14 +3,14 @@
 //! all its rows' multipliers at once (a matrix solve in each Newton step
 //! and in the velocity solve), so its step is its own.
 
-use bevy::math::DVec2;
-
 use super::newton::{Root, WireAt, newton_along};
 use super::projection::{TrackAt, newton_error};
 use super::settings::Gains;
-use super::solve::{InFrame, SolveError, in_frame, normal_length_squared, resistance, solve_on};
+use super::solve::{
+    InFrame, SolveError, in_frame, normal_length_squared, resistance, singular, solve_on,
+};
 use super::state::{Advance, BeadState, LinearForce, LinearForceLanes};
-use crate::geometry::{FixedTrack, ImplicitCurve, Track};
+use crate::geometry::{Coordinates, FixedTrack, ImplicitCurve, Track};
 use crate::lane::{Lane, Vector};
 
 /// One RATTLE step of length `h`: the position solve by Newton along
@@ -30,14 +30,14 @@ pub fn rattle<C: ImplicitCurve + ?Sized>(
 /// the position solve meets `C(x₁, t + h) = 0`, the velocity solve
 /// `∇C·(v₁ − w(x₁)) = 0` at `t + h`, the wire's own velocity `w` taking
 /// the place of `−∂C/∂t`.
-pub(crate) fn rattle_on<T: Track + ?Sized>(
+pub(crate) fn rattle_on<V: Coordinates, T: Track<V> + ?Sized>(
     track: &T,
     t: f64,
-    state: BeadState,
-    force: &LinearForce,
+    state: BeadState<V>,
+    force: &LinearForce<V>,
     mass: f64,
     h: f64,
-) -> Result<Advance, SolveError> {
+) -> Result<Advance<V>, SolveError> {
     let BeadState {
         position: x0,
         velocity: v0,
@@ -54,34 +54,34 @@ pub(crate) fn rattle_on<T: Track + ?Sized>(
             let lambda = solve_on(track, t, state, force, mass, Gains::NONE)?.lambda;
             resistance(surface, sliding, n0, relative, applied, lambda)
         }
-        None => DVec2::ZERO,
+        None => V::ZERO,
     };
-    let wire = TrackAt { track, t: t + h };
+    let wire = TrackAt::new(track, t + h);
     let step = rattle_lanes(
         &wire,
-        (x0.into(), v0.into()),
-        n0.into(),
+        (x0, v0),
+        n0,
         &force.lanes(),
-        resisted.into(),
+        resisted,
         mass,
         h,
         wire.scale(),
         true,
     );
-    let x1 = DVec2::from(step.x);
+    let x1 = step.x;
     if !step.root.found {
         return Err(newton_error(&step.root, x1));
     }
     if !step.end_usable {
-        return Err(SolveError::Singular { x: x1.x, y: x1.y });
+        return Err(singular(x1));
     }
     Ok(Advance {
         state: BeadState {
             position: x1,
-            velocity: step.v.into(),
+            velocity: step.v,
         },
         lambda: step.lambda,
-        constraint_force: step.constraint_force.into(),
+        constraint_force: step.constraint_force,
     })
 }
 

@@ -10,7 +10,7 @@ use super::projection::{along_wire, tangential, wire_velocity};
 use super::settings::Gains;
 use super::solve::{SolveError, resistance, solve_on};
 use super::state::{BeadState, LinearForce, LinearForceLanes};
-use crate::geometry::Track;
+use crate::geometry::{Coordinates, Track};
 use crate::lane::{Lane, Vector};
 
 /// The largest relative change of speed eq. (11) makes: a fourth-order
@@ -86,16 +86,16 @@ pub(crate) fn bead_energy_scale<T: Lane, V: Vector<T>>(
 /// Either way the velocity's normal component, which the scale multiplies
 /// from rounding, is removed again.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn restore<T: Track + ?Sized>(
+pub(crate) fn restore<V: Coordinates, T: Track<V> + ?Sized>(
     track: &T,
     t: f64,
     h: f64,
     euler: bool,
-    start: BeadState,
-    projected: BeadState,
-    force: &LinearForce,
+    start: BeadState<V>,
+    projected: BeadState<V>,
+    force: &LinearForce<V>,
     mass: f64,
-) -> Result<BeadState, SolveError> {
+) -> Result<BeadState<V>, SolveError> {
     let (x0, x1, t1) = (start.position, projected.position, t + h);
     let velocity = if euler {
         let (w0, w1) = (wire_velocity(track, t, x0), wire_velocity(track, t1, x1));
@@ -107,23 +107,23 @@ pub(crate) fn restore<T: Track + ?Sized>(
         let normal = track.geometry(t, x0).normal;
         if let Some((surface, sliding)) = track.surface() {
             let lambda = solve_on(track, t, start, force, mass, Gains::NONE)?.lambda;
-            let resisted = resistance(surface, sliding, normal, relative, mass * applied, lambda);
+            let resisted = resistance(surface, sliding, normal, relative, applied * mass, lambda);
             applied += resisted / mass;
         }
         let kick = along_wire(normal, applied, x0)?;
         let now = projected.velocity - w1;
         let scale = speed_scale(relative, kick, h, now);
-        w1 + scale * now
+        w1 + now * scale
     } else if T::MOVES || track.surface().is_some_and(|(s, _)| s.resists()) {
         return Ok(projected);
     } else {
         let scale = bead_energy_scale(
             &force.lanes(),
             mass,
-            (x0.into(), start.velocity.into()),
-            (x1.into(), projected.velocity.into()),
+            (x0, start.velocity),
+            (x1, projected.velocity),
         );
-        scale * projected.velocity
+        projected.velocity * scale
     };
     Ok(BeadState {
         velocity: tangential(track, t1, x1, velocity)?,

@@ -3,7 +3,7 @@
 use super::settings::Gains;
 use super::solve::{SolveError, Solved, solve_on};
 use super::state::{Advance, BeadState, LinearForce};
-use crate::geometry::{FixedTrack, ImplicitCurve, Track};
+use crate::geometry::{Coordinates, FixedTrack, ImplicitCurve, Track};
 use crate::lane::{Lane, V2, Vector};
 
 /// The acceleration at each later stage of eq. (7): eq. (4) solved afresh.
@@ -76,16 +76,16 @@ pub fn rk4<C: ImplicitCurve + ?Sized>(
 /// stage is solved at its own time.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn rk4_on<T: Track + ?Sized>(
+pub(crate) fn rk4_on<V: Coordinates, T: Track<V> + ?Sized>(
     track: &T,
     t: f64,
-    state: BeadState,
-    force: &LinearForce,
+    state: BeadState<V>,
+    force: &LinearForce<V>,
     mass: f64,
     gains: Gains,
-    first: &Solved,
+    first: &Solved<V>,
     h: f64,
-) -> Result<Advance, SolveError> {
+) -> Result<Advance<V>, SolveError> {
     let mut stages = TrackStages {
         track,
         start: t,
@@ -95,11 +95,11 @@ pub(crate) fn rk4_on<T: Track + ?Sized>(
         gains,
     };
     let (x, v, a) = (state.position, state.velocity, first.acceleration);
-    let (x1, v1) = rk4_lanes(x.into(), v.into(), a.into(), h, &mut stages)?;
+    let (x1, v1) = rk4_lanes(x, v, a, h, &mut stages)?;
     Ok(Advance {
         state: BeadState {
-            position: x1.into(),
-            velocity: v1.into(),
+            position: x1,
+            velocity: v1,
         },
         lambda: first.lambda,
         constraint_force: first.constraint_force,
@@ -107,25 +107,25 @@ pub(crate) fn rk4_on<T: Track + ?Sized>(
 }
 
 /// The stages of one bead on any wire: [`solve_on`] at each, at its time.
-struct TrackStages<'a, T: ?Sized> {
+struct TrackStages<'a, T: ?Sized, V> {
     track: &'a T,
     start: f64,
     h: f64,
-    force: &'a LinearForce,
+    force: &'a LinearForce<V>,
     mass: f64,
     gains: Gains,
 }
 
-impl<T: Track + ?Sized> Stages<f64> for TrackStages<'_, T> {
+impl<V: Coordinates, T: Track<V> + ?Sized> Stages<f64, V> for TrackStages<'_, T, V> {
     type Error = SolveError;
     #[inline(always)]
-    fn acceleration(&mut self, x: V2<f64>, v: V2<f64>, at: f64) -> Result<V2<f64>, SolveError> {
+    fn acceleration(&mut self, x: V, v: V, at: f64) -> Result<V, SolveError> {
         let stage = BeadState {
-            position: x.into(),
-            velocity: v.into(),
+            position: x,
+            velocity: v,
         };
         let t = self.start + at * self.h;
         solve_on(self.track, t, stage, self.force, self.mass, self.gains)
-            .map(|solved| solved.acceleration.into())
+            .map(|solved| solved.acceleration)
     }
 }

@@ -7,7 +7,7 @@ use super::friction;
 use super::settings::Gains;
 use super::state::{BeadState, LinearForce};
 use super::wire_normal::{along, usable};
-use crate::geometry::{FixedTrack, Geometry, ImplicitCurve, Surface, Track};
+use crate::geometry::{Coordinates, FixedTrack, Geometry, ImplicitCurve, Surface, Track};
 use crate::lane::{Lane, V2, Vector};
 
 /// Why a step could not be taken.
@@ -21,6 +21,18 @@ pub enum SolveError {
         x: f64,
         /// y of the point.
         y: f64,
+    },
+    /// As [`SolveError::Singular`], for a bead in space.
+    #[error(
+        "the bead is at a singular point of its wire ({x}, {y}, {z}), where the normal ∇C vanishes"
+    )]
+    SingularInSpace {
+        /// x of the point.
+        x: f64,
+        /// y of the point.
+        y: f64,
+        /// z of the point.
+        z: f64,
     },
     /// The RATTLE or projection Newton iteration did not reach tolerance.
     #[error(
@@ -59,25 +71,37 @@ pub enum SolveError {
 
 /// The constraint force at one state.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Solved {
+pub struct Solved<V = DVec2> {
     /// λ of eq. (3).
     pub lambda: f64,
     /// `λN`.
-    pub constraint_force: DVec2,
+    pub constraint_force: V,
     /// `(f + λN)/m`.
-    pub acceleration: DVec2,
+    pub acceleration: V,
+}
+
+/// [`SolveError::Singular`] (or [`SolveError::SingularInSpace`]) for a
+/// bead at the singular point `x` of its wire.
+#[cold]
+pub(crate) fn singular<V: Coordinates>(x: V) -> SolveError {
+    let p = x.xyz();
+    if V::DIMENSION == 2 {
+        SolveError::Singular { x: p.x, y: p.y }
+    } else {
+        SolveError::SingularInSpace {
+            x: p.x,
+            y: p.y,
+            z: p.z,
+        }
+    }
 }
 
 /// `|N|²` where the bead is at `x`, or [`SolveError::Singular`] where the
 /// normal vanishes or is not finite.
 #[inline(always)]
-pub(crate) fn normal_length_squared(normal: DVec2, x: DVec2) -> Result<f64, SolveError> {
-    let nn = normal.length_squared();
-    if usable(nn) {
-        Ok(nn)
-    } else {
-        Err(SolveError::Singular { x: x.x, y: x.y })
-    }
+pub(crate) fn normal_length_squared<V: Coordinates>(normal: V, x: V) -> Result<f64, SolveError> {
+    let nn = normal.dot(normal);
+    if usable(nn) { Ok(nn) } else { Err(singular(x)) }
 }
 
 /// Eqs. (3) and (4) on lanes: what [`constraint_force`] returns.
@@ -120,25 +144,17 @@ pub(crate) fn constraint_force<T: Lane, V: Vector<T>>(
 /// Eq. (3) where the wire's geometry is `g`, checked for a vanishing
 /// normal.
 #[inline(always)]
-fn constraint_force_at(
-    g: &Geometry,
-    state: BeadState,
-    f: DVec2,
+fn constraint_force_at<V: Coordinates>(
+    g: &Geometry<V>,
+    state: BeadState<V>,
+    f: V,
     mass: f64,
     gains: Gains,
-) -> Result<ConstraintForce<f64>, SolveError> {
+) -> Result<ConstraintForce<f64, V>, SolveError> {
     normal_length_squared(g.normal, state.position)?;
     let v = state.velocity;
-    let hv = g.hessian * v;
-    Ok(constraint_force(
-        g.normal.into(),
-        hv.into(),
-        g.c,
-        v.into(),
-        f.into(),
-        mass,
-        gains,
-    ))
+    let hv = V::hessian_times(&g.hessian, v);
+    Ok(constraint_force(g.normal, hv, g.c, v, f, mass, gains))
 }
 
 /// λ of eq. (3) for a bead of mass `mass` in `state` under the force `f`,
@@ -172,22 +188,22 @@ pub fn solve<C: ImplicitCurve + ?Sized>(
 /// so eq. (3) is solved with those, and `a_w` is added back to the
 /// acceleration.
 #[inline(always)]
-pub(crate) fn solve_on<T: Track + ?Sized>(
+pub(crate) fn solve_on<V: Coordinates, T: Track<V> + ?Sized>(
     track: &T,
     t: f64,
-    state: BeadState,
-    force: &LinearForce,
+    state: BeadState<V>,
+    force: &LinearForce<V>,
     mass: f64,
     gains: Gains,
-) -> Result<Solved, SolveError> {
+) -> Result<Solved<V>, SolveError> {
     let g = track.geometry(t, state.position);
     let f = force.at(state.position);
     if !T::MOVES && track.surface().is_none() {
         let solved = constraint_force_at(&g, state, f, mass, gains)?;
         return Ok(Solved {
             lambda: solved.lambda,
-            constraint_force: solved.lambda * g.normal,
-            acceleration: solved.acceleration.into(),
+            constraint_force: g.normal * solved.lambda,
+            acceleration: solved.acceleration,
         });
     }
     let InFrame {
@@ -200,47 +216,47 @@ pub(crate) fn solve_on<T: Track + ?Sized>(
         ..state
     };
     let solved = constraint_force_at(&g, seen, applied, mass, gains)?;
-    let mut acceleration = DVec2::from(solved.acceleration) + frame;
+    let mut acceleration = solved.acceleration + frame;
     if let Some((surface, sliding)) = track.surface() {
         acceleration +=
             resistance(surface, sliding, g.normal, relative, applied, solved.lambda) / mass;
     }
     Ok(Solved {
         lambda: solved.lambda,
-        constraint_force: solved.lambda * g.normal,
+        constraint_force: g.normal * solved.lambda,
         acceleration,
     })
 }
 
 /// A bead of mass `m` under the force `f`, seen from its wire's frame (see
 /// [`in_frame`]).
-pub(crate) struct InFrame {
+pub(crate) struct InFrame<V = DVec2> {
     /// The bead's velocity relative to the wire, `v_r = ẋ − w(x)`.
-    pub(crate) relative: DVec2,
+    pub(crate) relative: V,
     /// The frame's acceleration `a_w` where the bead is.
-    pub(crate) frame: DVec2,
+    pub(crate) frame: V,
     /// The force the bead feels in the frame, `f − m a_w`.
-    pub(crate) applied: DVec2,
+    pub(crate) applied: V,
 }
 
 /// `state` of a bead of mass `mass` under the force `f`, seen from its
 /// wire's frame at time `t`: for eq. (3) on a moving wire, RATTLE's and
 /// static friction's force along the wire.
 #[inline(always)]
-pub(crate) fn in_frame<T: Track + ?Sized>(
+pub(crate) fn in_frame<V: Coordinates, T: Track<V> + ?Sized>(
     track: &T,
     t: f64,
-    state: BeadState,
-    f: DVec2,
+    state: BeadState<V>,
+    f: V,
     mass: f64,
-) -> InFrame {
+) -> InFrame<V> {
     let twist = track.twist(t);
     let relative = state.velocity - twist.velocity_at(state.position);
     let frame = twist.acceleration_at(state.position, relative);
     InFrame {
         relative,
         frame,
-        applied: f - mass * frame,
+        applied: f - frame * mass,
     }
 }
 
@@ -252,16 +268,16 @@ pub(crate) fn in_frame<T: Track + ?Sized>(
 /// along the wire where the bead is) and damping the sliding itself; from
 /// rest (`sliding` zero), static friction cancels the force along the wire
 /// up to `μs |λ∇C|`, and past it kinetic friction opposes that force.
-pub(crate) fn resistance(
+pub(crate) fn resistance<V: Coordinates>(
     surface: &Surface,
-    sliding: DVec2,
-    normal: DVec2,
-    relative: DVec2,
-    applied: DVec2,
+    sliding: V,
+    normal: V,
+    relative: V,
+    applied: V,
     lambda: f64,
-) -> DVec2 {
-    let nn = normal.length_squared();
-    let along = |a: DVec2| along(normal, nn, a);
+) -> V {
+    let nn = normal.dot(normal);
+    let along = |a: V| along(normal, nn, a);
     let press = friction::press(lambda, nn);
     let damping = friction::damping(surface.damping, along(relative));
     let direction = along(sliding);

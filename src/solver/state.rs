@@ -3,27 +3,29 @@
 
 use bevy::math::DVec2;
 
+use crate::geometry::Coordinates;
 use crate::lane::{Lane, V2, Vector};
 
-/// Position and velocity of one bead.
+/// Position and velocity of one bead, in the plane (`DVec2`, the
+/// default) or in space (`DVec3`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct BeadState {
+pub struct BeadState<V = DVec2> {
     /// Position.
-    pub position: DVec2,
+    pub position: V,
     /// Velocity.
-    pub velocity: DVec2,
+    pub velocity: V,
 }
 
-impl BeadState {
+impl<V: Coordinates> BeadState<V> {
     /// Both vectors finite.
     pub fn is_finite(&self) -> bool {
         self.position.is_finite() && self.velocity.is_finite()
     }
 
     /// Kinetic and gravitational potential energy `(½ m |v|², -m g·x)`.
-    pub fn energy(&self, mass: f64, gravity: DVec2) -> (f64, f64) {
+    pub fn energy(&self, mass: f64, gravity: V) -> (f64, f64) {
         (
-            0.5 * mass * self.velocity.length_squared(),
+            0.5 * mass * self.velocity.dot(self.velocity),
             -mass * gravity.dot(self.position),
         )
     }
@@ -32,43 +34,44 @@ impl BeadState {
 /// An external force linearized about the step's starting position,
 /// eq. (5): `f(x) = force - stiffness (x - at)`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct LinearForce {
+pub struct LinearForce<V = DVec2> {
     /// The force at `at`.
-    pub force: DVec2,
+    pub force: V,
     /// The isotropic stiffness `S` (a spring's k).
     pub stiffness: f64,
     /// Where `force` was evaluated.
-    pub at: DVec2,
+    pub at: V,
 }
 
-impl LinearForce {
+impl<V: Coordinates> LinearForce<V> {
     /// A force that does not depend on position.
-    pub fn constant(force: DVec2) -> Self {
+    pub fn constant(force: V) -> Self {
         Self {
             force,
-            ..Self::default()
+            stiffness: 0.0,
+            at: V::ZERO,
         }
     }
 
     /// The potential of the force, `U(x) = −force·(x − at) + ½ S |x − at|²`
     /// (so `f = −∇U`), zero at `at`: the force of eq. (5) is conservative.
-    pub fn potential(&self, x: DVec2) -> f64 {
-        self.lanes().potential(x.into())
+    pub fn potential(&self, x: V) -> f64 {
+        self.lanes().potential(x)
     }
 
     /// `f(x)`.
     #[inline]
-    pub fn at(&self, x: DVec2) -> DVec2 {
-        self.lanes().at(x.into()).into()
+    pub fn at(&self, x: V) -> V {
+        self.lanes().at(x)
     }
 
     /// The force as the formulas over lanes take it.
     #[inline(always)]
-    pub(crate) fn lanes(&self) -> LinearForceLanes<f64> {
+    pub(crate) fn lanes(&self) -> LinearForceLanes<f64, V> {
         LinearForceLanes {
-            force: self.force.into(),
+            force: self.force,
             stiffness: self.stiffness,
-            at: self.at.into(),
+            at: self.at,
         }
     }
 }
@@ -99,14 +102,14 @@ impl<T: Lane, V: Vector<T>> LinearForceLanes<T, V> {
 /// What an integrator hands back: the new state and the constraint force
 /// it applied.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Advance {
+pub struct Advance<V = DVec2> {
     /// The new state.
-    pub state: BeadState,
+    pub state: BeadState<V>,
     /// The constraint multiplier the step applied (for RATTLE the mean of
     /// its position and velocity multipliers).
     pub lambda: f64,
     /// The constraint force the step applied.
-    pub constraint_force: DVec2,
+    pub constraint_force: V,
 }
 
 #[cfg(test)]

@@ -13,19 +13,19 @@ use super::rk4::rk4_on;
 use super::settings::StepSettings;
 use super::solve::{SolveError, solve_on};
 use super::state::{BeadState, LinearForce};
-use crate::geometry::{FixedTrack, ImplicitCurve, Track};
+use crate::geometry::{Coordinates, FixedTrack, ImplicitCurve, Track};
 use crate::lane::Lane;
 
 /// The result of one step.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StepOutput {
+pub struct StepOutput<V = DVec2> {
     /// The new state.
-    pub state: BeadState,
+    pub state: BeadState<V>,
     /// The constraint multiplier the step applied (for RATTLE the mean of
     /// its position and velocity multipliers).
     pub lambda: f64,
     /// The constraint force the step applied.
-    pub constraint_force: DVec2,
+    pub constraint_force: V,
     /// `C` at the new state.
     pub c: f64,
     /// `Ċ` at the new state.
@@ -48,21 +48,21 @@ pub fn step<C: ImplicitCurve + ?Sized>(
 }
 
 /// [`step`] on a wire that may move (see [`Track`]), the step starting at
-/// time `t`. Every method takes the wire's motion into account: the
+/// time `t`: a curve in the plane or a surface in space. Every method takes the wire's motion into account: the
 /// explicit ones through eq. (3) in the wire's frame at each stage's time,
 /// RATTLE and projection by solving `C(x, t + h) = 0` and
 /// `∇C·(ẋ − w) = 0` at the step's end. On a moving wire eq. (10) restores
 /// the speed relative to the wire, and eq. (11) is not applied: a moving
 /// wire does work on the bead, so there is no energy to keep.
 #[inline(always)]
-pub fn step_on<T: Track + ?Sized>(
+pub fn step_on<V: Coordinates, T: Track<V> + ?Sized>(
     track: &T,
     t: f64,
-    state: BeadState,
-    force: &LinearForce,
+    state: BeadState<V>,
+    force: &LinearForce<V>,
     mass: f64,
     settings: &StepSettings,
-) -> Result<StepOutput, SolveError> {
+) -> Result<StepOutput<V>, SolveError> {
     let h = settings.dt;
     let t1 = t + h;
     let gains = settings.gains();
@@ -126,7 +126,11 @@ pub fn constraint_state<C: ImplicitCurve + ?Sized>(curve: &C, state: BeadState) 
 
 /// `C` and `Ċ = ∇C·(ẋ − w)` at a state on a wire that may move, at time
 /// `t`.
-pub fn constraint_state_on<T: Track + ?Sized>(track: &T, t: f64, state: BeadState) -> (f64, f64) {
+pub fn constraint_state_on<V: Coordinates, T: Track<V> + ?Sized>(
+    track: &T,
+    t: f64,
+    state: BeadState<V>,
+) -> (f64, f64) {
     let g = track.geometry(t, state.position);
     let relative = if T::MOVES {
         state.velocity - track.twist(t).velocity_at(state.position)
