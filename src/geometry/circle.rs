@@ -62,16 +62,48 @@ pub(crate) struct CircleGeometry<T> {
     pub(crate) hessian: Sym2<T>,
 }
 
+/// `C = |p| − r` and `∇C = p / |p|` at `p` (relative to the centre) for a
+/// circle in the plane or a sphere in space, on lanes: one formula for
+/// both. The Hessian `(I − n nᵀ) / |p|` is assembled from `normal` and
+/// `inverse` in each dimension's matrix.
+#[derive(Clone, Copy)]
+pub(crate) struct Round<T, V> {
+    /// `|p|`: zero at the centre, where nothing else means anything.
+    pub(crate) len: T,
+    /// `C = |p| - r`.
+    pub(crate) c: T,
+    /// `∇C = p / |p|`.
+    pub(crate) normal: V,
+    /// `1 / |p|`.
+    pub(crate) inverse: T,
+}
+
+/// See [`Round`].
+#[inline(always)]
+pub(crate) fn round<T: Lane, V: Vector<T>>(p: V, radius: T) -> Round<T, V> {
+    let len = p.dot(p).sqrt();
+    let inverse = len.splat(1.0) / len;
+    Round {
+        len,
+        c: len - radius,
+        normal: p.scale(inverse),
+        inverse,
+    }
+}
+
 /// See [`CircleGeometry`].
 #[inline(always)]
 pub(crate) fn circle_geometry<T: Lane>(p: V2<T>, radius: T) -> CircleGeometry<T> {
-    let len = p.dot(p).sqrt();
+    let Round {
+        len,
+        c,
+        normal: n,
+        inverse: inv,
+    } = round(p, radius);
     let one = len.splat(1.0);
-    let inv = one / len;
-    let n = p.scale(inv);
     CircleGeometry {
         len,
-        c: len - radius,
+        c,
         normal: n,
         hessian: Sym2 {
             xx: (one - n.x * n.x) * inv,

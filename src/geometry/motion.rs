@@ -21,10 +21,10 @@
 
 use std::f64::consts::TAU;
 
-use bevy::math::DVec2;
+use bevy::math::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use super::{Coordinates, Geometry, ImplicitCurve, Placed, Pose, Surface};
+use super::{Coordinates, Geometry, ImplicitCurve, ImplicitSurface, Placed, Pose, Surface};
 use crate::validate::{ParamError, finite, finite_vector, positive};
 
 /// A rigid motion at one instant, in the plane or in space: the velocity
@@ -382,8 +382,32 @@ impl<V: Coordinates, T: Track<V> + ?Sized> Track<V> for Rough<'_, T, V> {
     }
 }
 
-/// A wire that stays put: the curve itself, in world coordinates.
-pub struct FixedTrack<'a, C: ImplicitCurve + ?Sized>(pub &'a C);
+/// A wire that stays put: the curve (in the plane) or the surface (in
+/// space) itself, in world coordinates.
+pub struct FixedTrack<'a, C: ?Sized>(pub &'a C);
+
+impl<S: ImplicitSurface + ?Sized> Track<DVec3> for FixedTrack<'_, S> {
+    const MOVES: bool = false;
+    #[inline(always)]
+    fn geometry(&self, _t: f64, x: DVec3) -> Geometry<DVec3> {
+        self.0.geometry(x)
+    }
+    fn scale(&self) -> f64 {
+        self.0.scale()
+    }
+    fn twist(&self, _t: f64) -> Twist<DVec3> {
+        Twist::default()
+    }
+    fn carry(&self, x: DVec3, _from: f64, _to: f64) -> DVec3 {
+        x
+    }
+    fn has_ends(&self) -> bool {
+        false
+    }
+    fn past_end(&self, _t: f64, _x: DVec3) -> f64 {
+        f64::NEG_INFINITY
+    }
+}
 
 impl<C: ImplicitCurve + ?Sized> Track for FixedTrack<'_, C> {
     const MOVES: bool = false;

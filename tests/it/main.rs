@@ -19,6 +19,7 @@ mod presets;
 mod readme;
 mod restart;
 mod scenes;
+mod space;
 mod tracks;
 #[cfg(feature = "gui")]
 mod window;

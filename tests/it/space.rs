@@ -1,0 +1,197 @@
+//! Beads on surfaces in space through the solver's one-row step, the
+//! same code that steps a bead on a curve in the plane.
+
+use std::f64::consts::TAU;
+
+use bevy::math::{DVec2, DVec3};
+use wirebead::geometry::{Circle, FixedTrack, Sphere};
+use wirebead::solver::{
+    BeadState, LinearForce, Method, Stabilization, StepSettings, constraint_state_on, step_on,
+};
+
+const G: f64 = 9.81;
+
+fn settings(method: Method, dt: f64) -> StepSettings {
+    StepSettings {
+        dt,
+        method,
+        alpha: 100.0,
+        beta: 20.0,
+        drift_bound: 1.0,
+    }
+}
+
+/// A bead inside a sphere of radius `r`, `alpha` from the downward
+/// vertical, moving round the vertical axis at the conical pendulum's
+/// speed `v² = g r sin²α / cos α`.
+fn conical_start(r: f64, alpha: f64) -> (BeadState<DVec3>, f64) {
+    let v = (G * r * alpha.sin().powi(2) / alpha.cos()).sqrt();
+    let state = BeadState {
+        position: DVec3::new(r * alpha.sin(), -r * alpha.cos(), 0.0),
+        velocity: DVec3::new(0.0, 0.0, -v),
+    };
+    (state, v)
+}
+
+/// RATTLE at 1 ms: the conical pendulum keeps its height to 1e-5 r and
+/// goes round in `2π r sin α / v` to 1e-5 (relative).
+#[test]
+fn a_conical_pendulum_on_a_sphere_keeps_its_height_and_period() {
+    let (r, alpha) = (1.5, 0.6);
+    let sphere = Sphere { radius: r };
+    let track = FixedTrack(&sphere);
+    let (mut state, v) = conical_start(r, alpha);
+    let force = LinearForce::constant(DVec3::new(0.0, -G, 0.0));
+    let s = settings(Method::Rattle, 1e-3);
+    let period = TAU * r * alpha.sin() / v;
+    let (height, mut worst) = (state.position.y, 0.0f64);
+    // The azimuth, unwrapped, and the time it passes 2π·k.
+    let (mut turned, mut previous) = (0.0f64, 0.0f64);
+    let mut passes = Vec::new();
+    let mut t = 0.0;
+    while passes.len() < 3 {
+        let out = step_on(&track, t, state, &force, 1.0, &s).expect("a step");
+        state = out.state;
+        t += s.dt;
+        worst = worst.max((state.position.y - height).abs());
+        // Going round from +x through −z: the azimuth about +y grows.
+        let azimuth = (-state.position.z).atan2(state.position.x);
+        let mut delta = azimuth - previous;
+        if delta < -TAU / 2.0 {
+            delta += TAU;
+        }
+        previous = azimuth;
+        let before = turned;
+        turned += delta;
+        let k = (passes.len() + 1) as f64;
+        if before < TAU * k && turned >= TAU * k {
+            let fraction = (TAU * k - before) / (turned - before);
+            passes.push(t - s.dt + fraction * s.dt);
+        }
+        assert!(t < 10.0 * period, "the bead did not go round");
+    }
+    assert!(worst <= 1e-5 * r, "height moved {worst:e}");
+    let measured = passes[2] / 3.0;
+    let error = (measured - period).abs() / period;
+    assert!(
+        error <= 1e-5,
+        "period {measured} against {period}: {error:e}"
+    );
+    let (c, c_dot) = constraint_state_on(&track, t, state);
+    assert!(
+        c.abs() <= 1e-12 && c_dot.abs() <= 1e-12,
+        "C = {c:e}, Ċ = {c_dot:e}"
+    );
+}
+
+/// From a start that is not a circular orbit, RATTLE keeps the angular
+/// momentum about the vertical to rounding (gravity and the sphere's
+/// push have no moment about it) and the energy to 1e-5 of m g r.
+#[test]
+fn a_spherical_pendulum_keeps_its_vertical_angular_momentum_and_energy() {
+    let r = 1.0;
+    let sphere = Sphere { radius: r };
+    let track = FixedTrack(&sphere);
+    let mut state = BeadState {
+        position: DVec3::new(r * 0.8f64.sin(), -r * 0.8f64.cos(), 0.0),
+        velocity: DVec3::new(0.0, 0.0, -1.3),
+    };
+    let m = 0.7;
+    let gravity = DVec3::new(0.0, -G, 0.0);
+    let force = LinearForce::constant(m * gravity);
+    let s = settings(Method::Rattle, 1e-3);
+    let momentum =
+        |b: &BeadState<DVec3>| m * (b.position.z * b.velocity.x - b.position.x * b.velocity.z);
+    let energy = |b: &BeadState<DVec3>| {
+        let (kinetic, potential) = b.energy(m, gravity);
+        kinetic + potential
+    };
+    let (l0, e0) = (momentum(&state), energy(&state));
+    let (mut worst_l, mut worst_e) = (0.0f64, 0.0f64);
+    for k in 0..5000 {
+        state = step_on(&track, k as f64 * s.dt, state, &force, m, &s)
+            .expect("a step")
+            .state;
+        worst_l = worst_l.max((momentum(&state) - l0).abs());
+        worst_e = worst_e.max((energy(&state) - e0).abs());
+    }
+    assert!(worst_l <= 1e-11 * l0.abs(), "L_y moved {worst_l:e} of {l0}");
+    assert!(worst_e <= 1e-5 * m * G * r, "energy moved {worst_e:e}");
+}
+
+/// A bead on a sphere moving in its xy great circle is a bead on a
+/// circle: every method gives the plane's trajectory, with z and its
+/// velocity exactly zero.
+#[test]
+fn a_sphere_cut_through_its_centre_steps_as_the_circle_does() {
+    let sphere = Sphere { radius: 1.2 };
+    let circle = Circle { radius: 1.2 };
+    for method in [
+        Method::ExplicitEuler(Stabilization::Baumgarte),
+        Method::SemiImplicitEuler(Stabilization::Baumgarte),
+        Method::SemiImplicitEuler(Stabilization::Projection),
+        Method::Rk4(Stabilization::Baumgarte),
+        Method::Rk4(Stabilization::Projection),
+        Method::Rattle,
+    ] {
+        let s = settings(method, 1.0 / 60.0);
+        let mut flat = BeadState {
+            position: DVec2::new(1.2 * 0.9f64.sin(), -1.2 * 0.9f64.cos()),
+            velocity: DVec2::new(0.5, 0.2),
+        };
+        let mut round = BeadState {
+            position: flat.position.extend(0.0),
+            velocity: flat.velocity.extend(0.0),
+        };
+        let (plane_force, space_force) = (
+            LinearForce::constant(DVec2::new(0.0, -G)),
+            LinearForce::constant(DVec3::new(0.0, -G, 0.0)),
+        );
+        let mut worst = 0.0f64;
+        for k in 0..300 {
+            let t = k as f64 * s.dt;
+            flat = step_on(&FixedTrack(&circle), t, flat, &plane_force, 1.0, &s)
+                .expect("a step in the plane")
+                .state;
+            round = step_on(&FixedTrack(&sphere), t, round, &space_force, 1.0, &s)
+                .expect("a step in space")
+                .state;
+            worst = worst.max((round.position.truncate() - flat.position).length());
+            assert_eq!((round.position.z, round.velocity.z), (0.0, 0.0), "{method}");
+        }
+        assert!(
+            worst <= 1e-10,
+            "{method}: {worst:e} from the plane's trajectory"
+        );
+    }
+}
+
+/// Every method holds a bead on a sphere: the drift stays within the
+/// method's own bound over 5 s of a swinging spherical pendulum.
+#[test]
+fn every_method_steps_a_bead_on_a_sphere() {
+    let r = 1.0;
+    let sphere = Sphere { radius: r };
+    let track = FixedTrack(&sphere);
+    for (method, bound) in [
+        (Method::ExplicitEuler(Stabilization::Baumgarte), 1e-2),
+        (Method::SemiImplicitEuler(Stabilization::Baumgarte), 1e-2),
+        (Method::SemiImplicitEuler(Stabilization::Projection), 1e-12),
+        (Method::Rk4(Stabilization::Baumgarte), 1e-3),
+        (Method::Rk4(Stabilization::Projection), 1e-12),
+        (Method::Rattle, 1e-12),
+    ] {
+        let (mut state, _) = conical_start(r, 0.5);
+        state.velocity *= 0.6;
+        let force = LinearForce::constant(DVec3::new(0.0, -G, 0.0));
+        let s = settings(method, 1.0 / 240.0);
+        let mut worst = 0.0f64;
+        for k in 0..1200 {
+            let out = step_on(&track, k as f64 * s.dt, state, &force, 1.0, &s)
+                .unwrap_or_else(|e| panic!("{method}: {e}"));
+            state = out.state;
+            worst = worst.max(out.c.abs());
+        }
+        assert!(worst <= bound * r, "{method}: |C| reached {worst:e}");
+    }
+}
