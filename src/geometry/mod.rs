@@ -46,7 +46,7 @@ pub use motion::{
     WireMotion,
 };
 pub use parabola::Parabola;
-pub use pose::{Placed, Pose};
+pub use pose::{Placed, PlacedSurface, Placement, Pose, Pose3};
 pub use shape::{WireKind, WireShape};
 pub use sine::Sine;
 pub use space::{Cone, Cylinder, ImplicitSurface, Plane, Sphere, Torus};

@@ -1,9 +1,60 @@
-//! [`Pose`] places a shape in the plane; [`Placed`] evaluates it there.
+//! [`Pose`] places a shape in the plane and [`Pose3`] in space;
+//! [`Placed`] and [`PlacedSurface`] evaluate it there, by one formula
+//! ([`placed_geometry`]): `C_w(x) = C(Rᵀ(x − o))`, `∇C_w = R ∇C`,
+//! `H_w = R H Rᵀ`.
 
-use bevy::math::{DMat2, DVec2, Quat, Vec3};
+use bevy::math::{DMat2, DMat3, DQuat, DVec2, DVec3, Quat, Vec3};
 
-use super::{Geometry, ImplicitCurve};
+use super::{Coordinates, Geometry, ImplicitCurve, ImplicitSurface};
 use crate::validate::ParamError;
+
+/// A rigid placement in the plane or in space, as [`placed_geometry`]
+/// takes it.
+pub trait Placement<V: Coordinates> {
+    /// The local origin in world coordinates.
+    fn origin(&self) -> V;
+    /// A world point in the local frame.
+    fn to_local(&self, p: V) -> V;
+    /// A local direction in world coordinates.
+    fn rotate(&self, d: V) -> V;
+    /// A local Hessian in world coordinates: `R H Rᵀ`.
+    fn rotate_hessian(&self, h: &V::Hessian) -> V::Hessian;
+    /// Whether the placement only translates (the rotation is exactly
+    /// none).
+    fn is_unrotated(&self) -> bool;
+}
+
+/// The geometry at the world point `p` of a shape whose geometry in its
+/// local frame is `local`, placed by `pose`: `C(Rᵀ(p − o))`, `R ∇C`,
+/// `R H Rᵀ`; an unrotated placement only translates.
+#[inline(always)]
+pub(crate) fn placed_geometry<V: Coordinates>(
+    pose: &impl Placement<V>,
+    p: V,
+    local: impl Fn(V) -> Geometry<V>,
+) -> Geometry<V> {
+    if pose.is_unrotated() {
+        // The common case needs no rotation, only the translation.
+        local(p - pose.origin())
+    } else {
+        rotated_geometry(pose, p, local)
+    }
+}
+
+/// [`placed_geometry`] with a rotation, kept out of the common path.
+#[inline(never)]
+fn rotated_geometry<V: Coordinates>(
+    pose: &impl Placement<V>,
+    p: V,
+    local: impl Fn(V) -> Geometry<V>,
+) -> Geometry<V> {
+    let g = local(pose.to_local(p));
+    Geometry {
+        c: g.c,
+        normal: pose.rotate(g.normal),
+        hessian: pose.rotate_hessian(&g.hessian),
+    }
+}
 
 /// Where a wire sits in the plane: a translation and a rotation, in `f64`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -83,6 +134,142 @@ impl Pose {
     }
 }
 
+impl Placement<DVec2> for Pose {
+    fn origin(&self) -> DVec2 {
+        self.origin
+    }
+    fn to_local(&self, p: DVec2) -> DVec2 {
+        Pose::to_local(self, p)
+    }
+    fn rotate(&self, d: DVec2) -> DVec2 {
+        Pose::rotate(self, d)
+    }
+    fn rotate_hessian(&self, h: &DMat2) -> DMat2 {
+        let r = self.matrix();
+        r * *h * r.transpose()
+    }
+    fn is_unrotated(&self) -> bool {
+        Pose::is_unrotated(self)
+    }
+}
+
+/// Where a wire sits in space: a translation and a rotation, in `f64`.
+/// Planar shapes lie in the local xy-plane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pose3 {
+    /// The local origin in world coordinates.
+    pub origin: DVec3,
+    /// The rotation from local to world (a unit quaternion).
+    pub rotation: DQuat,
+}
+
+impl Default for Pose3 {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
+impl Pose3 {
+    /// No translation, no rotation.
+    pub const IDENTITY: Self = Self {
+        origin: DVec3::ZERO,
+        rotation: DQuat::IDENTITY,
+    };
+
+    /// A pose turned right-handed by `angle` radians about `axis` (any
+    /// length but zero) through `origin`. Returns an error if the axis is
+    /// zero or anything is not finite.
+    pub fn from_axis_angle(origin: DVec3, axis: DVec3, angle: f64) -> Result<Self, ParamError> {
+        let finite = origin.is_finite() && axis.is_finite() && angle.is_finite();
+        if !finite {
+            return Err(ParamError::NotFinite {
+                name: "wire pose",
+                value: f64::NAN,
+            });
+        }
+        let length = axis.length();
+        if length == 0.0 {
+            return Err(ParamError::NotPositive {
+                name: "rotation axis length",
+                value: 0.0,
+            });
+        }
+        Ok(Self {
+            origin,
+            rotation: DQuat::from_axis_angle(axis / length, angle),
+        })
+    }
+
+    /// The rotation as a matrix.
+    pub fn matrix(&self) -> DMat3 {
+        DMat3::from_quat(self.rotation)
+    }
+
+    /// A world point in the local frame.
+    pub fn to_local(&self, p: DVec3) -> DVec3 {
+        self.matrix().transpose() * (p - self.origin)
+    }
+
+    /// A local point in world coordinates.
+    pub fn to_world(&self, p: DVec3) -> DVec3 {
+        self.origin + self.matrix() * p
+    }
+
+    /// A local direction in world coordinates.
+    pub fn rotate(&self, d: DVec3) -> DVec3 {
+        self.matrix() * d
+    }
+}
+
+impl Placement<DVec3> for Pose3 {
+    fn origin(&self) -> DVec3 {
+        self.origin
+    }
+    fn to_local(&self, p: DVec3) -> DVec3 {
+        Pose3::to_local(self, p)
+    }
+    fn rotate(&self, d: DVec3) -> DVec3 {
+        Pose3::rotate(self, d)
+    }
+    fn rotate_hessian(&self, h: &DMat3) -> DMat3 {
+        let r = self.matrix();
+        r * *h * r.transpose()
+    }
+    fn is_unrotated(&self) -> bool {
+        self.rotation == DQuat::IDENTITY
+    }
+}
+
+/// A surface placed in space by a [`Pose3`]: itself an
+/// [`ImplicitSurface`] in world coordinates.
+pub struct PlacedSurface<'a, S: ImplicitSurface + ?Sized = dyn ImplicitSurface + 'a> {
+    /// The surface in its local frame.
+    pub surface: &'a S,
+    /// Where it sits.
+    pub pose: Pose3,
+}
+
+impl<S: ImplicitSurface + ?Sized> ImplicitSurface for PlacedSurface<'_, S> {
+    fn value(&self, p: DVec3) -> f64 {
+        self.surface.value(self.pose.to_local(p))
+    }
+    fn gradient(&self, p: DVec3) -> DVec3 {
+        self.pose
+            .rotate(self.surface.gradient(self.pose.to_local(p)))
+    }
+    fn hessian(&self, p: DVec3) -> DMat3 {
+        self.pose
+            .rotate_hessian(&self.surface.hessian(self.pose.to_local(p)))
+    }
+    fn scale(&self) -> f64 {
+        self.surface.scale()
+    }
+    #[inline(always)]
+    fn geometry(&self, p: DVec3) -> Geometry<DVec3> {
+        placed_geometry(&self.pose, p, |local| self.surface.geometry(local))
+    }
+}
+
 /// A curve placed in the world by a [`Pose`]: itself an [`ImplicitCurve`] in
 /// world coordinates. `C` is the curve's type: `dyn ImplicitCurve` by
 /// default, or a concrete shape so the step's loops inline it.
@@ -109,8 +296,8 @@ impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Placed<'_, C> {
         self.pose.rotate(self.curve.gradient(self.pose.to_local(p)))
     }
     fn hessian(&self, p: DVec2) -> DMat2 {
-        let r = self.pose.matrix();
-        r * self.curve.hessian(self.pose.to_local(p)) * r.transpose()
+        self.pose
+            .rotate_hessian(&self.curve.hessian(self.pose.to_local(p)))
     }
     fn scale(&self) -> f64 {
         self.curve.scale()
@@ -123,25 +310,7 @@ impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Placed<'_, C> {
     }
     #[inline(always)]
     fn geometry(&self, p: DVec2) -> Geometry {
-        if self.pose.is_unrotated() {
-            // The common case needs no rotation, only the translation.
-            self.curve.geometry(p - self.pose.origin)
-        } else {
-            self.rotated_geometry(p)
-        }
-    }
-}
-
-impl<C: ImplicitCurve + ?Sized> Placed<'_, C> {
-    #[inline(never)]
-    fn rotated_geometry(&self, p: DVec2) -> Geometry {
-        let local = self.curve.geometry(self.pose.to_local(p));
-        let r = self.pose.matrix();
-        Geometry {
-            c: local.c,
-            normal: r * local.normal,
-            hessian: r * local.hessian * r.transpose(),
-        }
+        placed_geometry(&self.pose, p, |local| self.curve.geometry(local))
     }
 }
 
