@@ -243,3 +243,66 @@ fn a_cylinder_lying_along_z_steps_as_the_circle_does() {
     }
     assert!(worst <= 1e-10, "{worst:e} from the plane's trajectory");
 }
+
+/// A bead released 2° from the top of a one-sided sphere (it pushes
+/// outward only) slides off where the sphere would have to pull:
+/// `cos θ = ⅔ cos θ₀` (energy and the normal force), then falls at g.
+#[test]
+fn a_bead_slides_off_a_one_sided_sphere_where_cos_theta_is_two_thirds() {
+    use wirebead::geometry::{Side, Surface};
+    use wirebead::solver::{Contact, ContactEvent, step_surface};
+    let r = 2.0;
+    let sphere = Sphere { radius: r };
+    let track = FixedTrack(&sphere);
+    let surface = Surface {
+        side: Side::Positive,
+        ..Surface::PLAIN
+    };
+    let theta0 = 2f64.to_radians();
+    // Tipped toward +x and −z at once, so the slide is off every axis.
+    let across = DVec3::new(1.0, 0.0, -1.0).normalize();
+    let mut state = BeadState {
+        position: r * (theta0.cos() * DVec3::Y + theta0.sin() * across),
+        velocity: DVec3::ZERO,
+    };
+    let gravity = DVec3::new(0.0, -G, 0.0);
+    let force = LinearForce::constant(gravity);
+    let s = settings(Method::Rattle, 1e-3);
+    let mut contact = Contact::OnWire;
+    let mut left = None;
+    let mut t = 0.0;
+    while t < 3.0 {
+        let step =
+            step_surface(&track, t, state, &force, 1.0, &s, &surface, contact).expect("a step");
+        if let Some(ContactEvent::Left { time, position }) = step.event {
+            left = Some((time, position));
+        }
+        let before = state;
+        state = step.output.state;
+        contact = step.contact;
+        t += s.dt;
+        if let Some((time, _)) = left
+            && time < t - s.dt
+        {
+            // In flight for the whole step: the velocity gains g dt.
+            let gained = state.velocity - before.velocity;
+            assert!(
+                (gained - gravity * s.dt).length() <= 1e-12,
+                "in flight the bead gained {gained} in a step"
+            );
+        }
+        if state.position.y < -r {
+            break;
+        }
+    }
+    let (_, at) = left.expect("the bead left the sphere");
+    let cos_theta = at.y / at.length();
+    let expected = 2.0 / 3.0 * theta0.cos();
+    assert!(
+        (cos_theta - expected).abs() <= 1e-6,
+        "left at cos θ = {cos_theta}, expected {expected}"
+    );
+    // It left in the plane it slid in.
+    assert!((at.x + at.z).abs() <= 1e-12 * r, "left at {at}");
+    assert_eq!(contact, Contact::InFlight);
+}

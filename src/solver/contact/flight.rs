@@ -2,12 +2,9 @@
 //! alone ([`free_step`]), and landing or bouncing where the flight crosses
 //! the wire.
 
-use bevy::math::DVec2;
-
 use super::locate::locate;
 use super::{Contact, ContactEvent, MAX_EVENTS, SurfaceStep, Walk, bounces};
-use crate::geometry::Track;
-use crate::lane::V2;
+use crate::geometry::{Coordinates, Track};
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use crate::solver::method::Method;
 use crate::solver::projection::project_on;
@@ -16,16 +13,16 @@ use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
 use crate::solver::step::StepOutput;
 
-impl<T: Track + ?Sized> Walk<'_, T> {
+impl<V: Coordinates, T: Track<V> + ?Sized> Walk<'_, T, V> {
     /// The bead leaves its wire at `t` from `state` (an end, or where the
     /// wire would have to pull), flying on for `h`.
     pub(super) fn leave(
         &self,
         t: f64,
         h: f64,
-        state: BeadState,
+        state: BeadState<V>,
         events: u32,
-    ) -> Result<SurfaceStep, SolveError> {
+    ) -> Result<SurfaceStep<V>, SolveError> {
         let mut flown = self.in_flight(t, h, state, events + 1)?;
         flown.event = flown.event.or(Some(ContactEvent::Left {
             time: t,
@@ -39,9 +36,9 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         &self,
         t: f64,
         h: f64,
-        state: BeadState,
+        state: BeadState<V>,
         events: u32,
-    ) -> Result<SurfaceStep, SolveError> {
+    ) -> Result<SurfaceStep<V>, SolveError> {
         let side = self.surface.side.sign();
         let flown = free_step(self.settings.method, state, self.force, self.mass, h);
         if !flown.is_finite() {
@@ -59,7 +56,7 @@ impl<T: Track + ?Sized> Walk<'_, T> {
                 output: StepOutput {
                     state: flown,
                     lambda: 0.0,
-                    constraint_force: DVec2::ZERO,
+                    constraint_force: V::ZERO,
                     c,
                     c_dot: normal.dot(across),
                 },
@@ -79,7 +76,7 @@ impl<T: Track + ?Sized> Walk<'_, T> {
             velocity: arrived.velocity,
         };
         let (wire, along, across) = self.split(t + tau, touching)?;
-        let normal_speed = across.length();
+        let normal_speed = across.dot(across).sqrt();
         let e = self.surface.restitution;
         // A bounce one step of the forces would undo is a landing.
         let normal = self.track.geometry(t + tau, touching.position).normal;
@@ -100,7 +97,7 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         };
         let mut rest = if bounced {
             let off = BeadState {
-                velocity: wire + along - e * across,
+                velocity: wire + along - across * e,
                 ..touching
             };
             self.in_flight(t + tau, h - tau, off, events + 1)?
@@ -119,16 +116,16 @@ impl<T: Track + ?Sized> Walk<'_, T> {
 /// One step of length `h` of a bead under `force` alone, by the method's
 /// own integrator: the Euler steps of eq. (6), RK4, or RATTLE's velocity
 /// Verlet (both exact under a constant force).
-pub fn free_step(
+pub fn free_step<V: Coordinates>(
     method: Method,
-    state: BeadState,
-    force: &LinearForce,
+    state: BeadState<V>,
+    force: &LinearForce<V>,
     mass: f64,
     h: f64,
-) -> BeadState {
-    let (x, v) = (V2::from(state.position), V2::from(state.velocity));
-    let accel = |p: DVec2| force.at(p) / mass;
-    let a = V2::from(accel(state.position));
+) -> BeadState<V> {
+    let (x, v) = (state.position, state.velocity);
+    let accel = |p: V| force.at(p) / mass;
+    let a = accel(state.position);
     let (x1, v1) = match method {
         Method::ExplicitEuler(_) => explicit_euler_lanes(x, v, a, h),
         Method::SemiImplicitEuler(_) => semi_implicit_euler_lanes(x, v, a, h),
@@ -137,27 +134,27 @@ pub fn free_step(
             end
         }
         Method::Rattle => {
-            let half = state.velocity + 0.5 * h * accel(state.position);
-            let position = state.position + h * half;
-            let velocity = half + 0.5 * h * accel(position);
+            let half = state.velocity + accel(state.position) * (0.5 * h);
+            let position = state.position + half * h;
+            let velocity = half + accel(position) * (0.5 * h);
             return BeadState { position, velocity };
         }
     };
     BeadState {
-        position: x1.into(),
-        velocity: v1.into(),
+        position: x1,
+        velocity: v1,
     }
 }
 
 /// RK4's stages for a free bead.
-struct Free<'a> {
-    force: &'a LinearForce,
+struct Free<'a, V> {
+    force: &'a LinearForce<V>,
     mass: f64,
 }
 
-impl Stages<f64> for Free<'_> {
+impl<V: Coordinates> Stages<f64, V> for Free<'_, V> {
     type Error = std::convert::Infallible;
-    fn acceleration(&mut self, x: V2<f64>, _v: V2<f64>, _at: f64) -> Result<V2<f64>, Self::Error> {
-        Ok((self.force.at(x.into()) / self.mass).into())
+    fn acceleration(&mut self, x: V, _v: V, _at: f64) -> Result<V, Self::Error> {
+        Ok(self.force.at(x) / self.mass)
     }
 }

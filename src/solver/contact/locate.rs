@@ -2,14 +2,12 @@
 //! stop): regula falsi on the part's length, for a lone bead and an
 //! island alike.
 
-use bevy::math::DVec2;
-
 use super::Walk;
-use crate::geometry::Track;
+use crate::geometry::{Coordinates, Track};
 use crate::solver::solve::SolveError;
 use crate::solver::state::BeadState;
 
-impl<T: Track + ?Sized> Walk<'_, T> {
+impl<V: Coordinates, T: Track<V> + ?Sized> Walk<'_, T, V> {
     /// Where within a part of length `h` from `state` at `t` (sliding
     /// along `sliding`) the measure `g` (`g0` at the start, positive; not
     /// positive at the end) reaches zero: the time and the state there.
@@ -17,11 +15,11 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         &self,
         t: f64,
         h: f64,
-        state: BeadState,
-        sliding: DVec2,
+        state: BeadState<V>,
+        sliding: V,
         g0: f64,
-        g: impl Fn(f64, BeadState) -> Result<f64, SolveError>,
-    ) -> Result<(f64, BeadState), SolveError> {
+        g: impl Fn(f64, BeadState<V>) -> Result<f64, SolveError>,
+    ) -> Result<(f64, BeadState<V>), SolveError> {
         let tau = locate(h, g0, |tau| {
             g(tau, self.slide(t, tau, state, sliding)?.state)
         })?;

@@ -22,7 +22,7 @@ use super::solve::{SolveError, normal_length_squared, solve_on};
 use super::state::{BeadState, LinearForce};
 use super::step::{StepOutput, step_on};
 use super::wire_normal::across;
-use crate::geometry::{Rough, Surface, Track};
+use crate::geometry::{Coordinates, Rough, Surface, Track};
 
 mod flight;
 mod locate;
@@ -45,14 +45,14 @@ pub enum Contact {
 
 /// A change of a bead's contact during a step.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ContactEvent {
+pub enum ContactEvent<V = DVec2> {
     /// It left its one-sided wire at `time`, where the force holding it
     /// would have had to pull.
     Left {
         /// When.
         time: f64,
         /// Where.
-        position: DVec2,
+        position: V,
     },
     /// It reached its wire again at `time` with normal speed
     /// `normal_speed` (relative to the wire) and stayed on it, or bounced.
@@ -60,7 +60,7 @@ pub enum ContactEvent {
         /// When.
         time: f64,
         /// Where.
-        position: DVec2,
+        position: V,
         /// The speed across the wire it arrived with.
         normal_speed: f64,
         /// Whether it bounced off (restitution) rather than stayed on.
@@ -70,13 +70,13 @@ pub enum ContactEvent {
 
 /// The result of one [`step_surface`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SurfaceStep {
+pub struct SurfaceStep<V = DVec2> {
     /// The new state and what the step applied (λ zero in flight).
-    pub output: StepOutput,
+    pub output: StepOutput<V>,
     /// On the wire or in flight after the step.
     pub contact: Contact,
     /// The last change of contact during the step, if any.
-    pub event: Option<ContactEvent>,
+    pub event: Option<ContactEvent<V>>,
 }
 
 /// How many events one step may cut itself at before it takes the rest of
@@ -88,15 +88,16 @@ const MAX_EVENTS: u32 = 4;
 /// restitution `e` only where one step `dt` of the applied `force`'s push
 /// along the wire's `normal` (on a bead of inverse mass `inverse_mass`)
 /// would not undo the bounce; a slower one lands and stays on.
-pub(crate) fn bounces(
+pub(crate) fn bounces<V: Coordinates>(
     e: f64,
     normal_speed: f64,
-    normal: DVec2,
-    force: DVec2,
+    normal: V,
+    force: V,
     inverse_mass: f64,
     dt: f64,
 ) -> bool {
-    let push = (normal.dot(force) * inverse_mass).abs() / normal.length().max(f64::MIN_POSITIVE);
+    let length = normal.dot(normal).sqrt();
+    let push = (normal.dot(force) * inverse_mass).abs() / length.max(f64::MIN_POSITIVE);
     e > 0.0 && e * normal_speed > push * dt
 }
 
@@ -114,16 +115,16 @@ pub(crate) fn bounces(
 /// restitution `e`, the tangential kept; it stays on when `e` is zero or
 /// the bounce is slower than one step of its forces would undo.
 #[allow(clippy::too_many_arguments)]
-pub fn step_surface<T: Track + ?Sized>(
+pub fn step_surface<V: Coordinates, T: Track<V> + ?Sized>(
     track: &T,
     t: f64,
-    state: BeadState,
-    force: &LinearForce,
+    state: BeadState<V>,
+    force: &LinearForce<V>,
     mass: f64,
     settings: &StepSettings,
     surface: &Surface,
     contact: Contact,
-) -> Result<SurfaceStep, SolveError> {
+) -> Result<SurfaceStep<V>, SolveError> {
     if surface.is_plain() && !track.has_ends() {
         return Ok(SurfaceStep {
             output: step_on(track, t, state, force, mass, settings)?,
@@ -145,15 +146,15 @@ pub fn step_surface<T: Track + ?Sized>(
 }
 
 /// What every part of a cut step shares.
-struct Walk<'a, T: Track + ?Sized> {
+struct Walk<'a, T: ?Sized, V> {
     track: &'a T,
-    force: &'a LinearForce,
+    force: &'a LinearForce<V>,
     mass: f64,
     settings: &'a StepSettings,
     surface: &'a Surface,
 }
 
-impl<T: Track + ?Sized> Walk<'_, T> {
+impl<V: Coordinates, T: Track<V> + ?Sized> Walk<'_, T, V> {
     /// The settings for a part of length `h`.
     fn part(&self, h: f64) -> StepSettings {
         StepSettings {
@@ -168,9 +169,9 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         &self,
         t: f64,
         h: f64,
-        state: BeadState,
-        sliding: DVec2,
-    ) -> Result<StepOutput, SolveError> {
+        state: BeadState<V>,
+        sliding: V,
+    ) -> Result<StepOutput<V>, SolveError> {
         let rough = Rough {
             track: self.track,
             surface: self.surface,
@@ -180,13 +181,13 @@ impl<T: Track + ?Sized> Walk<'_, T> {
     }
 
     /// λ of eq. (3) with no stabilization: the force the wire must apply.
-    fn lambda(&self, t: f64, state: BeadState) -> Result<f64, SolveError> {
+    fn lambda(&self, t: f64, state: BeadState<V>) -> Result<f64, SolveError> {
         Ok(solve_on(self.track, t, state, self.force, self.mass, Gains::NONE)?.lambda)
     }
 
     /// The velocity relative to the wire, split into its component along
     /// the wire and its component across, at time `t`.
-    fn split(&self, t: f64, state: BeadState) -> Result<(DVec2, DVec2, DVec2), SolveError> {
+    fn split(&self, t: f64, state: BeadState<V>) -> Result<(V, V, V), SolveError> {
         let normal = self.track.geometry(t, state.position).normal;
         let nn = normal_length_squared(normal, state.position)?;
         let wire = self.track.twist(t).velocity_at(state.position);

@@ -2,10 +2,8 @@
 //! the wire cannot push with or past an end, and stopping and sticking
 //! where friction holds the bead.
 
-use bevy::math::DVec2;
-
 use super::{Contact, MAX_EVENTS, SurfaceStep, Walk};
-use crate::geometry::Track;
+use crate::geometry::{Coordinates, Track};
 use crate::solver::friction;
 use crate::solver::settings::Gains;
 use crate::solver::solve::{SolveError, Solved, in_frame, solve_on};
@@ -13,22 +11,22 @@ use crate::solver::state::BeadState;
 use crate::solver::step::StepOutput;
 use crate::solver::wire_normal::along;
 
-impl<T: Track + ?Sized> Walk<'_, T> {
+impl<V: Coordinates, T: Track<V> + ?Sized> Walk<'_, T, V> {
     /// A part of length `h` on the wire from `state` at `t`.
     pub(super) fn on_wire(
         &self,
         t: f64,
         h: f64,
-        state: BeadState,
+        state: BeadState<V>,
         events: u32,
-    ) -> Result<SurfaceStep, SolveError> {
+    ) -> Result<SurfaceStep<V>, SolveError> {
         let side = self.surface.side.sign();
         let cut = events < MAX_EVENTS;
         let ends = self.track.has_ends();
         // How far on the wire the bead is: negative past an end; λ's sign
         // the wire can push with.
-        let on_the_curve = |t: f64, x: BeadState| -self.track.past_end(t, x.position);
-        let pushing = |t: f64, x: BeadState| Ok::<f64, SolveError>(side * self.lambda(t, x)?);
+        let on_the_curve = |t: f64, x: BeadState<V>| -self.track.past_end(t, x.position);
+        let pushing = |t: f64, x: BeadState<V>| Ok::<f64, SolveError>(side * self.lambda(t, x)?);
         if cut && ends && on_the_curve(t, state) < 0.0 {
             return self.leave(t, h, state, events);
         }
@@ -39,7 +37,7 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         let friction = self.surface.friction.is_some();
         let (_, sliding, _) = self.split(t, state)?;
         if friction
-            && sliding == DVec2::ZERO
+            && sliding == V::ZERO
             && let Some(solved) = self.sticks(t, state)?
         {
             return self.held(t, h, state, solved);
@@ -60,10 +58,9 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         }
         if cut && friction && sliding.dot(self.split(end, out.state)?.1) < 0.0 {
             // Friction stopped the bead within the step: it stops there.
-            let (when, at) =
-                self.cut(t, h, state, sliding, sliding.length_squared(), |tau, x| {
-                    Ok(self.split(t + tau, x)?.1.dot(sliding))
-                })?;
+            let (when, at) = self.cut(t, h, state, sliding, sliding.dot(sliding), |tau, x| {
+                Ok(self.split(t + tau, x)?.1.dot(sliding))
+            })?;
             let (wire, _, across) = self.split(when, at)?;
             let stopped = BeadState {
                 velocity: wire + across,
@@ -81,15 +78,16 @@ impl<T: Track + ?Sized> Walk<'_, T> {
     /// The constraint force on a bead at rest on the wire if it stays so
     /// (the force along the wire within static friction); none if it
     /// slides.
-    fn sticks(&self, t: f64, state: BeadState) -> Result<Option<Solved>, SolveError> {
+    fn sticks(&self, t: f64, state: BeadState<V>) -> Result<Option<Solved<V>>, SolveError> {
         let solved = solve_on(self.track, t, state, self.force, self.mass, Gains::NONE)?;
         let f = self.force.at(state.position);
         let applied = in_frame(self.track, t, state, f, self.mass).applied;
         let normal = self.track.geometry(t, state.position).normal;
-        let nn = normal.length_squared();
+        let nn = normal.dot(normal);
         let pull = along(normal, nn, applied);
         let press = friction::press(solved.lambda, nn);
-        Ok(friction::holds(&self.surface.friction, pull.length(), press).then_some(solved))
+        let strength = pull.dot(pull).sqrt();
+        Ok(friction::holds(&self.surface.friction, strength, press).then_some(solved))
     }
 
     /// A part of length `h` in which static friction holds the bead still
@@ -98,9 +96,9 @@ impl<T: Track + ?Sized> Walk<'_, T> {
         &self,
         t: f64,
         h: f64,
-        state: BeadState,
-        solved: Solved,
-    ) -> Result<SurfaceStep, SolveError> {
+        state: BeadState<V>,
+        solved: Solved<V>,
+    ) -> Result<SurfaceStep<V>, SolveError> {
         let position = self.track.carry(state.position, t, t + h);
         let velocity = self.track.twist(t + h).velocity_at(position);
         let end = BeadState { position, velocity };
