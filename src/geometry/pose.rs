@@ -1,6 +1,6 @@
 //! [`Pose`] places a shape in the plane and [`Pose3`] in space;
 //! [`Placed`] and [`PlacedSurface`] evaluate it there, by one formula
-//! ([`placed_geometry`]): `C_w(x) = C(Rᵀ(x − o))`, `∇C_w = R ∇C`,
+//! (`placed_geometry`): `C_w(x) = C(Rᵀ(x − o))`, `∇C_w = R ∇C`,
 //! `H_w = R H Rᵀ`.
 
 use bevy::math::{DMat2, DMat3, DQuat, DVec2, DVec3, Quat, Vec3};
@@ -8,8 +8,8 @@ use bevy::math::{DMat2, DMat3, DQuat, DVec2, DVec3, Quat, Vec3};
 use super::{Coordinates, Geometry, ImplicitCurve, ImplicitSurface};
 use crate::validate::ParamError;
 
-/// A rigid placement in the plane or in space, as [`placed_geometry`]
-/// takes it.
+/// A rigid placement in the plane ([`Pose`]) or in space ([`Pose3`]):
+/// what placing a shape asks of it, `C(Rᵀ(x − o))`, `R ∇C` and `R H Rᵀ`.
 pub trait Placement<V: Coordinates> {
     /// The local origin in world coordinates.
     fn origin(&self) -> V;

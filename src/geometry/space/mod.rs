@@ -19,7 +19,7 @@
 //! The cylinder, the cone and the torus are surfaces of revolution about
 //! the local `y`-axis, `C = g(ρ, y)`; their gradient and Hessian follow
 //! from `g`'s derivatives by the chain rule in one place
-//! ([`revolution`]).
+//! (`revolution`).
 
 mod shapes;
 
