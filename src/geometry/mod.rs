@@ -49,7 +49,9 @@ pub use parabola::Parabola;
 pub use pose::{Placed, PlacedSurface, Placement, Pose, Pose3};
 pub use shape::{WireKind, WireShape};
 pub use sine::Sine;
-pub use space::{Cone, Cylinder, ImplicitSurface, Plane, Sphere, Torus};
+pub use space::{
+    Cone, Cylinder, ImplicitSurface, MovingSurface, Plane, SpaceMotion, SpacePath, Sphere, Torus,
+};
 pub use spline::{CubicPath, Spline, SplineKind, SplineSpec};
 pub use surface::{Friction, Side, Surface};
 pub use traced::{HINT_WINDOW, Parametric, Traced};

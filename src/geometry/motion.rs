@@ -24,7 +24,9 @@ use std::f64::consts::TAU;
 use bevy::math::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use super::{Coordinates, Geometry, ImplicitCurve, ImplicitSurface, Placed, Pose, Surface};
+use super::{
+    Coordinates, Geometry, ImplicitCurve, ImplicitSurface, Placed, Placement, Pose, Surface,
+};
 use crate::validate::{ParamError, finite, finite_vector, positive};
 
 /// A rigid motion at one instant, in the plane or in space: the velocity
@@ -79,14 +81,29 @@ pub enum WireMotion {
     Spin(Spin),
 }
 
-/// See [`WireMotion::Oscillate`].
+/// See [`WireMotion::Oscillate`]: in the plane (`DVec2`, the default) or
+/// in space (`DVec3`, [`SpaceMotion::Oscillate`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Oscillate {
-    /// The displacement's amplitude (world units, both axes).
-    pub amplitude: DVec2,
+pub struct Oscillate<V = DVec2> {
+    /// The displacement's amplitude (world units, every axis).
+    pub amplitude: V,
     /// The frequency in Hz.
     pub frequency: f64,
+}
+
+impl<V: Coordinates> Oscillate<V> {
+    /// The displacement `A sin(2π f t)` at `t`, its velocity and its
+    /// acceleration, exact.
+    pub fn at(&self, t: f64) -> (V, V, V) {
+        let w = TAU * self.frequency;
+        let (s, c) = (w * t).sin_cos();
+        (
+            self.amplitude * s,
+            self.amplitude * (w * c),
+            self.amplitude * (-w * w * s),
+        )
+    }
 }
 
 /// See [`WireMotion::Spin`].
@@ -125,14 +142,13 @@ impl WireMotion {
         match self {
             Self::Fixed => (base, Twist::default()),
             Self::Oscillate(o) => {
-                let w = TAU * o.frequency;
-                let (s, c) = (w * t).sin_cos();
-                let origin = base.origin + o.amplitude * s;
+                let (offset, velocity, acceleration) = o.at(t);
+                let origin = base.origin + offset;
                 let pose = Pose { origin, ..base };
                 let twist = Twist {
                     origin,
-                    velocity: o.amplitude * (w * c),
-                    acceleration: o.amplitude * (-w * w * s),
+                    velocity,
+                    acceleration,
                     ..Twist::default()
                 };
                 (pose, twist)
@@ -382,6 +398,13 @@ impl<V: Coordinates, T: Track<V> + ?Sized> Track<V> for Rough<'_, T, V> {
     }
 }
 
+/// Where the point of a wire at `x` when the wire sat at `from` is when
+/// it sits at `to`: the same local point, placed again.
+#[inline]
+pub(crate) fn carry<V: Coordinates, P: Placement<V>>(from: &P, to: &P, x: V) -> V {
+    to.to_world(from.to_local(x))
+}
+
 /// A wire that stays put: the curve (in the plane) or the surface (in
 /// space) itself, in world coordinates.
 pub struct FixedTrack<'a, C: ?Sized>(pub &'a C);
@@ -457,9 +480,7 @@ impl<C: ImplicitCurve + ?Sized> Track for MovingTrack<'_, C> {
         self.path.at(t).1
     }
     fn carry(&self, x: DVec2, from: f64, to: f64) -> DVec2 {
-        self.path
-            .pose(to)
-            .to_world(self.path.pose(from).to_local(x))
+        carry(&self.path.pose(from), &self.path.pose(to), x)
     }
     fn has_ends(&self) -> bool {
         self.curve.has_ends()

@@ -15,6 +15,8 @@ pub trait Placement<V: Coordinates> {
     fn origin(&self) -> V;
     /// A world point in the local frame.
     fn to_local(&self, p: V) -> V;
+    /// A local point in world coordinates.
+    fn to_world(&self, p: V) -> V;
     /// A local direction in world coordinates.
     fn rotate(&self, d: V) -> V;
     /// A local Hessian in world coordinates: `R H Rᵀ`.
@@ -141,6 +143,9 @@ impl Placement<DVec2> for Pose {
     fn to_local(&self, p: DVec2) -> DVec2 {
         Pose::to_local(self, p)
     }
+    fn to_world(&self, p: DVec2) -> DVec2 {
+        Pose::to_world(self, p)
+    }
     fn rotate(&self, d: DVec2) -> DVec2 {
         Pose::rotate(self, d)
     }
@@ -227,6 +232,9 @@ impl Placement<DVec3> for Pose3 {
     }
     fn to_local(&self, p: DVec3) -> DVec3 {
         Pose3::to_local(self, p)
+    }
+    fn to_world(&self, p: DVec3) -> DVec3 {
+        Pose3::to_world(self, p)
     }
     fn rotate(&self, d: DVec3) -> DVec3 {
         Pose3::rotate(self, d)

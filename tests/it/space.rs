@@ -299,3 +299,85 @@ fn a_bead_slides_off_a_one_sided_sphere_where_cos_theta_is_two_thirds() {
     assert!((at.x + at.z).abs() <= 1e-12 * r, "left at {at}");
     assert_eq!(contact, Contact::InFlight);
 }
+
+/// A plane spinning at ω about an axis that lies in it flings a bead
+/// that starts at rest on it (relative to it), with no gravity, along the
+/// plane away from the axis: its distance from the axis is `r₀ cosh ωt`,
+/// as on the plane's spinning rod.
+#[test]
+fn a_bead_on_a_plane_spinning_about_an_axis_in_it_slides_out_as_cosh() {
+    use wirebead::geometry::{MovingSurface, Plane, SpaceMotion, SpacePath};
+    let (r0, omega) = (0.2, 2.0);
+    // The plane y = 0 spins about z, which lies in it.
+    let path = SpacePath::Prescribed {
+        base: Pose3::IDENTITY,
+        motion: SpaceMotion::Spin {
+            angular_velocity: omega,
+            axis: DVec3::Z,
+        },
+    };
+    let track = MovingSurface {
+        surface: &Plane,
+        path: &path,
+    };
+    let start = DVec3::new(r0, 0.0, 0.4);
+    let mut state = BeadState {
+        position: start,
+        // Moving with the plane: ω ẑ × r.
+        velocity: DVec3::new(0.0, omega * r0, 0.0),
+    };
+    let s = settings(Method::Rattle, 1e-3);
+    let none = LinearForce::constant(DVec3::ZERO);
+    let mut worst = 0.0f64;
+    for k in 0..1500 {
+        let t = k as f64 * s.dt;
+        state = step_on(&track, t, state, &none, 1.0, &s)
+            .expect("a step")
+            .state;
+        let exact = r0 * (omega * (t + s.dt)).cosh();
+        let rho = state.position.truncate().length();
+        worst = worst.max((rho - exact).abs() / exact);
+        // Nothing pushes along the axis.
+        assert!((state.position.z - start.z).abs() <= 1e-12);
+    }
+    assert!(
+        worst <= 1e-5,
+        "relative error in the distance reached {worst:e}"
+    );
+}
+
+/// A sphere spinning about its centre moves none of its points off
+/// itself: a frictionless bead on it moves as on the sphere at rest, the
+/// frame's terms of eq. (15) cancelling, to 1e-9 over 3 s.
+#[test]
+fn a_sphere_spinning_about_its_centre_does_not_move_a_frictionless_bead() {
+    use wirebead::geometry::{MovingSurface, SpaceMotion, SpacePath};
+    let sphere = Sphere { radius: 1.0 };
+    let path = SpacePath::Prescribed {
+        base: Pose3::IDENTITY,
+        motion: SpaceMotion::Spin {
+            angular_velocity: 3.0,
+            axis: DVec3::new(0.3, 1.0, -0.2),
+        },
+    };
+    let spinning = MovingSurface {
+        surface: &sphere,
+        path: &path,
+    };
+    let (start, _) = conical_start(1.0, 0.7);
+    let (mut still, mut turning) = (start, start);
+    let s = settings(Method::Rattle, 1e-3);
+    let gravity = LinearForce::constant(DVec3::new(0.0, -G, 0.0));
+    let mut worst = 0.0f64;
+    for k in 0..3000 {
+        let t = k as f64 * s.dt;
+        still = step_on(&FixedTrack(&sphere), t, still, &gravity, 1.0, &s)
+            .expect("a step on the sphere at rest")
+            .state;
+        turning = step_on(&spinning, t, turning, &gravity, 1.0, &s)
+            .expect("a step on the spinning sphere")
+            .state;
+        worst = worst.max((still.position - turning.position).length());
+    }
+    assert!(worst <= 1e-9, "{worst:e} between the two");
+}

@@ -21,12 +21,14 @@
 //! from `g`'s derivatives by the chain rule in one place
 //! (`revolution`).
 
+mod motion;
 mod shapes;
 
 use bevy::math::{DMat3, DVec3};
 
 use super::Geometry;
 
+pub use motion::{MovingSurface, SpaceMotion, SpacePath};
 pub use shapes::{Cone, Cylinder, Plane, Sphere, Torus};
 
 /// A surface in space given implicitly by `C(x) = 0`.
