@@ -3,7 +3,7 @@
 //! both dimensions.
 
 use std::fmt::Debug;
-use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
+use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 
 use bevy::math::{DMat2, DMat3, DVec2, DVec3};
 
@@ -29,6 +29,7 @@ pub trait Coordinates:
     + Div<f64, Output = Self>
     + AddAssign
     + SubAssign
+    + MulAssign<f64>
 {
     /// The Hessian of a constraint: `DMat2` or `DMat3`.
     type Hessian: Copy + Debug + PartialEq + Send + Sync + 'static;

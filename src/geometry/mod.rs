@@ -32,6 +32,7 @@ mod space;
 mod spline;
 mod surface;
 mod traced;
+mod wire_space;
 
 use bevy::math::{DMat2, DVec2};
 
@@ -46,6 +47,7 @@ pub use motion::{
     WireMotion,
 };
 pub use parabola::Parabola;
+pub(crate) use pose::placed_geometry;
 pub use pose::{Placed, PlacedSurface, Placement, Pose, Pose3};
 pub use shape::{WireKind, WireShape};
 pub use sine::Sine;
@@ -55,6 +57,7 @@ pub use space::{
 pub use spline::{CubicPath, Spline, SplineKind, SplineSpec};
 pub use surface::{Friction, Side, Surface};
 pub use traced::{HINT_WINDOW, Parametric, Traced};
+pub use wire_space::{SurfaceWire, WireSpace};
 
 /// The value, gradient and Hessian of a constraint at one point.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -463,3 +463,136 @@ fn beads_keep_their_orbits_on_a_cone_a_torus_and_a_cylinder() {
     });
     assert!(fall <= 1e-9, "the fall or the turn was off by {fall:e}");
 }
+
+/// The conical pendulum again, as an island: a bob on a rod from a bead
+/// pinned in space by three axis rows, RATTLE at 1 ms. It keeps its
+/// height to 1e-5 L and goes round in `2π L sin α / v` to 1e-5.
+#[test]
+fn a_conical_pendulum_on_a_rod_from_a_pin_keeps_its_height_and_period() {
+    use wirebead::solver::{Island, IslandRow, IslandWork, RowKind};
+    let (length, alpha) = (1.2, 0.5);
+    let axis = |axis: DVec3| IslandRow {
+        kind: RowKind::Axis { axis, offset: 0.0 },
+        beads: vec![0],
+    };
+    let rows = vec![
+        axis(DVec3::X),
+        axis(DVec3::Y),
+        axis(DVec3::Z),
+        IslandRow {
+            kind: RowKind::Rod { length },
+            beads: vec![0, 1],
+        },
+    ];
+    let island = Island::new(&[1.0, 0.5], rows, vec![]).expect("an island");
+    let mut work = IslandWork::default();
+    let (bob, v) = conical_start(length, alpha);
+    let mut states = [BeadState::default(), bob];
+    let gravity = DVec3::new(0.0, -G, 0.0);
+    let forces = [
+        LinearForce::constant(gravity),
+        LinearForce::constant(gravity * 0.5),
+    ];
+    let s = settings(Method::Rattle, 1e-3);
+    let period = TAU * length * alpha.sin() / v;
+    let height = bob.position.y;
+    let (mut worst, mut turned, mut previous, mut t) = (0.0f64, 0.0f64, 0.0f64, 0.0);
+    let mut passes = Vec::new();
+    while passes.len() < 2 {
+        island
+            .step_at(t, &mut states, &forces, &s, &mut work)
+            .expect("a step");
+        t += s.dt;
+        let p = states[1].position;
+        worst = worst.max((p.y - height).abs());
+        let azimuth = (-p.z).atan2(p.x);
+        let mut delta = azimuth - previous;
+        if delta < -TAU / 2.0 {
+            delta += TAU;
+        }
+        previous = azimuth;
+        let before = turned;
+        turned += delta;
+        let k = (passes.len() + 1) as f64;
+        if before < TAU * k && turned >= TAU * k {
+            passes.push(t - s.dt + (TAU * k - before) / (turned - before) * s.dt);
+        }
+        assert!(t < 10.0 * period, "the bob did not go round");
+    }
+    assert!(worst <= 1e-5 * length, "height moved {worst:e}");
+    let error = (passes[1] / 2.0 - period).abs() / period;
+    assert!(error <= 1e-5, "period off by {error:e}");
+    assert!(states[0].position.length() <= 1e-12, "the pin moved");
+}
+
+/// Two beads on a sphere joined by a rod, as an island of two surface
+/// rows and a rod row: RATTLE keeps both on the sphere and the rod's
+/// length to 1e-12 and the energy to 1e-5 of m g r over 3 s.
+#[test]
+fn a_rod_between_two_beads_on_a_sphere_holds_as_an_island() {
+    use std::sync::Arc;
+    use wirebead::geometry::SurfaceWire;
+    use wirebead::solver::{Island, IslandRow, IslandWork, RowKind};
+    let r = 1.0;
+    let wire = || RowKind::Wire {
+        shape: SurfaceWire(Arc::new(Sphere { radius: r })),
+        pose: Pose3::IDENTITY,
+    };
+    let a = DVec3::new(0.6, -0.8, 0.0);
+    let b = DVec3::new(0.0, -0.8, 0.6);
+    let length = (a - b).length();
+    let rows = vec![
+        IslandRow {
+            kind: wire(),
+            beads: vec![0],
+        },
+        IslandRow {
+            kind: wire(),
+            beads: vec![1],
+        },
+        IslandRow {
+            kind: RowKind::Rod { length },
+            beads: vec![0, 1],
+        },
+    ];
+    let masses = [1.0, 2.0];
+    let island = Island::new(&masses, rows, vec![]).expect("an island");
+    let mut work = IslandWork::default();
+    let mut states = [
+        BeadState {
+            position: a,
+            velocity: DVec3::new(0.0, 0.0, 1.0),
+        },
+        BeadState {
+            position: b,
+            velocity: DVec3::new(-1.0, 0.0, 0.0),
+        },
+    ];
+    let gravity = DVec3::new(0.0, -G, 0.0);
+    let forces = masses.map(|m| LinearForce::constant(gravity * m));
+    let energy = |states: &[BeadState<DVec3>]| {
+        states
+            .iter()
+            .zip(masses)
+            .map(|(s, m)| {
+                let (kinetic, potential) = s.energy(m, gravity);
+                kinetic + potential
+            })
+            .sum::<f64>()
+    };
+    let e0 = energy(&states);
+    let s = settings(Method::Rattle, 1e-3);
+    let (mut off, mut drift) = (0.0f64, 0.0f64);
+    for k in 0..3000 {
+        island
+            .step_at(k as f64 * s.dt, &mut states, &forces, &s, &mut work)
+            .expect("a step");
+        for state in &states {
+            off = off.max((state.position.length() - r).abs());
+        }
+        off = off.max(((states[0].position - states[1].position).length() - length).abs());
+        drift = drift.max((energy(&states) - e0).abs());
+    }
+    assert!(off <= 1e-12, "off the sphere or the rod by {off:e}");
+    assert!(drift <= 1e-5 * 3.0 * G * r, "energy moved {drift:e}");
+}

@@ -125,6 +125,18 @@ impl SpacePath {
     pub fn pose(&self, t: f64) -> Pose3 {
         self.at(t).0
     }
+
+    /// The pose if the surface does not move.
+    pub fn fixed(&self) -> Option<Pose3> {
+        match self {
+            Self::Fixed(pose) => Some(*pose),
+            Self::Prescribed {
+                base,
+                motion: SpaceMotion::Fixed,
+            } => Some(*base),
+            Self::Prescribed { .. } => None,
+        }
+    }
 }
 
 /// A surface in its local frame carried along a [`SpacePath`].

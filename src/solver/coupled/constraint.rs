@@ -7,23 +7,23 @@ use std::sync::Arc;
 
 use bevy::math::DVec2;
 
-use crate::geometry::{ImplicitCurve, Near, Placed, Pose, WireShape};
+use crate::geometry::{WireSpace, placed_geometry};
 
 /// A constraint of a game's own among one or more beads: `C(x₁, …, xₖ) = 0`.
 ///
-/// As [`ImplicitCurve`] is for wires: give `C`, its gradient with respect
+/// As [`ImplicitCurve`](crate::geometry::ImplicitCurve) is for wires: give `C`, its gradient with respect
 /// to each bead's position, and the curvature term `J̇q̇` of `C̈`; the
 /// island solver does the rest. The slices hold the positions (and
 /// velocities) of the beads the constraint names, in the order it names
 /// them. `value`, `gradient` and `curvature` must agree (`gradient` the
 /// derivative of `value`, `curvature` the second derivative along `v`).
-pub trait Constraint: Send + Sync {
+pub trait Constraint<V = DVec2>: Send + Sync {
     /// `C` at the beads' positions `x`.
-    fn value(&self, x: &[DVec2]) -> f64;
+    fn value(&self, x: &[V]) -> f64;
     /// `∂C/∂xᵢ` for each bead, written into `gradient` (as long as `x`).
-    fn gradient(&self, x: &[DVec2], gradient: &mut [DVec2]);
+    fn gradient(&self, x: &[V], gradient: &mut [V]);
     /// `J̇q̇ = Σᵢⱼ vᵢᵀ (∂²C/∂xᵢ∂xⱼ) vⱼ` at positions `x`, velocities `v`.
-    fn curvature(&self, x: &[DVec2], v: &[DVec2]) -> f64;
+    fn curvature(&self, x: &[V], v: &[V]) -> f64;
     /// A characteristic length: the Newton tolerance and the divergence
     /// bound are in units of it.
     fn scale(&self) -> f64 {
@@ -31,15 +31,15 @@ pub trait Constraint: Send + Sync {
     }
 }
 
-/// What one row of an island is.
+/// What one row of an island is, in the plane (the default) or in space.
 #[derive(Clone)]
-pub enum RowKind {
+pub enum RowKind<V: WireSpace = DVec2> {
     /// One bead on a wire placed by `pose`: `C = C_wire(x)`.
     Wire {
         /// The wire's shape.
-        shape: WireShape,
+        shape: V::Shape,
         /// Where it sits.
-        pose: Pose,
+        pose: V::Pose,
     },
     /// Two beads at a fixed distance: `C = |x_a − x_b| − length`.
     Rod {
@@ -50,15 +50,15 @@ pub enum RowKind {
     /// (`axis` a unit vector). A pin is two of these.
     Axis {
         /// The line's normal, of unit length.
-        axis: DVec2,
+        axis: V,
         /// `axis·p` for the point `p` the bead is held at.
         offset: f64,
     },
     /// A game's own constraint.
-    Custom(Arc<dyn Constraint>),
+    Custom(Arc<dyn Constraint<V>>),
 }
 
-impl fmt::Debug for RowKind {
+impl<V: WireSpace> fmt::Debug for RowKind<V> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Wire { shape, pose } => f
@@ -77,7 +77,7 @@ impl fmt::Debug for RowKind {
     }
 }
 
-impl RowKind {
+impl<V: WireSpace> RowKind<V> {
     /// How many beads the row joins, where the kind fixes it.
     pub(crate) fn arity(&self) -> Option<usize> {
         match self {
@@ -90,7 +90,7 @@ impl RowKind {
     /// The characteristic length of the row.
     pub(crate) fn scale(&self) -> f64 {
         match self {
-            Self::Wire { shape, .. } => shape.curve().scale(),
+            Self::Wire { shape, .. } => V::shape_scale(shape),
             Self::Rod { length } => *length,
             Self::Axis { .. } => 1.0,
             Self::Custom(c) => c.scale(),
@@ -101,36 +101,35 @@ impl RowKind {
     /// and, where `rates`, `J̇q̇` (else zero), where the island's beads are
     /// at `x` with velocities `v`.
     /// `scratch` gathers a custom constraint's beads; `hint` is a wire's
-    /// curve parameter where its bead was (see [`ImplicitCurve::parameter`]).
+    /// curve parameter where its bead was (see [`ImplicitCurve::parameter`](crate::geometry::ImplicitCurve::parameter)).
     #[inline]
     pub(crate) fn evaluate(
         &self,
         beads: &[usize],
-        x: &[DVec2],
-        v: &[DVec2],
-        gradient: &mut [DVec2],
-        scratch: &mut Vec<DVec2>,
+        x: &[V],
+        v: &[V],
+        gradient: &mut [V],
+        scratch: &mut Vec<V>,
         hint: f64,
         rates: bool,
     ) -> (f64, f64) {
         match self {
             Self::Wire { shape, pose } => {
                 let (p, u) = (x[beads[0]], v[beads[0]]);
-                let g = Placed {
-                    curve: &Near {
-                        curve: shape.curve(),
-                        hint,
-                    },
-                    pose: *pose,
-                }
-                .geometry(p);
+                let g =
+                    placed_geometry(pose, p, |local| V::shape_geometry(shape, local, Some(hint)));
                 gradient[0] = g.normal;
-                (g.c, if rates { u.dot(g.hessian * u) } else { 0.0 })
+                let bend = if rates {
+                    u.dot(V::hessian_times(&g.hessian, u))
+                } else {
+                    0.0
+                };
+                (g.c, bend)
             }
             Self::Rod { length } => {
                 let (a, b) = (beads[0], beads[1]);
                 let d = x[a] - x[b];
-                let distance = d.length();
+                let distance = d.dot(d).sqrt();
                 let n = d / distance;
                 gradient[0] = n;
                 gradient[1] = -n;
@@ -141,7 +140,7 @@ impl RowKind {
                 let along = n.dot(relative);
                 (
                     distance - length,
-                    (relative.length_squared() - along * along) / distance,
+                    (relative.dot(relative) - along * along) / distance,
                 )
             }
             Self::Axis { axis, offset } => {
@@ -186,26 +185,27 @@ pub struct SpringLink {
 impl SpringLink {
     /// The force on bead `a` where the beads are at `x` with velocities `v`.
     #[inline]
-    pub fn force(&self, x: &[DVec2], v: &[DVec2]) -> DVec2 {
+    pub fn force<V: WireSpace>(&self, x: &[V], v: &[V]) -> V {
         let d = x[self.a] - x[self.b];
-        let distance = d.length();
+        let distance = d.dot(d).sqrt();
         if distance.is_nan() || distance <= 0.0 {
-            return DVec2::ZERO;
+            return V::ZERO;
         }
         let u = d / distance;
         let stretch = distance - self.rest_length;
         let rate = (v[self.a] - v[self.b]).dot(u);
-        -(self.stiffness * stretch + self.damping * rate) * u
+        u * -(self.stiffness * stretch + self.damping * rate)
     }
 
     /// The energy stored in the spring where the beads are at `x`.
-    pub fn energy(&self, x: &[DVec2]) -> f64 {
+    pub fn energy<V: WireSpace>(&self, x: &[V]) -> f64 {
         self.stored(x[self.a], x[self.b])
     }
 
     /// The energy stored in the spring with its ends at `a` and `b`.
-    pub(crate) fn stored(&self, a: DVec2, b: DVec2) -> f64 {
-        let stretch = (a - b).length() - self.rest_length;
+    pub(crate) fn stored<V: WireSpace>(&self, a: V, b: V) -> f64 {
+        let d = a - b;
+        let stretch = d.dot(d).sqrt() - self.rest_length;
         0.5 * self.stiffness * stretch * stretch
     }
 }

@@ -1,7 +1,10 @@
 //! [`Island::new`]: an island's beads, rows and springs checked and laid
 //! out, and why one cannot be built ([`IslandError`]).
 
+use bevy::math::DVec2;
+
 use super::Island;
+use crate::geometry::WireSpace;
 use crate::solver::coupled::constraint::{RowKind, SpringLink};
 use crate::solver::coupled::normal::NormalMatrix;
 
@@ -65,14 +68,14 @@ pub enum IslandError {
 /// One constraint row of an island: what it is and the beads it joins
 /// (indices into the island's beads).
 #[derive(Clone, Debug)]
-pub struct IslandRow {
+pub struct IslandRow<V: WireSpace = DVec2> {
     /// The kind of constraint.
-    pub kind: RowKind,
+    pub kind: RowKind<V>,
     /// The beads, in the order the kind takes them.
     pub beads: Vec<usize>,
 }
 
-fn describe(r: usize, kind: &RowKind) -> String {
+fn describe<V: WireSpace>(r: usize, kind: &RowKind<V>) -> String {
     let what = match kind {
         RowKind::Wire { .. } => "wire",
         RowKind::Rod { .. } => "rod",
@@ -82,12 +85,12 @@ fn describe(r: usize, kind: &RowKind) -> String {
     format!("constraint {r} ({what})")
 }
 
-impl Island {
+impl<V: WireSpace> Island<V> {
     /// An island of beads of the given masses, joined by `rows` and
     /// `springs`; every index and value is checked.
     pub fn new(
         masses: &[f64],
-        rows: Vec<IslandRow>,
+        rows: Vec<IslandRow<V>>,
         springs: Vec<SpringLink>,
     ) -> Result<Self, IslandError> {
         let beads = masses.len();
@@ -138,9 +141,9 @@ impl Island {
                     return Err(bad("length", "positive and finite", *length));
                 }
                 RowKind::Axis { axis, offset } => {
-                    let off = (axis.length() - 1.0).abs();
+                    let off = (axis.dot(*axis).sqrt() - 1.0).abs();
                     if off.is_nan() || off >= 1e-12 {
-                        return Err(bad("|axis|", "1", axis.length()));
+                        return Err(bad("|axis|", "1", axis.dot(*axis).sqrt()));
                     }
                     if !offset.is_finite() {
                         return Err(bad("the point", "finite", *offset));

@@ -2,7 +2,7 @@
 //! wire, land on it again (or bounce), slide against friction, stop and
 //! stick.
 
-use bevy::math::DVec2;
+use crate::geometry::WireSpace;
 
 use super::integrators::Stage;
 use super::newton::Direction;
@@ -16,7 +16,7 @@ use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
 use crate::solver::wire_normal::usable;
 
-impl Island {
+impl<V: WireSpace> Island<V> {
     /// Eq. (17) on the island at the step's start (λ from
     /// [`Island::leave`]): releases every stick row whose force passes
     /// static friction, and adds kinetic friction and damping to the force
@@ -25,10 +25,10 @@ impl Island {
     pub(super) fn resist(
         &self,
         time: f64,
-        states: &[BeadState],
-        forces: &mut [LinearForce],
-        work: &mut IslandWork,
-    ) -> Vec<(usize, usize, DVec2)> {
+        states: &[BeadState<V>],
+        forces: &mut [LinearForce<V>],
+        work: &mut IslandWork<V>,
+    ) -> Vec<(usize, usize, V)> {
         let mut slides = Vec::new();
         for (r, rough) in self.rough.iter().enumerate() {
             let Some(rough) = rough else { continue };
@@ -41,7 +41,7 @@ impl Island {
                 continue;
             }
             let row = self.wire_row(r, states, time);
-            let nn = row.normal.length_squared();
+            let nn = row.normal.dot(row.normal);
             if !usable(nn) {
                 continue;
             }
@@ -58,10 +58,10 @@ impl Island {
                 // It gives way: it slides toward the pull, against λ's push.
                 work.inactive[s] = true;
                 if let RowKind::Axis { axis, .. } = self.rows[s] {
-                    direction = -hold * axis;
+                    direction = axis * -hold;
                 }
             }
-            let speed = direction.length();
+            let speed = direction.dot(direction).sqrt();
             if speed > 0.0 {
                 forces[bead].force += friction::kinetic(&rough.friction, press, direction, speed);
             }
@@ -78,9 +78,9 @@ impl Island {
     pub(super) fn stop(
         &self,
         time: f64,
-        states: &mut [BeadState],
-        slides: &[(usize, usize, DVec2)],
-        work: &mut IslandWork,
+        states: &mut [BeadState<V>],
+        slides: &[(usize, usize, V)],
+        work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         let mut stopped = false;
         for &(r, bead, before) in slides {
@@ -97,13 +97,15 @@ impl Island {
             }
             let row = self.wire_row(r, states, time);
             let sliding = row.sliding(states[bead].velocity);
-            if before != DVec2::ZERO && sliding.dot(before) >= 0.0 {
+            if before != V::ZERO && sliding.dot(before) >= 0.0 {
                 continue;
             }
-            if before == DVec2::ZERO && sliding == DVec2::ZERO {
+            if before == V::ZERO && sliding == V::ZERO {
                 continue;
             }
-            let axis = row.tangent();
+            // In space a surface has no one tangent to hold along: the
+            // bead is not held still there, friction only slows it.
+            let Some(axis) = row.tangent() else { continue };
             self.place_stick(s, axis, axis.dot(states[bead].position), work);
             stopped = true;
         }
@@ -120,7 +122,7 @@ impl Island {
     }
 
     /// Takes stick row `s` back, as the line `axis·x = offset`.
-    pub(super) fn place_stick(&self, s: usize, axis: DVec2, offset: f64, work: &mut IslandWork) {
+    pub(super) fn place_stick(&self, s: usize, axis: V, offset: f64, work: &mut IslandWork<V>) {
         work.inactive[s] = false;
         work.sticks.resize(self.rows(), None);
         work.sticks[s] = Some((axis, offset));
@@ -132,9 +134,9 @@ impl Island {
     pub(super) fn leave(
         &self,
         time: f64,
-        states: &[BeadState],
-        forces: &[LinearForce],
-        work: &mut IslandWork,
+        states: &[BeadState<V>],
+        forces: &[LinearForce<V>],
+        work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         if states.len() != self.beads() || forces.len() != self.beads() {
             return Ok(()); // `advance` reports it
@@ -165,10 +167,10 @@ impl Island {
     pub(super) fn land(
         &self,
         time: f64,
-        states: &mut [BeadState],
-        forces: &[LinearForce],
+        states: &mut [BeadState<V>],
+        forces: &[LinearForce<V>],
         h: f64,
-        work: &mut IslandWork,
+        work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         work.time = time;
         for r in 0..self.rows() {
@@ -187,7 +189,7 @@ impl Island {
             work.load(states);
             self.newton(work, Direction::Current)?;
             self.evaluate_at_new(work);
-            let nn = normal.length_squared().max(f64::MIN_POSITIVE);
+            let nn = normal.dot(normal).max(f64::MIN_POSITIVE);
             let across = normal.dot(velocity - wire);
             let normal_speed = across.abs() / nn.sqrt();
             let force = forces[bead].at(position);

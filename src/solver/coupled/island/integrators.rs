@@ -7,21 +7,24 @@
 
 use super::newton::Direction;
 use super::{Island, IslandWork, RowReport};
-use bevy::math::DVec2;
+use crate::geometry::WireSpace;
 
-use crate::lane::V2;
 use crate::solver::rattle::{rattle_drift, rattle_half_kick};
 use crate::solver::rk4::{RK4_STAGES, rk4_plus};
 use crate::solver::settings::Gains;
-use crate::solver::solve::SolveError;
+use crate::solver::solve::{SolveError, singular};
 use crate::solver::state::LinearForce;
 
-impl Island {
+impl<V: WireSpace> Island<V> {
     /// Factors `J W Jᵀ` at the work's current state (`work.gradient` at
     /// `work.x`), or at the step's start (`work.first_gradient` at
     /// `work.x0`); a vanishing row is a singular point, reported at its
     /// first bead's position.
-    pub(super) fn factor(&self, work: &mut IslandWork, at_start: bool) -> Result<(), SolveError> {
+    pub(super) fn factor(
+        &self,
+        work: &mut IslandWork<V>,
+        at_start: bool,
+    ) -> Result<(), SolveError> {
         let (gradient, x) = if at_start {
             (&work.first_gradient, &work.x0)
         } else {
@@ -37,7 +40,7 @@ impl Island {
             )
             .map_err(|r| {
                 let p = x[self.entry_bead[self.row_start[r]]];
-                SolveError::Singular { x: p.x, y: p.y }
+                singular(p)
             })
     }
 
@@ -46,9 +49,9 @@ impl Island {
     /// `work.x0, work.v0` first at the step's start).
     pub(super) fn accelerate(
         &self,
-        forces: &[LinearForce],
+        forces: &[LinearForce<V>],
         gains: Gains,
-        work: &mut IslandWork,
+        work: &mut IslandWork<V>,
         stage: Stage,
     ) -> Result<(), SolveError> {
         if stage == Stage::Start {
@@ -65,7 +68,7 @@ impl Island {
             let pushed: f64 = (self.row_start[r]..self.row_start[r + 1])
                 .map(|e| {
                     let bead = self.entry_bead[e];
-                    work.gradient[e].dot(self.inverse_mass[bead] * work.force[bead])
+                    work.gradient[e].dot(work.force[bead] * self.inverse_mass[bead])
                 })
                 .sum();
             let c_dot = self.rate(r, &work.gradient, &work.v, &work.bias);
@@ -78,14 +81,14 @@ impl Island {
             work.force
                 .iter()
                 .zip(&self.inverse_mass)
-                .map(|(f, w)| *w * *f),
+                .map(|(f, w)| *f * *w),
         );
         self.push(&work.gradient, &work.lambda, &mut work.acceleration);
         Ok(())
     }
 
     /// Keeps the last solve's λ as the step's report.
-    pub(super) fn keep_lambda(&self, work: &mut IslandWork) {
+    pub(super) fn keep_lambda(&self, work: &mut IslandWork<V>) {
         work.reports.clear();
         work.reports
             .extend(work.lambda.iter().map(|&lambda| RowReport {
@@ -98,16 +101,16 @@ impl Island {
     /// first stage's.
     pub(super) fn rk4(
         &self,
-        forces: &[LinearForce],
+        forces: &[LinearForce<V>],
         gains: Gains,
         h: f64,
-        work: &mut IslandWork,
+        work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         self.accelerate(forces, gains, work, Stage::Start)?;
         self.keep_lambda(work);
         let n = self.beads();
         let start = work.time;
-        let pair = |x: &[DVec2], v: &[DVec2], i: usize| (V2::from(x[i]), V2::from(v[i]));
+        let pair = |x: &[V], v: &[V], i: usize| (x[i], v[i]);
         work.x_sum.clone_from(&work.v0);
         work.v_sum.clone_from(&work.acceleration);
         for (at, weight) in RK4_STAGES {
@@ -115,22 +118,20 @@ impl Island {
             // is (work.v, work.acceleration).
             for i in 0..n {
                 let derivative = pair(&work.v, &work.acceleration, i);
-                let (x, v) = rk4_plus(pair(&work.x0, &work.v0, i), at * h, derivative);
-                (work.x[i], work.v[i]) = (x.into(), v.into());
+                (work.x[i], work.v[i]) = rk4_plus(pair(&work.x0, &work.v0, i), at * h, derivative);
             }
             work.time = start + at * h;
             self.accelerate(forces, gains, work, Stage::Later)?;
             for i in 0..n {
                 let derivative = pair(&work.v, &work.acceleration, i);
-                let (x, v) = rk4_plus(pair(&work.x_sum, &work.v_sum, i), weight, derivative);
-                (work.x_sum[i], work.v_sum[i]) = (x.into(), v.into());
+                (work.x_sum[i], work.v_sum[i]) =
+                    rk4_plus(pair(&work.x_sum, &work.v_sum, i), weight, derivative);
             }
         }
         let sixth = h / 6.0;
         for i in 0..n {
             let sum = pair(&work.x_sum, &work.v_sum, i);
-            let (x, v) = rk4_plus(pair(&work.x0, &work.v0, i), sixth, sum);
-            (work.x[i], work.v[i]) = (x.into(), v.into());
+            (work.x[i], work.v[i]) = rk4_plus(pair(&work.x0, &work.v0, i), sixth, sum);
         }
         Ok(())
     }
@@ -139,9 +140,9 @@ impl Island {
     /// island's `C` along `W J₀ᵀ`), then the linear velocity solve.
     pub(super) fn rattle(
         &self,
-        forces: &[LinearForce],
+        forces: &[LinearForce<V>],
         h: f64,
-        work: &mut IslandWork,
+        work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         let n = self.beads();
         self.evaluate_at_start(work, work.time);

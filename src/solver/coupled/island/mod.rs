@@ -4,8 +4,8 @@
 //!
 //! | file | what it holds |
 //! |---|---|
-//! | `mod` | [`Island`] and what may change between steps (wires, axes, sides, friction), [`IslandWork`], [`RowReport`] |
-//! | `build` | [`Island::new`]: the rows and springs checked and laid out, [`IslandRow`], [`IslandError`] |
+//! | `mod` | [`Island`] and what may change between steps (wires, axes, sides, friction), [`IslandWork<V>`], [`RowReport`] |
+//! | `build` | [`Island::new`]: the rows and springs checked and laid out, [`IslandRow<V>`], [`IslandError`] |
 //! | `rows` | each row's `C`, gradient, `J̇q̇` and bias (eq. 15 for a moving wire), and the products with `J` |
 //! | `step` | [`Island::step`]: the step's outline, the Euler steps and the drift check (the lone bead's, bead by bead and row by row), substeps and halvings |
 //! | `integrators` | eq. (12) on an island (λ and the accelerations), RK4, RATTLE: each bead by the lone bead's formulas, the multipliers by matrix solves |
@@ -17,7 +17,7 @@ use bevy::math::DVec2;
 
 use super::constraint::{RowKind, SpringLink};
 use super::normal::{Factored, LuWork, NormalMatrix};
-use crate::geometry::{Friction, Pose, PosePath, Side, WireShape};
+use crate::geometry::{Friction, Side, WireSpace};
 use crate::solver::contact::ContactEvent;
 use crate::solver::state::BeadState;
 
@@ -62,9 +62,9 @@ pub struct RowReport {
 /// the topology, built once, and what it needs to solve eq. (12) fast (the
 /// pattern and symbolic factorization of `J W Jᵀ`). Positions, velocities
 /// and forces come with each step.
-pub struct Island {
+pub struct Island<V: WireSpace = DVec2> {
     inverse_mass: Vec<f64>,
-    rows: Vec<RowKind>,
+    rows: Vec<RowKind<V>>,
     /// Row `r`'s gradient entries are `row_start[r]..row_start[r + 1]`.
     row_start: Vec<usize>,
     /// The bead of each gradient entry.
@@ -72,7 +72,7 @@ pub struct Island {
     springs: Vec<SpringLink>,
     normal: NormalMatrix,
     /// The path of each wire row that moves (see [`Island::move_wire`]).
-    paths: Vec<Option<PosePath>>,
+    paths: Vec<Option<V::Path>>,
     /// How many rows have a path: with none, a step looks at no path.
     moving: usize,
     /// Each row's side (+1, −1, or 0 for a two-sided row) and restitution
@@ -98,17 +98,17 @@ struct RoughRow {
 /// The buffers one island's step works in, kept between steps so a step
 /// allocates nothing. Also what the last step reported.
 #[derive(Default)]
-pub struct IslandWork {
-    x0: Vec<DVec2>,
-    v0: Vec<DVec2>,
-    x: Vec<DVec2>,
-    v: Vec<DVec2>,
-    x_sum: Vec<DVec2>,
-    v_sum: Vec<DVec2>,
-    force: Vec<DVec2>,
-    acceleration: Vec<DVec2>,
-    gradient: Vec<DVec2>,
-    first_gradient: Vec<DVec2>,
+pub struct IslandWork<V: WireSpace = DVec2> {
+    x0: Vec<V>,
+    v0: Vec<V>,
+    x: Vec<V>,
+    v: Vec<V>,
+    x_sum: Vec<V>,
+    v_sum: Vec<V>,
+    force: Vec<V>,
+    acceleration: Vec<V>,
+    gradient: Vec<V>,
+    first_gradient: Vec<V>,
     c: Vec<f64>,
     curvature: Vec<f64>,
     /// Each row's `−∂C/∂t` (the moving wire's `∇C·w`; zero for the rest):
@@ -122,16 +122,16 @@ pub struct IslandWork {
     /// step (NaN: unknown), so a self-crossing track keeps it on its branch.
     hints: Vec<f64>,
     /// Where each stick row holds its bead: the line `axis·x = offset`.
-    sticks: Vec<Option<(DVec2, f64)>>,
+    sticks: Vec<Option<(V, f64)>>,
     /// What the last step did to one-sided rows: (row, bead, event).
-    events: Vec<(usize, usize, ContactEvent)>,
+    events: Vec<(usize, usize, ContactEvent<V>)>,
     rhs: Vec<f64>,
     lambda: Vec<f64>,
     lu: LuWork,
-    scratch: Vec<DVec2>,
+    scratch: Vec<V>,
     factored: Factored,
     reports: Vec<RowReport>,
-    bead_forces: Vec<DVec2>,
+    bead_forces: Vec<V>,
     substeps: u32,
     /// How many halvings deep the last step's substeps went; the next
     /// step starts there (see [`Island::step`]).
@@ -139,13 +139,13 @@ pub struct IslandWork {
     /// Steps in a row that went no deeper than they started.
     calm: u32,
     /// The states at the start of a step, restored if it fails.
-    start: Vec<BeadState>,
+    start: Vec<BeadState<V>>,
 }
 
-impl IslandWork {
+impl<V: WireSpace> IslandWork<V> {
     /// Takes `states` in as the current positions and velocities
     /// (`x`, `v`).
-    pub(super) fn load(&mut self, states: &[BeadState]) {
+    pub(super) fn load(&mut self, states: &[BeadState<V>]) {
         self.x.clear();
         self.x.extend(states.iter().map(|s| s.position));
         self.v.clear();
@@ -158,8 +158,8 @@ impl IslandWork {
     }
 
     /// The constraint force `Σ λ ∇C` on each bead at the end of the last
-    /// step (λ as [`IslandWork::rows`] reports it).
-    pub fn constraint_forces(&self) -> &[DVec2] {
+    /// step (λ as [`IslandWork<V>::rows`] reports it).
+    pub fn constraint_forces(&self) -> &[V] {
         &self.bead_forces
     }
 
@@ -182,16 +182,16 @@ impl IslandWork {
 
     /// The beads that left or landed on a one-sided row in the last step:
     /// `(row, bead, event)`.
-    pub fn events(&self) -> &[(usize, usize, ContactEvent)] {
+    pub fn events(&self) -> &[(usize, usize, ContactEvent<V>)] {
         &self.events
     }
 }
 
-impl Island {
+impl<V: WireSpace> Island<V> {
     /// Moves the wire of row `row` to `pose` (a wire that moves between
     /// steps), and gives it `shape` where one is given (a wire edited in
     /// place); rows of other kinds are left as they are.
-    pub fn place_wire(&mut self, row: usize, shape: Option<WireShape>, pose: Pose) {
+    pub fn place_wire(&mut self, row: usize, shape: Option<V::Shape>, pose: V::Pose) {
         if let Some(RowKind::Wire {
             shape: placed_shape,
             pose: placed,
@@ -211,8 +211,8 @@ impl Island {
     /// step: its rows are evaluated where the wire is at each stage's
     /// time, with the terms of eq. (15) (the step's times come from
     /// [`Island::step_at`]). `shape` as for [`Island::place_wire`].
-    pub fn move_wire(&mut self, row: usize, shape: Option<WireShape>, path: PosePath) {
-        if let Some(pose) = path.fixed() {
+    pub fn move_wire(&mut self, row: usize, shape: Option<V::Shape>, path: V::Path) {
+        if let Some(pose) = V::path_fixed(&path) {
             return self.place_wire(row, shape, pose);
         }
         if let Some(RowKind::Wire {
@@ -321,7 +321,7 @@ impl Island {
 
     /// Kinetic plus gravitational energy of the beads in `states`, plus the
     /// springs' stored energy.
-    pub fn energy(&self, states: &[BeadState], gravity: DVec2) -> f64 {
+    pub fn energy(&self, states: &[BeadState<V>], gravity: V) -> f64 {
         let beads: f64 = states
             .iter()
             .zip(&self.inverse_mass)

@@ -6,13 +6,12 @@
 //! row accepted.
 
 use super::{EXACT_STEPS, Island, IslandWork};
-use bevy::math::DVec2;
+use crate::geometry::WireSpace;
 
-use crate::lane::Vector;
 use crate::solver::newton::{NEWTON_MAX_ITERATIONS, newton_accepted, newton_within};
 use crate::solver::solve::SolveError;
 
-impl Island {
+impl<V: WireSpace> Island<V> {
     /// Newton's method for `C(x + W Jᵀ μ) = 0` from `work.x`, along the
     /// gradients of `direction`: moves `work.x` onto the constraints and
     /// returns with `work.lambda` holding the total μ.
@@ -30,7 +29,7 @@ impl Island {
     /// only, not `J̇q̇` or the bias.
     pub(super) fn newton(
         &self,
-        work: &mut IslandWork,
+        work: &mut IslandWork<V>,
         direction: Direction,
     ) -> Result<(), SolveError> {
         let rows = self.rows();
@@ -124,7 +123,7 @@ impl Island {
 
     /// The largest coordinate of row `r`'s beads at `x`: how far rounding
     /// the coordinates its `C` is computed from reaches.
-    fn reach(&self, r: usize, x: &[DVec2]) -> f64 {
+    fn reach(&self, r: usize, x: &[V]) -> f64 {
         (self.row_start[r]..self.row_start[r + 1])
             .map(|e| x[self.entry_bead[e]].reach())
             .fold(0.0, f64::max)
@@ -137,7 +136,7 @@ impl Island {
     /// convergence, so the step is halved.
     fn same_branch(
         &self,
-        work: &IslandWork,
+        work: &IslandWork<V>,
         direction: Direction,
         residual: f64,
     ) -> Result<(), SolveError> {

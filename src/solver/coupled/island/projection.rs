@@ -4,7 +4,7 @@
 //! `J W Jᵀ` for all its rows at once; the speed and energy are restored by
 //! the lone bead's scale factors, with targets summed over the island.
 
-use bevy::math::DVec2;
+use crate::geometry::WireSpace;
 
 use super::newton::Direction;
 use super::{Island, IslandWork};
@@ -12,13 +12,13 @@ use crate::solver::restore::{energy_scale, kinetic_scale};
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
 
-impl Island {
+impl<V: WireSpace> Island<V> {
     /// `Σ ½ m |v|²` of the beads' `velocities`.
-    fn kinetic(&self, velocities: impl IntoIterator<Item = DVec2>) -> f64 {
+    fn kinetic(&self, velocities: impl IntoIterator<Item = V>) -> f64 {
         velocities
             .into_iter()
             .zip(&self.inverse_mass)
-            .map(|(v, w)| 0.5 * v.length_squared() / w)
+            .map(|(v, w)| 0.5 * v.dot(v) / w)
             .sum()
     }
 
@@ -39,10 +39,10 @@ impl Island {
     pub fn project_velocities(
         &self,
         time: f64,
-        states: &mut [BeadState],
-        work: &mut IslandWork,
+        states: &mut [BeadState<V>],
+        work: &mut IslandWork<V>,
     ) -> Result<(f64, f64), SolveError> {
-        let kinetic = |states: &[BeadState]| self.kinetic(states.iter().map(|s| s.velocity));
+        let kinetic = |states: &[BeadState<V>]| self.kinetic(states.iter().map(|s| s.velocity));
         let before = kinetic(states);
         if states.len() != self.beads() {
             return Ok((before, before));
@@ -74,7 +74,7 @@ impl Island {
     /// Removes the velocity's component off the constraints:
     /// `v ← v − W Jᵀ (J W Jᵀ)⁻¹ J v` at `work.x` (rows evaluated there).
     /// Returns with the multipliers (of `−J v`) in `work.rhs`.
-    pub(super) fn project_velocity(&self, work: &mut IslandWork) -> Result<(), SolveError> {
+    pub(super) fn project_velocity(&self, work: &mut IslandWork<V>) -> Result<(), SolveError> {
         if self.rows() == 0 {
             return Ok(());
         }
@@ -100,14 +100,14 @@ impl Island {
     /// conservative island (no spring damping) what it was, eq. (11).
     pub(super) fn project(
         &self,
-        forces: &[LinearForce],
+        forces: &[LinearForce<V>],
         restore: Restore,
-        work: &mut IslandWork,
+        work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         self.newton(work, Direction::Current)?;
         self.evaluate_at_new(work);
         self.project_velocity(work)?;
-        let kinetic = |v: &[DVec2]| self.kinetic(v.iter().copied());
+        let kinetic = |v: &[V]| self.kinetic(v.iter().copied());
         let now = kinetic(&work.v);
         let h = match restore {
             Restore::Nothing => return Ok(()),
@@ -116,7 +116,7 @@ impl Island {
                 if self.springs.iter().any(|s| s.damping != 0.0) {
                     return Ok(());
                 }
-                let potential = |x: &[DVec2]| -> f64 {
+                let potential = |x: &[V]| -> f64 {
                     let applied: f64 = forces.iter().zip(x).map(|(f, x)| f.potential(*x)).sum();
                     applied + self.springs.iter().map(|s| s.energy(x)).sum::<f64>()
                 };
@@ -149,7 +149,10 @@ impl Island {
             .iter()
             .zip(&work.force)
             .zip(&self.inverse_mass)
-            .map(|((v, a), w)| 0.5 * (*v + h * *a).length_squared() / w)
+            .map(|((v, a), w)| {
+                let kicked = *v + *a * h;
+                0.5 * kicked.dot(kicked) / w
+            })
             .sum();
         let scale = kinetic_scale(target, now);
         for v in &mut work.v {

@@ -5,26 +5,24 @@
 use bevy::math::DVec2;
 
 use super::{Island, IslandWork};
-use crate::geometry::{ImplicitCurve, Near, Placed, Pose, Twist, WireShape};
+use crate::geometry::{Placement, Twist, WireSpace, placed_geometry};
 use crate::solver::coupled::constraint::RowKind;
 use crate::solver::state::{BeadState, LinearForce};
 use crate::solver::wire_normal::along;
 
-impl Island {
+impl<V: WireSpace> Island<V> {
     /// Wire row `r` where its bead is in `states` at `time`, whether the
     /// row is held or not (zero for a row of another kind).
-    pub(super) fn wire_row(&self, r: usize, states: &[BeadState], time: f64) -> RowAt {
+    pub(super) fn wire_row(&self, r: usize, states: &[BeadState<V>], time: f64) -> RowAt<V> {
         let (Some((shape, pose, twist)), Some(state)) = (
             self.wire_at(r, time),
             states.get(self.entry_bead[self.row_start[r]]),
         ) else {
             return RowAt::default();
         };
-        let g = Placed {
-            curve: shape.curve(),
-            pose,
-        }
-        .geometry(state.position);
+        let g = placed_geometry(&pose, state.position, |local| {
+            V::shape_geometry(shape, local, None)
+        });
         RowAt {
             c: g.c,
             normal: g.normal,
@@ -34,12 +32,12 @@ impl Island {
 
     /// The shape of wire row `r` and where its wire is at `time`, with its
     /// twist; none for a row of another kind.
-    fn wire_at(&self, r: usize, time: f64) -> Option<(&WireShape, Pose, Twist)> {
+    fn wire_at(&self, r: usize, time: f64) -> Option<(&V::Shape, V::Pose, Twist<V>)> {
         let RowKind::Wire { shape, pose } = &self.rows[r] else {
             return None;
         };
         let (pose, twist) = match &self.paths[r] {
-            Some(path) => path.at(time),
+            Some(path) => V::path_at(path, time),
             None => (*pose, Twist::default()),
         };
         Some((shape, pose, twist))
@@ -47,7 +45,7 @@ impl Island {
 
     /// Keeps each wire row's curve parameter where its bead is now (at
     /// `time`), and reports each set-aside row's own `C` and `Ċ`.
-    pub(super) fn follow(&self, time: f64, states: &[BeadState], work: &mut IslandWork) {
+    pub(super) fn follow(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
         work.hints.resize(self.rows(), f64::NAN);
         for r in 0..self.rows() {
             let (Some((shape, pose, _)), Some(state)) = (
@@ -56,8 +54,8 @@ impl Island {
             ) else {
                 continue;
             };
-            let local = pose.to_local(state.position);
-            work.hints[r] = shape.curve().parameter(local, work.hints[r]);
+            let local = Placement::to_local(&pose, state.position);
+            work.hints[r] = V::shape_parameter(shape, local, work.hints[r]);
             if work.inactive.get(r) == Some(&true)
                 && let Some(report) = work.reports.get_mut(r)
             {
@@ -73,11 +71,11 @@ impl Island {
     /// `rates` those two keep what they held).
     fn evaluate(
         &self,
-        x: &[DVec2],
-        v: &[DVec2],
+        x: &[V],
+        v: &[V],
         time: f64,
-        held: Held<'_>,
-        out: Rows<'_>,
+        held: Held<'_, V>,
+        out: Rows<'_, V>,
         rates: bool,
     ) {
         let Held {
@@ -93,7 +91,7 @@ impl Island {
             bias,
             scratch,
         } = out;
-        gradient.resize(self.entry_bead.len(), DVec2::ZERO);
+        gradient.resize(self.entry_bead.len(), V::ZERO);
         c.resize(self.rows(), 0.0);
         curvature.resize(self.rows(), 0.0);
         if rates {
@@ -104,7 +102,7 @@ impl Island {
             let range = self.row_start[r]..self.row_start[r + 1];
             if inactive.get(r) == Some(&true) {
                 // Set aside: no force, no error.
-                gradient[range].fill(DVec2::ZERO);
+                gradient[range].fill(V::ZERO);
                 (c[r], curvature[r], bias[r]) = (0.0, 0.0, 0.0);
                 continue;
             }
@@ -124,15 +122,10 @@ impl Island {
                 // Eq. (15): the wire where it is at `time`, seen from its frame.
                 let bead = self.entry_bead[range.start];
                 let (p, u) = (x[bead], v[bead]);
-                let (pose, twist) = path.at(time);
-                let g = Placed {
-                    curve: &Near {
-                        curve: shape.curve(),
-                        hint: hint(r),
-                    },
-                    pose,
-                }
-                .geometry(p);
+                let (pose, twist) = V::path_at(path, time);
+                let g = placed_geometry(&pose, p, |local| {
+                    V::shape_geometry(shape, local, Some(hint(r)))
+                });
                 let w = twist.velocity_at(p);
                 let relative = u - w;
                 gradient[range.start] = g.normal;
@@ -140,7 +133,7 @@ impl Island {
                 if !rates {
                     continue;
                 }
-                curvature[r] = relative.dot(g.hessian * relative)
+                curvature[r] = relative.dot(V::hessian_times(&g.hessian, relative))
                     - g.normal.dot(twist.acceleration_at(p, relative));
                 bias[r] = g.normal.dot(w);
                 continue;
@@ -163,25 +156,25 @@ impl Island {
 
     /// Evaluates the rows at the current state `work.x`, `work.v` (where
     /// the step ended, or the stage or Newton iterate being worked on).
-    pub(super) fn evaluate_at_new(&self, work: &mut IslandWork) {
+    pub(super) fn evaluate_at_new(&self, work: &mut IslandWork<V>) {
         self.evaluate_work(work, false, work.time, true);
     }
 
     /// [`Island::evaluate_at_new`] without `J̇q̇` and the bias: what a
     /// position solve's iterations need.
-    pub(super) fn evaluate_positions(&self, work: &mut IslandWork) {
+    pub(super) fn evaluate_positions(&self, work: &mut IslandWork<V>) {
         self.evaluate_work(work, false, work.time, false);
     }
 
     /// Evaluates the rows at the step's start `work.x0`, `work.v0` into
     /// `work.first_gradient` (and `work.c`, `work.curvature`, `work.bias`).
-    pub(super) fn evaluate_at_start(&self, work: &mut IslandWork, time: f64) {
+    pub(super) fn evaluate_at_start(&self, work: &mut IslandWork<V>, time: f64) {
         self.evaluate_work(work, true, time, true);
     }
 
     /// [`Island::evaluate`] on the work's state: the start's into
     /// `work.first_gradient`, or the current one into `work.gradient`.
-    fn evaluate_work(&self, work: &mut IslandWork, at_start: bool, time: f64, rates: bool) {
+    fn evaluate_work(&self, work: &mut IslandWork<V>, at_start: bool, time: f64, rates: bool) {
         let (x, v, gradient) = if at_start {
             (&work.x0, &work.v0, &mut work.first_gradient)
         } else {
@@ -208,7 +201,7 @@ impl Island {
     }
 
     /// `Σ g·v` over row `r`'s entries (`J v` of one row).
-    pub(super) fn along(&self, r: usize, gradient: &[DVec2], v: &[DVec2]) -> f64 {
+    pub(super) fn along(&self, r: usize, gradient: &[V], v: &[V]) -> f64 {
         (self.row_start[r]..self.row_start[r + 1])
             .map(|e| gradient[e].dot(v[self.entry_bead[e]]))
             .sum()
@@ -216,19 +209,13 @@ impl Island {
 
     /// `Ċ_r = Σ g·v − bias` over row `r`'s entries: the rate relative to
     /// a moving wire.
-    pub(super) fn rate(&self, r: usize, gradient: &[DVec2], v: &[DVec2], bias: &[f64]) -> f64 {
+    pub(super) fn rate(&self, r: usize, gradient: &[V], v: &[V], bias: &[f64]) -> f64 {
         self.along(r, gradient, v) - bias[r]
     }
 
     /// The applied forces at `(x, v)`: each bead's external force, plus
     /// the springs.
-    pub(super) fn applied(
-        &self,
-        forces: &[LinearForce],
-        x: &[DVec2],
-        v: &[DVec2],
-        out: &mut Vec<DVec2>,
-    ) {
+    pub(super) fn applied(&self, forces: &[LinearForce<V>], x: &[V], v: &[V], out: &mut Vec<V>) {
         out.clear();
         out.extend(forces.iter().zip(x).map(|(f, &p)| f.at(p)));
         for spring in &self.springs {
@@ -239,14 +226,14 @@ impl Island {
     }
 
     /// Adds `W Jᵀ μ` (with `gradient`) to `out`.
-    pub(super) fn push(&self, gradient: &[DVec2], mu: &[f64], out: &mut [DVec2]) {
+    pub(super) fn push(&self, gradient: &[V], mu: &[f64], out: &mut [V]) {
         for (r, &m) in mu.iter().enumerate() {
             let entries = self.row_start[r]..self.row_start[r + 1];
             for (&bead, g) in self.entry_bead[entries.clone()]
                 .iter()
                 .zip(&gradient[entries])
             {
-                out[bead] += (m * self.inverse_mass[bead]) * *g;
+                out[bead] += *g * (m * self.inverse_mass[bead]);
             }
         }
     }
@@ -255,39 +242,40 @@ impl Island {
 /// A wire row where its bead is: `C`, `∇C`, and the velocity of the
 /// wire's point there.
 #[derive(Clone, Copy, Default)]
-pub(super) struct RowAt {
+pub(super) struct RowAt<V = DVec2> {
     pub(super) c: f64,
-    pub(super) normal: DVec2,
-    pub(super) wire: DVec2,
+    pub(super) normal: V,
+    pub(super) wire: V,
 }
 
-impl RowAt {
+impl<V: WireSpace> RowAt<V> {
     /// The part of `velocity`, relative to the wire, along it.
-    pub(super) fn sliding(&self, velocity: DVec2) -> DVec2 {
+    pub(super) fn sliding(&self, velocity: V) -> V {
         let relative = velocity - self.wire;
-        let nn = self.normal.length_squared();
+        let nn = self.normal.dot(self.normal);
         along(self.normal, nn, relative)
     }
 
-    /// The unit direction along the wire: a stick row's axis.
-    pub(super) fn tangent(&self) -> DVec2 {
-        DVec2::new(-self.normal.y, self.normal.x).normalize_or_zero()
+    /// The unit direction along the wire, a stick row's axis (see
+    /// [`Coordinates::stick_axis`]).
+    pub(super) fn tangent(&self) -> Option<V> {
+        V::stick_axis(self.normal)
     }
 }
 
 /// Which rows [`Island::evaluate`] holds, and where along their curves
 /// the wire rows' beads were.
-struct Held<'a> {
+struct Held<'a, V> {
     inactive: &'a [bool],
     hints: &'a [f64],
-    sticks: &'a [Option<(DVec2, f64)>],
+    sticks: &'a [Option<(V, f64)>],
 }
 
 /// Where [`Island::evaluate`] writes.
-struct Rows<'a> {
-    gradient: &'a mut Vec<DVec2>,
+struct Rows<'a, V> {
+    gradient: &'a mut Vec<V>,
     c: &'a mut Vec<f64>,
     curvature: &'a mut Vec<f64>,
     bias: &'a mut Vec<f64>,
-    scratch: &'a mut Vec<DVec2>,
+    scratch: &'a mut Vec<V>,
 }

@@ -2,7 +2,7 @@
 //! the divergence check, and the substeps a step is halved into where its
 //! Newton solve finds no root.
 
-use bevy::math::DVec2;
+use crate::geometry::WireSpace;
 
 use super::integrators::Stage;
 use super::projection::Restore;
@@ -18,22 +18,22 @@ use crate::solver::step::drift_check;
 /// A step's flight, as [`Island::land_within`] takes it again: where and
 /// when it started, its forces and settings, the substep level it started
 /// at, and the rows it may land on.
-struct Flight<'a> {
+struct Flight<'a, V> {
     time: f64,
-    start: &'a [BeadState],
-    forces: &'a [LinearForce],
+    start: &'a [BeadState<V>],
+    forces: &'a [LinearForce<V>],
     settings: &'a StepSettings,
     level: u32,
     calm: u32,
     rows: &'a [usize],
 }
 
-impl Island {
+impl<V: WireSpace> Island<V> {
     /// One step of every bead of the island under `settings`: `states`
     /// (one per bead) advance, `forces` (one per bead, gravity included)
     /// are the external forces. On an error the states are left as they
     /// were. What the step reports of each row is in
-    /// [`IslandWork::rows`].
+    /// [`IslandWork<V>::rows`].
     ///
     /// Where a Newton solve (RATTLE's positions, projection) finds no
     /// root, as when a rope's free end whips round faster than a step can
@@ -42,14 +42,14 @@ impl Island {
     /// 2⁶ = 64 substeps. The next step starts as finely as this
     /// one ended, and tries one halving fewer after eight steps
     /// that needed no more, so a long rope does not fail its way down to
-    /// the same level every step; [`IslandWork::substeps`] says how many
+    /// the same level every step; [`IslandWork<V>::substeps`] says how many
     /// the last step took.
     pub fn step(
         &self,
-        states: &mut [BeadState],
-        forces: &[LinearForce],
+        states: &mut [BeadState<V>],
+        forces: &[LinearForce<V>],
         settings: &StepSettings,
-        work: &mut IslandWork,
+        work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         self.step_at(0.0, states, forces, settings, work)
     }
@@ -59,10 +59,10 @@ impl Island {
     pub fn step_at(
         &self,
         time: f64,
-        states: &mut [BeadState],
-        forces: &[LinearForce],
+        states: &mut [BeadState<V>],
+        forces: &[LinearForce<V>],
         settings: &StepSettings,
-        work: &mut IslandWork,
+        work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         work.events.clear();
         if work.inactive.len() != self.rows() {
@@ -117,7 +117,7 @@ impl Island {
     /// The one-sided rows set aside whose beads are off their wires on the
     /// side they push toward: the rows a flight may land on within the
     /// step.
-    fn flying(&self, time: f64, states: &[BeadState], work: &IslandWork) -> Vec<usize> {
+    fn flying(&self, time: f64, states: &[BeadState<V>], work: &IslandWork<V>) -> Vec<usize> {
         if states.len() != self.beads() {
             return Vec::new();
         }
@@ -129,7 +129,7 @@ impl Island {
 
     /// How far the nearest of `rows` is from crossing its wire at `time`:
     /// the least `side · C` (not positive once one has crossed).
-    fn crossing(&self, time: f64, states: &[BeadState], rows: &[usize]) -> f64 {
+    fn crossing(&self, time: f64, states: &[BeadState<V>], rows: &[usize]) -> f64 {
         rows.iter()
             .map(|&r| self.sides[r].0 * self.wire_row(r, states, time).c)
             .fold(f64::INFINITY, f64::min)
@@ -143,9 +143,9 @@ impl Island {
     /// was taken whole, to land at its end.
     fn land_within(
         &self,
-        flight: &Flight,
-        states: &mut [BeadState],
-        work: &mut IslandWork,
+        flight: &Flight<V>,
+        states: &mut [BeadState<V>],
+        work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         let Flight {
             time,
@@ -156,7 +156,7 @@ impl Island {
         } = *flight;
         let whole = states.to_vec();
         let (level, calm, events) = (work.level, work.calm, work.events.len());
-        let trial = |tau: f64, states: &mut [BeadState], work: &mut IslandWork| {
+        let trial = |tau: f64, states: &mut [BeadState<V>], work: &mut IslandWork<V>| {
             states.copy_from_slice(start);
             (work.level, work.calm) = (flight.level, flight.calm);
             let part = StepSettings {
@@ -196,7 +196,7 @@ impl Island {
     /// one-sided wire, on the side it pushes toward, starts in flight;
     /// stick rows start set aside (a bead slides until friction stops it),
     /// but a bead at rest on a rough wire starts held by static friction.
-    pub(super) fn start_rows(&self, time: f64, states: &[BeadState], work: &mut IslandWork) {
+    pub(super) fn start_rows(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
         let whole = states.len() == self.beads();
         work.inactive.clear();
         work.inactive.resize(self.rows(), false);
@@ -224,8 +224,9 @@ impl Island {
                 continue;
             }
             let row = self.wire_row(r, states, time);
-            if states[bead].velocity == row.wire {
-                let axis = row.tangent();
+            if states[bead].velocity == row.wire
+                && let Some(axis) = row.tangent()
+            {
                 self.place_stick(*s, axis, axis.dot(states[bead].position), work);
             }
         }
@@ -240,10 +241,10 @@ impl Island {
     fn substeps(
         &self,
         time: f64,
-        states: &mut [BeadState],
-        forces: &[LinearForce],
+        states: &mut [BeadState<V>],
+        forces: &[LinearForce<V>],
         settings: &StepSettings,
-        work: &mut IslandWork,
+        work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         let was = work.level.min(MAX_HALVINGS);
         let mut level = if work.calm >= CALM_STEPS {
@@ -286,10 +287,10 @@ impl Island {
     fn advance(
         &self,
         time: f64,
-        states: &mut [BeadState],
-        forces: &[LinearForce],
+        states: &mut [BeadState<V>],
+        forces: &[LinearForce<V>],
         settings: &StepSettings,
-        work: &mut IslandWork,
+        work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         let n = self.beads();
         if states.len() != n || forces.len() != n {
@@ -355,7 +356,7 @@ impl Island {
             self.project(forces, restore, work)?;
         }
         work.bead_forces.clear();
-        work.bead_forces.resize(n, DVec2::ZERO);
+        work.bead_forces.resize(n, V::ZERO);
         for (r, report) in work.reports.iter_mut().enumerate() {
             report.c = work.c[r];
             report.c_dot = self.rate(r, &work.gradient, &work.v, &work.bias);
@@ -364,7 +365,7 @@ impl Island {
                 .iter()
                 .zip(&work.gradient[entries])
             {
-                work.bead_forces[bead] += report.lambda * *g;
+                work.bead_forces[bead] += *g * report.lambda;
             }
         }
         for (state, (x, v)) in states.iter_mut().zip(work.x.iter().zip(&work.v)) {

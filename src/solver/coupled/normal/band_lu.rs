@@ -1,7 +1,7 @@
 //! The Newton matrix `J₁ W J₀ᵀ` of RATTLE's position solve as a band
 //! matrix, solved by Gaussian elimination with partial pivoting.
 
-use bevy::math::DVec2;
+use crate::geometry::Coordinates;
 
 use super::order::Band;
 use super::{NormalMatrix, REDUNDANT_PIVOT};
@@ -11,12 +11,12 @@ impl NormalMatrix {
     /// band's order of the rows, solved by [`eliminate_band`] (in `order`
     /// where the band reorders the rows).
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn solve_unsymmetric_band(
+    pub(super) fn solve_unsymmetric_band<V: Coordinates>(
         &self,
         band: &Band,
         inverse_mass: &[f64],
-        now: &[DVec2],
-        first: &[DVec2],
+        now: &[V],
+        first: &[V],
         m: &mut Vec<f64>,
         order: &mut Vec<f64>,
         rhs: &mut [f64],

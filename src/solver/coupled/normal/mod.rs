@@ -38,7 +38,7 @@
 
 use std::sync::OnceLock;
 
-use bevy::math::DVec2;
+use crate::geometry::Coordinates;
 use faer::dyn_stack::MemBuffer;
 use faer::sparse::SymbolicSparseColMat;
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
@@ -161,10 +161,10 @@ impl NormalMatrix {
     /// and the matrix is a band. Returns the index of a row whose
     /// diagonal vanishes (a singular point: no direction to push along) as
     /// the error.
-    pub(crate) fn factor(
+    pub(crate) fn factor<V: Coordinates>(
         &self,
         inverse_mass: &[f64],
-        gradient: &[DVec2],
+        gradient: &[V],
         inactive: &[bool],
         natural: bool,
         f: &mut Factored,
@@ -228,11 +228,11 @@ impl NormalMatrix {
     /// of RATTLE's position solve): in the rows' order where `natural` and
     /// the matrix is a band, else by faer's sparse LU. Returns
     /// `false` where the matrix is singular or faer could not factor it.
-    pub(crate) fn solve_unsymmetric(
+    pub(crate) fn solve_unsymmetric<V: Coordinates>(
         &self,
         inverse_mass: &[f64],
-        now: &[DVec2],
-        first: &[DVec2],
+        now: &[V],
+        first: &[V],
         lu: &mut LuWork,
         rhs: &mut [f64],
         natural: bool,

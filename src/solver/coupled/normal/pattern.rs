@@ -5,7 +5,7 @@
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use bevy::math::DVec2;
+use crate::geometry::Coordinates;
 use faer::Side;
 use faer::sparse::SymbolicSparseColMat;
 use faer::sparse::linalg::cholesky::{SymmetricOrdering, factorize_symbolic_cholesky};
@@ -150,13 +150,13 @@ impl NormalMatrix {
 
     /// The value of `J_now W J_firstᵀ` at the upper entry `k`, or at its
     /// mirror below the diagonal.
-    pub(super) fn unsymmetric_value(
+    pub(super) fn unsymmetric_value<V: Coordinates>(
         &self,
         k: usize,
         mirror: bool,
         inverse_mass: &[f64],
-        now: &[DVec2],
-        first: &[DVec2],
+        now: &[V],
+        first: &[V],
     ) -> f64 {
         self.terms[self.term_start[k]..self.term_start[k + 1]]
             .iter()

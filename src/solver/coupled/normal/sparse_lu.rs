@@ -1,7 +1,7 @@
 //! The Newton matrix `J₁ W J₀ᵀ` of RATTLE's position solve by faer's
 //! sparse LU, for an island whose matrix is not a band.
 
-use bevy::math::DVec2;
+use crate::geometry::Coordinates;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::SparseColMatRef;
 use faer::{Conj, MatMut, Par};
@@ -12,11 +12,11 @@ impl NormalMatrix {
     /// [`NormalMatrix::solve_unsymmetric`] by faer's sparse LU on the
     /// pattern of both triangles. Returns `false` where the matrix is
     /// singular or faer could not factor it.
-    pub(super) fn solve_unsymmetric_sparse(
+    pub(super) fn solve_unsymmetric_sparse<V: Coordinates>(
         &self,
         inverse_mass: &[f64],
-        now: &[DVec2],
-        first: &[DVec2],
+        now: &[V],
+        first: &[V],
         lu: &mut LuWork,
         rhs: &mut [f64],
     ) -> bool {

@@ -2,6 +2,7 @@
 //! by both factorizations.
 
 use super::*;
+use bevy::math::DVec2;
 
 /// A pinned chain of `links` rods bent at the beads, and a second set
 /// of gradients turned a little from the first: rows 0 and 1 pin bead

@@ -170,7 +170,7 @@ fn bad_islands_are_refused_in_words() {
         damping: 0.0,
     };
     assert_eq!(
-        Island::new(&[1.0, 1.0], vec![], vec![spring])
+        Island::<DVec2>::new(&[1.0, 1.0], vec![], vec![spring])
             .err()
             .expect("refused")
             .to_string(),
