@@ -82,7 +82,7 @@ pub enum WireMotion {
 }
 
 /// See [`WireMotion::Oscillate`]: in the plane (`DVec2`, the default) or
-/// in space (`DVec3`, [`SpaceMotion::Oscillate`]).
+/// in space (`DVec3`, [`SpaceMotion::Oscillate`](super::SpaceMotion::Oscillate)).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Oscillate<V = DVec2> {

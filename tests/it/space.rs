@@ -596,3 +596,193 @@ fn a_rod_between_two_beads_on_a_sphere_holds_as_an_island() {
     assert!(off <= 1e-12, "off the sphere or the rod by {off:e}");
     assert!(drift <= 1e-5 * 3.0 * G * r, "energy moved {drift:e}");
 }
+
+/// A hoop of radius `r` in its local xy-plane, its centre at the origin,
+/// spinning about the vertical y-axis at `omega`: the island of one bead
+/// held by the hoop's plane and its circle drawn out of it.
+fn hoop(
+    r: f64,
+    omega: f64,
+) -> (
+    wirebead::solver::Island<DVec3>,
+    wirebead::geometry::SpacePath,
+) {
+    use std::sync::Arc;
+    use wirebead::geometry::{Extruded, Flat, SpaceMotion, SpacePath, SurfaceWire};
+    use wirebead::solver::{Island, IslandRow, RowKind};
+    let row = |shape: SurfaceWire| IslandRow {
+        kind: RowKind::Wire {
+            shape,
+            pose: Pose3::IDENTITY,
+        },
+        beads: vec![0],
+    };
+    let rows = vec![
+        row(SurfaceWire(Arc::new(Flat))),
+        row(SurfaceWire(Arc::new(Extruded(Circle { radius: r })))),
+    ];
+    let mut island = Island::new(&[1.0], rows, vec![]).expect("a hoop");
+    let path = SpacePath::Prescribed {
+        base: Pose3::IDENTITY,
+        motion: SpaceMotion::Spin {
+            angular_velocity: omega,
+            axis: DVec3::Y,
+        },
+    };
+    island.move_wire(0, None, path);
+    island.move_wire(1, None, path);
+    (island, path)
+}
+
+/// A bead on the hoop at angle `theta` from its bottom at time `t`, at
+/// rest relative to the hoop (plus `rate`, dθ/dt along it).
+fn on_hoop(
+    path: &wirebead::geometry::SpacePath,
+    r: f64,
+    theta: f64,
+    rate: f64,
+    t: f64,
+) -> BeadState<DVec3> {
+    let (pose, twist) = path.at(t);
+    let local = DVec3::new(r * theta.sin(), -r * theta.cos(), 0.0);
+    let along = DVec3::new(r * theta.cos(), r * theta.sin(), 0.0) * rate;
+    let position = pose.to_world(local);
+    BeadState {
+        position,
+        velocity: twist.velocity_at(position) + pose.rotate(along),
+    }
+}
+
+/// The angle from the hoop's bottom of a bead at `position` at time `t`.
+fn hoop_angle(path: &wirebead::geometry::SpacePath, position: DVec3, t: f64) -> f64 {
+    let local = path.at(t).0.to_local(position);
+    local.x.atan2(-local.y)
+}
+
+/// The rotating hoop (RATTLE): above `ω² = g/r` a bead released at
+/// relative rest at `cos θ* = g/(ω² r)` stays there to 1e-6 rad over
+/// 10 s (at 0.5 ms; the rest at 1 ms); released 0.01 rad off it, it oscillates about θ* at
+/// `Ω = ω sin θ*` (within 1e-3); below, the bottom is stable with
+/// `Ω² = g/r − ω²`. The Jacobi integral `½|v_rel|² − ½ω²ρ² + g y` (per
+/// unit mass) holds to 1e-6 of g r.
+#[test]
+fn the_rotating_hoop_bifurcates_at_omega_squared_g_over_r() {
+    use wirebead::solver::IslandWork;
+    let r = 1.0;
+    let gravity = [LinearForce::constant(DVec3::new(0.0, -G, 0.0))];
+    // Steps the hoop for `duration` at `dt` from θ0 at relative rest; the
+    // angles and the Jacobi integral's largest change.
+    let run = |omega: f64, theta0: f64, duration: f64, dt: f64| {
+        let s = settings(Method::Rattle, dt);
+        let (island, path) = hoop(r, omega);
+        let mut work = IslandWork::default();
+        let mut states = [on_hoop(&path, r, theta0, 0.0, 0.0)];
+        let jacobi = |b: &BeadState<DVec3>, t: f64| {
+            let relative = b.velocity - path.at(t).1.velocity_at(b.position);
+            let rho2 = b.position.x * b.position.x + b.position.z * b.position.z;
+            0.5 * relative.dot(relative) - 0.5 * omega * omega * rho2 + G * b.position.y
+        };
+        let j0 = jacobi(&states[0], 0.0);
+        let (mut angles, mut worst) = (Vec::new(), 0.0f64);
+        let steps = (duration / s.dt).round() as usize;
+        for k in 0..steps {
+            let t = k as f64 * s.dt;
+            island
+                .step_at(t, &mut states, &gravity, &s, &mut work)
+                .expect("a step");
+            let t1 = t + s.dt;
+            angles.push((t1, hoop_angle(&path, states[0].position, t1)));
+            worst = worst.max((jacobi(&states[0], t1) - j0).abs());
+        }
+        (angles, worst)
+    };
+    let period = |angles: &[(f64, f64)], about: f64| {
+        let shifted: Vec<(f64, f64)> = angles.iter().map(|&(t, a)| (t, a - about)).collect();
+        wirebead::reference::period_from_crossings(&shifted).expect("oscillations")
+    };
+
+    let omega = 6.0;
+    let star = (G / (omega * omega * r)).acos();
+    // RATTLE's own equilibrium is θ* to O(h²): at 0.5 ms, within 1e-6.
+    let (angles, jacobi) = run(omega, star, 10.0, 5e-4);
+    let held = angles
+        .iter()
+        .map(|&(_, a)| (a - star).abs())
+        .fold(0.0, f64::max);
+    assert!(held <= 1e-6, "θ* = {star} wandered by {held:e}");
+    assert!(
+        jacobi <= 1e-6 * G * r,
+        "the Jacobi integral moved {jacobi:e}"
+    );
+
+    let (angles, _) = run(omega, star + 0.01, 5.0, 1e-3);
+    let expected = TAU / (omega * star.sin());
+    let measured = period(&angles, star);
+    assert!(
+        (measured - expected).abs() / expected <= 1e-3,
+        "about θ* the period was {measured}, against {expected}"
+    );
+
+    let omega = 2.0;
+    let (angles, jacobi) = run(omega, 0.01, 5.0, 1e-3);
+    let expected = TAU / (G / r - omega * omega).sqrt();
+    let measured = period(&angles, 0.0);
+    assert!(
+        (measured - expected).abs() / expected <= 1e-3,
+        "about the bottom the period was {measured}, against {expected}"
+    );
+    assert!(
+        jacobi <= 1e-6 * G * r,
+        "the Jacobi integral moved {jacobi:e}"
+    );
+}
+
+/// A circle in space, held as its plane and its circle drawn out of it
+/// (two rows of one bead), steps as the plane's bead on the circle: RATTLE
+/// over 5 s at 1 ms, the trajectories within 1e-10, z and its velocity
+/// exactly 0.
+#[test]
+fn a_circle_in_space_steps_as_the_circle_in_the_plane() {
+    use std::sync::Arc;
+    use wirebead::geometry::{Extruded, Flat, SurfaceWire};
+    use wirebead::solver::{Island, IslandRow, IslandWork, RowKind};
+    let r = 0.9;
+    let row = |shape: SurfaceWire| IslandRow {
+        kind: RowKind::Wire {
+            shape,
+            pose: Pose3::IDENTITY,
+        },
+        beads: vec![0],
+    };
+    let rows = vec![
+        row(SurfaceWire(Arc::new(Flat))),
+        row(SurfaceWire(Arc::new(Extruded(Circle { radius: r })))),
+    ];
+    let island = Island::new(&[1.0], rows, vec![]).expect("a circle in space");
+    let mut work = IslandWork::default();
+    let circle = Circle { radius: r };
+    let mut flat = BeadState {
+        position: DVec2::new(r * 1.2f64.sin(), -r * 1.2f64.cos()),
+        velocity: DVec2::ZERO,
+    };
+    let mut round = [BeadState {
+        position: flat.position.extend(0.0),
+        velocity: DVec3::ZERO,
+    }];
+    let s = settings(Method::Rattle, 1e-3);
+    let plane_force = LinearForce::constant(DVec2::new(0.0, -G));
+    let space_force = [LinearForce::constant(DVec3::new(0.0, -G, 0.0))];
+    let mut worst = 0.0f64;
+    for k in 0..5000 {
+        let t = k as f64 * s.dt;
+        flat = step_on(&FixedTrack(&circle), t, flat, &plane_force, 1.0, &s)
+            .expect("a step in the plane")
+            .state;
+        island
+            .step_at(t, &mut round, &space_force, &s, &mut work)
+            .expect("a step in space");
+        worst = worst.max((round[0].position.truncate() - flat.position).length());
+        assert_eq!((round[0].position.z, round[0].velocity.z), (0.0, 0.0));
+    }
+    assert!(worst <= 1e-10, "{worst:e} from the plane's trajectory");
+}

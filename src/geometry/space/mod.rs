@@ -22,6 +22,7 @@
 //! (`revolution`).
 
 mod motion;
+mod planar;
 mod shapes;
 
 use bevy::math::{DMat3, DVec3};
@@ -29,6 +30,7 @@ use bevy::math::{DMat3, DVec3};
 use super::Geometry;
 
 pub use motion::{MovingSurface, SpaceMotion, SpacePath};
+pub use planar::{Extruded, Flat};
 pub use shapes::{Cone, Cylinder, Plane, Sphere, Torus};
 
 /// A surface in space given implicitly by `C(x) = 0`.
