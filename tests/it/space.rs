@@ -66,6 +66,45 @@ fn conical_start(r: f64, alpha: f64) -> (BeadState<DVec3>, f64) {
     (state, v)
 }
 
+/// A bead's turns about the vertical axis, from +x through −z (the
+/// azimuth about +y growing, unwrapped), and the time each was completed,
+/// interpolated within its step.
+#[derive(Default)]
+struct Turns {
+    turned: f64,
+    previous: f64,
+    passes: Vec<f64>,
+}
+
+impl Turns {
+    /// Takes in the bead at `position` at the end `t` of a step of `dt`.
+    fn note(&mut self, position: DVec3, t: f64, dt: f64) {
+        let azimuth = (-position.z).atan2(position.x);
+        let mut delta = azimuth - self.previous;
+        if delta < -TAU / 2.0 {
+            delta += TAU;
+        }
+        self.previous = azimuth;
+        let before = self.turned;
+        self.turned += delta;
+        let k = (self.passes.len() + 1) as f64;
+        if before < TAU * k && self.turned >= TAU * k {
+            let fraction = (TAU * k - before) / (self.turned - before);
+            self.passes.push(t - dt + fraction * dt);
+        }
+    }
+
+    /// How many whole turns.
+    fn count(&self) -> usize {
+        self.passes.len()
+    }
+
+    /// The mean time of a turn, from the start.
+    fn period(&self) -> f64 {
+        self.passes[self.passes.len() - 1] / self.passes.len() as f64
+    }
+}
+
 /// RATTLE at 1 ms: the conical pendulum keeps its height to 1e-5 r and
 /// goes round in `2π r sin α / v` to 1e-5 (relative).
 #[test]
@@ -78,33 +117,18 @@ fn a_conical_pendulum_on_a_sphere_keeps_its_height_and_period() {
     let s = settings(Method::Rattle, 1e-3);
     let period = TAU * r * alpha.sin() / v;
     let (height, mut worst) = (state.position.y, 0.0f64);
-    // The azimuth, unwrapped, and the time it passes 2π·k.
-    let (mut turned, mut previous) = (0.0f64, 0.0f64);
-    let mut passes = Vec::new();
+    let mut turns = Turns::default();
     let mut t = 0.0;
-    while passes.len() < 3 {
+    while turns.count() < 3 {
         let out = step_on(&track, t, state, &force, 1.0, &s).expect("a step");
         state = out.state;
         t += s.dt;
         worst = worst.max((state.position.y - height).abs());
-        // Going round from +x through −z: the azimuth about +y grows.
-        let azimuth = (-state.position.z).atan2(state.position.x);
-        let mut delta = azimuth - previous;
-        if delta < -TAU / 2.0 {
-            delta += TAU;
-        }
-        previous = azimuth;
-        let before = turned;
-        turned += delta;
-        let k = (passes.len() + 1) as f64;
-        if before < TAU * k && turned >= TAU * k {
-            let fraction = (TAU * k - before) / (turned - before);
-            passes.push(t - s.dt + fraction * s.dt);
-        }
+        turns.note(state.position, t, s.dt);
         assert!(t < 10.0 * period, "the bead did not go round");
     }
     assert!(worst <= 1e-5 * r, "height moved {worst:e}");
-    let measured = passes[2] / 3.0;
+    let measured = turns.period();
     let error = (measured - period).abs() / period;
     assert!(
         error <= 1e-5,
@@ -496,31 +520,19 @@ fn a_conical_pendulum_on_a_rod_from_a_pin_keeps_its_height_and_period() {
     let s = settings(Method::Rattle, 1e-3);
     let period = TAU * length * alpha.sin() / v;
     let height = bob.position.y;
-    let (mut worst, mut turned, mut previous, mut t) = (0.0f64, 0.0f64, 0.0f64, 0.0);
-    let mut passes = Vec::new();
-    while passes.len() < 2 {
+    let (mut worst, mut t) = (0.0f64, 0.0);
+    let mut turns = Turns::default();
+    while turns.count() < 2 {
         island
             .step_at(t, &mut states, &forces, &s, &mut work)
             .expect("a step");
         t += s.dt;
-        let p = states[1].position;
-        worst = worst.max((p.y - height).abs());
-        let azimuth = (-p.z).atan2(p.x);
-        let mut delta = azimuth - previous;
-        if delta < -TAU / 2.0 {
-            delta += TAU;
-        }
-        previous = azimuth;
-        let before = turned;
-        turned += delta;
-        let k = (passes.len() + 1) as f64;
-        if before < TAU * k && turned >= TAU * k {
-            passes.push(t - s.dt + (TAU * k - before) / (turned - before) * s.dt);
-        }
+        worst = worst.max((states[1].position.y - height).abs());
+        turns.note(states[1].position, t, s.dt);
         assert!(t < 10.0 * period, "the bob did not go round");
     }
     assert!(worst <= 1e-5 * length, "height moved {worst:e}");
-    let error = (passes[1] / 2.0 - period).abs() / period;
+    let error = (turns.period() - period).abs() / period;
     assert!(error <= 1e-5, "period off by {error:e}");
     assert!(states[0].position.length() <= 1e-12, "the pin moved");
 }
