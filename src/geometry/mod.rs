@@ -52,8 +52,8 @@ pub use pose::{Placed, PlacedSurface, Placement, Pose, Pose3};
 pub use shape::{WireKind, WireShape};
 pub use sine::Sine;
 pub use space::{
-    Cone, Cylinder, Extruded, Flat, ImplicitSurface, MovingSurface, Plane, SpaceMotion, SpacePath,
-    Sphere, Torus,
+    Cone, Cylinder, Extruded, Flat, Helicoid, ImplicitSurface, MovingSurface, Plane, SpaceMotion,
+    SpacePath, Sphere, Torus,
 };
 pub use spline::{CubicPath, Spline, SplineKind, SplineSpec};
 pub use surface::{Friction, Side, Surface};

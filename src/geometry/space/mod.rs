@@ -21,6 +21,7 @@
 //! from `g`'s derivatives by the chain rule in one place
 //! (`revolution`).
 
+mod helicoid;
 mod motion;
 mod planar;
 mod shapes;
@@ -29,36 +30,37 @@ use bevy::math::{DMat3, DVec3};
 
 use super::Geometry;
 
+pub use helicoid::Helicoid;
 pub use motion::{MovingSurface, SpaceMotion, SpacePath};
 pub use planar::{Extruded, Flat};
 pub use shapes::{Cone, Cylinder, Plane, Sphere, Torus};
 
 /// A surface in space given implicitly by `C(x) = 0`.
 ///
-/// Implement this to put beads on a surface of your own. `value`,
-/// `gradient` and `hessian` must agree (the gradient of `value`, the
-/// Jacobian of `gradient`); the solver divides by `|∇C|²`, so a point
-/// where the gradient vanishes is a singular point and is reported as
-/// such.
+/// Implement this to put beads on a surface of your own: `geometry` gives
+/// the value `C`, the gradient `∇C` and the Hessian at a point, which
+/// must agree (the gradient of the value, the Jacobian of the gradient);
+/// the solver divides by `|∇C|²`, so a point where the gradient vanishes
+/// is a singular point and is reported as such.
 pub trait ImplicitSurface {
-    /// `C(x)`.
-    fn value(&self, p: DVec3) -> f64;
-    /// `∇C(x)`.
-    fn gradient(&self, p: DVec3) -> DVec3;
-    /// The Hessian of `C` at `x`.
-    fn hessian(&self, p: DVec3) -> DMat3;
+    /// `C(x)`, `∇C(x)` and the Hessian of `C` at `x`.
+    fn geometry(&self, p: DVec3) -> Geometry<DVec3>;
     /// A characteristic length (a sphere's radius): drift is reported
     /// relative to it and solver tolerances scale with it.
     fn scale(&self) -> f64 {
         1.0
     }
-    /// All three at once; override when they share work.
-    fn geometry(&self, p: DVec3) -> Geometry<DVec3> {
-        Geometry {
-            c: self.value(p),
-            normal: self.gradient(p),
-            hessian: self.hessian(p),
-        }
+    /// `C(x)`; override where it is cheaper alone.
+    fn value(&self, p: DVec3) -> f64 {
+        self.geometry(p).c
+    }
+    /// `∇C(x)`.
+    fn gradient(&self, p: DVec3) -> DVec3 {
+        self.geometry(p).normal
+    }
+    /// The Hessian of `C` at `x`.
+    fn hessian(&self, p: DVec3) -> DMat3 {
+        self.geometry(p).hessian
     }
 }
 

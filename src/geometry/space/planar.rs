@@ -16,14 +16,12 @@ use crate::geometry::{Geometry, ImplicitCurve};
 pub struct Flat;
 
 impl ImplicitSurface for Flat {
-    fn value(&self, p: DVec3) -> f64 {
-        p.z
-    }
-    fn gradient(&self, _p: DVec3) -> DVec3 {
-        DVec3::Z
-    }
-    fn hessian(&self, _p: DVec3) -> DMat3 {
-        DMat3::ZERO
+    fn geometry(&self, p: DVec3) -> Geometry<DVec3> {
+        Geometry {
+            c: p.z,
+            normal: DVec3::Z,
+            hessian: DMat3::ZERO,
+        }
     }
 }
 
@@ -35,12 +33,6 @@ pub struct Extruded<C>(pub C);
 impl<C: ImplicitCurve> ImplicitSurface for Extruded<C> {
     fn value(&self, p: DVec3) -> f64 {
         self.0.value(p.truncate())
-    }
-    fn gradient(&self, p: DVec3) -> DVec3 {
-        self.0.gradient(p.truncate()).extend(0.0)
-    }
-    fn hessian(&self, p: DVec3) -> DMat3 {
-        lift(self.0.hessian(p.truncate()))
     }
     fn scale(&self) -> f64 {
         self.0.scale()

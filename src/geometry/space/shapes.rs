@@ -14,14 +14,12 @@ use crate::geometry::circle::round;
 pub struct Plane;
 
 impl ImplicitSurface for Plane {
-    fn value(&self, p: DVec3) -> f64 {
-        p.y
-    }
-    fn gradient(&self, _p: DVec3) -> DVec3 {
-        DVec3::Y
-    }
-    fn hessian(&self, _p: DVec3) -> DMat3 {
-        DMat3::ZERO
+    fn geometry(&self, p: DVec3) -> Geometry<DVec3> {
+        Geometry {
+            c: p.y,
+            normal: DVec3::Y,
+            hessian: DMat3::ZERO,
+        }
     }
 }
 
@@ -34,15 +32,6 @@ pub struct Sphere {
 }
 
 impl ImplicitSurface for Sphere {
-    fn value(&self, p: DVec3) -> f64 {
-        self.geometry(p).c
-    }
-    fn gradient(&self, p: DVec3) -> DVec3 {
-        self.geometry(p).normal
-    }
-    fn hessian(&self, p: DVec3) -> DMat3 {
-        self.geometry(p).hessian
-    }
     fn scale(&self) -> f64 {
         self.radius
     }
@@ -144,12 +133,6 @@ macro_rules! of_revolution {
             fn value(&self, p: DVec3) -> f64 {
                 self.meridian(p.x.hypot(p.z), p.y).g
             }
-            fn gradient(&self, p: DVec3) -> DVec3 {
-                self.geometry(p).normal
-            }
-            fn hessian(&self, p: DVec3) -> DMat3 {
-                self.geometry(p).hessian
-            }
             fn scale(&self) -> f64 {
                 let scale: fn(&Self) -> f64 = $scale;
                 scale(self)
@@ -215,6 +198,7 @@ mod tests {
             },
             &POINTS,
         );
+        check_derivatives(&crate::geometry::Helicoid { pitch: 0.9 }, &POINTS);
     }
 
     /// On each surface `C = 0` and `|∇C| = 1`: `C` reads as a distance.
