@@ -177,7 +177,7 @@ fn a_spherical_pendulum_keeps_its_vertical_angular_momentum_and_energy() {
 }
 
 /// A bead on a sphere moving in its xy great circle is a bead on a
-/// circle: every method gives the plane's trajectory, with z and its
+/// circle: every stabilized method gives the plane's trajectory, with z and its
 /// velocity exactly zero.
 #[test]
 fn a_sphere_cut_through_its_centre_steps_as_the_circle_does() {
@@ -187,14 +187,12 @@ fn a_sphere_cut_through_its_centre_steps_as_the_circle_does() {
         position: DVec2::new(1.2 * 0.9f64.sin(), -1.2 * 0.9f64.cos()),
         velocity: DVec2::new(0.5, 0.2),
     };
-    for method in [
-        Method::ExplicitEuler(Stabilization::Baumgarte),
-        Method::SemiImplicitEuler(Stabilization::Baumgarte),
-        Method::SemiImplicitEuler(Stabilization::Projection),
-        Method::Rk4(Stabilization::Baumgarte),
-        Method::Rk4(Stabilization::Projection),
-        Method::Rattle,
-    ] {
+    // Every stabilized method (the unstabilized ones drift off the
+    // circle at this step in either dimension).
+    let stabilized = Method::ALL
+        .into_iter()
+        .filter(|m| m.stabilization() != Some(Stabilization::None));
+    for method in stabilized {
         let s = settings(method, 1.0 / 60.0);
         let (apart, off) = plane_against_space(&circle, &sphere, start, &s, 300);
         assert_eq!(off, 0.0, "{method}: left the plane");

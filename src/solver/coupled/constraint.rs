@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use bevy::math::DVec2;
 
-use crate::geometry::{WireSpace, placed_geometry};
+use crate::geometry::{Coordinates, WireSpace, placed_geometry};
 
 /// A constraint of a game's own among one or more beads: `C(x₁, …, xₖ) = 0`.
 ///
@@ -185,7 +185,7 @@ pub struct SpringLink {
 impl SpringLink {
     /// The force on bead `a` where the beads are at `x` with velocities `v`.
     #[inline]
-    pub fn force<V: WireSpace>(&self, x: &[V], v: &[V]) -> V {
+    pub fn force<V: Coordinates>(&self, x: &[V], v: &[V]) -> V {
         let d = x[self.a] - x[self.b];
         let distance = d.dot(d).sqrt();
         if distance.is_nan() || distance <= 0.0 {
@@ -198,12 +198,12 @@ impl SpringLink {
     }
 
     /// The energy stored in the spring where the beads are at `x`.
-    pub fn energy<V: WireSpace>(&self, x: &[V]) -> f64 {
+    pub fn energy<V: Coordinates>(&self, x: &[V]) -> f64 {
         self.stored(x[self.a], x[self.b])
     }
 
     /// The energy stored in the spring with its ends at `a` and `b`.
-    pub(crate) fn stored<V: WireSpace>(&self, a: V, b: V) -> f64 {
+    pub(crate) fn stored<V: Coordinates>(&self, a: V, b: V) -> f64 {
         let d = a - b;
         let stretch = d.dot(d).sqrt() - self.rest_length;
         0.5 * self.stiffness * stretch * stretch
