@@ -52,6 +52,21 @@ pub trait Coordinates:
     fn twice(omega: Self::Angular) -> Self::Angular;
     /// The components, `z` zero in the plane.
     fn xyz(self) -> DVec3;
+    /// The outer product `a bᵀ`.
+    fn outer(a: Self, b: Self) -> Self::Hessian;
+    /// A curve's second normal where `tangent` and `normal` are its unit
+    /// tangent and first normal: `tangent × normal` in space; zero in the
+    /// plane, where a curve has one normal.
+    fn binormal(tangent: Self, normal: Self) -> Self;
+    /// The point of `v`: `v` itself in space, its `x` and `y` in the
+    /// plane.
+    fn from_xyz(v: DVec3) -> Self;
+}
+
+/// `|v|`, as glam computes a length.
+#[inline]
+pub(crate) fn norm<V: Coordinates>(v: V) -> f64 {
+    v.dot(v).sqrt()
 }
 
 impl Coordinates for DVec2 {
@@ -79,6 +94,18 @@ impl Coordinates for DVec2 {
     fn xyz(self) -> DVec3 {
         self.extend(0.0)
     }
+    #[inline(always)]
+    fn outer(a: Self, b: Self) -> DMat2 {
+        DMat2::from_cols(a * b.x, a * b.y)
+    }
+    #[inline(always)]
+    fn binormal(_tangent: Self, _normal: Self) -> Self {
+        DVec2::ZERO
+    }
+    #[inline(always)]
+    fn from_xyz(v: DVec3) -> Self {
+        v.truncate()
+    }
 }
 
 impl Coordinates for DVec3 {
@@ -105,6 +132,18 @@ impl Coordinates for DVec3 {
     #[inline(always)]
     fn xyz(self) -> DVec3 {
         self
+    }
+    #[inline(always)]
+    fn outer(a: Self, b: Self) -> DMat3 {
+        DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+    }
+    #[inline(always)]
+    fn binormal(tangent: Self, normal: Self) -> Self {
+        tangent.cross(normal)
+    }
+    #[inline(always)]
+    fn from_xyz(v: DVec3) -> Self {
+        v
     }
 }
 

@@ -22,6 +22,7 @@ mod circle;
 mod coordinates;
 mod cycloid;
 mod ellipse;
+mod frames;
 mod line;
 mod motion;
 mod parabola;
@@ -52,13 +53,13 @@ pub use pose::{Placed, PlacedSurface, Placement, Pose, Pose3};
 pub use shape::{WireKind, WireShape};
 pub use sine::Sine;
 pub use space::{
-    Cone, Cylinder, Extruded, Flat, Helicoid, ImplicitSurface, MovingSurface, Plane, SpaceMotion,
-    SpacePath, Sphere, Torus,
+    Cone, CurveFrame, Cylinder, Extruded, Flat, Helicoid, Helix, ImplicitSurface, MovingSurface,
+    OnPlane, Plane, SpaceCurve, SpaceMotion, SpacePath, Sphere, Torus,
 };
 pub use spline::{CubicPath, Spline, SplineKind, SplineSpec};
 pub use surface::{Friction, Side, Surface};
 pub use traced::{HINT_WINDOW, Parametric, Traced};
-pub use wire_space::{SurfaceWire, WireSpace};
+pub use wire_space::{SpaceWire, WireSpace};
 
 /// The value, gradient and Hessian of a constraint at one point.
 #[derive(Clone, Copy, Debug, PartialEq)]

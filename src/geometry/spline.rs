@@ -3,17 +3,18 @@
 use std::sync::Arc;
 
 use bevy::math::cubic_splines::CubicCurve;
-use bevy::math::{DVec2, Vec2};
+use bevy::math::{DVec2, VectorSpace};
 use serde::{Deserialize, Serialize};
 
+use super::coordinates::norm;
 use super::traced::traced_curve;
-use super::{Parametric, Traced};
+use super::{Coordinates, Parametric, Traced};
 use crate::validate::ParamError;
 
 /// How a spline's points make its curve (Bevy's generators of
-/// `bevy::math::cubic_splines`).
+/// `bevy::math::cubic_splines`), in the plane (the default) or in space.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub enum SplineKind {
+pub enum SplineKind<V = DVec2> {
     /// Catmull–Rom: through every point (the cardinal spline of tension ½).
     #[default]
     CatmullRom,
@@ -23,11 +24,11 @@ pub enum SplineKind {
     /// derivative.
     BSpline,
     /// Hermite: through every point with the given tangent at each.
-    Hermite(Vec<DVec2>),
+    Hermite(Vec<V>),
     /// A curve's own polynomial coefficients `[a, b, c, d]` per segment
     /// (`a + b u + c u² + d u³`), as [`Spline::from_curve`] keeps a
     /// game's `CubicCurve`.
-    Segments(Vec<[DVec2; 4]>),
+    Segments(Vec<[V; 4]>),
 }
 
 /// What a scene file says of a spline:
@@ -35,11 +36,11 @@ pub enum SplineKind {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[serde(default)]
-pub struct SplineSpec {
+pub struct SplineSpec<V = DVec2> {
     /// How the points make the curve.
-    pub kind: SplineKind,
+    pub kind: SplineKind<V>,
     /// The control points (none for `Segments`).
-    pub points: Vec<DVec2>,
+    pub points: Vec<V>,
     /// Whether the curve closes on itself (a cyclic spline).
     pub closed: bool,
 }
@@ -51,38 +52,46 @@ pub struct SplineSpec {
 /// open spline ends at its first and last points, a closed one goes round.
 /// A scene's spline is computed as Bevy computes it, in `f64`; a game's
 /// `CubicCurve` keeps its `f32` coefficients, held in `f64`.
+///
+/// `Spline<DVec3>` is the same curve in space (`CubicCurve<Vec3>`), a
+/// wire by its offset along two normals (see
+/// [`SpaceCurve`](super::SpaceCurve)).
 #[derive(Clone, Serialize, Deserialize)]
-#[serde(try_from = "SplineSpec", into = "SplineSpec")]
-pub struct Spline(Arc<SplineInner>);
+#[serde(try_from = "SplineSpec<V>", into = "SplineSpec<V>")]
+#[serde(bound(
+    serialize = "V: Coordinates + Serialize",
+    deserialize = "V: Coordinates + Deserialize<'de>"
+))]
+pub struct Spline<V: Coordinates = DVec2>(Arc<SplineInner<V>>);
 
 /// What a [`Spline`] shares between its clones: kept behind one pointer so
 /// that a [`WireShape`](super::WireShape) stays small.
-struct SplineInner {
-    spec: SplineSpec,
-    traced: Traced<CubicPath>,
+struct SplineInner<V: Coordinates> {
+    spec: SplineSpec<V>,
+    traced: Traced<CubicPath<V>, V>,
 }
 
-impl std::fmt::Debug for Spline {
+impl<V: Coordinates> std::fmt::Debug for Spline<V> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         self.0.spec.fmt(f)
     }
 }
 
-impl PartialEq for Spline {
+impl<V: Coordinates> PartialEq for Spline<V> {
     fn eq(&self, other: &Self) -> bool {
         self.0.spec == other.0.spec
     }
 }
 
-impl From<Spline> for SplineSpec {
-    fn from(spline: Spline) -> Self {
+impl<V: Coordinates> From<Spline<V>> for SplineSpec<V> {
+    fn from(spline: Spline<V>) -> Self {
         spline.0.spec.clone()
     }
 }
 
-impl TryFrom<SplineSpec> for Spline {
+impl<V: Coordinates> TryFrom<SplineSpec<V>> for Spline<V> {
     type Error = ParamError;
-    fn try_from(spec: SplineSpec) -> Result<Self, ParamError> {
+    fn try_from(spec: SplineSpec<V>) -> Result<Self, ParamError> {
         Self::new(spec)
     }
 }
@@ -109,7 +118,7 @@ const B_SPLINE: [[f64; 4]; 4] = [
 ];
 
 /// A segment's coefficients: the characteristic matrix times the points.
-fn coefficients(p: [DVec2; 4], matrix: [[f64; 4]; 4]) -> [DVec2; 4] {
+fn coefficients<V: Coordinates>(p: [V; 4], matrix: [[f64; 4]; 4]) -> [V; 4] {
     matrix.map(|row| p[0] * row[0] + p[1] * row[1] + p[2] * row[2] + p[3] * row[3])
 }
 
@@ -117,7 +126,7 @@ fn coefficients(p: [DVec2; 4], matrix: [[f64; 4]; 4]) -> [DVec2; 4] {
 /// ends mirrored (`P₋₁ = 2P₀ − P₁`); closed, with its segments in the
 /// order `to_curve_cyclic` gives them (the first from the first point to
 /// the second).
-fn cardinal(s: f64, points: &[DVec2], closed: bool) -> Result<Vec<[DVec2; 4]>, ParamError> {
+fn cardinal<V: Coordinates>(s: f64, points: &[V], closed: bool) -> Result<Vec<[V; 4]>, ParamError> {
     let n = points.len();
     if n < 2 {
         return Err(refuse("a cardinal spline needs two points at least"));
@@ -145,14 +154,14 @@ fn cardinal(s: f64, points: &[DVec2], closed: bool) -> Result<Vec<[DVec2; 4]>, P
         .collect())
 }
 
-impl Spline {
+impl<V: Coordinates> Spline<V> {
     /// The spline `spec` describes, if its points make a curve: Bevy's
     /// generator of that kind (`CubicCardinalSpline`, `CubicBSpline`,
     /// `CubicHermite`, with `to_curve` or, closed, `to_curve_cyclic`),
     /// computed in `f64` with the same characteristic matrices, end
     /// mirroring and segment order, so a scene's points lie on the wire
     /// exactly.
-    pub fn new(spec: SplineSpec) -> Result<Self, ParamError> {
+    pub fn new(spec: SplineSpec<V>) -> Result<Self, ParamError> {
         let points = &spec.points;
         if points.iter().any(|p| !p.is_finite()) {
             return Err(refuse("a spline's points must be finite"));
@@ -209,28 +218,33 @@ impl Spline {
     }
 
     /// A wire along a game's own curve (its segments' coefficients, kept
-    /// in `f64`). It is closed if it ends where it starts (within 1e-6 of
+    /// in `f64`): a `CubicCurve<Vec2>` in the plane, a `CubicCurve<Vec3>`
+    /// in space. It is closed if it ends where it starts (within 1e-6 of
     /// its size).
-    pub fn from_curve(curve: &CubicCurve<Vec2>) -> Self {
-        let segments: Vec<[DVec2; 4]> = curve
+    pub fn from_curve<P>(curve: &CubicCurve<P>) -> Self
+    where
+        P: VectorSpace<Scalar = f32>,
+        V: From<P>,
+    {
+        let segments: Vec<[V; 4]> = curve
             .segments()
             .iter()
-            .map(|s| s.coeff.map(|c| c.as_dvec2()))
+            .map(|s| s.coeff.map(V::from))
             .collect();
         let start = segments[0][0];
         let [a, b, c, d] = segments[segments.len() - 1];
         let end = a + b + c + d;
         let size = segments
             .iter()
-            .map(|s| (s[1] + s[2] + s[3]).length())
+            .map(|s| norm(s[1] + s[2] + s[3]))
             .sum::<f64>();
-        let closed = (end - start).length() <= 1e-6 * size.max(f64::MIN_POSITIVE);
+        let closed = norm(end - start) <= 1e-6 * size.max(f64::MIN_POSITIVE);
         Self::from_segments(segments, closed, None)
     }
 
     /// A spline of these segments, described by `spec` (by the segments
     /// themselves if none).
-    fn from_segments(segments: Vec<[DVec2; 4]>, closed: bool, spec: Option<SplineSpec>) -> Self {
+    fn from_segments(segments: Vec<[V; 4]>, closed: bool, spec: Option<SplineSpec<V>>) -> Self {
         let path = CubicPath {
             segments: segments.clone(),
             closed,
@@ -247,53 +261,53 @@ impl Spline {
     }
 
     /// What it was made from.
-    pub fn spec(&self) -> &SplineSpec {
+    pub fn spec(&self) -> &SplineSpec<V> {
         &self.0.spec
     }
 
     /// The curve as a wire.
-    fn traced(&self) -> &Traced<CubicPath> {
+    pub(crate) fn traced(&self) -> &Traced<CubicPath<V>, V> {
         &self.0.traced
     }
 
     /// Its segments' coefficients, as [`SplineKind::Segments`].
-    pub fn traced_segments(&self) -> SplineKind {
+    pub fn traced_segments(&self) -> SplineKind<V> {
         SplineKind::Segments(self.traced().path().segments.clone())
     }
 
     /// Points along the curve, for drawing.
-    pub fn polyline(&self) -> impl Iterator<Item = DVec2> + '_ {
+    pub fn polyline(&self) -> impl Iterator<Item = V> + '_ {
         self.traced().polyline()
     }
 
     /// The curve's point at parameter `s` (segment `floor(s)`).
-    pub fn point(&self, s: f64) -> DVec2 {
+    pub fn point(&self, s: f64) -> V {
         self.traced().path().eval(s)[0]
     }
 
     /// Its lowest sampled point.
-    pub fn lowest(&self) -> DVec2 {
+    pub fn lowest(&self) -> V {
         self.polyline()
-            .min_by(|a, b| a.y.total_cmp(&b.y))
+            .min_by(|a, b| a.xyz().y.total_cmp(&b.xyz().y))
             .unwrap_or_default()
     }
 }
 
 /// A chain of cubic segments in `f64`, `s ∈ [0, n]`.
 #[derive(Clone, Debug)]
-pub struct CubicPath {
-    segments: Vec<[DVec2; 4]>,
+pub struct CubicPath<V = DVec2> {
+    segments: Vec<[V; 4]>,
     closed: bool,
 }
 
-impl Parametric for CubicPath {
+impl<V: Coordinates> Parametric<V> for CubicPath<V> {
     fn domain(&self) -> (f64, f64) {
         (0.0, self.segments.len() as f64)
     }
     fn closed(&self) -> bool {
         self.closed
     }
-    fn eval(&self, s: f64) -> [DVec2; 3] {
+    fn eval(&self, s: f64) -> [V; 3] {
         let last = self.segments.len() - 1;
         let i = (s.floor().max(0.0) as usize).min(last);
         let u = s - i as f64;
@@ -312,6 +326,7 @@ traced_curve!(Spline, |this| this.traced().scale());
 mod tests {
     use super::*;
     use crate::geometry::ImplicitCurve;
+    use bevy::math::Vec2;
     use bevy::math::cubic_splines::{
         CubicBSpline, CubicCardinalSpline, CubicGenerator, CubicHermite, CyclicCubicGenerator,
     };

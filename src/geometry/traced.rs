@@ -25,16 +25,19 @@
 
 use bevy::math::{DMat2, DVec2};
 
-use super::{Geometry, ImplicitCurve};
+use super::coordinates::norm;
+use super::frames::{perpendicular, rotation_minimizing};
+use super::{Coordinates, Geometry, ImplicitCurve};
 
-/// A curve `γ(s)` over a parameter interval.
-pub trait Parametric {
+/// A curve `γ(s)` over a parameter interval, in the plane (the default)
+/// or in space.
+pub trait Parametric<V: Coordinates = DVec2> {
     /// The parameter's interval `[start, end]`.
     fn domain(&self) -> (f64, f64);
     /// Whether `γ(end) = γ(start)` and the curve goes on round.
     fn closed(&self) -> bool;
     /// `γ(s)`, `γ′(s)` and `γ″(s)`.
-    fn eval(&self, s: f64) -> [DVec2; 3];
+    fn eval(&self, s: f64) -> [V; 3];
 }
 
 /// How many samples per unit of parameter the polyline takes.
@@ -43,12 +46,17 @@ const SAMPLES_PER_UNIT: f64 = 24.0;
 /// How far in parameter from a hint the nearest-point search looks.
 pub const HINT_WINDOW: f64 = 0.75;
 
-/// A [`Parametric`] curve as a wire, by its signed distance.
+/// A [`Parametric`] curve as a wire: by its signed distance in the plane,
+/// by its offset along two normals in space (see
+/// [`SpaceCurve`](super::SpaceCurve)).
 #[derive(Clone, Debug)]
-pub struct Traced<P> {
+pub struct Traced<P, V: Coordinates = DVec2> {
     path: P,
     /// `(s, γ(s))` along the curve.
-    samples: Vec<(f64, DVec2)>,
+    samples: Vec<(f64, V)>,
+    /// The rotation-minimizing normal at each sample (see
+    /// [`Traced::with_up`]).
+    normals: Vec<V>,
     /// The longest distance between neighbouring samples.
     spacing: f64,
     scale: f64,
@@ -56,39 +64,77 @@ pub struct Traced<P> {
 
 /// The point of a curve nearest some `x`.
 #[derive(Clone, Copy, Debug)]
-struct Nearest {
+pub(crate) struct Nearest<V> {
     /// `s*`.
-    s: f64,
+    pub(crate) s: f64,
     /// `γ(s*)`, `γ′(s*)`, `γ″(s*)` (or, past an end, the end's point and
     /// tangent and no curvature).
-    at: [DVec2; 3],
+    pub(crate) at: [V; 3],
     /// How far past an end along its tangent line the nearest point of the
     /// extended curve lies; zero or less on the curve.
-    past: f64,
+    pub(crate) past: f64,
 }
 
-impl<P: Parametric> Traced<P> {
+impl<V: Coordinates, P: Parametric<V>> Traced<P, V> {
     /// The curve `path` as a wire, with a polyline of samples to start the
-    /// nearest-point search from.
+    /// nearest-point search from; its rail normal starts as near `+y` as
+    /// there is.
     pub fn new(path: P) -> Self {
+        Self::with_up(path, V::from_xyz(bevy::math::DVec3::Y))
+    }
+
+    /// The curve `path` as a wire whose rotation-minimizing normal (the
+    /// first of its two rows in space, and the up of a rail's frame)
+    /// starts as near `up` as there is at the curve's start. On a closed
+    /// curve the turn it gathers round the loop is spread over the loop.
+    pub fn with_up(path: P, up: V) -> Self {
         let (start, end) = path.domain();
         let n = (((end - start) * SAMPLES_PER_UNIT).ceil() as usize).clamp(16, 1 << 16);
-        let samples: Vec<(f64, DVec2)> = (0..=n)
+        let samples: Vec<(f64, V)> = (0..=n)
             .map(|i| {
                 let s = start + (end - start) * i as f64 / n as f64;
                 (s, path.eval(s)[0])
             })
             .collect();
-        let gaps = || samples.windows(2).map(|w| (w[1].1 - w[0].1).length());
+        let gaps = || samples.windows(2).map(|w| norm(w[1].1 - w[0].1));
         let length: f64 = gaps().sum();
         let spacing = gaps().fold(0.0, f64::max);
         let scale = (length / (end - start).max(1.0)).max(f64::MIN_POSITIVE);
+        let points: Vec<V> = samples.iter().map(|(_, p)| *p).collect();
+        let tangents: Vec<V> = samples
+            .iter()
+            .map(|&(s, _)| {
+                let d1 = path.eval(s)[1];
+                d1 / norm(d1).max(f64::MIN_POSITIVE)
+            })
+            .collect();
+        let normals = rotation_minimizing(&points, &tangents, up, path.closed());
         Self {
             path,
             samples,
+            normals,
             spacing,
             scale,
         }
+    }
+
+    /// The curve's rotation-minimizing normal at parameter `s`, across the
+    /// unit tangent `tangent` there: the samples' normals interpolated and
+    /// made perpendicular to it.
+    pub(crate) fn normal_at(&self, s: f64, tangent: V) -> V {
+        let (start, end) = self.path.domain();
+        let last = self.samples.len() - 1;
+        let at = ((s - start) / (end - start) * last as f64).clamp(0.0, last as f64);
+        let i = (at.floor() as usize).min(last.saturating_sub(1));
+        let u = at - i as f64;
+        let j = (i + 1).min(last);
+        let blend = self.normals[i] * (1.0 - u) + self.normals[j] * u;
+        perpendicular(blend, tangent)
+    }
+
+    /// The characteristic length: its length per unit of parameter.
+    pub fn length_scale(&self) -> f64 {
+        self.scale
     }
 
     /// The parametrized curve.
@@ -97,7 +143,7 @@ impl<P: Parametric> Traced<P> {
     }
 
     /// The sample points, in order (for drawing).
-    pub fn polyline(&self) -> impl Iterator<Item = DVec2> + '_ {
+    pub fn polyline(&self) -> impl Iterator<Item = V> + '_ {
         self.samples.iter().map(|(_, p)| *p)
     }
 
@@ -106,9 +152,12 @@ impl<P: Parametric> Traced<P> {
     /// bead is on); none if the hint is not finite or the window's nearest
     /// sample is at its edge (the bead went farther: the whole curve is
     /// searched).
-    fn windowed_sample(&self, x: DVec2, hint: f64) -> Option<usize> {
+    fn windowed_sample(&self, x: V, hint: f64) -> Option<usize> {
         let last = self.samples.len() - 1;
-        let distance = |i: usize| (self.samples[i].1 - x).length_squared();
+        let distance = |i: usize| {
+            let d = self.samples[i].1 - x;
+            d.dot(d)
+        };
         if !hint.is_finite() {
             return None;
         }
@@ -137,15 +186,11 @@ impl<P: Parametric> Traced<P> {
     /// else refined from every sample that is a local minimum of the
     /// distance within one sample spacing of the nearest (near a crossing,
     /// both branches), the nearest of those.
-    fn nearest(&self, x: DVec2, hint: f64) -> Nearest {
+    pub(crate) fn nearest(&self, x: V, hint: f64) -> Nearest<V> {
         if let Some(i) = self.windowed_sample(x, hint) {
             return self.refine(x, i);
         }
-        let distance: Vec<f64> = self
-            .samples
-            .iter()
-            .map(|(_, p)| (*p - x).length())
-            .collect();
+        let distance: Vec<f64> = self.samples.iter().map(|(_, p)| norm(*p - x)).collect();
         let best = distance.iter().copied().fold(f64::INFINITY, f64::min);
         let last = distance.len() - 1;
         let closed = self.path.closed();
@@ -165,19 +210,19 @@ impl<P: Parametric> Traced<P> {
         (0..=last)
             .filter(|&i| distance[i] <= best + self.spacing && minimum(i))
             .map(|i| self.refine(x, i))
-            .min_by(|a, b| (a.at[0] - x).length().total_cmp(&(b.at[0] - x).length()))
+            .min_by(|a, b| norm(a.at[0] - x).total_cmp(&norm(b.at[0] - x)))
             .unwrap_or_else(|| self.refine(x, 0))
     }
 
     /// The curve's parameter at the point nearest `x`, searched near
     /// `hint` (within [`HINT_WINDOW`] of it, else anywhere).
-    pub fn parameter(&self, x: DVec2, hint: f64) -> f64 {
+    pub fn parameter(&self, x: V, hint: f64) -> f64 {
         self.nearest(x, hint).s
     }
 
     /// The nearest point of the curve (extended past its ends) to `x`,
     /// refined by Newton's method from sample `closest`.
-    fn refine(&self, x: DVec2, closest: usize) -> Nearest {
+    fn refine(&self, x: V, closest: usize) -> Nearest<V> {
         let (start, end) = self.path.domain();
         let last = self.samples.len() - 1;
         let closed = self.path.closed();
@@ -195,7 +240,7 @@ impl<P: Parametric> Traced<P> {
         let mut s = self.samples[closest].0;
         let f = |s: f64| {
             let [p, d1, d2] = self.path.eval(wrap(s, start, period, closed));
-            ((p - x).dot(d1), d1.length_squared() + (p - x).dot(d2))
+            ((p - x).dot(d1), d1.dot(d1) + (p - x).dot(d2))
         };
         for _ in 0..60 {
             let (value, slope) = f(s);
@@ -221,12 +266,12 @@ impl<P: Parametric> Traced<P> {
             // Past an end: the nearest point of the end's tangent line.
             for (bound, sign) in [(start, -1.0), (end, 1.0)] {
                 let [p, d1, _] = self.path.eval(bound);
-                let along = (x - p).dot(d1) / d1.length_squared().max(f64::MIN_POSITIVE);
+                let along = (x - p).dot(d1) / d1.dot(d1).max(f64::MIN_POSITIVE);
                 if sign * along > 0.0 && (s - bound).abs() <= 1e-9 * period.max(1.0) {
                     return Nearest {
                         s: bound,
-                        at: [p, d1, DVec2::ZERO],
-                        past: sign * along * d1.length(),
+                        at: [p, d1, V::ZERO],
+                        past: sign * along * norm(d1),
                     };
                 }
             }
@@ -292,6 +337,42 @@ fn wrap(s: f64, start: f64, period: f64, closed: bool) -> f64 {
     }
 }
 
+/// One row of a traced curve: `C = n̂·d`, the offset `d = x − γ(s*)` from
+/// the nearest point taken along a unit normal `n̂` of the curve there,
+/// with `γ′` and `γ″` at `s*`. Then `∇C = n̂` and
+/// `H = −(n̂·γ″) / (|γ′|² − d·γ″) t̂ t̂ᵀ`, for the normal carried along the
+/// curve without turning about it (in the plane, the only normal: there
+/// `n̂·γ″ = κ|γ′|²` and this is `−κ/(1 − κC) t̂t̂ᵀ`). Singular, the normal
+/// reported as zero, where `γ′` vanishes (a cusp) or `|γ′|² − d·γ″` does
+/// (a centre of curvature).
+pub(crate) fn offset_row<V: Coordinates>(
+    normal: V,
+    offset: V,
+    d1: V,
+    d2: V,
+    scale: f64,
+) -> Geometry<V> {
+    let speed2 = d1.dot(d1);
+    let speed = speed2.sqrt();
+    let stretch = speed2 - offset.dot(d2);
+    let c = normal.dot(offset);
+    if !(speed > 1e-12 * scale && stretch > 1e-9 * speed2 && normal.is_finite()) {
+        // A cusp, or a centre of curvature: no normal to push along.
+        return Geometry {
+            c,
+            normal: V::ZERO,
+            hessian: V::outer(V::ZERO, V::ZERO),
+        };
+    }
+    let tangent = d1 / speed;
+    let k = -normal.dot(d2) / stretch;
+    Geometry {
+        c,
+        normal,
+        hessian: V::outer(tangent, tangent * k),
+    }
+}
+
 impl<P: Parametric> ImplicitCurve for Traced<P> {
     fn value(&self, p: DVec2) -> f64 {
         self.geometry(p).c
@@ -313,26 +394,9 @@ impl<P: Parametric> ImplicitCurve for Traced<P> {
             at: [point, d1, d2],
             ..
         } = self.nearest(p, hint);
-        let speed = d1.length();
-        let tangent = d1 / speed;
+        let tangent = d1 / norm(d1);
         let normal = DVec2::new(-tangent.y, tangent.x);
-        let c = normal.dot(p - point);
-        let curvature = d1.perp_dot(d2) / (speed * speed * speed);
-        let stretch = 1.0 - curvature * c;
-        if !(speed > 1e-12 * self.scale && stretch > 1e-9 && normal.is_finite()) {
-            // A cusp, or a centre of curvature: no normal to push along.
-            return Geometry {
-                c,
-                normal: DVec2::ZERO,
-                hessian: DMat2::ZERO,
-            };
-        }
-        let k = -curvature / stretch;
-        Geometry {
-            c,
-            normal,
-            hessian: DMat2::from_cols(tangent * (k * tangent.x), tangent * (k * tangent.y)),
-        }
+        offset_row(normal, p - point, d1, d2, self.scale)
     }
     fn has_ends(&self) -> bool {
         !self.path.closed()

@@ -1,8 +1,8 @@
 //! [`WireSpace`]: what a wire is in the plane and in space, for the rows
 //! of an island: its shape, where it sits and how it moves. A curve
 //! ([`WireShape`]) placed by a [`Pose`] on a [`PosePath`] in the plane; a
-//! surface ([`SurfaceWire`]) placed by a [`Pose3`] on a [`SpacePath`] in
-//! space.
+//! surface or one of a curve's two rows ([`SpaceWire`]) placed by a
+//! [`Pose3`] on a [`SpacePath`] in space.
 
 use std::fmt::Debug;
 use std::sync::Arc;
@@ -10,14 +10,15 @@ use std::sync::Arc;
 use bevy::math::{DVec2, DVec3};
 
 use super::{
-    Coordinates, Geometry, ImplicitSurface, Placement, Pose, Pose3, PosePath, SpacePath, Twist,
-    WireShape,
+    Coordinates, Geometry, ImplicitSurface, Placement, Pose, Pose3, PosePath, SpaceCurve,
+    SpacePath, Twist, WireShape,
 };
 
 /// The coordinates with the wires that live in them.
 pub trait WireSpace: Coordinates {
-    /// A wire's shape in its local frame: a curve ([`WireShape`]) in the
-    /// plane, a surface ([`SurfaceWire`]) in space.
+    /// A wire row's shape in its local frame: a curve ([`WireShape`]) in
+    /// the plane, a surface or one row of a curve ([`SpaceWire`]) in
+    /// space.
     type Shape: Clone + Debug + Send + Sync + 'static;
     /// Where a wire sits: [`Pose`] or [`Pose3`].
     type Pose: Placement<Self> + Copy + Debug + Default + PartialEq + Send + Sync + 'static;
@@ -42,14 +43,44 @@ pub trait WireSpace: Coordinates {
     fn stick_axis(normal: Self) -> Option<Self>;
 }
 
-/// A surface as a wire in space: shared, so an island's rows clone it
-/// cheaply.
+/// One constraint row of a wire in space: a surface's, or one of a
+/// curve's two. Shared, so an island's rows clone it cheaply. A bead on a
+/// curve takes both of [`SpaceWire::curve`]'s rows.
 #[derive(Clone)]
-pub struct SurfaceWire(pub Arc<dyn ImplicitSurface + Send + Sync>);
+pub enum SpaceWire {
+    /// A surface: its one row.
+    Surface(Arc<dyn ImplicitSurface + Send + Sync>),
+    /// A curve and which of its two rows (0 or 1).
+    Curve {
+        /// The curve.
+        curve: Arc<dyn SpaceCurve + Send + Sync>,
+        /// Its row: 0 or 1.
+        row: usize,
+    },
+}
 
-impl Debug for SurfaceWire {
+impl SpaceWire {
+    /// A surface's row.
+    pub fn surface(surface: impl ImplicitSurface + Send + Sync + 'static) -> Self {
+        Self::Surface(Arc::new(surface))
+    }
+
+    /// A curve's two rows.
+    pub fn curve(curve: impl SpaceCurve + Send + Sync + 'static) -> [Self; 2] {
+        let curve: Arc<dyn SpaceCurve + Send + Sync> = Arc::new(curve);
+        [0, 1].map(|row| Self::Curve {
+            curve: curve.clone(),
+            row,
+        })
+    }
+}
+
+impl Debug for SpaceWire {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("SurfaceWire(..)")
+        match self {
+            Self::Surface(_) => f.write_str("Surface(..)"),
+            Self::Curve { row, .. } => write!(f, "Curve {{ row: {row} }}"),
+        }
     }
 }
 
@@ -83,7 +114,7 @@ impl WireSpace for DVec2 {
 }
 
 impl WireSpace for DVec3 {
-    type Shape = SurfaceWire;
+    type Shape = SpaceWire;
     type Pose = Pose3;
     type Path = SpacePath;
     #[inline]
@@ -94,14 +125,25 @@ impl WireSpace for DVec3 {
         path.fixed()
     }
     #[inline]
-    fn shape_geometry(shape: &SurfaceWire, p: Self, _hint: Option<f64>) -> Geometry<DVec3> {
-        shape.0.geometry(p)
+    fn shape_geometry(shape: &SpaceWire, p: Self, hint: Option<f64>) -> Geometry<DVec3> {
+        match shape {
+            SpaceWire::Surface(surface) => surface.geometry(p),
+            SpaceWire::Curve { curve, row } => {
+                curve.rows(p, hint.unwrap_or(f64::NAN))[(*row).min(1)]
+            }
+        }
     }
-    fn shape_scale(shape: &SurfaceWire) -> f64 {
-        shape.0.scale()
+    fn shape_scale(shape: &SpaceWire) -> f64 {
+        match shape {
+            SpaceWire::Surface(surface) => surface.scale(),
+            SpaceWire::Curve { curve, .. } => curve.scale(),
+        }
     }
-    fn shape_parameter(_shape: &SurfaceWire, _p: Self, _hint: f64) -> f64 {
-        f64::NAN
+    fn shape_parameter(shape: &SpaceWire, p: Self, hint: f64) -> f64 {
+        match shape {
+            SpaceWire::Surface(_) => f64::NAN,
+            SpaceWire::Curve { curve, .. } => curve.parameter(p, hint),
+        }
     }
     fn stick_axis(_normal: Self) -> Option<Self> {
         None

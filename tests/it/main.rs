@@ -7,6 +7,7 @@ mod bad_input;
 mod baumgarte;
 mod common;
 mod controls;
+mod curves;
 #[cfg(feature = "debug-render")]
 mod debug_render;
 mod fuzz;

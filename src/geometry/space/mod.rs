@@ -21,6 +21,7 @@
 //! from `g`'s derivatives by the chain rule in one place
 //! (`revolution`).
 
+mod curve;
 mod helicoid;
 mod motion;
 mod planar;
@@ -28,8 +29,9 @@ mod shapes;
 
 use bevy::math::{DMat3, DVec3};
 
-use super::Geometry;
+use super::{Coordinates, Geometry};
 
+pub use curve::{CurveFrame, Helix, OnPlane, SpaceCurve};
 pub use helicoid::Helicoid;
 pub use motion::{MovingSurface, SpaceMotion, SpacePath};
 pub use planar::{Extruded, Flat};
@@ -93,7 +95,7 @@ pub(crate) fn revolution(p: DVec3, meridian: impl Fn(f64, f64) -> Meridian) -> G
     let (d_rho, h_rho) = if rho > 0.0 {
         let d = DVec3::new(p.x / rho, 0.0, p.z / rho);
         let xz = DMat3::from_diagonal(DVec3::new(1.0, 0.0, 1.0));
-        (d, (xz - outer(d, d)) * (1.0 / rho))
+        (d, (xz - DVec3::outer(d, d)) * (1.0 / rho))
     } else {
         (DVec3::ZERO, DMat3::ZERO)
     };
@@ -102,14 +104,8 @@ pub(crate) fn revolution(p: DVec3, meridian: impl Fn(f64, f64) -> Meridian) -> G
         c: m.g,
         normal: m.g_rho * d_rho + m.g_y * e_y,
         hessian: h_rho * m.g_rho
-            + outer(d_rho, d_rho) * m.g_rho_rho
-            + (outer(d_rho, e_y) + outer(e_y, d_rho)) * m.g_rho_y
-            + outer(e_y, e_y) * m.g_y_y,
+            + DVec3::outer(d_rho, d_rho) * m.g_rho_rho
+            + (DVec3::outer(d_rho, e_y) + DVec3::outer(e_y, d_rho)) * m.g_rho_y
+            + DVec3::outer(e_y, e_y) * m.g_y_y,
     }
-}
-
-/// `a bᵀ`.
-#[inline]
-pub(crate) fn outer(a: DVec3, b: DVec3) -> DMat3 {
-    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
 }

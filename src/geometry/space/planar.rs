@@ -38,12 +38,16 @@ impl<C: ImplicitCurve> ImplicitSurface for Extruded<C> {
         self.0.scale()
     }
     fn geometry(&self, p: DVec3) -> Geometry<DVec3> {
-        let g = self.0.geometry(p.truncate());
-        Geometry {
-            c: g.c,
-            normal: g.normal.extend(0.0),
-            hessian: lift(g.hessian),
-        }
+        extrude(self.0.geometry(p.truncate()))
+    }
+}
+
+/// A curve's geometry at `(x, y)` as its extrusion's at `(x, y, z)`.
+pub(crate) fn extrude(g: Geometry) -> Geometry<DVec3> {
+    Geometry {
+        c: g.c,
+        normal: g.normal.extend(0.0),
+        hessian: lift(g.hessian),
     }
 }
 

@@ -4,9 +4,9 @@
 use bevy::math::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 
-use super::{ImplicitSurface, Meridian, outer, revolution};
-use crate::geometry::Geometry;
+use super::{ImplicitSurface, Meridian, revolution};
 use crate::geometry::circle::round;
+use crate::geometry::{Coordinates, Geometry};
 
 /// The plane `y = 0` of the wire's local frame, its positive side `+y`:
 /// `C = y`.
@@ -49,7 +49,7 @@ impl ImplicitSurface for Sphere {
         Geometry {
             c: g.c,
             normal: g.normal,
-            hessian: (DMat3::IDENTITY - outer(g.normal, g.normal)) * g.inverse,
+            hessian: (DMat3::IDENTITY - DVec3::outer(g.normal, g.normal)) * g.inverse,
         }
     }
 }
