@@ -22,7 +22,9 @@ use std::time::Duration;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 
-use crate::dynamics::{BeadPosition, BeadVelocity, SimParams};
+use bevy::math::DVec3;
+
+use crate::dynamics::{BeadPosition, BeadVelocity, Dimension, SimParams};
 use crate::plugin::{
     ParallelStep, WireBeadPlugin, compute_on_all_cores, use_single_threaded_executors,
 };
@@ -134,9 +136,19 @@ pub fn idle(app: &mut App) {
 
 /// A bead's position and velocity, or `None` if `bead` is not a bead.
 pub fn bead_state(world: &World, bead: Entity) -> Option<BeadState> {
+    state_in(world, bead)
+}
+
+/// [`bead_state`] of a bead in space.
+pub fn space_bead_state(world: &World, bead: Entity) -> Option<BeadState<DVec3>> {
+    state_in(world, bead)
+}
+
+/// The state of a bead of either dimension.
+fn state_in<V: Dimension>(world: &World, bead: Entity) -> Option<BeadState<V>> {
     let bead = world.get_entity(bead).ok()?;
     Some(BeadState {
-        position: bead.get::<BeadPosition>()?.0,
-        velocity: bead.get::<BeadVelocity>()?.0,
+        position: bead.get::<BeadPosition<V>>()?.0,
+        velocity: bead.get::<BeadVelocity<V>>()?.0,
     })
 }

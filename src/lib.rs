@@ -37,6 +37,7 @@
 //! | [`Surface`], [`WireContact`], [`ContactChanged`] | one-sided wires a bead leaves and lands on, restitution, friction; each bead's contact and the message when it changes |
 //! | [`PrescribedMotion`] | a wire that moves ([`WireMotion`]: oscillates or spins), its motion exact in the constraint force; a wire the game moves is followed |
 //! | [`Rod`], [`Pin`], [`Joint`], [`Spring`] | links between beads, each on an entity of its own; [`Constraint`] for a game's own joint |
+//! | [`SpaceBead`], [`SpaceWire`], [`Dimension`] | beads in space on surfaces and curves (`BeadPosition<DVec3>`, …), stepped in islands; each system is written once over the [`Dimension`] |
 //! | [`Islands`], [`ConstraintDiagnostics`] | the beads links join, solved together (`J W Jᵀ λ = …`); each link's `C`, `Ċ`, λ |
 //! | [`SimParams`], [`NextParams`], [`NextBeadParams`], [`NextWireShape`] | applied and edited parameters; [`Restart`] applies the edits |
 //! | [`Method`] | an [`Integrator`] with its [`Stabilization`] (RATTLE takes none) |
@@ -96,9 +97,10 @@ pub use controls::KeyboardControlsPlugin;
 pub use dynamics::{
     Bead, BeadBundle, BeadDiagnostics, BeadDiverged, BeadForce, BeadForces, BeadForcesItem,
     BeadMass, BeadParams, BeadPosition, BeadVelocity, ConstraintDiagnostics, ContactChanged,
-    Diverged, DivergenceReason, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams, NextParams,
-    NextWireShape, OnWire, Pin, PrescribedMotion, Rod, SimParams, Spring, SpringAnchor, Wire,
-    WireBeads, WireContact, pose_of,
+    Dimension, Diverged, DivergenceReason, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams,
+    NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, Rod, SimParams, SpaceBead,
+    SpaceBeadBundle, SpaceWire, Spring, SpringAnchor, Wire, WireBeads, WireContact, WireRows,
+    pose_of,
 };
 pub use geometry::{
     Friction, ImplicitCurve, Oscillate, Side, Spin, Surface, WireKind, WireMotion, WireShape,

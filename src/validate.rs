@@ -3,7 +3,7 @@
 //! The bottom layer of the crate: plain values only, so the geometry, the
 //! solver and the ECS types all report bad input in the same words.
 
-use bevy::math::DVec2;
+use bevy::math::{DVec2, DVec3};
 
 /// What is wrong with a parameter, in words, with the value it got.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -45,14 +45,12 @@ pub enum ParamError {
         value: f64,
     },
     /// A vector had a NaN or infinite component.
-    #[error("{name} must be finite, got ({x}, {y})")]
+    #[error("{name} must be finite, got {components}")]
     VectorNotFinite {
         /// The parameter's name.
         name: &'static str,
-        /// Its x component.
-        x: f64,
-        /// Its y component.
-        y: f64,
+        /// Its components, as `(x, y)` or `(x, y, z)`.
+        components: String,
     },
     /// A name that is not one of the choices.
     #[error("unknown {kind} {got:?}; expected one of: {expected}")]
@@ -96,15 +94,34 @@ pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, ParamError> 
     }
 }
 
-/// `v`, if both components are finite.
-pub(crate) fn finite_vector(name: &'static str, v: DVec2) -> Result<DVec2, ParamError> {
-    if v.is_finite() {
+/// A vector's components, for [`finite_vector`]: `DVec2` or `DVec3`.
+pub trait Components: Copy {
+    /// `[x, y]` or `[x, y, z]`.
+    fn components(&self) -> Vec<f64>;
+}
+
+impl Components for DVec2 {
+    fn components(&self) -> Vec<f64> {
+        self.to_array().to_vec()
+    }
+}
+
+impl Components for DVec3 {
+    fn components(&self) -> Vec<f64> {
+        self.to_array().to_vec()
+    }
+}
+
+/// `v`, if every component is finite.
+pub(crate) fn finite_vector<V: Components>(name: &'static str, v: V) -> Result<V, ParamError> {
+    let components = v.components();
+    if components.iter().all(|c| c.is_finite()) {
         Ok(v)
     } else {
+        let listed: Vec<String> = components.iter().map(f64::to_string).collect();
         Err(ParamError::VectorNotFinite {
             name,
-            x: v.x,
-            y: v.y,
+            components: format!("({})", listed.join(", ")),
         })
     }
 }

@@ -2,7 +2,7 @@
 //! accumulated for the next step and the parameters a restart returns to;
 //! its parameters for the next run and the spring anchor that pulls it.
 
-use bevy::math::DVec2;
+use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -10,7 +10,7 @@ use bevy::ecs::lifecycle::HookContext;
 use bevy::ecs::query::QueryData;
 use bevy::ecs::world::DeferredWorld;
 
-use crate::geometry::Twist;
+use crate::geometry::{Coordinates, Twist};
 use crate::solver::{BeadState, LinearForce};
 use crate::validate::{ParamError, finite_vector, positive};
 
@@ -21,26 +21,26 @@ use crate::validate::{ParamError, finite_vector, positive};
 #[reflect(Component)]
 #[serde(deny_unknown_fields)]
 #[serde(default)]
-pub struct BeadParams {
+pub struct BeadParams<V: Coordinates = DVec2> {
     /// Mass in kg.
     pub mass: f64,
     /// Where a restart puts the bead.
-    pub initial_position: DVec2,
+    pub initial_position: V,
     /// The velocity a restart gives it.
-    pub initial_velocity: DVec2,
+    pub initial_velocity: V,
 }
 
-impl Default for BeadParams {
+impl<V: Coordinates> Default for BeadParams<V> {
     fn default() -> Self {
         Self {
             mass: 1.0,
-            initial_position: DVec2::new(0.0, -1.0),
-            initial_velocity: DVec2::ZERO,
+            initial_position: V::from_xyz(DVec3::new(0.0, -1.0, 0.0)),
+            initial_velocity: V::ZERO,
         }
     }
 }
 
-impl BeadParams {
+impl<V: Coordinates> BeadParams<V> {
     /// Checks every field; the first problem found is returned.
     pub fn validate(&self) -> Result<(), ParamError> {
         positive("mass", self.mass)?;
@@ -51,7 +51,7 @@ impl BeadParams {
     /// The initial velocity in the world on a wire moving by `twist` at
     /// t = 0: the initial velocity is relative to the wire's own where the
     /// bead starts.
-    pub(crate) fn initial_velocity_on(&self, twist: &Twist) -> DVec2 {
+    pub(crate) fn initial_velocity_on(&self, twist: &Twist<V>) -> V {
         self.initial_velocity + twist.velocity_at(self.initial_position)
     }
 }
@@ -84,8 +84,53 @@ impl BeadParams {
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
 #[reflect(Component)]
 #[require(BeadPosition, BeadVelocity, BeadMass, BeadForce)]
-#[component(on_add = remember_start)]
+#[component(on_add = remember_start::<DVec2>)]
 pub struct Bead;
+
+/// A bead in space: [`Bead`]'s marker for the columns of three
+/// coordinates, `BeadPosition<DVec3>`, `BeadVelocity<DVec3>`,
+/// [`BeadMass`] and `BeadForce<DVec3>`, which it requires. Put it on a
+/// [`SpaceWire`](crate::SpaceWire) with [`OnWire`](crate::OnWire), join
+/// it to others by rods, pins, springs and joints, or leave it free.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
+#[reflect(Component)]
+#[require(BeadPosition<DVec3>, BeadVelocity<DVec3>, BeadMass, BeadForce<DVec3>)]
+#[component(on_add = remember_start::<DVec3>)]
+pub struct SpaceBead;
+
+impl SpaceBead {
+    /// A bead in space at its initial position with its initial velocity,
+    /// if the parameters are valid: every component of it, to spawn in one
+    /// expression.
+    pub fn new(params: BeadParams<DVec3>) -> Result<SpaceBeadBundle, ParamError> {
+        params.validate()?;
+        Ok((
+            SpaceBead,
+            BeadPosition(params.initial_position),
+            BeadVelocity(params.initial_velocity),
+            BeadMass(params.mass),
+            params,
+        ))
+    }
+
+    /// A bead in space of the given mass at rest at `position`.
+    pub fn at_rest(mass: f64, position: DVec3) -> Result<SpaceBeadBundle, ParamError> {
+        Self::new(BeadParams {
+            mass,
+            initial_position: position,
+            initial_velocity: DVec3::ZERO,
+        })
+    }
+}
+
+/// Every component of a bead in space, as [`SpaceBead::new`] makes them.
+pub type SpaceBeadBundle = (
+    SpaceBead,
+    BeadPosition<DVec3>,
+    BeadVelocity<DVec3>,
+    BeadMass,
+    BeadParams<DVec3>,
+);
 
 impl Bead {
     /// A bead at its initial position with its initial velocity, if the
@@ -117,16 +162,19 @@ impl Bead {
 pub type BeadBundle = (Bead, BeadPosition, BeadVelocity, BeadMass, BeadParams);
 
 /// A bead spawned without [`BeadParams`] restarts where it was spawned.
-fn remember_start(mut world: DeferredWorld, context: HookContext) {
+fn remember_start<V: Coordinates + Reflect + TypePath>(
+    mut world: DeferredWorld,
+    context: HookContext,
+) {
     let entity = context.entity;
-    if world.get::<BeadParams>(entity).is_some() {
+    if world.get::<BeadParams<V>>(entity).is_some() {
         return;
     }
     let start = world.entity(entity);
     let params = BeadParams {
         mass: start.get::<BeadMass>().map_or(1.0, BeadMass::get),
-        initial_position: start.get::<BeadPosition>().map_or(DVec2::ZERO, |p| p.0),
-        initial_velocity: start.get::<BeadVelocity>().map_or(DVec2::ZERO, |v| v.0),
+        initial_position: start.get::<BeadPosition<V>>().map_or(V::ZERO, |p| p.0),
+        initial_velocity: start.get::<BeadVelocity<V>>().map_or(V::ZERO, |v| v.0),
     };
     world.commands().entity(entity).insert_if_new(params);
 }
@@ -135,12 +183,12 @@ fn remember_start(mut world: DeferredWorld, context: HookContext) {
 /// may too (a teleport).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut, Reflect)]
 #[reflect(Component)]
-pub struct BeadPosition(pub DVec2);
+pub struct BeadPosition<V: Coordinates = DVec2>(pub V);
 
 /// A bead's velocity. The step writes it; a game may too (a kick).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut, Reflect)]
 #[reflect(Component)]
-pub struct BeadVelocity(pub DVec2);
+pub struct BeadVelocity<V: Coordinates = DVec2>(pub V);
 
 /// A bead's mass in kg, positive and finite: made only by
 /// [`BeadMass::new`], so the step never divides by a bad one. 1 kg by
@@ -175,14 +223,14 @@ impl BeadMass {
 /// consumes it, so both are zero again after every step.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
 #[reflect(Component)]
-pub struct BeadForce {
-    force: DVec2,
+pub struct BeadForce<V: Coordinates = DVec2> {
+    force: V,
     stiffness: f64,
 }
 
-impl BeadForce {
+impl<V: Coordinates> BeadForce<V> {
     /// The force added so far, and its stiffness.
-    pub fn get(&self) -> (DVec2, f64) {
+    pub fn get(&self) -> (V, f64) {
         (self.force, self.stiffness)
     }
 
@@ -190,9 +238,9 @@ impl BeadForce {
     /// gravity plus the accumulated force, linearized at the bead's
     /// position.
     #[inline(always)]
-    pub(crate) fn linear(&self, mass: f64, gravity: DVec2, at: DVec2) -> LinearForce {
+    pub(crate) fn linear(&self, mass: f64, gravity: V, at: V) -> LinearForce<V> {
         LinearForce {
-            force: self.force + mass * gravity,
+            force: self.force + gravity * mass,
             stiffness: self.stiffness,
             at,
         }
@@ -214,28 +262,28 @@ impl BeadForce {
 /// [`add_spring`](BeadForcesItem::add_spring) on each item.
 #[derive(QueryData)]
 #[query_data(mutable)]
-pub struct BeadForces {
+pub struct BeadForces<V: Coordinates + Reflect + TypePath = DVec2> {
     /// Where the bead is (a spring pulls from here).
-    pub position: &'static BeadPosition,
+    pub position: &'static BeadPosition<V>,
     /// The accumulator.
-    pub force: &'static mut BeadForce,
+    pub force: &'static mut BeadForce<V>,
 }
 
-impl BeadForcesItem<'_, '_> {
+impl<V: Coordinates + Reflect + TypePath> BeadForcesItem<'_, '_, V> {
     /// Adds a constant force for the next step.
-    pub fn add_force(&mut self, force: DVec2) {
+    pub fn add_force(&mut self, force: V) {
         self.force.force += force;
     }
 
     /// Adds a spring `k (anchor - x)` for the next step.
-    pub fn add_spring(&mut self, k: f64, anchor: DVec2) {
-        let pull = k * (anchor - self.position.0);
+    pub fn add_spring(&mut self, k: f64, anchor: V) {
+        let pull = (anchor - self.position.0) * k;
         self.force.force += pull;
         self.force.stiffness += k;
     }
 
     /// The force added for the next step so far, and its stiffness.
-    pub fn accumulated(&self) -> (DVec2, f64) {
+    pub fn accumulated(&self) -> (V, f64) {
         self.force.get()
     }
 }
@@ -244,25 +292,28 @@ impl BeadForcesItem<'_, '_> {
 /// and force.
 #[derive(QueryData)]
 #[query_data(mutable)]
-pub(crate) struct BeadMotion {
-    pub(crate) position: &'static mut BeadPosition,
-    pub(crate) velocity: &'static mut BeadVelocity,
+pub(crate) struct BeadMotion<V: Coordinates + Reflect + TypePath = DVec2> {
+    pub(crate) position: &'static mut BeadPosition<V>,
+    pub(crate) velocity: &'static mut BeadVelocity<V>,
     pub(crate) mass: &'static mut BeadMass,
-    pub(crate) force: &'static mut BeadForce,
+    pub(crate) force: &'static mut BeadForce<V>,
 }
 
 /// A bead's position and velocity as the solver takes them.
 #[inline(always)]
-fn state_of(position: &BeadPosition, velocity: &BeadVelocity) -> BeadState {
+fn state_of<V: Coordinates>(
+    position: &BeadPosition<V>,
+    velocity: &BeadVelocity<V>,
+) -> BeadState<V> {
     BeadState {
         position: position.0,
         velocity: velocity.0,
     }
 }
 
-impl BeadMotionItem<'_, '_> {
+impl<V: Coordinates + Reflect + TypePath> BeadMotionItem<'_, '_, V> {
     /// Position and velocity.
-    pub(crate) fn state(&self) -> BeadState {
+    pub(crate) fn state(&self) -> BeadState<V> {
         state_of(&self.position, &self.velocity)
     }
 
@@ -274,7 +325,7 @@ impl BeadMotionItem<'_, '_> {
     /// Stores a step's new state and clears the consumed force (touching
     /// the force only where one was added).
     #[inline]
-    pub(crate) fn advance_to(&mut self, state: BeadState) {
+    pub(crate) fn advance_to(&mut self, state: BeadState<V>) {
         self.position.0 = state.position;
         self.velocity.0 = state.velocity;
         // Marked changed only where a force was added.
@@ -282,7 +333,7 @@ impl BeadMotionItem<'_, '_> {
     }
 
     /// Applies `params`' mass and initial state, the force cleared.
-    pub(crate) fn reset(&mut self, params: &BeadParams) {
+    pub(crate) fn reset(&mut self, params: &BeadParams<V>) {
         self.mass.set_if_neq(BeadMass(params.mass));
         self.advance_to(state_of(
             &BeadPosition(params.initial_position),
@@ -291,9 +342,9 @@ impl BeadMotionItem<'_, '_> {
     }
 }
 
-impl BeadMotionReadOnlyItem<'_, '_> {
+impl<V: Coordinates + Reflect + TypePath> BeadMotionReadOnlyItem<'_, '_, V> {
     /// Position and velocity.
-    pub(crate) fn state(&self) -> BeadState {
+    pub(crate) fn state(&self) -> BeadState<V> {
         state_of(self.position, self.velocity)
     }
 

@@ -6,6 +6,7 @@ use std::fmt;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use crate::geometry::Coordinates;
 use crate::solver::{BeadState, RowReport, SolveError};
 
 /// Per-bead diagnostics, updated after every step (on beads that have
@@ -14,7 +15,7 @@ use crate::solver::{BeadState, RowReport, SolveError};
 /// [`SimClock`](crate::SimClock)'s.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
 #[reflect(Component)]
-pub struct BeadDiagnostics {
+pub struct BeadDiagnostics<V: Coordinates = DVec2> {
     /// The constraint value `C` (the drift off the wire).
     pub c: f64,
     /// Its rate `Ċ`.
@@ -24,24 +25,24 @@ pub struct BeadDiagnostics {
     pub lambda: f64,
     /// The constraint force `λN` of the last step (for RATTLE the mean of
     /// its two multipliers' forces).
-    pub constraint_force: DVec2,
+    pub constraint_force: V,
     /// `½ m |v|²`.
     pub kinetic: f64,
     /// `-m g·x`.
     pub potential: f64,
 }
 
-impl BeadDiagnostics {
+impl<V: Coordinates> BeadDiagnostics<V> {
     /// The diagnostics of a bead of `mass` at `state` under `gravity`: its
     /// wire row's `C`, `Ċ` and λ (all zero for a bead on no wire) and the
     /// constraint force on it. The one place the bead step, the island
     /// step and a restart fill them in.
     pub(crate) fn of(
-        state: BeadState,
+        state: BeadState<V>,
         mass: f64,
-        gravity: DVec2,
+        gravity: V,
         row: RowReport,
-        constraint_force: DVec2,
+        constraint_force: V,
     ) -> Self {
         let (kinetic, potential) = state.energy(mass, gravity);
         Self {

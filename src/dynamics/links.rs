@@ -14,15 +14,18 @@ use bevy::ecs::query::QueryFilter;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use super::Dimension;
+use super::dimension::placed_by;
+use crate::geometry::Coordinates;
 use crate::solver::Constraint;
 use crate::validate::{ParamError, finite_vector, non_negative, positive};
 
 /// What a step reports of one constraint: its drift, the drift's rate and
 /// its multiplier. Kept on every [`Rod`], [`Pin`] and [`Joint`].
 ///
-/// A pin's two rows are reported together: `c` is the bead's distance from
-/// its point, `c_dot` the rate of that distance, `lambda` the length of the
-/// pin's force `(λx, λy)`.
+/// A pin's rows (two in the plane, three in space) are reported together:
+/// `c` is the bead's distance from its point, `c_dot` the rate of that
+/// distance, `lambda` the length of the pin's force `(λx, λy[, λz])`.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
 #[reflect(Component)]
 pub struct ConstraintDiagnostics {
@@ -86,15 +89,15 @@ impl Rod {
 #[component(immutable)]
 #[reflect(Component)]
 #[require(ConstraintDiagnostics)]
-pub struct Pin {
+pub struct Pin<V: Coordinates = DVec2> {
     bead: Entity,
-    at: DVec2,
+    at: V,
     anchor: Option<Entity>,
 }
 
-impl Pin {
+impl<V: Dimension> Pin<V> {
     /// A pin holding `bead` at the world point `at`, if it is finite.
-    pub fn new(bead: Entity, at: DVec2) -> Result<Self, ParamError> {
+    pub fn new(bead: Entity, at: V) -> Result<Self, ParamError> {
         finite_vector("pin point", at)?;
         Ok(Self {
             bead,
@@ -104,9 +107,10 @@ impl Pin {
     }
 
     /// A pin holding `bead` at `offset` in the frame of `anchor`'s
-    /// `Transform` (its translation and its rotation about z), if the
-    /// offset is finite and the anchor is not the bead.
-    pub fn on(bead: Entity, anchor: Entity, offset: DVec2) -> Result<Self, ParamError> {
+    /// `Transform` (in the plane its translation and its rotation about
+    /// z; in space all of it), if the offset is finite and the anchor is
+    /// not the bead.
+    pub fn on(bead: Entity, anchor: Entity, offset: V) -> Result<Self, ParamError> {
         distinct(bead, anchor, "a pin cannot be anchored to its own bead")?;
         finite_vector("pin offset", offset)?;
         Ok(Self {
@@ -122,7 +126,7 @@ impl Pin {
     }
 
     /// The point: in the world, or in the anchor's frame.
-    pub fn at(&self) -> DVec2 {
+    pub fn at(&self) -> V {
         self.at
     }
 
@@ -134,14 +138,10 @@ impl Pin {
     /// The point in the world now: the fixed point, or the offset placed by
     /// the anchor's `Transform` read from `transforms`; `None` where the
     /// anchor has no finite `Transform` there.
-    pub fn locate<F: QueryFilter>(&self, transforms: &Query<&Transform, F>) -> Option<DVec2> {
+    pub fn locate<F: QueryFilter>(&self, transforms: &Query<&Transform, F>) -> Option<V> {
         match self.anchor {
             None => Some(self.at),
-            Some(anchor) => {
-                let transform = transforms.get(anchor).ok()?;
-                let pose = super::wire::pose_of(transform).ok()?;
-                Some(pose.to_world(self.at))
-            }
+            Some(anchor) => placed_by(transforms.get(anchor).ok()?, self.at),
         }
     }
 }
@@ -201,12 +201,12 @@ impl Spring {
 #[derive(Component, Clone)]
 #[component(immutable)]
 #[require(ConstraintDiagnostics)]
-pub struct Joint {
+pub struct Joint<V: Dimension = DVec2> {
     beads: Vec<Entity>,
-    constraint: Arc<dyn Constraint>,
+    constraint: Arc<dyn Constraint<V>>,
 }
 
-impl fmt::Debug for Joint {
+impl<V: Dimension> fmt::Debug for Joint<V> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("Joint")
             .field("beads", &self.beads)
@@ -214,11 +214,11 @@ impl fmt::Debug for Joint {
     }
 }
 
-impl Joint {
+impl<V: Dimension> Joint<V> {
     /// A joint among `beads` (at least one, all different).
     pub fn new(
         beads: Vec<Entity>,
-        constraint: impl Constraint + 'static,
+        constraint: impl Constraint<V> + 'static,
     ) -> Result<Self, ParamError> {
         if beads.is_empty() {
             return Err(ParamError::Incompatible(
@@ -244,7 +244,7 @@ impl Joint {
     }
 
     /// The constraint.
-    pub fn constraint(&self) -> &Arc<dyn Constraint> {
+    pub fn constraint(&self) -> &Arc<dyn Constraint<V>> {
         &self.constraint
     }
 }

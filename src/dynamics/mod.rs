@@ -6,19 +6,22 @@
 
 mod bead;
 mod diagnostics;
+mod dimension;
 mod links;
 mod params;
 mod wire;
 
 pub use bead::{
     Bead, BeadBundle, BeadForce, BeadForces, BeadForcesItem, BeadMass, BeadParams, BeadPosition,
-    BeadVelocity, NextBeadParams, SpringAnchor,
+    BeadVelocity, NextBeadParams, SpaceBead, SpaceBeadBundle, SpringAnchor,
 };
 pub(crate) use bead::{BeadMotion, BeadMotionItem};
 pub use diagnostics::{BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason};
+pub use dimension::{Dimension, WireRows};
 pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
 pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, NextParams, SimParams};
 pub(crate) use wire::WirePose;
 pub use wire::{
-    ContactChanged, NextWireShape, OnWire, PrescribedMotion, Wire, WireBeads, WireContact, pose_of,
+    ContactChanged, NextWireShape, OnWire, PrescribedMotion, SpaceWire, Wire, WireBeads,
+    WireContact, pose_of,
 };

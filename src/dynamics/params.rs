@@ -6,12 +6,12 @@
 //! returns a [`ParamError`] that names the parameter and the value it got,
 //! leaving the previous value in place.
 
-use bevy::math::DVec2;
+use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::solver::{Integrator, Method, Stabilization, StepSettings};
-use crate::validate::{ParamError, finite_vector, non_negative, positive};
+use crate::validate::{ParamError, finite, finite_vector, non_negative, positive};
 
 /// The smallest timestep accepted, in seconds.
 pub const MIN_TIMESTEP: f64 = 1e-6;
@@ -32,6 +32,9 @@ pub struct SimParams {
     pub timestep: f64,
     /// Gravitational acceleration; `(0, -9.81)` is "down".
     pub gravity: DVec2,
+    /// Gravity's `z` component, for beads in space (the plane is space's
+    /// `z = 0`); zero by default.
+    pub gravity_z: f64,
     /// Baumgarte's spring constant α (1/s²).
     pub alpha: f64,
     /// Baumgarte's damping constant β (1/s).
@@ -50,6 +53,7 @@ impl Default for SimParams {
         Self {
             timestep: 1.0 / 60.0,
             gravity: DVec2::new(0.0, -9.81),
+            gravity_z: 0.0,
             alpha: 100.0,
             beta: 20.0,
             drag_stiffness: 20.0,
@@ -73,10 +77,16 @@ impl SimParams {
             });
         }
         finite_vector("gravity", self.gravity)?;
+        finite("gravity z", self.gravity_z)?;
         non_negative("alpha", self.alpha)?;
         non_negative("beta", self.beta)?;
         non_negative("drag stiffness k", self.drag_stiffness)?;
         positive("divergence bound", self.divergence_bound).map(drop)
+    }
+
+    /// Gravity in space: `(x, y, z)`.
+    pub fn gravity_in_space(&self) -> DVec3 {
+        self.gravity.extend(self.gravity_z)
     }
 
     /// The settings every bead's step shares.
@@ -159,6 +169,7 @@ impl TryFrom<SimParamsFile> for SimParams {
         Ok(Self {
             timestep: f.timestep,
             gravity: f.gravity,
+            gravity_z: 0.0,
             alpha: f.alpha,
             beta: f.beta,
             drag_stiffness: f.drag_stiffness,

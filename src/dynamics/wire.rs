@@ -3,11 +3,12 @@
 
 use std::sync::Arc;
 
+use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 
 use crate::geometry::{
-    Circle, Ellipse, ImplicitCurve, Line, Parabola, Pose, PosePath, Sine, Surface, WireMotion,
-    WireShape,
+    Circle, Coordinates, Ellipse, ImplicitCurve, ImplicitSurface, Line, Parabola, Pose, Sine,
+    SpaceCurve, SpaceMotion, SpaceShape, Surface, WireMotion, WireShape, WireSpace,
 };
 use crate::solver::{Contact, ContactEvent};
 use crate::validate::ParamError;
@@ -112,18 +113,37 @@ impl Wire {
 ///
 /// A wire without this component whose `Transform` the game writes is
 /// followed instead: see [`WireBeadSystems::Prepare`](crate::WireBeadSystems::Prepare).
+///
+/// `PrescribedMotion<DVec3>` moves a [`SpaceWire`] by a
+/// [`SpaceMotion`](crate::geometry::SpaceMotion): an oscillation along a
+/// 3D amplitude or a spin about any axis through its origin.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
-pub struct PrescribedMotion(WireMotion);
+pub struct PrescribedMotion<V: WireSpace = DVec2>(V::Motion);
 
 impl PrescribedMotion {
-    /// The motion, if its numbers are valid.
+    /// The motion of a wire in the plane, if its numbers are valid.
     pub fn new(motion: WireMotion) -> Result<Self, ParamError> {
-        motion.validate()?;
+        Self::validated(motion)
+    }
+}
+
+impl PrescribedMotion<DVec3> {
+    /// The motion of a wire in space, if its numbers are valid (a spin's
+    /// axis not zero).
+    pub fn in_space(motion: SpaceMotion) -> Result<Self, ParamError> {
+        Self::validated(motion)
+    }
+}
+
+impl<V: WireSpace> PrescribedMotion<V> {
+    /// The motion, if its numbers are valid.
+    fn validated(motion: V::Motion) -> Result<Self, ParamError> {
+        V::validate_motion(&motion)?;
         Ok(Self(motion))
     }
 
     /// The motion.
-    pub fn motion(&self) -> WireMotion {
+    pub fn motion(&self) -> V::Motion {
         self.0
     }
 }
@@ -133,27 +153,32 @@ impl PrescribedMotion {
 /// prescribed, or followed from the poses the game writes; none if its
 /// `Transform` is not finite.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
-pub(crate) struct WirePose(Option<PosePath>);
+pub(crate) struct WirePose<V: WireSpace = DVec2>(Option<V::Path>);
 
-impl Default for WirePose {
+impl<V: WireSpace> Default for WirePose<V> {
     fn default() -> Self {
-        Self(Some(PosePath::Fixed(Pose::IDENTITY)))
+        Self(Some(V::fixed_path(V::Pose::default())))
     }
 }
 
-impl WirePose {
-    /// The wire held at `transform`, or none if it is not finite.
-    pub(crate) fn from_transform(transform: &Transform) -> Self {
-        Self(pose_of(transform).ok().map(PosePath::Fixed))
+impl<V: WireSpace> WirePose<V> {
+    /// A wire on `path`, or none if its transform is not finite.
+    pub(crate) fn new(path: Option<V::Path>) -> Self {
+        Self(path)
     }
 
     /// A wire on `path`.
-    pub(crate) fn on(path: PosePath) -> Self {
+    pub(crate) fn on(path: V::Path) -> Self {
         Self(Some(path))
     }
 
+    /// The path, if the wire's transform is finite.
+    pub(crate) fn path(&self) -> Option<V::Path> {
+        self.0
+    }
+
     /// The path, or the error that the wire's transform is not finite.
-    pub(crate) fn get(&self) -> Result<PosePath, ParamError> {
+    pub(crate) fn get(&self) -> Result<V::Path, ParamError> {
         self.0.ok_or(ParamError::NotFinite {
             name: "wire transform",
             value: f64::NAN,
@@ -165,6 +190,57 @@ impl WirePose {
 /// finite.
 pub fn pose_of(transform: &Transform) -> Result<Pose, ParamError> {
     Pose::from_translation_rotation(transform.translation, transform.rotation)
+}
+
+/// A wire in space: a surface ([`SpaceShape::Surface`], one constraint
+/// row on each bead it holds) or a curve ([`SpaceShape::Curve`], two),
+/// placed by the entity's `Transform` (translation and rotation; the wire
+/// should be a top-level entity), moved by a
+/// [`PrescribedMotion<DVec3>`](PrescribedMotion). Beads go on it with
+/// [`OnWire`]; a [`SpaceBead`](crate::SpaceBead) on it steps in an island
+/// of its own or with the beads it is joined to.
+#[derive(Component, Clone, Debug)]
+#[require(Transform, WirePose<DVec3>)]
+pub struct SpaceWire {
+    shape: SpaceShape,
+    surface: Option<Box<Surface>>,
+}
+
+impl SpaceWire {
+    /// A wire of this shape, its surface plain.
+    pub fn new(shape: SpaceShape) -> Self {
+        Self {
+            shape,
+            surface: None,
+        }
+    }
+
+    /// A surface as a wire.
+    pub fn surface_of(surface: impl ImplicitSurface + Send + Sync + 'static) -> Self {
+        Self::new(SpaceShape::surface(surface))
+    }
+
+    /// A curve as a wire.
+    pub fn curve(curve: impl SpaceCurve + Send + Sync + 'static) -> Self {
+        Self::new(SpaceShape::curve(curve))
+    }
+
+    /// The wire with a surface (one-sided, rough, damped), if it is valid.
+    pub fn with_surface(self, surface: Surface) -> Result<Self, ParamError> {
+        surface.validate()?;
+        let surface = (surface != Surface::PLAIN).then(|| Box::new(surface));
+        Ok(Self { surface, ..self })
+    }
+
+    /// The wire's surface.
+    pub fn surface(&self) -> &Surface {
+        self.surface.as_deref().unwrap_or(&Surface::PLAIN)
+    }
+
+    /// The shape.
+    pub fn shape(&self) -> &SpaceShape {
+        &self.shape
+    }
 }
 
 /// An edited shape for a wire, applied (and removed) by the next
@@ -239,11 +315,11 @@ impl WireContact {
 /// Sent when a bead leaves its one-sided wire or lands on it (also
 /// logged, one line).
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
-pub struct ContactChanged {
+pub struct ContactChanged<V: Coordinates = DVec2> {
     /// The bead.
     pub bead: Entity,
     /// What happened, when and where.
-    pub event: ContactEvent,
+    pub event: ContactEvent<V>,
 }
 
 /// The beads on a wire, kept by Bevy from their [`OnWire`].

@@ -8,6 +8,7 @@ use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 use bevy::math::{DMat2, DMat3, DVec2, DVec3};
 
 use crate::lane::Vector;
+use crate::validate::Components;
 
 /// The coordinates a bead moves in: [`DVec2`] in the plane, [`DVec3`] in
 /// space. The solver's types ([`BeadState`](crate::solver::BeadState),
@@ -15,6 +16,7 @@ use crate::lane::Vector;
 /// parameter that defaults to the plane. Implemented for those two only.
 pub trait Coordinates:
     Vector<f64>
+    + Components
     + Copy
     + Default
     + Debug

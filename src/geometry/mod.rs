@@ -59,7 +59,7 @@ pub use space::{
 pub use spline::{CubicPath, Spline, SplineKind, SplineSpec};
 pub use surface::{Friction, Side, Surface};
 pub use traced::{HINT_WINDOW, Parametric, Traced};
-pub use wire_space::{SpaceWire, WireSpace};
+pub use wire_space::{SpaceRow, SpaceShape, WireSpace};
 
 /// The value, gradient and Hessian of a constraint at one point.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,7 +1,7 @@
 //! [`WireSpace`]: what a wire is in the plane and in space, for the rows
 //! of an island: its shape, where it sits and how it moves. A curve
 //! ([`WireShape`]) placed by a [`Pose`] on a [`PosePath`] in the plane; a
-//! surface or one of a curve's two rows ([`SpaceWire`]) placed by a
+//! surface or one of a curve's two rows ([`SpaceRow`]) placed by a
 //! [`Pose3`] on a [`SpacePath`] in space.
 
 use std::fmt::Debug;
@@ -11,19 +11,30 @@ use bevy::math::{DVec2, DVec3};
 
 use super::{
     Coordinates, Geometry, ImplicitSurface, Placement, Pose, Pose3, PosePath, SpaceCurve,
-    SpacePath, Twist, WireShape,
+    SpaceMotion, SpacePath, Twist, WireMotion, WireShape,
 };
+use crate::validate::ParamError;
 
 /// The coordinates with the wires that live in them.
 pub trait WireSpace: Coordinates {
     /// A wire row's shape in its local frame: a curve ([`WireShape`]) in
-    /// the plane, a surface or one row of a curve ([`SpaceWire`]) in
+    /// the plane, a surface or one row of a curve ([`SpaceRow`]) in
     /// space.
     type Shape: Clone + Debug + Send + Sync + 'static;
     /// Where a wire sits: [`Pose`] or [`Pose3`].
     type Pose: Placement<Self> + Copy + Debug + Default + PartialEq + Send + Sync + 'static;
     /// Where a wire is over time: [`PosePath`] or [`SpacePath`].
     type Path: Copy + Debug + PartialEq + Send + Sync + 'static;
+    /// A wire's prescribed motion: [`WireMotion`] or [`SpaceMotion`].
+    type Motion: Copy + Debug + PartialEq + Send + Sync + 'static;
+    /// A wire resting at `pose`.
+    fn fixed_path(pose: Self::Pose) -> Self::Path;
+    /// A wire moving by `motion` about `base`.
+    fn prescribed_path(base: Self::Pose, motion: Self::Motion) -> Self::Path;
+    /// The resting pose of a prescribed path.
+    fn prescribed_base(path: &Self::Path) -> Option<Self::Pose>;
+    /// Whether `motion`'s numbers are valid.
+    fn validate_motion(motion: &Self::Motion) -> Result<(), ParamError>;
     /// The pose and twist of `path` at `t`.
     fn path_at(path: &Self::Path, t: f64) -> (Self::Pose, Twist<Self>);
     /// The pose of `path` if it does not move.
@@ -45,9 +56,9 @@ pub trait WireSpace: Coordinates {
 
 /// One constraint row of a wire in space: a surface's, or one of a
 /// curve's two. Shared, so an island's rows clone it cheaply. A bead on a
-/// curve takes both of [`SpaceWire::curve`]'s rows.
+/// curve takes both of [`SpaceRow::curve`]'s rows.
 #[derive(Clone)]
-pub enum SpaceWire {
+pub enum SpaceRow {
     /// A surface: its one row.
     Surface(Arc<dyn ImplicitSurface + Send + Sync>),
     /// A curve and which of its two rows (0 or 1).
@@ -59,7 +70,7 @@ pub enum SpaceWire {
     },
 }
 
-impl SpaceWire {
+impl SpaceRow {
     /// A surface's row.
     pub fn surface(surface: impl ImplicitSurface + Send + Sync + 'static) -> Self {
         Self::Surface(Arc::new(surface))
@@ -68,6 +79,11 @@ impl SpaceWire {
     /// A curve's two rows.
     pub fn curve(curve: impl SpaceCurve + Send + Sync + 'static) -> [Self; 2] {
         let curve: Arc<dyn SpaceCurve + Send + Sync> = Arc::new(curve);
+        Self::curve_rows(&curve)
+    }
+
+    /// The two rows of a shared curve.
+    pub fn curve_rows(curve: &Arc<dyn SpaceCurve + Send + Sync>) -> [Self; 2] {
         [0, 1].map(|row| Self::Curve {
             curve: curve.clone(),
             row,
@@ -75,7 +91,54 @@ impl SpaceWire {
     }
 }
 
-impl Debug for SpaceWire {
+/// A wire's shape in space: a surface, one row on each bead it holds, or
+/// a curve, two.
+#[derive(Clone)]
+pub enum SpaceShape {
+    /// A surface `C(x) = 0`.
+    Surface(Arc<dyn ImplicitSurface + Send + Sync>),
+    /// A curve.
+    Curve(Arc<dyn SpaceCurve + Send + Sync>),
+}
+
+impl SpaceShape {
+    /// A surface.
+    pub fn surface(surface: impl ImplicitSurface + Send + Sync + 'static) -> Self {
+        Self::Surface(Arc::new(surface))
+    }
+
+    /// A curve.
+    pub fn curve(curve: impl SpaceCurve + Send + Sync + 'static) -> Self {
+        Self::Curve(Arc::new(curve))
+    }
+
+    /// The rows it puts on each bead it holds: one or two.
+    pub fn rows(&self) -> Vec<SpaceRow> {
+        match self {
+            Self::Surface(surface) => vec![SpaceRow::Surface(surface.clone())],
+            Self::Curve(curve) => SpaceRow::curve_rows(curve).to_vec(),
+        }
+    }
+
+    /// Its characteristic length.
+    pub fn scale(&self) -> f64 {
+        match self {
+            Self::Surface(surface) => surface.scale(),
+            Self::Curve(curve) => curve.scale(),
+        }
+    }
+}
+
+impl Debug for SpaceShape {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Surface(_) => f.write_str("Surface(..)"),
+            Self::Curve(_) => f.write_str("Curve(..)"),
+        }
+    }
+}
+
+impl Debug for SpaceRow {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Self::Surface(_) => f.write_str("Surface(..)"),
@@ -88,6 +151,22 @@ impl WireSpace for DVec2 {
     type Shape = WireShape;
     type Pose = Pose;
     type Path = PosePath;
+    type Motion = WireMotion;
+    fn fixed_path(pose: Pose) -> PosePath {
+        PosePath::Fixed(pose)
+    }
+    fn prescribed_path(base: Pose, motion: WireMotion) -> PosePath {
+        PosePath::Prescribed { base, motion }
+    }
+    fn prescribed_base(path: &PosePath) -> Option<Pose> {
+        match path {
+            PosePath::Prescribed { base, .. } => Some(*base),
+            _ => None,
+        }
+    }
+    fn validate_motion(motion: &WireMotion) -> Result<(), ParamError> {
+        motion.validate()
+    }
     #[inline]
     fn path_at(path: &PosePath, t: f64) -> (Pose, Twist) {
         path.at(t)
@@ -114,9 +193,25 @@ impl WireSpace for DVec2 {
 }
 
 impl WireSpace for DVec3 {
-    type Shape = SpaceWire;
+    type Shape = SpaceRow;
     type Pose = Pose3;
     type Path = SpacePath;
+    type Motion = SpaceMotion;
+    fn fixed_path(pose: Pose3) -> SpacePath {
+        SpacePath::Fixed(pose)
+    }
+    fn prescribed_path(base: Pose3, motion: SpaceMotion) -> SpacePath {
+        SpacePath::Prescribed { base, motion }
+    }
+    fn prescribed_base(path: &SpacePath) -> Option<Pose3> {
+        match path {
+            SpacePath::Prescribed { base, .. } => Some(*base),
+            SpacePath::Fixed(_) => None,
+        }
+    }
+    fn validate_motion(motion: &SpaceMotion) -> Result<(), ParamError> {
+        motion.validate()
+    }
     #[inline]
     fn path_at(path: &SpacePath, t: f64) -> (Pose3, Twist<DVec3>) {
         path.at(t)
@@ -125,24 +220,24 @@ impl WireSpace for DVec3 {
         path.fixed()
     }
     #[inline]
-    fn shape_geometry(shape: &SpaceWire, p: Self, hint: Option<f64>) -> Geometry<DVec3> {
+    fn shape_geometry(shape: &SpaceRow, p: Self, hint: Option<f64>) -> Geometry<DVec3> {
         match shape {
-            SpaceWire::Surface(surface) => surface.geometry(p),
-            SpaceWire::Curve { curve, row } => {
+            SpaceRow::Surface(surface) => surface.geometry(p),
+            SpaceRow::Curve { curve, row } => {
                 curve.rows(p, hint.unwrap_or(f64::NAN))[(*row).min(1)]
             }
         }
     }
-    fn shape_scale(shape: &SpaceWire) -> f64 {
+    fn shape_scale(shape: &SpaceRow) -> f64 {
         match shape {
-            SpaceWire::Surface(surface) => surface.scale(),
-            SpaceWire::Curve { curve, .. } => curve.scale(),
+            SpaceRow::Surface(surface) => surface.scale(),
+            SpaceRow::Curve { curve, .. } => curve.scale(),
         }
     }
-    fn shape_parameter(shape: &SpaceWire, p: Self, hint: f64) -> f64 {
+    fn shape_parameter(shape: &SpaceRow, p: Self, hint: f64) -> f64 {
         match shape {
-            SpaceWire::Surface(_) => f64::NAN,
-            SpaceWire::Curve { curve, .. } => curve.parameter(p, hint),
+            SpaceRow::Surface(_) => f64::NAN,
+            SpaceRow::Curve { curve, .. } => curve.parameter(p, hint),
         }
     }
     fn stick_axis(_normal: Self) -> Option<Self> {

@@ -2,13 +2,14 @@
 //! applied and pending parameters, the order of the step's sets, the
 //! compute-pool setting, and what a bead brings along.
 
+use bevy::math::DVec3;
 use bevy::prelude::*;
 
 use super::parallel::{ParallelStep, StepSplit};
 use super::schedule;
 use crate::dynamics::{
     Bead, BeadDiagnostics, BeadDiverged, BeadForce, BeadMass, BeadParams, BeadPosition,
-    BeadVelocity, ContactChanged, NextBeadParams, NextParams, SimParams,
+    BeadVelocity, ContactChanged, NextBeadParams, NextParams, SimParams, SpaceBead,
 };
 
 /// The parameters ([`SimParams`], [`NextParams`]), the step's sets in
@@ -62,6 +63,8 @@ impl Plugin for ParamsPlugin {
             for registered in [
                 app.try_register_required_components::<Bead, Transform>(),
                 app.try_register_required_components::<Bead, BeadDiagnostics>(),
+                app.try_register_required_components::<SpaceBead, Transform>(),
+                app.try_register_required_components::<SpaceBead, BeadDiagnostics<DVec3>>(),
             ] {
                 if let Err(err) = registered {
                     warn!("wirebead: could not give beads their Transform and diagnostics: {err}");
@@ -75,6 +78,7 @@ impl Plugin for ParamsPlugin {
             .register_type::<StepSplit>()
             .add_message::<BeadDiverged>()
             .add_message::<ContactChanged>()
+            .add_message::<ContactChanged<DVec3>>()
             .register_type::<Bead>()
             .register_type::<BeadPosition>()
             .register_type::<BeadVelocity>()
@@ -82,6 +86,12 @@ impl Plugin for ParamsPlugin {
             .register_type::<BeadForce>()
             .register_type::<BeadParams>()
             .register_type::<BeadDiagnostics>()
+            .register_type::<SpaceBead>()
+            .register_type::<BeadPosition<DVec3>>()
+            .register_type::<BeadVelocity<DVec3>>()
+            .register_type::<BeadForce<DVec3>>()
+            .register_type::<BeadParams<DVec3>>()
+            .register_type::<BeadDiagnostics<DVec3>>()
             .register_type::<NextBeadParams>()
             .register_type::<SimParams>()
             .register_type::<ParallelStep>()

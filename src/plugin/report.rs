@@ -6,9 +6,10 @@
 use std::sync::{Mutex, PoisonError};
 
 use bevy::ecs::system::SystemParam;
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::dynamics::{BeadDiverged, ContactChanged, Diverged, DivergenceReason};
+use crate::dynamics::{BeadDiverged, ContactChanged, Dimension, Diverged, DivergenceReason};
 use crate::solver::ContactEvent;
 
 /// Divergences found inside a (possibly parallel) loop, reported after it.
@@ -55,24 +56,24 @@ impl Divergences<'_, '_> {
 
 /// Sends [`ContactChanged`] and logs the change in one line.
 #[derive(SystemParam)]
-pub(crate) struct ContactReports<'w> {
-    messages: MessageWriter<'w, ContactChanged>,
+pub(crate) struct ContactReports<'w, V: Dimension = DVec2> {
+    messages: MessageWriter<'w, ContactChanged<V>>,
 }
 
-impl ContactReports<'_> {
+impl<V: Dimension> ContactReports<'_, V> {
     /// Reports that `bead`'s contact changed.
-    pub(crate) fn report(&mut self, bead: Entity, event: ContactEvent) {
+    pub(crate) fn report(&mut self, bead: Entity, event: ContactEvent<V>) {
         info!("wirebead: bead {bead} {}", describe_event(&event));
         self.messages.write(ContactChanged { bead, event });
     }
 }
 
 /// A change of contact in words, for the log.
-fn describe_event(event: &ContactEvent) -> String {
+fn describe_event<V: Dimension>(event: &ContactEvent<V>) -> String {
     match *event {
         ContactEvent::Left { time, position } => format!(
-            "left its wire at t = {time:.4} s at ({:.3}, {:.3}), where the wire would have had to pull",
-            position.x, position.y
+            "left its wire at t = {time:.4} s at {}, where the wire would have had to pull",
+            point(position)
         ),
         ContactEvent::Landed {
             time,
@@ -80,11 +81,21 @@ fn describe_event(event: &ContactEvent) -> String {
             normal_speed,
             bounced,
         } => format!(
-            "landed on its wire at t = {time:.4} s at ({:.3}, {:.3}) at {normal_speed:.3} m/s across it and {}",
-            position.x,
-            position.y,
+            "landed on its wire at t = {time:.4} s at {} at {normal_speed:.3} m/s across it and {}",
+            point(position),
             if bounced { "bounced off" } else { "stayed on" }
         ),
+    }
+}
+
+/// A point for the log: `(x, y)` in the plane, `(x, y, z)` in space, to
+/// the millimetre.
+fn point<V: Dimension>(p: V) -> String {
+    let p = p.xyz();
+    if V::DIMENSION == 3 {
+        format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z)
+    } else {
+        format!("({:.3}, {:.3})", p.x, p.y)
     }
 }
 

@@ -1,17 +1,18 @@
 //! [`RestartPlugin`]: [`Restart`] applies the pending edits and returns
 //! every bead to its initial state, as the assignment's space bar did.
 
+use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 
 use super::clock::SimClock;
 use super::islands::Islands;
 use super::schedule::WireBeadSystems;
-use super::wires::{prescribed, set_pose};
+use super::wires::prescribed;
 use crate::dynamics::{
-    BeadDiagnostics, BeadMotion, BeadMotionItem, BeadParams, Diverged, NextBeadParams, NextParams,
-    NextWireShape, OnWire, PrescribedMotion, SimParams, Wire, WireContact, WirePose,
+    BeadDiagnostics, BeadMotion, BeadMotionItem, BeadParams, Dimension, Diverged, NextBeadParams,
+    NextParams, NextWireShape, OnWire, PrescribedMotion, SimParams, Wire, WireContact, WirePose,
 };
-use crate::geometry::{MovingTrack, Track};
+use crate::geometry::{MovingTrack, Track, WireSpace};
 use crate::solver::{RowReport, constraint_state_on};
 
 /// Restarts the run: applies [`NextParams`] and every [`NextBeadParams`],
@@ -29,17 +30,17 @@ pub struct RestartPlugin;
 
 impl Plugin for RestartPlugin {
     fn build(&self, app: &mut App) {
-        app.add_message::<Restart>()
-            .add_systems(PreUpdate, apply_restart.in_set(WireBeadSystems::Restart));
+        app.add_message::<Restart>().add_systems(
+            PreUpdate,
+            (apply_restart, restart_in_space)
+                .chain()
+                .in_set(WireBeadSystems::Restart),
+        );
     }
 }
 
 /// The diagnostics of a bead's current state on `track`, before any step.
-fn diagnose<T: Track>(
-    track: &T,
-    bead: &BeadMotionItem,
-    gravity: bevy::math::DVec2,
-) -> BeadDiagnostics {
+fn diagnose<T: Track>(track: &T, bead: &BeadMotionItem<DVec2>, gravity: DVec2) -> BeadDiagnostics {
     let (c, c_dot) = constraint_state_on(track, 0.0, bead.state());
     let row = RowReport {
         c,
@@ -87,17 +88,7 @@ fn apply_restart(
             *wire = wire.reshaped(edit.shape());
             commands.entity(entity).remove::<NextWireShape>();
         }
-        // A wire on a prescribed motion goes back to its resting pose; one
-        // the game moved starts again at rest where it is.
-        match motion {
-            Some(motion) => {
-                *pose = prescribed(motion, &pose, &transform);
-                if let Ok(path) = pose.get() {
-                    set_pose(&mut transform, path.pose(0.0));
-                }
-            }
-            None => *pose = WirePose::from_transform(&transform),
-        }
+        rest_wire(motion, &mut transform, &mut pose);
     }
     *params = pending.get().clone();
     time.set_timestep_seconds(params.timestep);
@@ -108,20 +99,10 @@ fn apply_restart(
         if let Some(edit) = edit {
             bead_params.set_if_neq(*edit.get());
         }
-        if let Err(err) = bead_params.validate() {
-            // Written directly, not through `NextBeadParams`.
-            warn!(
-                "wirebead: bead {entity} was not restarted: its BeadParams are invalid ({err}); it keeps its state"
-            );
+        if !reset_bead(entity, &mut bead, &bead_params, contact, &mut commands) {
             continue;
         }
-        bead.reset(&bead_params);
-        if let Some(mut contact) = contact {
-            contact.set_if_neq(WireContact::default());
-        }
-        commands
-            .entity(entity)
-            .remove::<(Diverged, NextBeadParams)>();
+        commands.entity(entity).remove::<NextBeadParams>();
         let wire = on_wire.and_then(|on| wires.get(on.0).ok());
         let Some((_, wire, _, pose, ..)) = wire else {
             if let Some(mut diagnostics) = diagnostics {
@@ -138,6 +119,102 @@ fn apply_restart(
                 path: &path,
             };
             *diagnostics = diagnose(&track, &bead, params.gravity);
+        }
+    }
+}
+
+/// A wire back where a run starts: one on a prescribed motion at its
+/// resting pose, one the game moved at rest where it is.
+fn rest_wire<V: Dimension>(
+    motion: Option<&PrescribedMotion<V>>,
+    transform: &mut Transform,
+    pose: &mut WirePose<V>,
+) {
+    match motion {
+        Some(motion) => {
+            *pose = prescribed(motion, pose, transform);
+            if let Ok(path) = pose.get() {
+                V::set_pose(transform, V::path_at(&path, 0.0).0);
+            }
+        }
+        None => *pose = WirePose::from_transform(transform),
+    }
+}
+
+/// A bead back at its [`BeadParams`], its contact and divergence cleared;
+/// false, with a one-line warning, if its parameters are invalid (written
+/// directly, not through [`NextBeadParams`]): it keeps its state.
+fn reset_bead<V: Dimension>(
+    entity: Entity,
+    bead: &mut BeadMotionItem<V>,
+    params: &BeadParams<V>,
+    contact: Option<Mut<WireContact>>,
+    commands: &mut Commands,
+) -> bool {
+    if let Err(err) = params.validate() {
+        warn!(
+            "wirebead: bead {entity} was not restarted: its BeadParams are invalid ({err}); it keeps its state"
+        );
+        return false;
+    }
+    bead.reset(params);
+    if let Some(mut contact) = contact {
+        contact.set_if_neq(WireContact::default());
+    }
+    commands.entity(entity).remove::<Diverged>();
+    true
+}
+
+/// Handles [`Restart`] for beads and wires in space, after
+/// [`apply_restart`] applied the parameters: each wire at its resting
+/// pose, each bead at its [`BeadParams<DVec3>`](BeadParams) (its initial
+/// velocity relative to its wire's own at t = 0), its diagnostics those of
+/// its new state until the first step fills in its rows.
+fn restart_in_space(
+    mut restarts: MessageReader<Restart>,
+    params: Res<SimParams>,
+    mut wires: Query<(
+        &mut Transform,
+        &mut WirePose<DVec3>,
+        Option<&PrescribedMotion<DVec3>>,
+    )>,
+    mut beads: Query<(
+        Entity,
+        BeadMotion<DVec3>,
+        &BeadParams<DVec3>,
+        Option<&mut BeadDiagnostics<DVec3>>,
+        Option<&mut WireContact>,
+        Option<&OnWire>,
+    )>,
+    mut islands: ResMut<Islands<DVec3>>,
+    mut commands: Commands,
+) {
+    if restarts.read().count() == 0 {
+        return;
+    }
+    islands.mark_dirty();
+    for (mut transform, mut pose, motion) in &mut wires {
+        rest_wire(motion, &mut transform, &mut pose);
+    }
+    let gravity = DVec3::gravity(&params);
+    for (entity, mut bead, bead_params, diagnostics, contact, on_wire) in &mut beads {
+        if !reset_bead(entity, &mut bead, bead_params, contact, &mut commands) {
+            continue;
+        }
+        let path = on_wire.and_then(|on| wires.get(on.0).ok()?.1.get().ok());
+        if let Some(path) = path {
+            let twist = DVec3::path_at(&path, 0.0).1;
+            bead.velocity.0 = bead_params.initial_velocity_on(&twist);
+        }
+        if let Some(mut diagnostics) = diagnostics {
+            let state = bead.state();
+            *diagnostics = BeadDiagnostics::of(
+                state,
+                bead.mass(),
+                gravity,
+                RowReport::default(),
+                DVec3::ZERO,
+            );
         }
     }
 }

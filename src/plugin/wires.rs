@@ -2,14 +2,17 @@
 //! [`WireBeadSystems::Prepare`]. It reads each changed wire `Transform`
 //! once, so the beads do not; writes the `Transform` of a wire on a
 //! prescribed motion; and takes in the pose of a wire the game moves.
+//! Each system runs for the plane's wires and for space's.
+
+use std::marker::PhantomData;
 
 use bevy::ecs::entity::EntityHashSet;
+use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 
 use super::clock::{SimClock, advance_clock};
 use super::schedule::WireBeadSystems;
-use crate::dynamics::{PrescribedMotion, SimParams, Wire, WirePose, pose_of};
-use crate::geometry::{Pose, PoseHistory, PosePath};
+use crate::dynamics::{Dimension, PrescribedMotion, SimParams, WirePose};
 
 /// Places the wires for each step: a wire's pose when it is added, its
 /// prescribed motion, or the motion a game gives it by writing its
@@ -19,79 +22,100 @@ pub struct WirePosePlugin;
 
 impl Plugin for WirePosePlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<MovingWires>()
-            .add_observer(wire_added)
-            .add_systems(
-                FixedUpdate,
-                place_wires
-                    .run_if(wires_to_place)
-                    .before(advance_clock)
-                    .in_set(WireBeadSystems::Prepare),
-            );
+        add_wire_poses::<DVec2>(app);
+        add_wire_poses::<DVec3>(app);
     }
+}
+
+/// The systems that place the wires of one dimension.
+fn add_wire_poses<V: Dimension>(app: &mut App) {
+    app.init_resource::<MovingWires<V>>()
+        .add_observer(wire_added::<V>)
+        .add_systems(
+            FixedUpdate,
+            place_wires::<V>
+                .run_if(wires_to_place::<V>)
+                .before(advance_clock)
+                .in_set(WireBeadSystems::Prepare),
+        );
 }
 
 /// The wires a game moved that have not come to rest: placed again each
 /// step until they do.
-#[derive(Resource, Default)]
-pub(crate) struct MovingWires(EntityHashSet);
+#[derive(Resource)]
+pub(crate) struct MovingWires<V>(EntityHashSet, PhantomData<V>);
+
+impl<V> Default for MovingWires<V> {
+    fn default() -> Self {
+        Self(EntityHashSet::default(), PhantomData)
+    }
+}
 
 /// Whether any wire needs placing: one on a prescribed motion, one whose
 /// `Transform` changed, or one still moving. Where none does (every wire
 /// at rest) the step skips [`place_wires`] altogether.
-fn wires_to_place(
-    driven: Query<(), With<PrescribedMotion>>,
-    moved: Query<(), (With<Wire>, Without<PrescribedMotion>, Changed<Transform>)>,
-    moving: Res<MovingWires>,
+fn wires_to_place<V: Dimension>(
+    driven: Query<(), With<PrescribedMotion<V>>>,
+    moved: Query<
+        (),
+        (
+            With<V::Wire>,
+            Without<PrescribedMotion<V>>,
+            Changed<Transform>,
+        ),
+    >,
+    moving: Res<MovingWires<V>>,
 ) -> bool {
     !driven.is_empty() || !moving.0.is_empty() || !moved.is_empty()
 }
 
 /// Places every wire for the coming step, from [`SimClock::time`] to one
 /// timestep later (the clock advances after this).
-pub(crate) fn place_wires(
+///
+/// A wire on a [`PrescribedMotion`] is on its motion about its resting
+/// pose, and its `Transform` is written where the step ends. A wire whose
+/// `Transform` the game wrote is followed (see [`Dimension::followed`]);
+/// the rest stay where they are, unvisited.
+pub(crate) fn place_wires<V: Dimension>(
     params: Res<SimParams>,
     clock: Res<SimClock>,
-    mut driven: Query<(&PrescribedMotion, &mut Transform, &mut WirePose)>,
-    mut followed: Query<(Ref<Transform>, &mut WirePose), (With<Wire>, Without<PrescribedMotion>)>,
-    moved: Query<Entity, (With<Wire>, Without<PrescribedMotion>, Changed<Transform>)>,
-    mut moving: ResMut<MovingWires>,
+    mut driven: Query<(&PrescribedMotion<V>, &mut Transform, &mut WirePose<V>)>,
+    mut followed: Query<
+        (Ref<Transform>, &mut WirePose<V>),
+        (With<V::Wire>, Without<PrescribedMotion<V>>),
+    >,
+    moved: Query<
+        Entity,
+        (
+            With<V::Wire>,
+            Without<PrescribedMotion<V>>,
+            Changed<Transform>,
+        ),
+    >,
+    mut moving: ResMut<MovingWires<V>>,
 ) {
     let (start, h) = (clock.time, params.timestep);
-    let end = start + h;
     for (motion, mut transform, mut pose) in &mut driven {
         let placed = prescribed(motion, &pose, &transform);
         pose.set_if_neq(placed);
-        if let Ok(path) = placed.get() {
-            set_pose(&mut transform, path.pose(end));
+        if let Some(path) = placed.path() {
+            V::set_pose(&mut transform, V::path_at(&path, start + h).0);
         }
     }
-    // Only the wires whose `Transform` changed, and the ones that were
-    // still moving: the rest stay where they are, unvisited.
     let mut still_moving = EntityHashSet::default();
     let before = moving.0.iter().copied().filter(|&e| !moved.contains(e));
     for entity in moved.iter().chain(before) {
         let Ok((transform, mut pose)) = followed.get_mut(entity) else {
             continue;
         };
-        let Ok(now) = pose_of(&transform) else {
+        let Ok(now) = V::pose_of(&transform) else {
             pose.set_if_neq(WirePose::from_transform(&transform));
             continue;
         };
-        let mut history = match pose.get() {
-            Ok(PosePath::Fixed(at)) if at == now => continue,
-            Ok(PosePath::Fixed(at)) => PoseHistory::at_rest(f64::NEG_INFINITY, at),
-            Ok(PosePath::Followed(history)) => history,
-            Ok(path @ PosePath::Prescribed { .. }) => PoseHistory::at_rest(start, path.pose(start)),
-            Err(_) => PoseHistory::at_rest(start, now),
-        };
-        history.push(end, h, now);
-        let path = if history.is_at_rest() {
-            PosePath::Fixed(now)
-        } else {
+        let (path, moves) = V::followed(pose.path(), now, start, h);
+        if moves {
             still_moving.insert(entity);
-            PosePath::Followed(history)
-        };
+        }
         pose.set_if_neq(WirePose::on(path));
     }
     moving.0 = still_moving;
@@ -99,7 +123,10 @@ pub(crate) fn place_wires(
 
 /// Places a wire where its `Transform` puts it the moment it is added, so
 /// that a game moving it from its first step on moves it from there.
-fn wire_added(add: On<Add, Wire>, mut wires: Query<(&Transform, &mut WirePose)>) {
+fn wire_added<V: Dimension>(
+    add: On<Add, V::Wire>,
+    mut wires: Query<(&Transform, &mut WirePose<V>)>,
+) {
     if let Ok((transform, mut pose)) = wires.get_mut(add.entity) {
         *pose = WirePose::from_transform(transform);
     }
@@ -107,31 +134,17 @@ fn wire_added(add: On<Add, Wire>, mut wires: Query<(&Transform, &mut WirePose)>)
 
 /// A wire on `motion` about its resting pose: the one `pose` already
 /// holds, else its `Transform`'s (when the motion first applies).
-pub(crate) fn prescribed(
-    motion: &PrescribedMotion,
-    pose: &WirePose,
+pub(crate) fn prescribed<V: Dimension>(
+    motion: &PrescribedMotion<V>,
+    pose: &WirePose<V>,
     transform: &Transform,
-) -> WirePose {
-    let base = match pose.get() {
-        Ok(PosePath::Prescribed { base, .. }) => Ok(base),
-        _ => pose_of(transform),
+) -> WirePose<V> {
+    let base = match pose.path().and_then(|path| V::prescribed_base(&path)) {
+        Some(base) => Ok(base),
+        None => V::pose_of(transform),
     };
     match base {
-        Ok(base) => WirePose::on(PosePath::Prescribed {
-            base,
-            motion: motion.motion(),
-        }),
+        Ok(base) => WirePose::on(V::prescribed_path(base, motion.motion())),
         Err(_) => WirePose::from_transform(transform),
-    }
-}
-
-/// Writes an in-plane pose into a `Transform` (x, y and the rotation about
-/// z; z kept), converted to `f32` at this edge.
-pub(crate) fn set_pose(transform: &mut Transform, pose: Pose) {
-    let origin = pose.origin.as_vec2();
-    if origin.is_finite() && pose.rotation.is_finite() {
-        transform.translation.x = origin.x;
-        transform.translation.y = origin.y;
-        transform.rotation = Quat::from_rotation_z(pose.rotation.to_angle() as f32);
     }
 }

@@ -21,6 +21,7 @@ mod readme;
 mod restart;
 mod scenes;
 mod space;
+mod space_plugin;
 mod tracks;
 #[cfg(feature = "gui")]
 mod window;

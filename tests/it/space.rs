@@ -57,7 +57,7 @@ fn plane_against_space<C: ImplicitCurve + ?Sized, S: ImplicitSurface + ?Sized>(
 /// A bead inside a sphere of radius `r`, `alpha` from the downward
 /// vertical, moving round the vertical axis at the conical pendulum's
 /// speed `v² = g r sin²α / cos α`.
-fn conical_start(r: f64, alpha: f64) -> (BeadState<DVec3>, f64) {
+pub(crate) fn conical_start(r: f64, alpha: f64) -> (BeadState<DVec3>, f64) {
     let v = (G * r * alpha.sin().powi(2) / alpha.cos()).sqrt();
     let state = BeadState {
         position: DVec3::new(r * alpha.sin(), -r * alpha.cos(), 0.0),
@@ -540,11 +540,11 @@ fn a_conical_pendulum_on_a_rod_from_a_pin_keeps_its_height_and_period() {
 /// length to 1e-12 and the energy to 1e-5 of m g r over 3 s.
 #[test]
 fn a_rod_between_two_beads_on_a_sphere_holds_as_an_island() {
-    use wirebead::geometry::SpaceWire;
+    use wirebead::geometry::SpaceRow;
     use wirebead::solver::{Island, IslandRow, IslandWork, RowKind};
     let r = 1.0;
     let wire = || RowKind::Wire {
-        shape: SpaceWire::surface(Sphere { radius: r }),
+        shape: SpaceRow::surface(Sphere { radius: r }),
         pose: Pose3::IDENTITY,
     };
     let a = DVec3::new(0.6, -0.8, 0.0);
@@ -610,7 +610,7 @@ fn a_rod_between_two_beads_on_a_sphere_holds_as_an_island() {
 pub(crate) fn curve_rows(
     curve: impl wirebead::geometry::SpaceCurve + Send + Sync + 'static,
 ) -> [wirebead::solver::IslandRow<DVec3>; 2] {
-    wirebead::geometry::SpaceWire::curve(curve).map(|shape| wirebead::solver::IslandRow {
+    wirebead::geometry::SpaceRow::curve(curve).map(|shape| wirebead::solver::IslandRow {
         kind: wirebead::solver::RowKind::Wire {
             shape,
             pose: Pose3::IDENTITY,

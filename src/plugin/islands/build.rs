@@ -4,12 +4,12 @@
 use std::collections::HashMap;
 
 use bevy::ecs::system::SystemParam;
-use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::{CachedIsland, InIsland, IslandReport, Islands, LinkRows};
+use super::{CachedIsland, InIsland, IslandReport, Islands, LinkRows, WireRow};
 use crate::dynamics::{
-    BeadMotion, DivergenceReason, Joint, OnWire, Pin, Rod, Spring, Wire, WirePose,
+    Bead, BeadMotion, Dimension, DivergenceReason, Joint, OnWire, Pin, Rod, SpaceBead, Spring,
+    WirePose, WireRows,
 };
 use crate::plugin::clock::SimClock;
 use crate::plugin::report::Divergences;
@@ -17,41 +17,45 @@ use crate::solver::{self, BeadState, Island, IslandRow, IslandWork, RowKind, Spr
 
 /// Every link in the world, as the rebuild reads them.
 #[derive(SystemParam)]
-pub(super) struct Links<'w, 's> {
+pub(super) struct Links<'w, 's, V: Dimension> {
     rods: Query<'w, 's, (Entity, &'static Rod)>,
-    pins: Query<'w, 's, (Entity, &'static Pin)>,
-    joints: Query<'w, 's, (Entity, &'static Joint)>,
+    pins: Query<'w, 's, (Entity, &'static Pin<V>)>,
+    joints: Query<'w, 's, (Entity, &'static Joint<V>)>,
     springs: Query<'w, 's, (Entity, &'static Spring)>,
+    /// Every bead, of either dimension: a link that names a bead of the
+    /// other dimension is that dimension's, not a link to nothing.
+    any_bead: Query<'w, 's, (), Or<(With<Bead>, With<SpaceBead>)>>,
 }
 
 /// A link while the islands are built: its rows and the beads it names.
-struct Pending {
+struct Pending<V: Dimension> {
     entity: Entity,
-    rows: Vec<IslandRow>,
+    rows: Vec<IslandRow<V>>,
     pin: bool,
     anchored: bool,
 }
 
-/// The two rows that hold a bead at `at`.
-fn pin_rows(at: DVec2) -> Vec<IslandRow> {
-    [DVec2::X, DVec2::Y]
-        .map(|axis| IslandRow {
+/// The rows that hold a bead at `at`, one along each axis.
+fn pin_rows<V: Dimension>(at: V) -> Vec<IslandRow<V>> {
+    V::AXES
+        .iter()
+        .map(|&axis| IslandRow {
             kind: RowKind::Axis {
                 axis,
                 offset: axis.dot(at),
             },
             beads: vec![0],
         })
-        .to_vec()
+        .collect()
 }
 
 /// Rebuilds [`Islands`] after the topology changed, and keeps the
 /// [`InIsland`] marker on exactly the beads in one.
-pub(super) fn prepare_islands(
-    mut islands: ResMut<Islands>,
-    links: Links,
-    mut beads: Query<(Entity, BeadMotion, Option<&OnWire>, Has<InIsland>)>,
-    wires: Query<(&Wire, &WirePose)>,
+pub(super) fn prepare_islands<V: Dimension>(
+    mut islands: ResMut<Islands<V>>,
+    links: Links<V>,
+    mut beads: Query<(Entity, BeadMotion<V>, Option<&OnWire>, Has<InIsland>)>,
+    wires: Query<(&V::Wire, &WirePose<V>)>,
     transforms: Query<&Transform>,
     mut commands: Commands,
     mut divergences: Divergences,
@@ -60,14 +64,30 @@ pub(super) fn prepare_islands(
     islands.dirty = false;
     islands.cached.clear();
     let is_bead = |e: Entity| beads.contains(e);
+    // A link naming a bead of the other dimension is the other
+    // dimension's to build (or to refuse, if it mixes them).
+    let ours = |named: &[Entity]| named.iter().any(|&b| is_bead(b));
     let missing = |what: &str, link: Entity, bead: Entity| {
-        warn!("wirebead: {what} {link} names {bead}, which is not a bead; the {what} is left out");
+        if links.any_bead.contains(bead) {
+            warn!(
+                "wirebead: {what} {link} joins beads in the plane and in space; the {what} is left out"
+            );
+        } else {
+            warn!(
+                "wirebead: {what} {link} names {bead}, which is not a bead; the {what} is left out"
+            );
+        }
     };
+    let elsewhere =
+        |named: &[Entity]| !ours(named) && named.iter().all(|&b| links.any_bead.contains(b));
     // Every link with the beads it names (as entities, for now).
-    let mut named: Vec<(Pending, Vec<Entity>)> = Vec::new();
+    let mut named: Vec<(Pending<V>, Vec<Entity>)> = Vec::new();
     let mut springs: Vec<(Entity, Spring)> = Vec::new();
     for (entity, rod) in &links.rods {
         let beads = rod.beads();
+        if elsewhere(&beads) {
+            continue;
+        }
         match beads.iter().find(|b| !is_bead(**b)) {
             Some(&b) => missing("rod", entity, b),
             None => named.push((
@@ -87,6 +107,9 @@ pub(super) fn prepare_islands(
         }
     }
     for (entity, pin) in &links.pins {
+        if elsewhere(&[pin.bead()]) {
+            continue;
+        }
         if !is_bead(pin.bead()) {
             missing("pin", entity, pin.bead());
             continue;
@@ -109,6 +132,9 @@ pub(super) fn prepare_islands(
         ));
     }
     for (entity, joint) in &links.joints {
+        if elsewhere(joint.beads()) {
+            continue;
+        }
         match joint.beads().iter().find(|b| !is_bead(**b)) {
             Some(&b) => missing("joint", entity, b),
             None => named.push((
@@ -126,13 +152,16 @@ pub(super) fn prepare_islands(
         }
     }
     for (entity, spring) in &links.springs {
+        if elsewhere(&spring.beads()) {
+            continue;
+        }
         match spring.beads().iter().find(|b| !is_bead(**b)) {
             Some(&b) => missing("spring", entity, b),
             None => springs.push((entity, *spring)),
         }
     }
-    // The beads in islands: every bead a link names, and every bead on no
-    // wire.
+    // The beads in islands: every bead a link names, every bead on no
+    // wire, and in space every bead.
     let mut index: HashMap<Entity, usize> = HashMap::new();
     let mut members: Vec<Entity> = Vec::new();
     let mut join = |bead: Entity, members: &mut Vec<Entity>| {
@@ -152,7 +181,7 @@ pub(super) fn prepare_islands(
         }
     }
     for (entity, _, on_wire, _) in &beads {
-        if on_wire.is_none() {
+        if on_wire.is_none() || !V::LONE_STEP {
             join(entity, &mut members);
         }
     }
@@ -174,7 +203,7 @@ pub(super) fn prepare_islands(
         }
     }
     // Sort the links into their groups, with bead indices local to them.
-    let mut group_links: Vec<Vec<(Pending, Vec<usize>)>> =
+    let mut group_links: Vec<Vec<(Pending<V>, Vec<usize>)>> =
         (0..groups.len()).map(|_| Vec::new()).collect();
     let mut group_springs: Vec<Vec<SpringLink>> = vec![Vec::new(); groups.len()];
     for ((pending, _), local) in named.into_iter().zip(&link_beads) {
@@ -208,16 +237,21 @@ pub(super) fn prepare_islands(
             masses.push(bead.mass());
             let Some(on_wire) = on_wire else { continue };
             match wires.get(on_wire.0).map(|(w, p)| (w, p.get())) {
-                Ok((wire, Ok(pose))) => {
-                    sides.push((rows.len(), local, *wire.surface()));
-                    wire_rows.push((local, rows.len(), on_wire.0));
-                    rows.push(IslandRow {
-                        kind: RowKind::Wire {
-                            shape: wire.shape().clone(),
-                            pose: pose.pose(clock.time),
-                        },
-                        beads: vec![local],
-                    });
+                Ok((wire, Ok(path))) => {
+                    let pose = V::path_at(&path, clock.time).0;
+                    for (part, shape) in wire.rows().into_iter().enumerate() {
+                        sides.push((rows.len(), local, *wire.surface()));
+                        wire_rows.push(WireRow {
+                            bead: local,
+                            row: rows.len(),
+                            wire: on_wire.0,
+                            part,
+                        });
+                        rows.push(IslandRow {
+                            kind: RowKind::Wire { shape, pose },
+                            beads: vec![local],
+                        });
+                    }
                 }
                 Ok((_, Err(e))) => invalid = Some(e.to_string()),
                 Err(_) => invalid = Some(format!("entity {} has no Wire", on_wire.0)),
@@ -241,14 +275,15 @@ pub(super) fn prepare_islands(
             }
         }
         // A rough wire's bead gets a row to hold it still while static
-        // friction can (set aside while it slides).
+        // friction can (set aside while it slides), where it has one
+        // direction to be held in (along a curve in the plane).
         let mut sticks = Vec::new();
         for &(row, local, surface) in &sides {
-            if surface.friction.is_some() {
+            if surface.friction.is_some() && V::stick_axis(V::AXES[0]).is_some() {
                 sticks.push((row, rows.len()));
                 rows.push(IslandRow {
                     kind: RowKind::Axis {
-                        axis: DVec2::X,
+                        axis: V::AXES[0],
                         offset: 0.0,
                     },
                     beads: vec![local],
@@ -322,23 +357,23 @@ pub(super) fn prepare_islands(
 /// motion, and the beads' velocities projected onto the island's
 /// constraints ([`Island::project_velocities`]), so that the state a run
 /// starts from is the one simulated. A change is logged in one line.
-fn start_island(
-    island: &mut Island,
+fn start_island<V: Dimension>(
+    island: &mut Island<V>,
     entities: &[Entity],
-    wire_rows: &[(usize, usize, Entity)],
-    wires: &Query<(&Wire, &WirePose)>,
-    beads: &mut Query<(Entity, BeadMotion, Option<&OnWire>, Has<InIsland>)>,
+    wire_rows: &[WireRow],
+    wires: &Query<(&V::Wire, &WirePose<V>)>,
+    beads: &mut Query<(Entity, BeadMotion<V>, Option<&OnWire>, Has<InIsland>)>,
     clock: &SimClock,
-) -> IslandWork {
-    for &(_, row, wire) in wire_rows {
-        if let Ok((_, pose)) = wires.get(wire)
+) -> IslandWork<V> {
+    for wire_row in wire_rows {
+        if let Ok((_, pose)) = wires.get(wire_row.wire)
             && let Ok(path) = pose.get()
         {
-            island.move_wire(row, None, path);
+            island.move_wire(wire_row.row, None, path);
         }
     }
     let mut work = IslandWork::default();
-    let mut states: Vec<BeadState> = Vec::with_capacity(entities.len());
+    let mut states: Vec<BeadState<V>> = Vec::with_capacity(entities.len());
     for &entity in entities {
         match beads.get(entity) {
             Ok((_, bead, ..)) if bead.state().is_finite() => states.push(bead.state()),
@@ -353,8 +388,9 @@ fn start_island(
     let mut changed = Vec::new();
     for (&entity, state) in entities.iter().zip(&states) {
         if let Ok((_, mut bead, ..)) = beads.get_mut(entity) {
-            let change = (state.velocity - bead.velocity.0).length();
-            if change > 1e-9 * bead.velocity.length().max(1.0) {
+            let change = state.velocity - bead.velocity.0;
+            let speed = bead.velocity.0.dot(bead.velocity.0).sqrt();
+            if change.dot(change).sqrt() > 1e-9 * speed.max(1.0) {
                 changed.push(entity.to_string());
             }
             if bead.velocity.0 != state.velocity {

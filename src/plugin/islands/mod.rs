@@ -13,62 +13,71 @@ mod build;
 mod step;
 
 use bevy::ecs::lifecycle::{Add, Insert, Remove};
+use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 
 use super::clock::advance_clock;
 use super::schedule::WireBeadSystems;
 use super::wires::place_wires;
-use crate::dynamics::{Bead, ConstraintDiagnostics, Joint, OnWire, Pin, Rod, Spring, Wire};
+use crate::dynamics::{ConstraintDiagnostics, Dimension, Joint, OnWire, Pin, Rod, Spring};
 use crate::solver::{BeadState, Island, IslandWork, LinearForce, SolveError};
 
-/// Builds and steps the [`Islands`]: beads joined by links, and free beads.
+/// Builds and steps the [`Islands`]: beads joined by links, and free beads,
+/// in the plane (`Islands`) and in space (`Islands<DVec3>`, where every
+/// bead steps in an island, those on a wire and joined to nothing in one
+/// of their own).
 #[derive(Default)]
 pub struct IslandPlugin;
 
 impl Plugin for IslandPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<Islands>()
-            .register_type::<Rod>()
+        app.register_type::<Rod>()
             .register_type::<Pin>()
+            .register_type::<Pin<DVec3>>()
             .register_type::<Spring>()
-            .register_type::<ConstraintDiagnostics>()
-            .add_observer(topology_changed::<Add, Bead>)
-            .add_observer(topology_changed::<Remove, Bead>)
-            .add_observer(topology_changed::<Insert, OnWire>)
-            .add_observer(topology_changed::<Remove, OnWire>)
-            .add_observer(topology_changed::<Insert, Wire>)
-            .add_observer(topology_changed::<Remove, Wire>)
-            .add_observer(topology_changed::<Insert, Rod>)
-            .add_observer(topology_changed::<Remove, Rod>)
-            .add_observer(topology_changed::<Insert, Pin>)
-            .add_observer(topology_changed::<Remove, Pin>)
-            .add_observer(topology_changed::<Insert, Spring>)
-            .add_observer(topology_changed::<Remove, Spring>)
-            .add_observer(topology_changed::<Insert, Joint>)
-            .add_observer(topology_changed::<Remove, Joint>)
-            // Built as soon as the topology changes or a run restarts, so
-            // that the state a run starts from is the one simulated, and
-            // again before a step if a game changed it since.
-            .add_systems(
-                PreUpdate,
-                build::prepare_islands
-                    .run_if(islands_changed)
-                    .after(WireBeadSystems::Restart),
-            )
-            .add_systems(
-                FixedUpdate,
-                (
-                    build::prepare_islands
-                        .run_if(islands_changed)
-                        .after(place_wires)
-                        .before(advance_clock)
-                        .in_set(WireBeadSystems::Prepare),
-                    step::step_islands
-                        .run_if(any_island)
-                        .in_set(WireBeadSystems::Step),
-                ),
-            );
+            .register_type::<ConstraintDiagnostics>();
+        add_islands::<DVec2>(app);
+        add_islands::<DVec3>(app);
     }
+}
+
+/// The islands of one dimension: their resource, the lifecycle observers
+/// that mark them for a rebuild, the rebuild and the step.
+fn add_islands<V: Dimension>(app: &mut App) {
+    app.init_resource::<Islands<V>>()
+        .add_observer(topology_changed::<Add, V::Bead, V>)
+        .add_observer(topology_changed::<Remove, V::Bead, V>)
+        .add_observer(topology_changed::<Insert, OnWire, V>)
+        .add_observer(topology_changed::<Remove, OnWire, V>)
+        .add_observer(topology_changed::<Insert, V::Wire, V>)
+        .add_observer(topology_changed::<Remove, V::Wire, V>)
+        .add_observer(topology_changed::<Insert, Rod, V>)
+        .add_observer(topology_changed::<Remove, Rod, V>)
+        .add_observer(topology_changed::<Insert, Pin<V>, V>)
+        .add_observer(topology_changed::<Remove, Pin<V>, V>)
+        .add_observer(topology_changed::<Insert, Spring, V>)
+        .add_observer(topology_changed::<Remove, Spring, V>)
+        .add_observer(topology_changed::<Insert, Joint<V>, V>)
+        .add_observer(topology_changed::<Remove, Joint<V>, V>)
+        .add_systems(
+            PreUpdate,
+            build::prepare_islands::<V>
+                .run_if(islands_changed::<V>)
+                .after(WireBeadSystems::Restart),
+        )
+        .add_systems(
+            FixedUpdate,
+            (
+                build::prepare_islands::<V>
+                    .run_if(islands_changed::<V>)
+                    .after(place_wires::<V>)
+                    .before(advance_clock)
+                    .in_set(WireBeadSystems::Prepare),
+                step::step_islands::<V>
+                    .run_if(any_island::<V>)
+                    .in_set(WireBeadSystems::Step),
+            ),
+        );
 }
 
 /// Marks a bead stepped in an island (joined to another bead or a point,
@@ -98,23 +107,33 @@ pub struct IslandReport {
 enum LinkRows {
     /// One row: a rod or a joint.
     One(Entity, usize),
-    /// A pin's two rows.
+    /// A pin's rows, one for each axis.
     Pin(Entity, usize),
 }
 
+/// A wire row of an island: the bead it holds, the row, the wire, and
+/// which of the wire's rows it is (a curve in space has two).
+#[derive(Clone, Copy, Debug)]
+struct WireRow {
+    bead: usize,
+    row: usize,
+    wire: Entity,
+    part: usize,
+}
+
 /// One island as the step keeps it.
-struct CachedIsland {
+struct CachedIsland<V: Dimension> {
     report: IslandReport,
-    island: Island,
-    work: IslandWork,
-    states: Vec<BeadState>,
-    forces: Vec<LinearForce>,
+    island: Island<V>,
+    work: IslandWork<V>,
+    states: Vec<BeadState<V>>,
+    forces: Vec<LinearForce<V>>,
     /// Each bead's mass, as the island was built with it (a restart or a
     /// change of links builds it again).
     masses: Vec<f64>,
     links: Vec<LinkRows>,
-    /// The wire row of each bead on a wire: (bead, row, wire entity).
-    wire_rows: Vec<(usize, usize, Entity)>,
+    /// The wire rows of the beads on a wire.
+    wire_rows: Vec<WireRow>,
     /// The first row of each pin fixed to another entity, and the pin.
     anchored: Vec<(usize, Entity)>,
     /// What this step did: not stepped (a bead of it has stopped), or the
@@ -124,14 +143,24 @@ struct CachedIsland {
 
 /// The islands of the current topology: beads joined by constraints and
 /// springs, each solved as one system. Rebuilt when a link, a bead or a
-/// wire is added, changed or removed, or the run restarts.
-#[derive(Resource, Default)]
-pub struct Islands {
-    cached: Vec<CachedIsland>,
+/// wire is added, changed or removed, or the run restarts. `Islands` are
+/// the plane's, `Islands<DVec3>` space's.
+#[derive(Resource)]
+pub struct Islands<V: Dimension = DVec2> {
+    cached: Vec<CachedIsland<V>>,
     dirty: bool,
 }
 
-impl Islands {
+impl<V: Dimension> Default for Islands<V> {
+    fn default() -> Self {
+        Self {
+            cached: Vec::new(),
+            dirty: false,
+        }
+    }
+}
+
+impl<V: Dimension> Islands<V> {
     /// What the last step of each island reported.
     pub fn iter(&self) -> impl Iterator<Item = &IslandReport> {
         self.cached.iter().map(|c| &c.report)
@@ -150,19 +179,22 @@ impl Islands {
 
 /// Marks the islands for a rebuild: observed on the lifecycle events that
 /// change which beads are joined or on which wire.
-fn topology_changed<E: EntityEvent, B: Bundle>(_: On<E, B>, mut islands: ResMut<Islands>) {
+fn topology_changed<E: EntityEvent, B: Bundle, V: Dimension>(
+    _: On<E, B>,
+    mut islands: ResMut<Islands<V>>,
+) {
     islands.mark_dirty();
 }
 
 /// Whether the islands need a rebuild: the run condition of
 /// [`build::prepare_islands`], so a step with nothing changed costs the executor
 /// no task.
-fn islands_changed(islands: Res<Islands>) -> bool {
+fn islands_changed<V: Dimension>(islands: Res<Islands<V>>) -> bool {
     islands.dirty
 }
 
 /// Whether there is an island to step: the run condition of
 /// [`step::step_islands`].
-fn any_island(islands: Res<Islands>) -> bool {
+fn any_island<V: Dimension>(islands: Res<Islands<V>>) -> bool {
     !islands.cached.is_empty()
 }

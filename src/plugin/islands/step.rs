@@ -7,13 +7,12 @@ use bevy::prelude::*;
 use super::{CachedIsland, InIsland, Islands, LinkRows};
 use crate::dynamics::{
     BeadDiagnostics, BeadForce, BeadMotion, BeadPosition, BeadVelocity, ConstraintDiagnostics,
-    Diverged, DivergenceReason, Pin, SimParams, Wire, WireContact, WirePose,
+    Dimension, Diverged, DivergenceReason, Pin, SimParams, WireContact, WirePose, WireRows,
 };
 use crate::plugin::clock::SimClock;
 use crate::plugin::parallel::{ParallelStep, StepSplit};
 use crate::plugin::report::{ContactReports, Divergences};
-use crate::plugin::writeback::place;
-use crate::solver::{BeadState, Contact, StepSettings};
+use crate::solver::{BeadState, Contact, RowReport, StepSettings};
 
 /// The beads [`step_islands`] steps: those in an island that have not
 /// stopped.
@@ -24,33 +23,33 @@ type Stepped = (With<InIsland>, Without<Diverged>);
 /// task pool from [`ParallelStep::threshold`] beads in islands up), writes
 /// back the states, the diagnostics and the `Transform`s. An island whose
 /// step fails stops as a whole, each of its beads marked [`Diverged`].
-pub(super) fn step_islands(
+pub(super) fn step_islands<V: Dimension>(
     params: Res<SimParams>,
     clock: Res<SimClock>,
     parallel: Res<ParallelStep>,
-    mut islands: ResMut<Islands>,
+    mut islands: ResMut<Islands<V>>,
     mut beads: ParamSet<(
-        Query<(&BeadPosition, &BeadVelocity, &BeadForce), Stepped>,
+        Query<(&BeadPosition<V>, &BeadVelocity<V>, &BeadForce<V>), Stepped>,
         Query<
             (
-                BeadMotion,
-                Option<&mut BeadDiagnostics>,
+                BeadMotion<V>,
+                Option<&mut BeadDiagnostics<V>>,
                 Option<&mut Transform>,
                 Option<&mut WireContact>,
             ),
             Stepped,
         >,
     )>,
-    mut changes: ContactReports,
-    wires: Query<(Ref<Wire>, &WirePose)>,
-    pins: Query<&Pin>,
+    mut changes: ContactReports<V>,
+    wires: Query<(Ref<V::Wire>, &WirePose<V>)>,
+    pins: Query<&Pin<V>>,
     transforms: Query<&Transform, Without<InIsland>>,
     mut diagnostics: Query<&mut ConstraintDiagnostics>,
     mut divergences: Divergences,
     mut split: ResMut<StepSplit>,
 ) {
     let settings = params.step_settings();
-    let gravity = params.gravity;
+    let gravity = V::gravity(&params);
     let mut stepped_beads = 0;
     // The gather looks up the three columns it reads, not every column
     // the write-back needs.
@@ -73,19 +72,22 @@ pub(super) fn step_islands(
                 .forces
                 .push(force.linear(mass, gravity, state.position));
         }
-        for &(_, row, wire) in &cached.wire_rows {
-            let Ok((wire, pose)) = wires.get(wire) else {
+        for wire_row in &cached.wire_rows {
+            let Ok((wire, pose)) = wires.get(wire_row.wire) else {
                 continue;
             };
             if let Ok(path) = pose.get() {
-                let reshaped = wire.is_changed().then(|| wire.shape().clone());
-                cached.island.move_wire(row, reshaped, path);
+                let reshaped = wire
+                    .is_changed()
+                    .then(|| wire.rows().swap_remove(wire_row.part));
+                cached.island.move_wire(wire_row.row, reshaped, path);
             }
         }
         for &(row, pin) in &cached.anchored {
             if let Some(at) = pins.get(pin).ok().and_then(|p| p.locate(&transforms)) {
-                cached.island.place_axis(row, at.x);
-                cached.island.place_axis(row + 1, at.y);
+                for (k, axis) in V::AXES.iter().enumerate() {
+                    cached.island.place_axis(row + k, axis.dot(at));
+                }
             }
         }
         cached.outcome = Some(Ok(()));
@@ -145,9 +147,9 @@ pub(super) fn step_islands(
             let state = cached.states[i];
             bead.advance_to(state);
             if let Some(mut transform) = transform {
-                place(&mut transform, state.position);
+                V::place(&mut transform, state.position);
             }
-            let wire_row = cached.wire_rows.iter().find(|w| w.0 == i).map(|w| w.1);
+            let wire_row = cached.wire_rows.iter().find(|w| w.bead == i).map(|w| w.row);
             if let (Some(mut contact), Some(row)) = (contact, wire_row) {
                 let held = if cached.work.holds(row) {
                     Contact::OnWire
@@ -173,23 +175,7 @@ pub(super) fn step_islands(
                         lambda: rows[row].lambda,
                     },
                 ),
-                LinkRows::Pin(entity, row) => {
-                    let (x, y) = (rows[row], rows[row + 1]);
-                    let c = x.c.hypot(y.c);
-                    let c_dot = if c > 0.0 {
-                        (x.c * x.c_dot + y.c * y.c_dot) / c
-                    } else {
-                        0.0
-                    };
-                    (
-                        entity,
-                        ConstraintDiagnostics {
-                            c,
-                            c_dot,
-                            lambda: x.lambda.hypot(y.lambda),
-                        },
-                    )
-                }
+                LinkRows::Pin(entity, row) => (entity, pin_report(&rows[row..][..V::AXES.len()])),
             };
             if let Ok(mut d) = diagnostics.get_mut(entity) {
                 *d = report;
@@ -201,9 +187,22 @@ pub(super) fn step_islands(
     }
 }
 
+/// A pin's rows reported together: the bead's distance from its point,
+/// that distance's rate, and the length of the pin's force.
+fn pin_report(rows: &[RowReport]) -> ConstraintDiagnostics {
+    let c = rows.iter().fold(0.0, |sum, r| f64::hypot(sum, r.c));
+    let c_dot = if c > 0.0 {
+        rows.iter().map(|r| r.c * r.c_dot).sum::<f64>() / c
+    } else {
+        0.0
+    };
+    let lambda = rows.iter().fold(0.0, |sum, r| f64::hypot(sum, r.lambda));
+    ConstraintDiagnostics { c, c_dot, lambda }
+}
+
 /// Steps one gathered island (see [`step_islands`]), its result into
 /// its `outcome`.
-fn step_island(cached: &mut CachedIsland, time: f64, settings: &StepSettings) {
+fn step_island<V: Dimension>(cached: &mut CachedIsland<V>, time: f64, settings: &StepSettings) {
     if cached.outcome.is_none() {
         return;
     }

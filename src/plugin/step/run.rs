@@ -8,12 +8,11 @@ use bevy::prelude::*;
 
 use super::table::{TableWire, WireTable, with_curve};
 use crate::dynamics::{
-    BeadDiagnostics, BeadForce, BeadMass, BeadPosition, BeadVelocity, DivergenceReason, OnWire,
-    SimParams, WireContact,
+    BeadDiagnostics, BeadForce, BeadMass, BeadPosition, BeadVelocity, Dimension, DivergenceReason,
+    OnWire, SimParams, WireContact,
 };
 use crate::geometry::{FixedTrack, MovingTrack, Near, Placed, Surface, Track, WireShape};
 use crate::plugin::report::{FoundDivergences, FoundEvents};
-use crate::plugin::writeback::place;
 use crate::solver::{self, BeadState, Contact, LinearForce, RowReport, StepOutput, StepSettings};
 
 /// How many batches of [`solver::LANES`] beads one call of the batched step
@@ -192,7 +191,7 @@ impl StepContext<'_> {
         }
         if let Some(transforms) = run.transforms.as_deref_mut() {
             for (j, t) in transforms[range].iter_mut().enumerate() {
-                place(t, DVec2::new(out.x[j], out.y[j]));
+                DVec2::place(t, DVec2::new(out.x[j], out.y[j]));
             }
         }
     }
@@ -225,7 +224,7 @@ impl StepContext<'_> {
             Err(reason) => {
                 // The bead keeps its state; its `Transform` shows it.
                 if let Some(transform) = run.outputs(i).transform {
-                    place(transform, bead.state.position);
+                    DVec2::place(transform, bead.state.position);
                 }
                 self.found.push(run.entities[i], reason, self.time);
             }
@@ -322,7 +321,7 @@ impl StepContext<'_> {
             *diagnostics = self.diagnose(&out, mass);
         }
         if let Some(transform) = transform {
-            place(transform, out.state.position);
+            DVec2::place(transform, out.state.position);
         }
     }
 }

@@ -1,0 +1,182 @@
+//! [`Dimension`]: the plane's or space's components, so that each system
+//! is written once and runs for both.
+
+use bevy::math::{DQuat, DVec2, DVec3};
+use bevy::prelude::*;
+use bevy::reflect::{GetTypeRegistration, Typed};
+
+use super::wire::WirePose;
+use super::{Bead, SimParams, SpaceBead, SpaceWire, Wire};
+use crate::geometry::{
+    Placement, Pose, Pose3, PoseHistory, PosePath, SpacePath, Surface, WireSpace,
+};
+use crate::validate::ParamError;
+
+/// The plane (`DVec2`) or space (`DVec3`) as the plugin keeps them: which
+/// components a bead and a wire of that dimension have, and how a wire's
+/// `Transform` and a bead's position meet the solver's `f64` values.
+/// Implemented for those two only.
+pub trait Dimension:
+    WireSpace + Reflect + FromReflect + TypePath + Typed + GetTypeRegistration
+{
+    /// The bead's marker: [`Bead`] or [`SpaceBead`].
+    type Bead: Component;
+    /// The wire: [`Wire`] or [`SpaceWire`].
+    type Wire: Component + WireRows<Self>;
+    /// The unit axes: a pin is a row along each.
+    const AXES: &'static [Self];
+    /// Whether a bead on a wire and joined to nothing has a step of its
+    /// own (the plane's per-bead step, with its batched fast path); if not
+    /// (in space), it steps as an island of one.
+    const LONE_STEP: bool;
+    /// Gravity in these coordinates.
+    fn gravity(params: &SimParams) -> Self;
+    /// A wire's pose from its `Transform`: in the plane its translation's
+    /// x and y and its turn about z; in space all of it.
+    fn pose_of(transform: &Transform) -> Result<Self::Pose, ParamError>;
+    /// A wire's path after a game moved its `Transform` to `now` over the
+    /// step from `start` to `end = start + h`, and whether it is still
+    /// moving: in the plane, from its history (so the wire's velocity
+    /// enters the step); in space, at rest where it was put.
+    fn followed(
+        path: Option<Self::Path>,
+        now: Self::Pose,
+        start: f64,
+        h: f64,
+    ) -> (Self::Path, bool);
+    /// Writes a pose into a `Transform`, in `f32` at this edge.
+    fn set_pose(transform: &mut Transform, pose: Self::Pose);
+    /// Writes a bead's position into its `Transform`'s translation, in
+    /// `f32` at this edge (in the plane, `z` kept); a non-finite position
+    /// is not written.
+    fn place(transform: &mut Transform, position: Self);
+}
+
+/// What a wire component gives an island: the rows it puts on each bead it
+/// holds and its surface.
+pub trait WireRows<V: WireSpace> {
+    /// One row in the plane; one (a surface) or two (a curve) in space.
+    fn rows(&self) -> Vec<V::Shape>;
+    /// Its surface: one-sided, rough or damped.
+    fn surface(&self) -> &Surface;
+}
+
+impl WireRows<DVec2> for Wire {
+    fn rows(&self) -> Vec<crate::geometry::WireShape> {
+        vec![self.shape().clone()]
+    }
+    fn surface(&self) -> &Surface {
+        Wire::surface(self)
+    }
+}
+
+impl WireRows<DVec3> for SpaceWire {
+    fn rows(&self) -> Vec<crate::geometry::SpaceRow> {
+        self.shape().rows()
+    }
+    fn surface(&self) -> &Surface {
+        SpaceWire::surface(self)
+    }
+}
+
+impl Dimension for DVec2 {
+    type Bead = Bead;
+    type Wire = Wire;
+    const AXES: &'static [Self] = &[DVec2::X, DVec2::Y];
+    const LONE_STEP: bool = true;
+    fn gravity(params: &SimParams) -> Self {
+        params.gravity
+    }
+    fn pose_of(transform: &Transform) -> Result<Pose, ParamError> {
+        Pose::from_translation_rotation(transform.translation, transform.rotation)
+    }
+    fn followed(path: Option<PosePath>, now: Pose, start: f64, h: f64) -> (PosePath, bool) {
+        let mut history = match path {
+            Some(PosePath::Fixed(at)) if at == now => return (PosePath::Fixed(now), false),
+            Some(PosePath::Fixed(at)) => PoseHistory::at_rest(f64::NEG_INFINITY, at),
+            Some(PosePath::Followed(history)) => history,
+            Some(path @ PosePath::Prescribed { .. }) => {
+                PoseHistory::at_rest(start, path.pose(start))
+            }
+            None => PoseHistory::at_rest(start, now),
+        };
+        history.push(start + h, h, now);
+        if history.is_at_rest() {
+            (PosePath::Fixed(now), false)
+        } else {
+            (PosePath::Followed(history), true)
+        }
+    }
+    fn set_pose(transform: &mut Transform, pose: Pose) {
+        let origin = pose.origin.as_vec2();
+        if origin.is_finite() && pose.rotation.is_finite() {
+            transform.translation.x = origin.x;
+            transform.translation.y = origin.y;
+            transform.rotation = Quat::from_rotation_z(pose.rotation.to_angle() as f32);
+        }
+    }
+    #[inline(always)]
+    fn place(transform: &mut Transform, position: Self) {
+        let at = position.as_vec2();
+        if at.is_finite() {
+            transform.translation.x = at.x;
+            transform.translation.y = at.y;
+        }
+    }
+}
+
+impl Dimension for DVec3 {
+    type Bead = SpaceBead;
+    type Wire = SpaceWire;
+    const AXES: &'static [Self] = &[DVec3::X, DVec3::Y, DVec3::Z];
+    const LONE_STEP: bool = false;
+    fn gravity(params: &SimParams) -> Self {
+        params.gravity_in_space()
+    }
+    fn pose_of(transform: &Transform) -> Result<Pose3, ParamError> {
+        let origin = transform.translation.as_dvec3();
+        let rotation = transform.rotation.as_dquat();
+        if !origin.is_finite() || !rotation.is_finite() || rotation.length_squared() == 0.0 {
+            return Err(ParamError::NotFinite {
+                name: "wire transform",
+                value: f64::NAN,
+            });
+        }
+        Ok(Pose3 {
+            origin,
+            rotation: rotation.normalize(),
+        })
+    }
+    fn followed(_path: Option<SpacePath>, now: Pose3, _start: f64, _h: f64) -> (SpacePath, bool) {
+        (SpacePath::Fixed(now), false)
+    }
+    fn set_pose(transform: &mut Transform, pose: Pose3) {
+        let origin = pose.origin.as_vec3();
+        let rotation: DQuat = pose.rotation;
+        if origin.is_finite() && rotation.is_finite() {
+            transform.translation = origin;
+            transform.rotation = rotation.as_quat();
+        }
+    }
+    #[inline(always)]
+    fn place(transform: &mut Transform, position: Self) {
+        let at = position.as_vec3();
+        if at.is_finite() {
+            transform.translation = at;
+        }
+    }
+}
+
+impl<V: Dimension> WirePose<V> {
+    /// The wire held at `transform`, or none if it is not finite.
+    pub(crate) fn from_transform(transform: &Transform) -> Self {
+        Self::new(V::pose_of(transform).ok().map(V::fixed_path))
+    }
+}
+
+/// A point in the frame of `transform`, in the world: `offset` placed by
+/// the entity's pose (see [`Dimension::pose_of`]); `None` if the
+/// transform is not finite.
+pub(crate) fn placed_by<V: Dimension>(transform: &Transform, offset: V) -> Option<V> {
+    V::pose_of(transform).ok().map(|pose| pose.to_world(offset))
+}

@@ -1,0 +1,369 @@
+//! Beads in space through the plugin: `SpaceBead`s on `SpaceWire`s, joined
+//! by rods and pins, stepped in islands and written to their `Transform`s.
+
+use std::f64::consts::TAU;
+
+use bevy::math::DVec3;
+use bevy::prelude::*;
+use wirebead::geometry::{Circle, Helix, OnPlane, Pose3, SpaceMotion, SpacePath, Sphere};
+use wirebead::headless::{Headless, run_for, space_bead_state};
+use wirebead::prelude::*;
+use wirebead::{ConstraintDiagnostics, Islands, SpaceBead, SpaceWire};
+
+use crate::space::conical_start;
+
+const G: f64 = 9.81;
+
+/// A headless app stepping with RATTLE at `dt`.
+fn app(dt: f64) -> App {
+    let params = SimParams {
+        timestep: dt,
+        method: Method::Rattle,
+        ..default()
+    };
+    Headless::new(WireBeadPlugin::new(params).expect("valid parameters"))
+        .single_threaded()
+        .build()
+}
+
+/// A bead in space of mass 1 at `position` moving at `velocity`, on
+/// `wire` if there is one.
+fn spawn(app: &mut App, wire: Option<Entity>, position: DVec3, velocity: DVec3) -> Entity {
+    let bead = SpaceBead::new(BeadParams {
+        mass: 1.0,
+        initial_position: position,
+        initial_velocity: velocity,
+    })
+    .expect("a valid bead");
+    let mut bead = app.world_mut().spawn(bead);
+    if let Some(wire) = wire {
+        bead.insert(OnWire(wire));
+    }
+    bead.id()
+}
+
+/// The conical pendulum inside a sphere of radius 1.2 m, 40° from the
+/// downward vertical, through the plugin (RATTLE at 1 ms, 3 s): its height
+/// stays within 1e-5 r, it stays on the sphere to 1e-12, its `Transform`
+/// is its position in `f32`, and it steps in an island of its own.
+#[test]
+fn a_conical_pendulum_on_a_sphere_steps_through_the_plugin() {
+    let (r, alpha) = (1.2, 40f64.to_radians());
+    let mut app = app(1e-3);
+    let wire = app
+        .world_mut()
+        .spawn(SpaceWire::surface_of(Sphere { radius: r }))
+        .id();
+    let (start, _) = conical_start(r, alpha);
+    let bead = spawn(&mut app, Some(wire), start.position, start.velocity);
+    let mut worst = (0.0f64, 0.0f64);
+    for _ in 0..30 {
+        run_for(&mut app, 0.1);
+        let state = space_bead_state(app.world(), bead).expect("a bead in space");
+        worst.0 = worst.0.max((state.position.y - start.position.y).abs());
+        worst.1 = worst.1.max((state.position.length() - r).abs());
+        let transform = app.world().get::<Transform>(bead).expect("a transform");
+        assert_eq!(transform.translation, state.position.as_vec3());
+    }
+    assert!(worst.0 <= 1e-5 * r, "the height moved {:e}", worst.0);
+    assert!(worst.1 <= 1e-12, "left the sphere by {:e}", worst.1);
+    let islands = app.world().resource::<Islands<DVec3>>();
+    let report = islands.of(bead).expect("an island of its own");
+    assert_eq!((report.beads.len(), report.rows), (1, 1));
+}
+
+/// A bead from rest on a helix wire (its two rows) through the plugin,
+/// RATTLE at 1 ms for 3 s: `y(t) = −½ g sin²φ t²`, `tan φ = p/(2πr)`,
+/// within 1e-5 relative, and on the helix to 1e-12.
+#[test]
+fn a_bead_slides_down_a_helix_wire() {
+    let (radius, pitch) = (0.8, 0.5);
+    let mut app = app(1e-3);
+    let wire = app
+        .world_mut()
+        .spawn(SpaceWire::curve(Helix { radius, pitch }))
+        .id();
+    let bead = spawn(
+        &mut app,
+        Some(wire),
+        DVec3::new(radius, 0.0, 0.0),
+        DVec3::ZERO,
+    );
+    run_for(&mut app, 3.0);
+    let p = space_bead_state(app.world(), bead)
+        .expect("a bead")
+        .position;
+    let slope = (pitch / (TAU * radius)).atan();
+    let exact = -0.5 * G * slope.sin().powi(2) * 9.0;
+    assert!(
+        ((p.y - exact) / exact).abs() <= 1e-5,
+        "y = {} against {exact}",
+        p.y
+    );
+    let [a, b] = wirebead::geometry::SpaceCurve::rows(&Helix { radius, pitch }, p, f64::NAN);
+    assert!(
+        a.c.hypot(b.c) <= 1e-12,
+        "off the helix by {:e}",
+        a.c.hypot(b.c)
+    );
+    let islands = app.world().resource::<Islands<DVec3>>();
+    assert_eq!(islands.of(bead).map(|r| r.rows), Some(2));
+}
+
+/// A rope of five beads in space hanging from a pin by rods of 0.3 m,
+/// started swinging out of every plane: RATTLE at 1 ms for 2 s holds every
+/// rod and the pin to 1e-9 and keeps the island's energy to 1e-4 of its
+/// drop, `m g` times the rope's length.
+#[test]
+fn a_rope_in_space_hangs_from_a_pin() {
+    let mut app = app(1e-3);
+    let link = 0.3;
+    let beads: Vec<Entity> = (0..5)
+        .map(|i| {
+            let k = i as f64;
+            let at = DVec3::new(0.2 * k * link, -0.9 * k * link, 0.2 * k * link)
+                .normalize_or_zero()
+                * (k * link);
+            spawn(&mut app, None, at, DVec3::new(0.0, 0.0, 0.4 * k))
+        })
+        .collect();
+    let world = app.world_mut();
+    let mut links = vec![
+        world
+            .spawn(Pin::new(beads[0], DVec3::ZERO).expect("a pin"))
+            .id(),
+    ];
+    for pair in beads.windows(2) {
+        let rod = Rod::new(pair[0], pair[1], link).expect("a rod");
+        links.push(world.spawn(rod).id());
+    }
+    run_for(&mut app, 0.001);
+    let energy = |app: &App| {
+        app.world()
+            .resource::<Islands<DVec3>>()
+            .of(beads[0])
+            .expect("one island")
+            .energy
+    };
+    let e0 = energy(&app);
+    let (mut held, mut drift) = (0.0f64, 0.0f64);
+    for _ in 0..20 {
+        run_for(&mut app, 0.1);
+        for &link in &links {
+            let c = app
+                .world()
+                .get::<ConstraintDiagnostics>(link)
+                .expect("a link");
+            held = held.max(c.c.abs());
+        }
+        drift = drift.max((energy(&app) - e0).abs());
+    }
+    assert!(held <= 1e-9, "a link drifted {held:e}");
+    assert!(
+        drift <= 1e-4 * 5.0 * G * 4.0 * link,
+        "the energy moved {drift:e}"
+    );
+    let report = app
+        .world()
+        .resource::<Islands<DVec3>>()
+        .of(beads[0])
+        .cloned();
+    assert_eq!(report.map(|r| (r.beads.len(), r.rows)), Some((5, 7)));
+}
+
+/// A vertical hoop of radius `r` spinning at `omega` about the y-axis,
+/// and its spin.
+fn spinning_hoop(app: &mut App, r: f64, omega: f64) -> (Entity, SpaceMotion) {
+    let spin = SpaceMotion::Spin {
+        angular_velocity: omega,
+        axis: DVec3::Y,
+    };
+    let wire = app
+        .world_mut()
+        .spawn((
+            SpaceWire::curve(OnPlane(Circle { radius: r })),
+            PrescribedMotion::in_space(spin).expect("a spin"),
+        ))
+        .id();
+    (wire, spin)
+}
+
+/// The rotating hoop through the plugin: a hoop of radius 1 spinning at
+/// 6 rad/s about its vertical diameter (`PrescribedMotion::in_space`), a
+/// bead released at relative rest at `cos θ* = g/(ω² r)` stays there to
+/// 1e-6 rad over 2 s (RATTLE at 0.5 ms), and the plugin turns the wire's
+/// `Transform` with it.
+#[test]
+fn a_bead_on_a_spinning_hoop_wire_stays_at_its_equilibrium() {
+    let (r, omega) = (1.0, 6.0);
+    let mut app = app(5e-4);
+    let (wire, spin) = spinning_hoop(&mut app, r, omega);
+    let star = (G / (omega * omega * r)).acos();
+    let local = DVec3::new(r * star.sin(), -r * star.cos(), 0.0);
+    let path = SpacePath::Prescribed {
+        base: Pose3::IDENTITY,
+        motion: spin,
+    };
+    let velocity = path.at(0.0).1.velocity_at(local);
+    let bead = spawn(&mut app, Some(wire), local, velocity);
+    let mut worst = 0.0f64;
+    for _ in 0..20 {
+        run_for(&mut app, 0.1);
+        let t = app.world().resource::<wirebead::SimClock>().time;
+        let p = space_bead_state(app.world(), bead)
+            .expect("a bead")
+            .position;
+        let local = path.at(t).0.to_local(p);
+        worst = worst.max((local.x.atan2(-local.y) - star).abs());
+        let turned = app.world().get::<Transform>(wire).expect("a wire").rotation;
+        let expected = Quat::from_axis_angle(Vec3::Y, (omega * t) as f32);
+        assert!(
+            turned.dot(expected).abs() > 1.0 - 1e-6,
+            "the hoop is at {turned} at t = {t}, not {expected}"
+        );
+    }
+    assert!(worst <= 1e-6, "θ* = {star} wandered by {worst:e}");
+}
+
+/// `Restart` returns beads in space to their `BeadParams` and wires on a
+/// prescribed motion to their resting pose: a bead on the spinning hoop
+/// run 0.5 s, restarted and run 0.5 s again ends bit for bit where it
+/// ended the first time, and right after the restart it is where it
+/// started, at rest relative to the hoop.
+#[test]
+fn a_restart_returns_beads_in_space_to_their_start() {
+    let (r, omega) = (1.0, 4.0);
+    let mut app = app(1e-3);
+    let (wire, spin) = spinning_hoop(&mut app, r, omega);
+    let start = DVec3::new(r * 0.5f64.sin(), -r * 0.5f64.cos(), 0.0);
+    let relative_rest = spin.at(Pose3::IDENTITY, 0.0).1.velocity_at(start);
+    let bead = spawn(&mut app, Some(wire), start, relative_rest);
+    // The velocity a bead in space restarts with is relative to its wire.
+    app.world_mut()
+        .entity_mut(bead)
+        .insert(BeadParams::<DVec3> {
+            mass: 1.0,
+            initial_position: start,
+            initial_velocity: DVec3::ZERO,
+        });
+    run_for(&mut app, 0.5);
+    let first = space_bead_state(app.world(), bead).expect("a bead");
+    assert!((first.position - start).length() > 1e-2, "it did not move");
+    app.world_mut().write_message(Restart);
+    wirebead::headless::idle(&mut app);
+    let restarted = space_bead_state(app.world(), bead).expect("a bead");
+    assert_eq!(restarted.position, start);
+    assert_eq!(restarted.velocity, relative_rest);
+    let rotation = app.world().get::<Transform>(wire).expect("a wire").rotation;
+    assert_eq!(rotation, Quat::IDENTITY);
+    run_for(&mut app, 0.5);
+    let again = space_bead_state(app.world(), bead).expect("a bead");
+    assert_eq!(
+        (again.position, again.velocity),
+        (first.position, first.velocity)
+    );
+}
+
+/// A bead in space at a singular point of its wire (a sphere's centre)
+/// and one whose position a game made not finite are stopped and marked
+/// `Diverged` with their reasons, their `Transform`s never written with a
+/// NaN; a rod between a bead in the plane and one in space is left out
+/// and both go on stepping.
+#[test]
+fn bad_beads_in_space_are_stopped_and_mixed_rods_left_out() {
+    let mut app = app(1e-3);
+    let sphere = app
+        .world_mut()
+        .spawn(SpaceWire::surface_of(Sphere { radius: 1.0 }))
+        .id();
+    let centre = spawn(&mut app, Some(sphere), DVec3::ZERO, DVec3::X);
+    let lost = spawn(&mut app, None, DVec3::new(0.0, -3.0, 0.0), DVec3::ZERO);
+    app.world_mut()
+        .entity_mut(lost)
+        .insert(BeadPosition(DVec3::new(f64::NAN, 0.0, 0.0)));
+    let free = spawn(&mut app, None, DVec3::new(0.0, 5.0, 0.0), DVec3::ZERO);
+    let flat = app
+        .world_mut()
+        .spawn(Bead::at_rest(1.0, bevy::math::DVec2::new(0.0, 5.0)).expect("a bead"))
+        .id();
+    app.world_mut()
+        .spawn(Rod::new(free, flat, 1.0).expect("a rod"));
+    run_for(&mut app, 0.1);
+    let world = app.world();
+    let reason = |bead| world.get::<Diverged>(bead).map(|d| d.reason.to_string());
+    assert!(
+        reason(centre).is_some_and(|r| r.contains("singular")),
+        "{:?}",
+        reason(centre)
+    );
+    assert!(
+        reason(lost).is_some_and(|r| r.contains("finite")),
+        "{:?}",
+        reason(lost)
+    );
+    for bead in [centre, lost] {
+        let t = world.get::<Transform>(bead).expect("a transform");
+        assert!(t.translation.is_finite());
+    }
+    // Free fall for 0.1 s, in space and in the plane, the rod left out.
+    let fallen = space_bead_state(world, free).expect("a bead").position.y;
+    let expected = 5.0 - 0.5 * G * 0.01;
+    assert!((fallen - expected).abs() < 1e-9, "fell to {fallen}");
+    let flat_y = wirebead::headless::bead_state(world, flat)
+        .expect("a bead")
+        .position
+        .y;
+    assert!((flat_y - expected).abs() < 1e-9, "fell to {flat_y}");
+    assert!(world.get::<Diverged>(free).is_none() && world.get::<Diverged>(flat).is_none());
+}
+
+/// Sixty beads in space (on spheres, on helices and free), stepped with
+/// the islands split over threads and on one thread, end bit for bit the
+/// same after 0.5 s.
+#[test]
+fn beads_in_space_step_the_same_in_parallel_and_in_sequence() {
+    let run = |parallel: wirebead::ParallelStep| {
+        let params = SimParams {
+            timestep: 1e-3,
+            method: Method::Rattle,
+            ..default()
+        };
+        let mut app = Headless::new(WireBeadPlugin::new(params).expect("valid parameters"))
+            .parallel(parallel)
+            .build();
+        let sphere = app
+            .world_mut()
+            .spawn(SpaceWire::surface_of(Sphere { radius: 1.0 }))
+            .id();
+        let helix = app
+            .world_mut()
+            .spawn(SpaceWire::curve(Helix {
+                radius: 1.0,
+                pitch: 0.7,
+            }))
+            .id();
+        let beads: Vec<Entity> = (0..60)
+            .map(|i| {
+                let a = 0.1 * i as f64;
+                let on = [Some(sphere), Some(helix), None][i % 3];
+                let at = match i % 3 {
+                    0 => DVec3::new(a.sin() * 0.6, -0.8, a.cos() * 0.6),
+                    1 => DVec3::new(a.cos(), 0.7 * a / std::f64::consts::TAU, a.sin()),
+                    _ => DVec3::new(a, 0.0, -a),
+                };
+                spawn(&mut app, on, at, DVec3::new(0.3, 0.0, 0.2 * a))
+            })
+            .collect();
+        run_for(&mut app, 0.5);
+        beads
+            .iter()
+            .map(|&b| {
+                let s = space_bead_state(app.world(), b).expect("a bead");
+                (s.position, s.velocity)
+            })
+            .collect::<Vec<_>>()
+    };
+    let parallel = run(wirebead::ParallelStep { threshold: 1 });
+    let sequential = run(wirebead::ParallelStep::OFF);
+    assert_eq!(parallel, sequential);
+}
