@@ -108,7 +108,9 @@ pub use geometry::{
 pub use plugin::{
     IslandReport, Islands, ParallelStep, Restart, SimClock, WireBeadPlugin, WireBeadSystems,
 };
-pub use preset::{ActivePreset, LoadPreset, SceneLink, ScenePreset, ScenePresetPlugin};
+pub use preset::{
+    ActivePreset, LoadPreset, SceneFile, SceneLink, ScenePreset, ScenePresetPlugin, SpaceScene,
+};
 pub use solver::{Constraint, Integrator, Method, Stabilization};
 pub use validate::ParamError;
 

@@ -14,8 +14,8 @@ pub use comparison::{Comparison, compare, comparison_markdown, pendulum_config};
 pub use plot::{FIGURE_SIZE, plot_convergence, plot_series, plot_trajectories};
 pub use run::{CSV_HEADER, Row, RunConfig, RunOutput, Summary, simulate, summarize, write_csv};
 pub use scene::{
-    SceneComparison, SceneRow, SceneRun, compare_scene, load_scene, scene_comparison_markdown,
-    simulate_scene, write_scene_csv,
+    Measure, Scene, SceneComparison, SceneRow, SceneRun, SceneSpace, compare_scene, load_scene,
+    load_scene_file, scene_comparison_markdown, simulate_scene, write_scene_csv,
 };
 pub use studies::{Study, StudyRun, assignment_setup, assignment_studies, figures};
 

@@ -15,8 +15,8 @@ use std::process::ExitCode;
 use bevy::math::DVec2;
 use clap::{Args, Parser, Subcommand};
 use wirebead::prelude::*;
-use wirebead::{Integrator, Stabilization, WireKind};
-use wirebead_analysis::{self as analysis, RunConfig};
+use wirebead::{Integrator, SceneFile, Stabilization, WireKind};
+use wirebead_analysis::{self as analysis, RunConfig, Scene};
 
 /// Headless runs, the assignment's figures, and the method comparison.
 #[derive(Parser, Debug)]
@@ -163,8 +163,17 @@ fn simulate_scene(
     args: SimulateArgs,
     path: &std::path::Path,
 ) -> Result<ExitCode, Box<dyn std::error::Error>> {
-    let preset = analysis::load_scene(path)?;
-    let own = preset.params.clone();
+    match analysis::load_scene_file(path)? {
+        SceneFile::Plane(scene) => simulate_scene_in(args, &scene),
+        SceneFile::Space(scene) => simulate_scene_in(args, &scene),
+    }
+}
+
+fn simulate_scene_in<S: Scene>(
+    args: SimulateArgs,
+    preset: &S,
+) -> Result<ExitCode, Box<dyn std::error::Error>> {
+    let own = preset.params().clone();
     let method = match (args.integrator, args.stabilization) {
         (None, None) => own.method,
         (integrator, stabilization) => Method::new(
@@ -182,7 +191,7 @@ fn simulate_scene(
         ..own
     };
     params.validate()?;
-    let run = analysis::simulate_scene(&preset, params, args.duration)?;
+    let run = analysis::simulate_scene(preset, params, args.duration)?;
     analysis::write_scene_csv(&args.out, &run)?;
     eprintln!("wrote {} rows to {}", run.rows.len(), args.out.display());
     Ok(exit_code(run.diverged))
@@ -234,10 +243,11 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
             dt,
             ..
         } => {
-            let preset = analysis::load_scene(&path)?;
             std::fs::create_dir_all(&out_dir)?;
-            let table = analysis::compare_scene(&preset, duration, &dt)?;
-            let md = analysis::scene_comparison_markdown(&table, &preset, duration);
+            let md = match analysis::load_scene_file(&path)? {
+                SceneFile::Plane(scene) => compare_scene_in(&scene, duration, &dt)?,
+                SceneFile::Space(scene) => compare_scene_in(&scene, duration, &dt)?,
+            };
             let stem = path
                 .file_name()
                 .and_then(|n| n.to_str())
@@ -264,6 +274,18 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+/// Every method on a scene, as markdown.
+fn compare_scene_in<S: Scene>(
+    preset: &S,
+    duration: f64,
+    dt: &[f64],
+) -> Result<String, Box<dyn std::error::Error>> {
+    let table = analysis::compare_scene(preset, duration, dt)?;
+    Ok(analysis::scene_comparison_markdown(
+        &table, preset, duration,
+    ))
 }
 
 fn main() -> ExitCode {

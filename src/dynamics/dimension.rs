@@ -6,7 +6,7 @@ use bevy::prelude::*;
 use bevy::reflect::{GetTypeRegistration, Typed};
 
 use super::wire::WirePose;
-use super::{Bead, SimParams, SpaceBead, SpaceWire, Wire};
+use super::{Bead, BeadBundle, BeadParams, SimParams, SpaceBead, SpaceBeadBundle, SpaceWire, Wire};
 use crate::geometry::{
     Placement, Pose, Pose3, PoseHistory, PosePath, SpacePath, Surface, WireSpace,
 };
@@ -21,6 +21,8 @@ pub trait Dimension:
 {
     /// The bead's marker: [`Bead`] or [`SpaceBead`].
     type Bead: Component;
+    /// Every component of a bead, as [`Dimension::bead`] makes them.
+    type BeadBundle: Bundle;
     /// The wire: [`Wire`] or [`SpaceWire`].
     type Wire: Component + WireRows<Self>;
     /// The unit axes: a pin is a row along each.
@@ -31,6 +33,9 @@ pub trait Dimension:
     const LONE_STEP: bool;
     /// Gravity in these coordinates.
     fn gravity(params: &SimParams) -> Self;
+    /// A bead at its initial state, if its parameters are valid
+    /// ([`Bead::new`] or [`SpaceBead::new`]).
+    fn bead(params: BeadParams<Self>) -> Result<Self::BeadBundle, ParamError>;
     /// A wire's pose from its `Transform`: in the plane its translation's
     /// x and y and its turn about z; in space all of it.
     fn pose_of(transform: &Transform) -> Result<Self::Pose, ParamError>;
@@ -81,11 +86,15 @@ impl WireRows<DVec3> for SpaceWire {
 
 impl Dimension for DVec2 {
     type Bead = Bead;
+    type BeadBundle = BeadBundle;
     type Wire = Wire;
     const AXES: &'static [Self] = &[DVec2::X, DVec2::Y];
     const LONE_STEP: bool = true;
     fn gravity(params: &SimParams) -> Self {
         params.gravity
+    }
+    fn bead(params: BeadParams) -> Result<BeadBundle, ParamError> {
+        Bead::new(params)
     }
     fn pose_of(transform: &Transform) -> Result<Pose, ParamError> {
         Pose::from_translation_rotation(transform.translation, transform.rotation)
@@ -127,11 +136,15 @@ impl Dimension for DVec2 {
 
 impl Dimension for DVec3 {
     type Bead = SpaceBead;
+    type BeadBundle = SpaceBeadBundle;
     type Wire = SpaceWire;
     const AXES: &'static [Self] = &[DVec3::X, DVec3::Y, DVec3::Z];
     const LONE_STEP: bool = false;
     fn gravity(params: &SimParams) -> Self {
         params.gravity_in_space()
+    }
+    fn bead(params: BeadParams<DVec3>) -> Result<SpaceBeadBundle, ParamError> {
+        SpaceBead::new(params)
     }
     fn pose_of(transform: &Transform) -> Result<Pose3, ParamError> {
         let origin = transform.translation.as_dvec3();

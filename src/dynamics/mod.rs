@@ -19,7 +19,7 @@ pub(crate) use bead::{BeadMotion, BeadMotionItem};
 pub use diagnostics::{BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason};
 pub use dimension::{Dimension, WireRows};
 pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
-pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, NextParams, SimParams};
+pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, NextParams, SimParams, SpaceParams};
 pub(crate) use wire::WirePose;
 pub use wire::{
     ContactChanged, NextWireShape, OnWire, PrescribedMotion, SpaceWire, Wire, WireBeads,

@@ -106,9 +106,13 @@ impl SimParams {
 #[derive(Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[serde(default)]
-struct SimParamsFile {
+#[serde(bound(
+    serialize = "G: Gravity + Serialize",
+    deserialize = "G: Gravity + Deserialize<'de>"
+))]
+struct SimParamsFile<G: Gravity = DVec2> {
     timestep: f64,
-    gravity: DVec2,
+    gravity: G,
     alpha: f64,
     beta: f64,
     drag_stiffness: f64,
@@ -124,6 +128,52 @@ struct SimParamsFile {
     divergence_bound: f64,
 }
 
+/// Gravity as a scene file writes it: two components in the plane, three
+/// in space.
+trait Gravity: Copy {
+    /// `params`' gravity.
+    fn of(params: &SimParams) -> Self;
+    /// The in-plane components and `z`.
+    fn components(self) -> (DVec2, f64);
+}
+
+impl Gravity for DVec2 {
+    fn of(params: &SimParams) -> Self {
+        params.gravity
+    }
+    fn components(self) -> (DVec2, f64) {
+        (self, 0.0)
+    }
+}
+
+impl Gravity for DVec3 {
+    fn of(params: &SimParams) -> Self {
+        params.gravity_in_space()
+    }
+    fn components(self) -> (DVec2, f64) {
+        (self.truncate(), self.z)
+    }
+}
+
+/// [`SimParams`] as a scene file in space writes them: as in the plane,
+/// with gravity's three components, `gravity: (0.0, -9.81, 0.0)`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "SimParamsFile<DVec3>", into = "SimParamsFile<DVec3>")]
+pub struct SpaceParams(pub SimParams);
+
+impl TryFrom<SimParamsFile<DVec3>> for SpaceParams {
+    type Error = ParamError;
+    fn try_from(file: SimParamsFile<DVec3>) -> Result<Self, ParamError> {
+        SimParams::try_from(file).map(Self)
+    }
+}
+
+impl From<SpaceParams> for SimParamsFile<DVec3> {
+    fn from(params: SpaceParams) -> Self {
+        params.0.into()
+    }
+}
+
 fn serialize_present<S: serde::Serializer>(
     value: &Option<Stabilization>,
     serializer: S,
@@ -137,7 +187,7 @@ fn deserialize_present<'de, D: serde::Deserializer<'de>>(
     Stabilization::deserialize(deserializer).map(Some)
 }
 
-impl Default for SimParamsFile {
+impl<G: Gravity> Default for SimParamsFile<G> {
     /// The defaults, with the stabilization left to the integrator: a file
     /// that names only `integrator: Rattle` means RATTLE.
     fn default() -> Self {
@@ -148,11 +198,11 @@ impl Default for SimParamsFile {
     }
 }
 
-impl From<SimParams> for SimParamsFile {
+impl<G: Gravity> From<SimParams> for SimParamsFile<G> {
     fn from(p: SimParams) -> Self {
         Self {
             timestep: p.timestep,
-            gravity: p.gravity,
+            gravity: G::of(&p),
             alpha: p.alpha,
             beta: p.beta,
             drag_stiffness: p.drag_stiffness,
@@ -163,13 +213,14 @@ impl From<SimParams> for SimParamsFile {
     }
 }
 
-impl TryFrom<SimParamsFile> for SimParams {
+impl<G: Gravity> TryFrom<SimParamsFile<G>> for SimParams {
     type Error = ParamError;
-    fn try_from(f: SimParamsFile) -> Result<Self, ParamError> {
+    fn try_from(f: SimParamsFile<G>) -> Result<Self, ParamError> {
+        let (gravity, gravity_z) = f.gravity.components();
         Ok(Self {
             timestep: f.timestep,
-            gravity: f.gravity,
-            gravity_z: 0.0,
+            gravity,
+            gravity_z,
             alpha: f.alpha,
             beta: f.beta,
             drag_stiffness: f.drag_stiffness,

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
 
-use super::traced::traced_curve;
+use super::traced::delegate_curve;
 use super::{Parametric, Traced};
 
 /// One arch of a cycloid hanging cusps up, vertex at the local origin:
@@ -115,4 +115,4 @@ impl Parametric for CycloidArch {
     }
 }
 
-traced_curve!(Cycloid, |this| this.radius);
+delegate_curve!(Cycloid, |this| this.traced(), this.radius);

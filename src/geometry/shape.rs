@@ -9,6 +9,7 @@ use std::sync::Arc;
 use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
 
+use super::traced::delegate_curve;
 use super::{Circle, Cycloid, Ellipse, ImplicitCurve, Line, Parabola, Sine, Spline};
 use crate::validate::{ParamError, finite, positive};
 
@@ -219,6 +220,8 @@ impl FromStr for WireKind {
             })
     }
 }
+
+delegate_curve!(WireShape, |this| this.curve(), this.curve().scale());
 
 #[cfg(test)]
 mod tests {

@@ -7,7 +7,7 @@ use bevy::math::{DVec2, VectorSpace};
 use serde::{Deserialize, Serialize};
 
 use super::coordinates::norm;
-use super::traced::traced_curve;
+use super::traced::delegate_curve;
 use super::{Coordinates, Parametric, Traced};
 use crate::validate::ParamError;
 
@@ -320,7 +320,7 @@ impl<V: Coordinates> Parametric<V> for CubicPath<V> {
     }
 }
 
-traced_curve!(Spline, |this| this.traced().scale());
+delegate_curve!(Spline, |this| this.traced(), this.traced().scale());
 
 #[cfg(test)]
 mod tests {

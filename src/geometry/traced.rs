@@ -287,46 +287,57 @@ impl<V: Coordinates, P: Parametric<V>> Traced<P, V> {
     }
 }
 
-/// Implements [`ImplicitCurve`] for a shape whose method `traced()` gives
-/// its [`Traced`] curve, with `scale` its characteristic length.
-macro_rules! traced_curve {
-    ($shape:ty, |$this:ident| $scale:expr) => {
+/// Implements [`ImplicitCurve`] for a shape by handing every call to the
+/// curve `$target` (`$this` the shape), with `$scale` its characteristic
+/// length: a traced shape's [`Traced`], or a [`WireShape`](super::WireShape)'s
+/// own curve.
+macro_rules! delegate_curve {
+    ($shape:ty, |$this:ident| $target:expr, $scale:expr) => {
         impl $crate::geometry::ImplicitCurve for $shape {
             fn value(&self, p: DVec2) -> f64 {
-                self.traced().value(p)
+                let $this = self;
+                $target.value(p)
             }
             fn gradient(&self, p: DVec2) -> DVec2 {
-                self.traced().gradient(p)
+                let $this = self;
+                $target.gradient(p)
             }
             fn hessian(&self, p: DVec2) -> bevy::math::DMat2 {
-                self.traced().hessian(p)
+                let $this = self;
+                $target.hessian(p)
             }
             fn scale(&self) -> f64 {
                 let $this = self;
                 $scale
             }
             fn geometry(&self, p: DVec2) -> $crate::geometry::Geometry {
-                self.traced().geometry(p)
+                let $this = self;
+                $target.geometry(p)
             }
             fn has_ends(&self) -> bool {
-                self.traced().has_ends()
+                let $this = self;
+                $target.has_ends()
             }
             fn past_end(&self, p: DVec2) -> f64 {
-                self.traced().past_end(p)
+                let $this = self;
+                $target.past_end(p)
             }
             fn parameter(&self, p: DVec2, hint: f64) -> f64 {
-                self.traced().parameter(p, hint)
+                let $this = self;
+                $crate::geometry::ImplicitCurve::parameter($target, p, hint)
             }
             fn geometry_near(&self, p: DVec2, hint: f64) -> $crate::geometry::Geometry {
-                self.traced().geometry_near(p, hint)
+                let $this = self;
+                $target.geometry_near(p, hint)
             }
             fn past_end_near(&self, p: DVec2, hint: f64) -> f64 {
-                self.traced().past_end_near(p, hint)
+                let $this = self;
+                $target.past_end_near(p, hint)
             }
         }
     };
 }
-pub(crate) use traced_curve;
+pub(crate) use delegate_curve;
 
 /// `s` brought into `[start, start + period)` on a closed curve.
 fn wrap(s: f64, start: f64, period: f64, closed: bool) -> f64 {

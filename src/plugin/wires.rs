@@ -31,6 +31,7 @@ impl Plugin for WirePosePlugin {
 fn add_wire_poses<V: Dimension>(app: &mut App) {
     app.init_resource::<MovingWires<V>>()
         .add_observer(wire_added::<V>)
+        .add_observer(motion_added::<V>)
         .add_systems(
             FixedUpdate,
             place_wires::<V>
@@ -129,6 +130,19 @@ fn wire_added<V: Dimension>(
 ) {
     if let Ok((transform, mut pose)) = wires.get_mut(add.entity) {
         *pose = WirePose::from_transform(transform);
+    }
+}
+
+/// Puts a wire on its prescribed motion the moment the motion is
+/// inserted, so that an island built before the first step (at spawn)
+/// starts its beads on the moving wire.
+fn motion_added<V: Dimension>(
+    insert: On<Insert, PrescribedMotion<V>>,
+    mut wires: Query<(&PrescribedMotion<V>, &Transform, &mut WirePose<V>)>,
+) {
+    if let Ok((motion, transform, mut pose)) = wires.get_mut(insert.entity) {
+        let placed = prescribed(motion, &pose, transform);
+        pose.set_if_neq(placed);
     }
 }
 

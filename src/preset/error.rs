@@ -13,6 +13,20 @@ pub enum PresetError {
         .0.code
     )]
     Parse(#[from] ron::error::SpannedError),
+    /// A value of the wrong form in one item: a vector with two components
+    /// in a scene in space, a word where a number goes.
+    #[error(
+        "malformed scene file at line {}, column {} in {item}: {}",
+        .error.span.start.line,
+        .error.span.start.col,
+        .error.code
+    )]
+    Malformed {
+        /// Where it is: `wires[0].beads[1].initial_position`.
+        item: String,
+        /// What is wrong, and where in the file.
+        error: Box<ron::error::SpannedError>,
+    },
     /// A field the format does not have (a misspelt name, or one from a
     /// later version): refused rather than ignored.
     #[error(
@@ -76,6 +90,14 @@ pub enum PresetError {
     /// The scene has no bead.
     #[error("the scene has no bead")]
     Empty,
+    /// A scene in space where one in the plane was asked for.
+    #[error(
+        "the scene is in space (dimension: 3); the window and this command take scenes in the plane"
+    )]
+    InSpace,
+    /// A dimension other than 2 or 3.
+    #[error("dimension must be 2 or 3, got {0}")]
+    Dimension(u8),
 }
 
 impl PresetError {
@@ -98,6 +120,10 @@ impl PresetError {
                     known: expected.join(", "),
                 }
             }
+            _ if !path.is_empty() && path != "." && path != "?" => PresetError::Malformed {
+                item: path,
+                error: Box::new(error),
+            },
             _ => PresetError::Parse(error),
         }
     }

@@ -7,26 +7,30 @@ use serde::{Deserialize, Serialize};
 
 use super::error::PresetError;
 use crate::dynamics::{BeadParams, SimParams};
-use crate::geometry::{Friction, Side, Surface, WireMotion, WireShape};
+use crate::geometry::{Coordinates, Friction, Side, Surface, WireMotion, WireShape};
 use crate::validate::{ParamError, finite, finite_vector, non_negative, positive};
 
 /// A bead of a scene file: its name (optional) and its parameters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[serde(default)]
-pub struct BeadPreset {
+#[serde(bound(
+    serialize = "V: Coordinates + Serialize",
+    deserialize = "V: Coordinates + Deserialize<'de>"
+))]
+pub struct BeadPreset<V: Coordinates = DVec2> {
     /// The name links refer to it by; empty for none (it is then
     /// `bead<i>`, `i` its place in the file).
     pub name: String,
     /// Mass in kg.
     pub mass: f64,
     /// Where a restart puts the bead.
-    pub initial_position: DVec2,
+    pub initial_position: V,
     /// The velocity a restart gives it.
-    pub initial_velocity: DVec2,
+    pub initial_velocity: V,
 }
 
-impl Default for BeadPreset {
+impl<V: Coordinates> Default for BeadPreset<V> {
     fn default() -> Self {
         let params = BeadParams::default();
         Self {
@@ -38,9 +42,9 @@ impl Default for BeadPreset {
     }
 }
 
-impl BeadPreset {
+impl<V: Coordinates> BeadPreset<V> {
     /// The bead's parameters.
-    pub fn params(&self) -> BeadParams {
+    pub fn params(&self) -> BeadParams<V> {
         BeadParams {
             mass: self.mass,
             initial_position: self.initial_position,
@@ -64,23 +68,23 @@ pub struct RodPreset {
 /// A pin of a scene file: a bead held at a point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct PinPreset {
+pub struct PinPreset<V = DVec2> {
     /// The bead's name.
     pub bead: String,
     /// The point.
-    pub at: DVec2,
+    pub at: V,
 }
 
 /// A constraint of a scene file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum ConstraintPreset {
+pub enum ConstraintPreset<V = DVec2> {
     /// See [`Rod`](crate::Rod).
     Rod(RodPreset),
     /// See [`Pin`](crate::Pin).
-    Pin(PinPreset),
+    Pin(PinPreset<V>),
 }
 
-impl ConstraintPreset {
+impl<V> ConstraintPreset<V> {
     /// `rod` or `pin`.
     pub fn kind(&self) -> &'static str {
         match self {
@@ -163,6 +167,10 @@ impl WirePreset {
 pub struct ScenePreset {
     /// A human-readable name.
     pub name: String,
+    /// `2`, or left out: a scene in the plane (a scene in space says `3`;
+    /// see [`SpaceScene`](super::SpaceScene)).
+    #[serde(default = "plane", skip_serializing_if = "is_plane")]
+    pub dimension: u8,
     /// The parameters (missing fields take their defaults).
     #[serde(default)]
     pub params: SimParams,
@@ -181,23 +189,26 @@ pub struct ScenePreset {
 }
 
 impl ScenePreset {
-    /// Parses and validates a preset.
+    /// Parses and validates a scene in the plane; a scene in space is
+    /// refused (read it with [`SceneFile::from_ron`](super::SceneFile::from_ron)).
     pub fn from_ron(text: &str) -> Result<Self, PresetError> {
-        let mut de = ron::Deserializer::from_str(text)?;
-        let preset: Self = match serde_path_to_error::deserialize(&mut de) {
-            Ok(preset) => preset,
-            Err(err) => {
-                let item = err.path().to_string();
-                return Err(PresetError::at(item, de.span_error(err.into_inner())));
-            }
-        };
-        de.end().map_err(|e| de.span_error(e))?;
+        match dimension_of(text) {
+            2 => {}
+            3 => return Err(PresetError::InSpace),
+            other => return Err(PresetError::Dimension(other)),
+        }
+        let preset: Self = parse(text)?;
         preset.validate()?;
         Ok(preset)
     }
 
     /// Checks the parameters, every wire and every bead.
     pub fn validate(&self) -> Result<(), PresetError> {
+        match self.dimension {
+            2 => {}
+            3 => return Err(PresetError::InSpace),
+            other => return Err(PresetError::Dimension(other)),
+        }
         self.params.validate().map_err(PresetError::Params)?;
         for (index, wire) in self.wires.iter().enumerate() {
             wire.shape
@@ -208,37 +219,9 @@ impl ScenePreset {
                 .and_then(|_| wire.motion.validate())
                 .and_then(|_| wire.surface().validate())
                 .map_err(|source| PresetError::Wire { index, source })?;
-            for (bead, preset) in wire.beads.iter().enumerate() {
-                preset
-                    .params()
-                    .validate()
-                    .map_err(|source| PresetError::Bead {
-                        wire: index,
-                        bead,
-                        source,
-                    })?;
-            }
         }
-        let names = self.bead_names();
-        let free_names = &names[self.wire_bead_count()..];
-        for (bead, name) in self.beads.iter().zip(free_names) {
-            bead.params()
-                .validate()
-                .map_err(|source| PresetError::FreeBead {
-                    name: name.clone(),
-                    source,
-                })?;
-        }
-        for (i, name) in names.iter().enumerate() {
-            if names[..i].contains(name) {
-                return Err(PresetError::DuplicateName(name.clone()));
-            }
-        }
-        self.resolve_links(&names)?;
-        if names.is_empty() {
-            return Err(PresetError::Empty);
-        }
-        Ok(())
+        let wires: Vec<&[BeadPreset]> = self.wires.iter().map(|w| w.beads.as_slice()).collect();
+        check_beads_and_links(&wires, &self.beads, &self.constraints, &self.springs).map(drop)
     }
 
     /// Every bead of the file in order: the wires' beads, then the free
@@ -247,100 +230,189 @@ impl ScenePreset {
         self.wires.iter().flat_map(|w| &w.beads).chain(&self.beads)
     }
 
-    fn wire_bead_count(&self) -> usize {
-        self.wires.iter().map(|w| w.beads.len()).sum()
-    }
-
     /// Each bead's name, in the file's order: its own, or `bead<i>`.
     pub fn bead_names(&self) -> Vec<String> {
-        self.all_beads()
-            .enumerate()
-            .map(|(i, b)| {
-                if b.name.is_empty() {
-                    format!("bead{i}")
-                } else {
-                    b.name.clone()
-                }
-            })
-            .collect()
+        names_of(self.all_beads())
     }
 
     /// The constraints, then the springs, with the beads they name as
     /// indices into [`ScenePreset::all_beads`], every value checked.
     pub fn links(&self) -> Result<Vec<SceneLink>, PresetError> {
-        self.resolve_links(&self.bead_names())
+        resolve_links(&self.constraints, &self.springs, &self.bead_names())
     }
+}
 
-    pub(super) fn resolve_links(&self, names: &[String]) -> Result<Vec<SceneLink>, PresetError> {
-        let find = |item: &dyn Fn() -> String, name: &str| {
-            names
-                .iter()
-                .position(|n| n == name)
-                .ok_or_else(|| PresetError::Link {
-                    item: item(),
-                    problem: format!("no bead is named {name:?}"),
-                })
-        };
-        let problem = |item: String| {
-            move |e: ParamError| PresetError::Link {
-                item,
-                problem: e.to_string(),
-            }
-        };
-        let mut links = Vec::new();
-        for (index, constraint) in self.constraints.iter().enumerate() {
-            let item = || format!("constraint {index} ({})", constraint.kind());
-            links.push(match constraint {
-                ConstraintPreset::Rod(rod) => {
-                    let (a, b) = (find(&item, &rod.a)?, find(&item, &rod.b)?);
-                    if a == b {
-                        return Err(problem(item())(ParamError::Incompatible(
-                            "a rod must join two different beads",
-                        )));
-                    }
-                    positive("rod length", rod.length).map_err(problem(item()))?;
-                    SceneLink::Rod {
-                        a,
-                        b,
-                        length: rod.length,
-                    }
-                }
-                ConstraintPreset::Pin(pin) => {
-                    let bead = find(&item, &pin.bead)?;
-                    finite_vector("pin point", pin.at).map_err(problem(item()))?;
-                    SceneLink::Pin { bead, at: pin.at }
-                }
-            });
+/// The one field read before the rest: which kind of scene a file is.
+#[derive(Deserialize)]
+struct Dimension {
+    #[serde(default = "plane")]
+    dimension: u8,
+}
+
+/// A scene file's `dimension`: 2 (the plane) where it gives none, and
+/// where the file is too broken to tell (the full parse then says where).
+pub(super) fn dimension_of(text: &str) -> u8 {
+    parse::<Dimension>(text).map_or(2, |probe| probe.dimension)
+}
+
+/// A scene file's dimension when it gives none: the plane.
+pub(super) fn plane() -> u8 {
+    2
+}
+
+/// Whether a dimension is the plane's (and goes unwritten).
+fn is_plane(dimension: &u8) -> bool {
+    *dimension == 2
+}
+
+/// A scene file's text as `T`, the error naming the item and the place
+/// in the file where it is wrong.
+pub(super) fn parse<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, PresetError> {
+    let mut de = ron::Deserializer::from_str(text)?;
+    let parsed: T = match serde_path_to_error::deserialize(&mut de) {
+        Ok(parsed) => parsed,
+        Err(err) => {
+            let item = err.path().to_string();
+            return Err(PresetError::at(item, de.span_error(err.into_inner())));
         }
-        for (index, spring) in self.springs.iter().enumerate() {
-            let item = || format!("spring {index}");
-            let (a, b) = (find(&item, &spring.a)?, find(&item, &spring.b)?);
-            if a == b {
-                return Err(problem(item())(ParamError::Incompatible(
-                    "a spring must join two different beads",
-                )));
+    };
+    de.end().map_err(|e| de.span_error(e))?;
+    Ok(parsed)
+}
+
+/// Each bead's name, in order: its own, or `bead<i>`.
+pub(super) fn names_of<'a, V: Coordinates>(
+    beads: impl Iterator<Item = &'a BeadPreset<V>>,
+) -> Vec<String> {
+    beads
+        .enumerate()
+        .map(|(i, b)| {
+            if b.name.is_empty() {
+                format!("bead{i}")
+            } else {
+                b.name.clone()
             }
-            for (name, value) in [
-                ("spring rest length", spring.rest_length),
-                ("spring stiffness", spring.stiffness),
-                ("spring damping", spring.damping),
-            ] {
-                non_negative(name, value).map_err(problem(item()))?;
-            }
-            links.push(SceneLink::Spring {
-                a,
-                b,
-                spring: spring.clone(),
-            });
+        })
+        .collect()
+}
+
+/// Checks a scene's beads (each wire's, then the free ones), that their
+/// names are distinct, and its links; the links with their beads resolved.
+pub(super) fn check_beads_and_links<V: Coordinates>(
+    wires: &[&[BeadPreset<V>]],
+    free: &[BeadPreset<V>],
+    constraints: &[ConstraintPreset<V>],
+    springs: &[SpringPreset],
+) -> Result<Vec<SceneLink<V>>, PresetError> {
+    for (index, beads) in wires.iter().enumerate() {
+        for (bead, preset) in beads.iter().enumerate() {
+            preset
+                .params()
+                .validate()
+                .map_err(|source| PresetError::Bead {
+                    wire: index,
+                    bead,
+                    source,
+                })?;
         }
-        Ok(links)
     }
+    let names = names_of(wires.iter().copied().flatten().chain(free));
+    let free_names = &names[names.len() - free.len()..];
+    for (bead, name) in free.iter().zip(free_names) {
+        bead.params()
+            .validate()
+            .map_err(|source| PresetError::FreeBead {
+                name: name.clone(),
+                source,
+            })?;
+    }
+    for (i, name) in names.iter().enumerate() {
+        if names[..i].contains(name) {
+            return Err(PresetError::DuplicateName(name.clone()));
+        }
+    }
+    let links = resolve_links(constraints, springs, &names)?;
+    if names.is_empty() {
+        return Err(PresetError::Empty);
+    }
+    Ok(links)
+}
+
+/// The constraints, then the springs, with the beads they name as indices
+/// into `names`, every value checked.
+pub(super) fn resolve_links<V: Coordinates>(
+    constraints: &[ConstraintPreset<V>],
+    springs: &[SpringPreset],
+    names: &[String],
+) -> Result<Vec<SceneLink<V>>, PresetError> {
+    let find = |item: &dyn Fn() -> String, name: &str| {
+        names
+            .iter()
+            .position(|n| n == name)
+            .ok_or_else(|| PresetError::Link {
+                item: item(),
+                problem: format!("no bead is named {name:?}"),
+            })
+    };
+    let problem = |item: String| {
+        move |e: ParamError| PresetError::Link {
+            item,
+            problem: e.to_string(),
+        }
+    };
+    let mut links = Vec::new();
+    for (index, constraint) in constraints.iter().enumerate() {
+        let item = || format!("constraint {index} ({})", constraint.kind());
+        links.push(match constraint {
+            ConstraintPreset::Rod(rod) => {
+                let (a, b) = (find(&item, &rod.a)?, find(&item, &rod.b)?);
+                if a == b {
+                    return Err(problem(item())(ParamError::Incompatible(
+                        "a rod must join two different beads",
+                    )));
+                }
+                positive("rod length", rod.length).map_err(problem(item()))?;
+                SceneLink::Rod {
+                    a,
+                    b,
+                    length: rod.length,
+                }
+            }
+            ConstraintPreset::Pin(pin) => {
+                let bead = find(&item, &pin.bead)?;
+                finite_vector("pin point", pin.at).map_err(problem(item()))?;
+                SceneLink::Pin { bead, at: pin.at }
+            }
+        });
+    }
+    for (index, spring) in springs.iter().enumerate() {
+        let item = || format!("spring {index}");
+        let (a, b) = (find(&item, &spring.a)?, find(&item, &spring.b)?);
+        if a == b {
+            return Err(problem(item())(ParamError::Incompatible(
+                "a spring must join two different beads",
+            )));
+        }
+        for (name, value) in [
+            ("spring rest length", spring.rest_length),
+            ("spring stiffness", spring.stiffness),
+            ("spring damping", spring.damping),
+        ] {
+            non_negative(name, value).map_err(problem(item()))?;
+        }
+        links.push(SceneLink::Spring {
+            a,
+            b,
+            spring: spring.clone(),
+        });
+    }
+    Ok(links)
 }
 
 /// A link of a scene with its beads as indices into
 /// [`ScenePreset::all_beads`].
 #[derive(Clone, Debug, PartialEq)]
-pub enum SceneLink {
+pub enum SceneLink<V = DVec2> {
     /// A rod between beads `a` and `b`.
     Rod {
         /// The first bead.
@@ -355,7 +427,7 @@ pub enum SceneLink {
         /// The bead.
         bead: usize,
         /// The point.
-        at: DVec2,
+        at: V,
     },
     /// A spring between beads `a` and `b`.
     Spring {

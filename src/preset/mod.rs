@@ -28,6 +28,9 @@
 mod error;
 mod format;
 mod plugin;
+mod space;
+#[cfg(test)]
+mod space_tests;
 mod spawn;
 #[cfg(test)]
 mod tests;
@@ -41,4 +44,41 @@ pub use plugin::{
     ActivePreset, LoadPreset, ScenePresetLoader, ScenePresetPlugin, apply_loaded_preset,
     load_requested_preset, report_preset_errors,
 };
+pub use space::{
+    ConePreset, RotationPreset, SpaceMotionPreset, SpaceScene, SpaceShapePreset, SpaceWirePreset,
+    SpinPreset,
+};
 pub use spawn::FromPreset;
+
+/// A scene file of either dimension, as its `dimension` says: in the
+/// plane (none, or `2`) or in space (`3`).
+#[derive(Clone, Debug)]
+pub enum SceneFile {
+    /// A scene in the plane.
+    Plane(ScenePreset),
+    /// A scene in space.
+    Space(SpaceScene),
+}
+
+impl SceneFile {
+    /// Parses and validates a scene file of either dimension.
+    pub fn from_ron(text: &str) -> Result<Self, PresetError> {
+        match format::dimension_of(text) {
+            2 => ScenePreset::from_ron(text).map(Self::Plane),
+            3 => {
+                let scene: SpaceScene = format::parse(text)?;
+                scene.validate()?;
+                Ok(Self::Space(scene))
+            }
+            other => Err(PresetError::Dimension(other)),
+        }
+    }
+
+    /// The scene's name.
+    pub fn name(&self) -> &str {
+        match self {
+            Self::Plane(scene) => &scene.name,
+            Self::Space(scene) => &scene.name,
+        }
+    }
+}

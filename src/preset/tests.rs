@@ -155,7 +155,7 @@ fn a_broken_file_and_bad_tracks_in_a_file_are_refused_in_words() {
         ScenePreset::from_ron("(name: \"broken\", wires: [")
             .unwrap_err()
             .to_string(),
-        "malformed scene file at line 1, column 25: Expected opening `(` for struct `WirePreset`"
+        "malformed scene file at line 1, column 25 in wires[0]: Expected opening `(` for struct `WirePreset`"
     );
     let scene = |wire: &str| {
         ScenePreset::from_ron(&format!("(name: \"t\", wires: [({wire}, beads: [()])])"))

@@ -1,0 +1,361 @@
+//! Scene files in space (`dimension: 3`): [`SpaceScene`], every vector
+//! with three components, wires that are curves or surfaces placed by a
+//! position and a rotation about any axis.
+
+use bevy::math::{DQuat, DVec3};
+use bevy::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::error::PresetError;
+use super::format::{
+    BeadPreset, ConstraintPreset, SceneLink, SpringPreset, check_beads_and_links, names_of,
+};
+use super::spawn::{FromPreset, spawn_beads_and_links};
+use crate::dynamics::{PrescribedMotion, SpaceParams, SpaceWire};
+use crate::geometry::{
+    Circle, Cone, Cycloid, Cylinder, Ellipse, Friction, Helix, Line, OnPlane, Oscillate, Parabola,
+    Plane, Pose3, Side, Sine, SpaceMotion, SpaceShape, Sphere, Spline, Surface, Torus, WireShape,
+};
+use crate::validate::{ParamError, finite, finite_vector, positive};
+
+/// A wire's shape in a scene file in space: a planar shape in the wire's
+/// local xy-plane, a helix or a spline (curves), or a surface.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub enum SpaceShapePreset {
+    /// `Circle((radius: r))`, in the local xy-plane.
+    Circle(Circle),
+    /// `Ellipse((a: a, b: b))`, in the local xy-plane.
+    Ellipse(Ellipse),
+    /// `Line(())`, the local x-axis.
+    Line(Line),
+    /// `Parabola((focal_length: f))`, in the local xy-plane.
+    Parabola(Parabola),
+    /// `Sine((amplitude: a, wavelength: l))`, in the local xy-plane.
+    Sine(Sine),
+    /// `Cycloid((radius: r))`, in the local xy-plane.
+    Cycloid(Cycloid),
+    /// `Helix((radius: r, pitch: p))`: `(r cos θ, p θ / 2π, r sin θ)`.
+    Helix(Helix),
+    /// `Spline((kind: …, points: [(x, y, z), …], closed: …))`.
+    Spline(Spline<DVec3>),
+    /// `Plane(())`: local `y = 0`, its positive side `+y`.
+    Plane(()),
+    /// `Sphere((radius: r))`, positive outside.
+    Sphere(Sphere),
+    /// `Cylinder((radius: r))` about the local y-axis, positive outside.
+    Cylinder(Cylinder),
+    /// `Cone((half_angle_degrees: a))`: apex at the origin, opening along
+    /// `+y`, positive outside.
+    Cone(ConePreset),
+    /// `Torus((major_radius: R, minor_radius: r))` about the local
+    /// y-axis, positive outside.
+    Torus(Torus),
+}
+
+/// A cone as a scene file gives it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConePreset {
+    /// The half angle in degrees, strictly between 0 and 90.
+    pub half_angle_degrees: f64,
+}
+
+impl SpaceShapePreset {
+    /// The planar shape, for the six that lie in the local xy-plane.
+    fn planar(&self) -> Option<WireShape> {
+        Some(match self {
+            Self::Circle(c) => WireShape::Circle(*c),
+            Self::Ellipse(e) => WireShape::Ellipse(*e),
+            Self::Line(l) => WireShape::Line(*l),
+            Self::Parabola(p) => WireShape::Parabola(*p),
+            Self::Sine(s) => WireShape::Sine(*s),
+            Self::Cycloid(c) => WireShape::Cycloid(c.clone()),
+            _ => return None,
+        })
+    }
+
+    /// Whether its sizes are valid: positive radii and pitch, a cone's
+    /// angle strictly between 0° and 90°, a torus's tube inside its ring.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        if let Some(planar) = self.planar() {
+            return planar.validate();
+        }
+        match self {
+            Self::Helix(h) => {
+                positive("helix radius", h.radius)?;
+                positive("helix pitch", h.pitch).map(drop)
+            }
+            Self::Sphere(s) => positive("radius", s.radius).map(drop),
+            Self::Cylinder(c) => positive("radius", c.radius).map(drop),
+            Self::Cone(c) => {
+                let a = finite("cone half angle", c.half_angle_degrees)?;
+                if a > 0.0 && a < 90.0 {
+                    Ok(())
+                } else {
+                    Err(ParamError::OutOfRange {
+                        name: "cone half angle (degrees)",
+                        min: 0.0,
+                        max: 90.0,
+                        value: a,
+                    })
+                }
+            }
+            Self::Torus(t) => {
+                positive("major radius", t.major_radius)?;
+                positive("minor radius", t.minor_radius).map(drop)
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The shape as a wire: a curve or a surface.
+    pub fn shape(&self) -> SpaceShape {
+        match self {
+            Self::Helix(h) => SpaceShape::curve(*h),
+            Self::Spline(s) => SpaceShape::curve(s.clone()),
+            Self::Plane(()) => SpaceShape::surface(Plane),
+            Self::Sphere(s) => SpaceShape::surface(*s),
+            Self::Cylinder(c) => SpaceShape::surface(*c),
+            Self::Cone(c) => SpaceShape::surface(Cone {
+                half_angle: c.half_angle_degrees.to_radians(),
+            }),
+            Self::Torus(t) => SpaceShape::surface(*t),
+            planar => SpaceShape::curve(OnPlane(planar.planar().unwrap_or(WireShape::Line(Line)))),
+        }
+    }
+}
+
+/// A turn about `axis` (through the wire's origin) by `angle_degrees`,
+/// right-handed: `rotation: (axis: (0.0, 1.0, 0.0), angle_degrees: 30.0)`.
+/// None by default.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[serde(default)]
+pub struct RotationPreset {
+    /// The axis, not zero (its length does not matter).
+    pub axis: DVec3,
+    /// The angle in degrees.
+    pub angle_degrees: f64,
+}
+
+impl Default for RotationPreset {
+    fn default() -> Self {
+        Self {
+            axis: DVec3::Z,
+            angle_degrees: 0.0,
+        }
+    }
+}
+
+impl RotationPreset {
+    /// The rotation as a unit quaternion, if the axis is not zero and
+    /// everything is finite.
+    pub fn quaternion(&self) -> Result<DQuat, ParamError> {
+        finite_vector("rotation axis", self.axis)?;
+        finite("rotation angle", self.angle_degrees)?;
+        let axis = self
+            .axis
+            .try_normalize()
+            .ok_or(ParamError::Incompatible("a rotation axis must not be zero"))?;
+        Ok(DQuat::from_axis_angle(
+            axis,
+            self.angle_degrees.to_radians(),
+        ))
+    }
+}
+
+/// A spin as a scene file in space gives it:
+/// `Spin((angular_velocity: w, axis: (0.0, 1.0, 0.0)))`, right-handed
+/// about `axis` (by default `(0, 0, 1)`, the plane's counter-clockwise
+/// turn).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpinPreset {
+    /// Radians per second.
+    pub angular_velocity: f64,
+    /// The axis through the wire's origin, not zero.
+    #[serde(default = "z_axis")]
+    pub axis: DVec3,
+}
+
+fn z_axis() -> DVec3 {
+    DVec3::Z
+}
+
+/// How a wire in space moves about its resting pose.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum SpaceMotionPreset {
+    /// It stays where it is placed.
+    #[default]
+    Fixed,
+    /// `Oscillate((amplitude: (ax, ay, az), frequency: f))`.
+    Oscillate(Oscillate<DVec3>),
+    /// See [`SpinPreset`].
+    Spin(SpinPreset),
+}
+
+impl SpaceMotionPreset {
+    /// The motion.
+    pub fn motion(&self) -> SpaceMotion {
+        match *self {
+            Self::Fixed => SpaceMotion::Fixed,
+            Self::Oscillate(o) => SpaceMotion::Oscillate(o),
+            Self::Spin(s) => SpaceMotion::Spin {
+                angular_velocity: s.angular_velocity,
+                axis: s.axis,
+            },
+        }
+    }
+}
+
+/// One wire of a scene in space and the beads on it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpaceWirePreset {
+    /// The shape, in the wire's frame.
+    pub shape: SpaceShapePreset,
+    /// Where the wire's origin sits.
+    #[serde(default)]
+    pub position: DVec3,
+    /// How it is turned about its origin.
+    #[serde(default)]
+    pub rotation: RotationPreset,
+    /// How it moves about that pose. Its beads' initial velocities are
+    /// relative to the wire's own at `t = 0`.
+    #[serde(default)]
+    pub motion: SpaceMotionPreset,
+    /// Which way it pushes (see [`Side`]).
+    #[serde(default)]
+    pub side: Side,
+    /// On a one-sided wire, the share of the normal speed a landing bead
+    /// bounces off with.
+    #[serde(default)]
+    pub restitution: f64,
+    /// Coulomb friction along it.
+    #[serde(default)]
+    pub friction: Friction,
+    /// Viscous damping along it, N·s/m.
+    #[serde(default)]
+    pub damping: f64,
+    /// The beads on it.
+    #[serde(default)]
+    pub beads: Vec<BeadPreset<DVec3>>,
+}
+
+impl SpaceWirePreset {
+    /// Its side, restitution, friction and damping.
+    pub fn surface(&self) -> Surface {
+        Surface {
+            side: self.side,
+            restitution: self.restitution,
+            friction: self.friction,
+            damping: self.damping,
+        }
+    }
+
+    /// Its resting pose, if its position and rotation are valid.
+    pub fn pose(&self) -> Result<Pose3, ParamError> {
+        let origin = finite_vector("wire position", self.position)?;
+        Ok(Pose3 {
+            origin,
+            rotation: self.rotation.quaternion()?,
+        })
+    }
+
+    /// Checks its shape, pose, motion and surface.
+    fn validate(&self) -> Result<(), ParamError> {
+        self.shape.validate()?;
+        self.pose()?;
+        self.motion.motion().validate()?;
+        self.surface().validate()
+    }
+}
+
+/// A whole scene in space: `dimension: 3`, parameters (gravity with three
+/// components), wires, free beads, rods, pins and springs.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpaceScene {
+    /// A human-readable name.
+    pub name: String,
+    /// Always 3.
+    pub dimension: u8,
+    /// The parameters (missing fields take their defaults).
+    #[serde(default)]
+    pub params: SpaceParams,
+    /// The wires.
+    #[serde(default)]
+    pub wires: Vec<SpaceWirePreset>,
+    /// The free beads, on no wire.
+    #[serde(default)]
+    pub beads: Vec<BeadPreset<DVec3>>,
+    /// Rods and pins (`at: (x, y, z)`).
+    #[serde(default)]
+    pub constraints: Vec<ConstraintPreset<DVec3>>,
+    /// Springs between beads.
+    #[serde(default)]
+    pub springs: Vec<SpringPreset>,
+}
+
+impl SpaceScene {
+    /// Checks the parameters, every wire, every bead and every link.
+    pub fn validate(&self) -> Result<(), PresetError> {
+        if self.dimension != 3 {
+            return Err(PresetError::Params(ParamError::Incompatible(
+                "a scene in space says dimension: 3",
+            )));
+        }
+        finite_vector("gravity", self.params.0.gravity_in_space()).map_err(PresetError::Params)?;
+        self.params.0.validate().map_err(PresetError::Params)?;
+        for (index, wire) in self.wires.iter().enumerate() {
+            wire.validate()
+                .map_err(|source| PresetError::Wire { index, source })?;
+        }
+        let wires: Vec<&[BeadPreset<DVec3>]> =
+            self.wires.iter().map(|w| w.beads.as_slice()).collect();
+        check_beads_and_links(&wires, &self.beads, &self.constraints, &self.springs).map(drop)
+    }
+
+    /// Every bead of the file in order: the wires' beads, then the free
+    /// ones.
+    pub fn all_beads(&self) -> impl Iterator<Item = &BeadPreset<DVec3>> {
+        self.wires.iter().flat_map(|w| &w.beads).chain(&self.beads)
+    }
+
+    /// Each bead's name, in the file's order: its own, or `bead<i>`.
+    pub fn bead_names(&self) -> Vec<String> {
+        names_of(self.all_beads())
+    }
+
+    /// The links with their beads resolved (see
+    /// [`ScenePreset::links`](super::ScenePreset::links)).
+    pub fn links(&self) -> Result<Vec<SceneLink<DVec3>>, PresetError> {
+        super::format::resolve_links(&self.constraints, &self.springs, &self.bead_names())
+    }
+
+    /// Spawns the scene: its wires, beads (named) and links, each marked
+    /// [`FromPreset`]. The beads in the file's order.
+    pub fn spawn(&self, commands: &mut Commands) -> Vec<Entity> {
+        let mut wires = Vec::new();
+        for wire in &self.wires {
+            let Ok(pose) = wire.pose() else { continue };
+            let transform = Transform::from_translation(pose.origin.as_vec3())
+                .with_rotation(pose.rotation.as_quat());
+            let component = SpaceWire::new(wire.shape.shape()).with_surface(wire.surface());
+            let motion = wire.motion.motion();
+            let wire_entity = component.ok().map(|component| {
+                let mut entity = commands.spawn((component, transform, FromPreset));
+                if let Ok(prescribed) = PrescribedMotion::in_space(motion)
+                    && motion != SpaceMotion::Fixed
+                {
+                    entity.insert(prescribed);
+                }
+                entity.id()
+            });
+            let (_, twist) = motion.at(pose, 0.0);
+            wires.push((wire_entity, twist, wire.beads.as_slice()));
+        }
+        let links = self.links().unwrap_or_default();
+        spawn_beads_and_links(&wires, &self.beads, links, self.bead_names(), commands)
+    }
+}
