@@ -367,3 +367,100 @@ fn beads_in_space_step_the_same_in_parallel_and_in_sequence() {
     let sequential = run(wirebead::ParallelStep::OFF);
     assert_eq!(parallel, sequential);
 }
+
+/// Friction and damping on curves in space act along the curve's one
+/// tangent, the two rows pressing as one: a bead sent round a horizontal
+/// hoop with damping 0.8 N·s/m and no gravity along it slows as
+/// `v₀ e^{−c t / m}` (within 1e-3 over 2 s, not twice as fast); on a rough
+/// helix (μs = 0.5, μk = 0.3) a bead at rest stays put where the slope's
+/// tangent 0.32 is below μs (after its first step, to 1e-9 over 1 s); and
+/// down a rough straight incline in space at 0.80, sliding, it speeds up
+/// at `g (sin φ − μk cos φ)` to 1e-6 (the incline's turn is an `f32`
+/// rotation).
+#[test]
+fn friction_and_damping_act_along_a_curve_in_space() {
+    use wirebead::Surface;
+    use wirebead::geometry::Friction;
+    // Damping round a horizontal hoop.
+    let (c, v0, r) = (0.8, 2.0, 1.0);
+    let mut damped = app(1e-3);
+    let wire = SpaceWire::curve(OnPlane(Circle { radius: r }))
+        .with_surface(Surface {
+            damping: c,
+            ..Surface::PLAIN
+        })
+        .expect("a damped hoop");
+    let flat = Transform::from_rotation(Quat::from_rotation_x(std::f32::consts::FRAC_PI_2));
+    let hoop = damped.world_mut().spawn((wire, flat)).id();
+    // On the hoop in the xz-plane, moving along it.
+    let at = DVec3::new(r, 0.0, 0.0);
+    let bead = spawn(&mut damped, Some(hoop), at, DVec3::new(0.0, 0.0, v0));
+    run_for(&mut damped, 2.0);
+    let speed = space_bead_state(damped.world(), bead)
+        .expect("a bead")
+        .velocity
+        .length();
+    let expected = v0 * (-c * 2.0f64).exp();
+    assert!(
+        ((speed - expected) / expected).abs() <= 1e-3,
+        "{speed} m/s, against {expected}"
+    );
+    // Static and kinetic friction on helices.
+    let rough = Surface {
+        friction: Friction::new(0.5, 0.3).expect("friction"),
+        ..Surface::PLAIN
+    };
+    let on_helix = |pitch: f64, duration: f64| {
+        let mut app = app(1e-3);
+        let wire = SpaceWire::curve(Helix { radius: 1.0, pitch })
+            .with_surface(rough)
+            .expect("a rough helix");
+        let helix = app.world_mut().spawn(wire).id();
+        let bead = spawn(
+            &mut app,
+            Some(helix),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::ZERO,
+        );
+        run_for(&mut app, duration);
+        space_bead_state(app.world(), bead)
+            .expect("a bead")
+            .position
+    };
+    // Static friction takes hold at the end of the first step, when the
+    // bead's sliding velocity is first not zero: it creeps that step only.
+    let (early, late) = (on_helix(2.0, 0.05), on_helix(2.0, 1.0));
+    assert!(
+        (late - early).length() <= 1e-9,
+        "slid from {early} to {late}"
+    );
+    assert!(
+        (late - DVec3::new(1.0, 0.0, 0.0)).length() <= 1e-5,
+        "at {late}"
+    );
+    // Kinetic friction down a rough straight incline at tan φ = 0.80 in
+    // space: once sliding, it speeds up at exactly g (sin φ − μk cos φ).
+    let slope = (5.0f64 / TAU).atan();
+    let mut incline = app(1e-3);
+    let wire = SpaceWire::curve(OnPlane(wirebead::geometry::Line))
+        .with_surface(rough)
+        .expect("a rough incline");
+    let tilt = Transform::from_rotation(Quat::from_rotation_z(-(slope as f32)));
+    let line = incline.world_mut().spawn((wire, tilt)).id();
+    let bead = spawn(&mut incline, Some(line), DVec3::ZERO, DVec3::ZERO);
+    let speed = |app: &App| {
+        space_bead_state(app.world(), bead)
+            .expect("a bead")
+            .velocity
+            .length()
+    };
+    run_for(&mut incline, 0.05);
+    let v0 = speed(&incline);
+    run_for(&mut incline, 0.1);
+    let measured = (speed(&incline) - v0) / 0.1;
+    let expected = G * (slope.sin() - 0.3 * slope.cos());
+    assert!(
+        ((measured - expected) / expected).abs() <= 1e-6,
+        "sped up at {measured} m/s², against {expected}"
+    );
+}

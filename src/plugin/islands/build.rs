@@ -239,8 +239,12 @@ pub(super) fn prepare_islands<V: Dimension>(
             match wires.get(on_wire.0).map(|(w, p)| (w, p.get())) {
                 Ok((wire, Ok(path))) => {
                     let pose = V::path_at(&path, clock.time).0;
-                    for (part, shape) in wire.rows().into_iter().enumerate() {
-                        sides.push((rows.len(), local, *wire.surface()));
+                    let shapes = wire.rows();
+                    // A curve in space: its two rows rub as one (see
+                    // `Island::pair_rows`).
+                    let partner = (shapes.len() == 2).then_some(rows.len() + 1);
+                    sides.push((rows.len(), local, *wire.surface(), partner));
+                    for (part, shape) in shapes.into_iter().enumerate() {
                         wire_rows.push(WireRow {
                             bead: local,
                             row: rows.len(),
@@ -276,10 +280,12 @@ pub(super) fn prepare_islands<V: Dimension>(
         }
         // A rough wire's bead gets a row to hold it still while static
         // friction can (set aside while it slides), where it has one
-        // direction to be held in (along a curve in the plane).
+        // direction to be held in: along a curve (in the plane or in
+        // space), not on a surface.
         let mut sticks = Vec::new();
-        for &(row, local, surface) in &sides {
-            if surface.friction.is_some() && V::stick_axis(V::AXES[0]).is_some() {
+        for &(row, local, surface, partner) in &sides {
+            let one_tangent = partner.is_some() || V::stick_axis(V::AXES[0]).is_some();
+            if surface.friction.is_some() && one_tangent {
                 sticks.push((row, rows.len()));
                 rows.push(IslandRow {
                     kind: RowKind::Axis {
@@ -297,11 +303,14 @@ pub(super) fn prepare_islands<V: Dimension>(
                 .map_err(|e| DivergenceReason::InvalidConstraint(e.to_string())),
         };
         let built = built.map(|mut island| {
-            for (row, _, surface) in sides {
+            for (row, _, surface, partner) in sides {
                 island.set_side(row, surface.side, surface.restitution);
                 if surface.resists() {
                     let stick = sticks.iter().find(|s| s.0 == row).map(|s| s.1);
                     island.set_rough(row, surface.friction, surface.damping, stick);
+                    if let Some(partner) = partner {
+                        island.pair_rows(row, partner);
+                    }
                 }
             }
             island

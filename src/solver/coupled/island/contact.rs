@@ -20,15 +20,16 @@ impl<V: WireSpace> Island<V> {
     /// Eq. (17) on the island at the step's start (λ from
     /// [`Island::leave`]): releases every stick row whose force passes
     /// static friction, and adds kinetic friction and damping to the force
-    /// on each sliding bead. Returns each rough row's bead and its sliding
-    /// velocity at the start.
+    /// on each sliding bead. Returns each rough row's bead, its sliding
+    /// velocity at the start, and whether static friction let go of it
+    /// this step.
     pub(super) fn resist(
         &self,
         time: f64,
         states: &[BeadState<V>],
         forces: &mut [LinearForce<V>],
         work: &mut IslandWork<V>,
-    ) -> Vec<(usize, usize, V)> {
+    ) -> Vec<(usize, usize, V, bool)> {
         let mut slides = Vec::new();
         for (r, rough) in self.rough.iter().enumerate() {
             let Some(rough) = rough else { continue };
@@ -45,9 +46,25 @@ impl<V: WireSpace> Island<V> {
             if !usable(nn) {
                 continue;
             }
-            let press = friction::press(work.lambda[r], nn);
-            let sliding = row.sliding(states[bead].velocity);
+            let mut press = friction::press(work.lambda[r], nn);
+            let mut sliding = row.sliding(states[bead].velocity);
+            if let Some(p) = rough.partner {
+                // A curve in space: the two rows press together and the
+                // bead slides along the one tangent left.
+                let other = self.wire_row(p, states, time);
+                let nn = other.normal.dot(other.normal);
+                if !usable(nn) {
+                    continue;
+                }
+                press = press.hypot(friction::press(work.lambda[p], nn));
+                sliding = RowAt {
+                    wire: V::ZERO,
+                    ..other
+                }
+                .sliding(sliding);
+            }
             let mut direction = sliding;
+            let mut released = false;
             if let Some(s) = rough.stick
                 && !work.inactive[s]
             {
@@ -57,6 +74,7 @@ impl<V: WireSpace> Island<V> {
                 }
                 // It gives way: it slides toward the pull, against λ's push.
                 work.inactive[s] = true;
+                released = true;
                 if let RowKind::Axis { axis, .. } = self.rows[s] {
                     direction = axis * -hold;
                 }
@@ -66,7 +84,7 @@ impl<V: WireSpace> Island<V> {
                 forces[bead].force += friction::kinetic(&rough.friction, press, direction, speed);
             }
             forces[bead].force += friction::damping(rough.damping, sliding);
-            slides.push((r, bead, sliding));
+            slides.push((r, bead, sliding, released));
         }
         slides
     }
@@ -79,11 +97,11 @@ impl<V: WireSpace> Island<V> {
         &self,
         time: f64,
         states: &mut [BeadState<V>],
-        slides: &[(usize, usize, V)],
+        slides: &[(usize, usize, V, bool)],
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         let mut stopped = false;
-        for &(r, bead, before) in slides {
+        for &(r, bead, before, released) in slides {
             let Some(RoughRow {
                 stick: Some(s),
                 friction,
@@ -96,16 +114,33 @@ impl<V: WireSpace> Island<V> {
                 continue;
             }
             let row = self.wire_row(r, states, time);
-            let sliding = row.sliding(states[bead].velocity);
+            let partner = self.rough[r]
+                .and_then(|rough| rough.partner)
+                .map(|p| self.wire_row(p, states, time));
+            let mut sliding = row.sliding(states[bead].velocity);
+            if let Some(other) = partner {
+                sliding = RowAt {
+                    wire: V::ZERO,
+                    ..other
+                }
+                .sliding(sliding);
+            }
             if before != V::ZERO && sliding.dot(before) >= 0.0 {
                 continue;
             }
-            if before == V::ZERO && sliding == V::ZERO {
+            // From rest: held at the step's end, unless static friction let
+            // go of it at the step's start (it then slides on).
+            if before == V::ZERO && (sliding == V::ZERO || released) {
                 continue;
             }
             // In space a surface has no one tangent to hold along: the
-            // bead is not held still there, friction only slows it.
-            let Some(axis) = row.tangent() else { continue };
+            // bead is not held still there, friction only slows it. A
+            // curve has one, across both its normals.
+            let tangent = match partner {
+                Some(other) => row.tangent_with(&other),
+                None => row.tangent(),
+            };
+            let Some(axis) = tangent else { continue };
             self.place_stick(s, axis, axis.dot(states[bead].position), work);
             stopped = true;
         }

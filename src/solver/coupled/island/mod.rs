@@ -93,6 +93,9 @@ struct RoughRow {
     damping: f64,
     /// An axis row, set aside while the bead slides.
     stick: Option<usize>,
+    /// The other row of a curve in space on the same bead (see
+    /// [`Island::pair_rows`]): the two press and slide as one.
+    partner: Option<usize>,
 }
 
 /// The buffers one island's step works in, kept between steps so a step
@@ -269,14 +272,36 @@ impl<V: WireSpace> Island<V> {
         if let (Some(RowKind::Wire { .. }), Some(slot)) =
             (self.rows.get(row), self.rough.get_mut(row))
         {
+            let partner = slot.and_then(|rough| rough.partner);
             let was = slot.replace(RoughRow {
                 friction,
                 damping: damping.max(0.0),
                 stick,
+                partner,
             });
             if was.is_none() {
                 self.rough_rows += 1;
             }
+        }
+    }
+
+    /// Joins wire row `second` to the rough wire row `first` (see
+    /// [`Island::set_rough`]) as the two rows of one curve in space on one
+    /// bead: the wire presses with their two forces together,
+    /// `|λ₁∇C₁ + λ₂∇C₂|`, friction and damping act along the curve's one
+    /// tangent, and static friction holds the bead along it. Call after
+    /// `set_rough`; rows that are not two wire rows of one bead are left
+    /// as they were.
+    pub fn pair_rows(&mut self, first: usize, second: usize) {
+        let bead = |r: usize| {
+            matches!(self.rows.get(r), Some(RowKind::Wire { .. }))
+                .then(|| self.entry_bead[self.row_start[r]])
+        };
+        if first == second || bead(first).is_none() || bead(first) != bead(second) {
+            return;
+        }
+        if let Some(Some(rough)) = self.rough.get_mut(first) {
+            rough.partner = Some(second);
         }
     }
 

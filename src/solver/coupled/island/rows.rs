@@ -261,6 +261,14 @@ impl<V: WireSpace> RowAt<V> {
     pub(super) fn tangent(&self) -> Option<V> {
         V::stick_axis(self.normal)
     }
+
+    /// The unit direction along a curve in space whose other row is
+    /// `other`: across both normals.
+    pub(super) fn tangent_with(&self, other: &Self) -> Option<V> {
+        let t = V::binormal(self.normal, other.normal);
+        let size = t.dot(t).sqrt();
+        (size > 0.0 && size.is_finite()).then(|| t / size)
+    }
 }
 
 /// Which rows [`Island::evaluate`] holds, and where along their curves
