@@ -99,8 +99,8 @@ pub use dynamics::{
     BeadMass, BeadParams, BeadPosition, BeadVelocity, ConstraintDiagnostics, ContactChanged,
     Dimension, Diverged, DivergenceReason, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams,
     NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, Rod, SimParams, SpaceBead,
-    SpaceBeadBundle, SpaceWire, Spring, SpringAnchor, Wire, WireBeads, WireContact, WireRows,
-    pose_of,
+    SpaceBeadBundle, SpaceParams, SpaceWire, Spring, SpringAnchor, Wire, WireBeads, WireContact,
+    WireRows, pose_of,
 };
 pub use geometry::{
     Friction, ImplicitCurve, Oscillate, Side, Spin, Surface, WireKind, WireMotion, WireShape,

@@ -4,12 +4,14 @@
 
 use std::error::Error;
 
+mod bifurcation;
 mod comparison;
 mod plot;
 mod run;
 mod scene;
 mod studies;
 
+pub use bifurcation::{HoopPoint, HoopSweep, bifurcation, hoop_equilibrium};
 pub use comparison::{Comparison, compare, comparison_markdown, pendulum_config};
 pub use plot::{FIGURE_SIZE, plot_convergence, plot_series, plot_trajectories};
 pub use run::{CSV_HEADER, Row, RunConfig, RunOutput, Summary, simulate, summarize, write_csv};

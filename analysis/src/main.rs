@@ -7,6 +7,7 @@
 //! cargo run --release -p wirebead-analysis -- figures --out-dir docs/figures
 //! cargo run --release -p wirebead-analysis -- compare --out-dir docs/compare
 //! cargo run --release -p wirebead-analysis -- compare --scene assets/scenes/double_pendulum.scene.ron --out-dir docs/compare
+//! cargo run --release -p wirebead-analysis -- bifurcation --out-dir docs/bifurcation
 //! ```
 
 use std::path::PathBuf;
@@ -31,7 +32,8 @@ enum Command {
     /// Run one simulation and write a CSV (`t,x,y,vx,vy,c,c_dot,lambda,energy`);
     /// with `--scene`, any scene file (`t`, then
     /// `<bead>.x,<bead>.y,<bead>.vx,<bead>.vy,<bead>.on` for each bead, `on` 1
-    /// while held on its wire, then `energy,max_abs_c`).
+    /// while held on its wire, then `energy,max_abs_c`; in space
+    /// `<bead>.x,<bead>.y,<bead>.z,<bead>.vx,<bead>.vy,<bead>.vz,<bead>.on`).
     Simulate(SimulateArgs),
     /// Reproduce the assignment's three studies: trajectory, drift and energy PNGs,
     /// the CSV behind each, and summary.md.
@@ -70,6 +72,33 @@ enum Command {
         #[arg(long, value_delimiter = ',', value_parser = parse_seconds,
               default_value = "1/30,1/60,1/120,1/240")]
         dt: Vec<f64>,
+    },
+    /// The rotating hoop's bifurcation: sweep the hoop's spin ω, run a bead
+    /// from just off the bottom with light damping, and plot the angle it
+    /// settles at against the theory (θ* = 0 below √(g/r), cos θ* =
+    /// g/(ω² r) above), as `bifurcation.png` with `bifurcation.csv`.
+    Bifurcation {
+        /// Where to write everything.
+        #[arg(long)]
+        out_dir: PathBuf,
+        /// Hoop radius (m).
+        #[arg(long, default_value_t = 1.0)]
+        radius: f64,
+        /// Gravity magnitude (m/s²).
+        #[arg(long, default_value_t = 9.81)]
+        gravity: f64,
+        /// The fastest spin (rad/s); the sweep runs from it / count up.
+        #[arg(long, default_value_t = 8.0)]
+        omega_max: f64,
+        /// How many spins.
+        #[arg(long, default_value_t = 32)]
+        count: u32,
+        /// Damping along the hoop (N·s/m on a bead of 1 kg).
+        #[arg(long, default_value_t = 1.0)]
+        damping: f64,
+        /// Simulated seconds per spin.
+        #[arg(long, default_value_t = 30.0)]
+        duration: f64,
     },
 }
 
@@ -254,6 +283,34 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                 .map_or("scene", |n| n.trim_end_matches(".scene.ron"));
             std::fs::write(out_dir.join(format!("{stem}.md")), &md)?;
             print!("{md}");
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Bifurcation {
+            out_dir,
+            radius,
+            gravity,
+            omega_max,
+            count,
+            damping,
+            duration,
+        } => {
+            if count == 0 || !(omega_max.is_finite() && omega_max > 0.0) {
+                return Err(
+                    "bifurcation: --count must be at least 1 and --omega-max positive".into(),
+                );
+            }
+            let sweep = analysis::HoopSweep {
+                radius,
+                gravity,
+                omegas: (1..=count)
+                    .map(|i| omega_max * f64::from(i) / f64::from(count))
+                    .collect(),
+                damping,
+                duration,
+                ..analysis::HoopSweep::default()
+            };
+            let written = analysis::bifurcation(&out_dir, &sweep)?;
+            eprintln!("wrote {} files to {}", written.len(), out_dir.display());
             Ok(ExitCode::SUCCESS)
         }
         Command::Compare {

@@ -14,7 +14,7 @@ use crate::run::Row;
 
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
-fn register_font() {
+pub(crate) fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         // The font ships in assets/fonts, so plots never depend on system fonts.
@@ -23,7 +23,7 @@ fn register_font() {
 }
 
 /// Line colours for up to twelve series.
-fn palette(i: usize) -> RGBColor {
+pub(crate) fn palette(i: usize) -> RGBColor {
     const COLOURS: [RGBColor; 12] = [
         RGBColor(31, 119, 180),
         RGBColor(214, 39, 40),

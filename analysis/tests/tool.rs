@@ -311,3 +311,42 @@ fn a_planar_scene_run_in_space_gives_the_planes_trajectory() {
     }
     assert!(worst <= 1e-10, "{worst:e} apart");
 }
+
+/// The rotating hoop's bifurcation (r = 1 m, damping 1 N·s/m, RATTLE at
+/// 2 ms, 15 s a spin): below `√(g/r)` = 3.13 rad/s the bead settles at the
+/// bottom, above it at `acos(g/(ω² r))`, each within 1e-4 rad; the CSV and
+/// the plot are written.
+#[test]
+fn bifurcation_settles_where_the_theory_says() {
+    let dir = out_dir("bifurcation");
+    let sweep = analysis::HoopSweep {
+        omegas: vec![2.0, 5.0, 7.0],
+        duration: 15.0,
+        ..analysis::HoopSweep::default()
+    };
+    let points = sweep.run().unwrap();
+    for p in &points {
+        let expected = analysis::hoop_equilibrium(p.omega, 9.81, 1.0);
+        assert!(
+            (p.settled - expected).abs() <= 1e-4,
+            "at {} rad/s it settled at {} rad, against {expected}",
+            p.omega,
+            p.settled
+        );
+    }
+    assert!(points[0].theory == 0.0 && points[1].theory > 1.0);
+    let written = analysis::bifurcation(
+        &dir,
+        &analysis::HoopSweep {
+            omegas: vec![2.0, 5.0],
+            duration: 2.0,
+            ..analysis::HoopSweep::default()
+        },
+    )
+    .unwrap();
+    let (header, rows) = read_csv(&written[0]);
+    assert_eq!(header.join(","), "omega,settled_deg,theory_deg,swing_deg");
+    assert_eq!(rows.len(), 2);
+    let png = image::open(&written[1]).unwrap();
+    assert!(png.width() > 800);
+}
