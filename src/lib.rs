@@ -98,9 +98,9 @@ pub use dynamics::{
     Bead, BeadBundle, BeadDiagnostics, BeadDiverged, BeadForce, BeadForces, BeadForcesItem,
     BeadMass, BeadParams, BeadPosition, BeadVelocity, ConstraintDiagnostics, ContactChanged,
     Dimension, Diverged, DivergenceReason, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams,
-    NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, Rod, SimParams, SpaceBead,
-    SpaceBeadBundle, SpaceParams, SpaceWire, Spring, SpringAnchor, Wire, WireBeads, WireContact,
-    WireRows, pose_of,
+    NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, RailOrientation, Rod, SimParams,
+    SpaceBead, SpaceBeadBundle, SpaceParams, SpaceWire, Spring, SpringAnchor, Wire, WireBeads,
+    WireContact, WireRows, pose_of,
 };
 pub use geometry::{
     Friction, ImplicitCurve, Oscillate, Side, Spin, Surface, WireKind, WireMotion, WireShape,

@@ -9,6 +9,7 @@ mod diagnostics;
 mod dimension;
 mod links;
 mod params;
+mod rail;
 mod wire;
 
 pub use bead::{
@@ -20,6 +21,7 @@ pub use diagnostics::{BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason}
 pub use dimension::{Dimension, WireRows};
 pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
 pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, NextParams, SimParams, SpaceParams};
+pub use rail::RailOrientation;
 pub(crate) use wire::WirePose;
 pub use wire::{
     ContactChanged, NextWireShape, OnWire, PrescribedMotion, SpaceWire, Wire, WireBeads,

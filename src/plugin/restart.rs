@@ -10,7 +10,8 @@ use super::schedule::WireBeadSystems;
 use super::wires::prescribed;
 use crate::dynamics::{
     BeadDiagnostics, BeadMotion, BeadMotionItem, BeadParams, Dimension, Diverged, NextBeadParams,
-    NextParams, NextWireShape, OnWire, PrescribedMotion, SimParams, Wire, WireContact, WirePose,
+    NextParams, NextWireShape, OnWire, PrescribedMotion, RailOrientation, SimParams, Wire,
+    WireContact, WirePose,
 };
 use crate::geometry::{MovingTrack, Track, WireSpace};
 use crate::solver::{RowReport, constraint_state_on};
@@ -185,6 +186,7 @@ fn restart_in_space(
         Option<&mut BeadDiagnostics<DVec3>>,
         Option<&mut WireContact>,
         Option<&OnWire>,
+        Option<&mut RailOrientation>,
     )>,
     mut islands: ResMut<Islands<DVec3>>,
     mut commands: Commands,
@@ -197,9 +199,12 @@ fn restart_in_space(
         rest_wire(motion, &mut transform, &mut pose);
     }
     let gravity = DVec3::gravity(&params);
-    for (entity, mut bead, bead_params, diagnostics, contact, on_wire) in &mut beads {
+    for (entity, mut bead, bead_params, diagnostics, contact, on_wire, rail) in &mut beads {
         if !reset_bead(entity, &mut bead, bead_params, contact, &mut commands) {
             continue;
+        }
+        if let Some(mut rail) = rail {
+            rail.restart();
         }
         let path = on_wire.and_then(|on| wires.get(on.0).ok()?.1.get().ok());
         if let Some(path) = path {

@@ -5,9 +5,13 @@ use bevy::ecs::change_detection::Tick;
 use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 
+use super::clock::SimClock;
 use super::parallel::ParallelStep;
 use super::schedule::WireBeadSystems;
-use crate::dynamics::{BeadPosition, Dimension};
+use crate::dynamics::{
+    BeadParams, BeadPosition, Dimension, OnWire, RailOrientation, SpaceWire, WirePose,
+};
+use crate::geometry::{SpaceShape, WireSpace};
 
 /// Keeps each bead's `Transform` at its position where the step did not
 /// write it itself (a restart, a game's own edit).
@@ -18,7 +22,10 @@ impl Plugin for WritebackPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<LastStep>().add_systems(
             FixedUpdate,
-            (write_transforms::<DVec2>, write_transforms::<DVec3>)
+            (
+                write_transforms::<DVec2>,
+                (write_transforms::<DVec3>, orient_rails).chain(),
+            )
                 .in_set(WireBeadSystems::Writeback),
         );
     }
@@ -49,5 +56,37 @@ fn write_transforms<V: Dimension>(
         beads.par_iter_mut().for_each(write);
     } else {
         beads.iter_mut().for_each(write);
+    }
+}
+
+/// Turns each bead with a [`RailOrientation`] on a curve in space with its
+/// track, where it is after the step (see [`RailOrientation`]); a
+/// rotation that is not finite is never written.
+fn orient_rails(
+    clock: Res<SimClock>,
+    mut beads: Query<(
+        &BeadPosition<DVec3>,
+        &BeadParams<DVec3>,
+        &OnWire,
+        &mut RailOrientation,
+        &mut Transform,
+    )>,
+    wires: Query<(&SpaceWire, &WirePose<DVec3>)>,
+) {
+    for (position, params, on, mut rail, mut transform) in &mut beads {
+        let Ok((wire, pose)) = wires.get(on.0) else {
+            continue;
+        };
+        let (SpaceShape::Curve(curve), Ok(path)) = (wire.shape(), pose.get()) else {
+            continue;
+        };
+        let pose = DVec3::path_at(&path, clock.time).0;
+        let start = (&DVec3::path_at(&path, 0.0).0, params.initial_position);
+        if let Some(rotation) = rail.orient(curve.as_ref(), &pose, position.0, start) {
+            let rotation = rotation.as_quat();
+            if rotation.is_finite() {
+                transform.rotation = rotation;
+            }
+        }
     }
 }

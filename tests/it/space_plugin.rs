@@ -464,3 +464,95 @@ fn friction_and_damping_act_along_a_curve_in_space() {
         "sped up at {measured} m/s², against {expected}"
     );
 }
+
+/// A cart on a banked circular track (a hoop of 2 m tilted 20° from
+/// level) with `RailOrientation` up `+y`: over 3 s its up axis stays the
+/// track's normal (the tilted plane's) to 1e-9 in `f64` and to `f32` in
+/// its `Transform`, and its forward runs along the track. On a vertical
+/// loop the same cart's up points to the loop's centre, upside down at
+/// the top.
+#[test]
+fn a_cart_turns_with_its_track() {
+    use wirebead::RailOrientation;
+    let tilt = 20f64.to_radians();
+    let mut banked = app(1e-3);
+    // The circle's local xy-plane turned to lie 20° from level.
+    let bank = Quat::from_rotation_x((-std::f64::consts::FRAC_PI_2 + tilt) as f32);
+    let track = banked
+        .world_mut()
+        .spawn((
+            SpaceWire::curve(OnPlane(Circle { radius: 2.0 })),
+            Transform::from_rotation(bank),
+        ))
+        .id();
+    // The track as the plugin reads it: the Transform's turn in f64.
+    let turn = bank.as_dquat().normalize();
+    let plane_normal = turn * DVec3::Z;
+    let start = turn * DVec3::new(2.0, 0.0, 0.0);
+    let along = turn * DVec3::new(0.0, 3.0, 0.0);
+    let cart = spawn(&mut banked, Some(track), start, along);
+    banked
+        .world_mut()
+        .entity_mut(cart)
+        .insert(RailOrientation::new(DVec3::Y).expect("an up"));
+    let mut worst = (0.0f64, 0.0f64, 0.0f64);
+    for _ in 0..30 {
+        run_for(&mut banked, 0.1);
+        let world = banked.world();
+        let rail = world.get::<RailOrientation>(cart).expect("a rail");
+        let up = rail.rotation() * DVec3::Y;
+        worst.0 = worst.0.max((up - plane_normal).length());
+        let velocity = space_bead_state(world, cart).expect("a cart").velocity;
+        let forward = rail.rotation() * DVec3::NEG_Z;
+        worst.1 = worst.1.max(forward.cross(velocity.normalize()).length());
+        let transform = world.get::<Transform>(cart).expect("a transform");
+        let up32 = (transform.rotation * Vec3::Y).as_dvec3();
+        worst.2 = worst.2.max((up32 - plane_normal).length());
+    }
+    assert!(
+        worst.0 <= 1e-9,
+        "its up left the track's normal by {:e}",
+        worst.0
+    );
+    assert!(
+        worst.1 <= 1e-9,
+        "its forward left the track by {:e}",
+        worst.1
+    );
+    assert!(worst.2 <= 1e-6, "its Transform's up is {:e} off", worst.2);
+
+    // Through a vertical loop, from the bottom: upside down at the top.
+    let mut looping = app(1e-3);
+    let lap = looping
+        .world_mut()
+        .spawn(SpaceWire::curve(OnPlane(Circle { radius: 1.0 })))
+        .id();
+    let fast = (5.0 * G).sqrt() + 1.0;
+    let cart = spawn(
+        &mut looping,
+        Some(lap),
+        DVec3::new(0.0, -1.0, 0.0),
+        DVec3::new(fast, 0.0, 0.0),
+    );
+    looping
+        .world_mut()
+        .entity_mut(cart)
+        .insert(RailOrientation::new(DVec3::Y).expect("an up"));
+    let mut upside_down = false;
+    for _ in 0..200 {
+        run_for(&mut looping, 0.005);
+        let world = looping.world();
+        let p = space_bead_state(world, cart).expect("a cart").position;
+        let up = world
+            .get::<RailOrientation>(cart)
+            .expect("a rail")
+            .rotation()
+            * DVec3::Y;
+        assert!(
+            (up + p).length() <= 1e-9,
+            "its up {up} is not toward the centre from {p}"
+        );
+        upside_down |= up.y < -0.999;
+    }
+    assert!(upside_down, "it never went over the top");
+}

@@ -31,7 +31,7 @@
 
 use std::f64::consts::TAU;
 
-use bevy::math::DVec3;
+use bevy::math::{DMat3, DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 
 use super::planar::extrude;
@@ -85,6 +85,37 @@ pub struct CurveFrame {
     pub tangent: DVec3,
     /// Across it: the normal of the first row.
     pub normal: DVec3,
+}
+
+impl CurveFrame {
+    /// The second normal, `t̂ × n̂`.
+    pub fn binormal(&self) -> DVec3 {
+        self.tangent.cross(self.normal)
+    }
+
+    /// The angle about the tangent, from the normal toward the binormal,
+    /// that turns the normal as near `up` as it goes.
+    pub fn roll_toward(&self, up: DVec3) -> f64 {
+        up.dot(self.binormal()).atan2(up.dot(self.normal))
+    }
+
+    /// The frame with its normal turned by `roll` about the tangent.
+    pub fn rolled(&self, roll: f64) -> Self {
+        let (sin, cos) = roll.sin_cos();
+        Self {
+            tangent: self.tangent,
+            normal: self.normal * cos + self.binormal() * sin,
+        }
+    }
+
+    /// The rotation that turns a model's axes onto the frame, as a rail
+    /// carries a cart: its forward (Bevy's `−z`) along the tangent, its up
+    /// (`+y`) along the normal. Not finite where the frame is zero.
+    pub fn rotation(&self) -> DQuat {
+        let back = -self.tangent;
+        let up = self.normal;
+        DQuat::from_mat3(&DMat3::from_cols(up.cross(back), up, back))
+    }
 }
 
 /// A planar shape in space: the curve `C(x, y) = 0` of the wire's local
