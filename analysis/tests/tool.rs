@@ -350,3 +350,42 @@ fn bifurcation_settles_where_the_theory_says() {
     let png = image::open(&written[1]).unwrap();
     assert!(png.width() > 800);
 }
+
+/// Every scene in space that ships (`assets/scenes`, `dimension: 3`) runs
+/// 1 s through the plugin with RATTLE holding each bead on its wire, rod or
+/// pin to 1e-12 and, where no wire is driven (which does work on the
+/// beads), the energy to 1e-3 of its start.
+#[test]
+fn every_shipped_scene_in_space_runs() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes");
+    let mut seen = Vec::new();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let Ok(wirebead::SceneFile::Space(scene)) = analysis::load_scene_file(&path) else {
+            continue;
+        };
+        let run = analysis::simulate_scene(&scene, scene.params.0.clone(), 1.0).unwrap();
+        assert!(run.diverged.is_none(), "{}: {:?}", scene.name, run.diverged);
+        let e0 = run.rows[0].energy;
+        let driven = scene
+            .wires
+            .iter()
+            .any(|w| w.motion != wirebead::preset::SpaceMotionPreset::Fixed);
+        for row in &run.rows {
+            assert!(
+                row.max_abs_c <= 1e-12,
+                "{}: |C| = {:e}",
+                scene.name,
+                row.max_abs_c
+            );
+            assert!(
+                driven || (row.energy - e0).abs() <= 1e-3 * e0.abs().max(1.0),
+                "{}: energy {} from {e0}",
+                scene.name,
+                row.energy
+            );
+        }
+        seen.push(scene.name);
+    }
+    assert!(seen.len() >= 6, "only {seen:?}");
+}
