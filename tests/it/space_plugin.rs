@@ -556,3 +556,50 @@ fn a_cart_turns_with_its_track() {
     }
     assert!(upside_down, "it never went over the top");
 }
+
+/// A bead in space sliding off the top of a one-sided sphere through the
+/// plugin (its island's row pushes only outward): it leaves where
+/// `cos θ = ⅔ cos θ₀`, within 1e-3 (an island finds the step it leaves
+/// in, 4.3e-4 here; the lone step of the plane finds the moment, to
+/// 1e-6), a `ContactChanged<DVec3>` says so and its `WireContact` reads in
+/// flight.
+#[test]
+fn a_bead_leaves_a_one_sided_sphere_in_space_through_the_plugin() {
+    use wirebead::solver::ContactEvent;
+    use wirebead::{ContactChanged, Side, Surface, WireContact};
+    let r = 2.0;
+    let mut app = app(1e-3);
+    let wire = SpaceWire::surface_of(Sphere { radius: r })
+        .with_surface(Surface {
+            side: Side::Positive,
+            ..Surface::PLAIN
+        })
+        .expect("a one-sided sphere");
+    let sphere = app.world_mut().spawn(wire).id();
+    let theta0 = 2f64.to_radians();
+    let across = DVec3::new(1.0, 0.0, -1.0).normalize();
+    let start = r * (theta0.cos() * DVec3::Y + theta0.sin() * across);
+    let bead = spawn(&mut app, Some(sphere), start, DVec3::ZERO);
+    let mut left = None;
+    for _ in 0..300 {
+        run_for(&mut app, 0.01);
+        let changes = app.world().resource::<Messages<ContactChanged<DVec3>>>();
+        for change in changes.iter_current_update_messages() {
+            if let ContactEvent::Left { position, .. } = change.event {
+                left.get_or_insert(position);
+            }
+        }
+        if left.is_some() {
+            break;
+        }
+    }
+    let at = left.expect("the bead left the sphere");
+    let expected = 2.0 / 3.0 * theta0.cos();
+    let cos_theta = at.y / at.length();
+    assert!(
+        (cos_theta - expected).abs() <= 1e-3,
+        "left at cos θ = {cos_theta}, against {expected}"
+    );
+    let contact = app.world().get::<WireContact>(bead).expect("a contact");
+    assert!(!contact.is_on(), "its contact still reads on the sphere");
+}
