@@ -8,7 +8,8 @@ use bevy::reflect::{GetTypeRegistration, Typed};
 use super::wire::WirePose;
 use super::{Bead, BeadBundle, BeadParams, SimParams, SpaceBead, SpaceBeadBundle, SpaceWire, Wire};
 use crate::geometry::{
-    Placement, Pose, Pose3, PoseHistory, PosePath, SpacePath, Surface, WireSpace,
+    History, HistoryPose, Placement, Pose, Pose3, PoseHistory, PosePath, SpaceHistory, SpacePath,
+    Surface, WireSpace,
 };
 use crate::validate::ParamError;
 
@@ -41,8 +42,7 @@ pub trait Dimension:
     fn pose_of(transform: &Transform) -> Result<Self::Pose, ParamError>;
     /// A wire's path after a game moved its `Transform` to `now` over the
     /// step from `start` to `end = start + h`, and whether it is still
-    /// moving: in the plane, from its history (so the wire's velocity
-    /// enters the step); in space, at rest where it was put.
+    /// moving, from its history (so the wire's velocity enters the step).
     fn followed(
         path: Option<Self::Path>,
         now: Self::Pose,
@@ -100,7 +100,7 @@ impl Dimension for DVec2 {
         Pose::from_translation_rotation(transform.translation, transform.rotation)
     }
     fn followed(path: Option<PosePath>, now: Pose, start: f64, h: f64) -> (PosePath, bool) {
-        let mut history = match path {
+        let history = match path {
             Some(PosePath::Fixed(at)) if at == now => return (PosePath::Fixed(now), false),
             Some(PosePath::Fixed(at)) => PoseHistory::at_rest(f64::NEG_INFINITY, at),
             Some(PosePath::Followed(history)) => history,
@@ -109,12 +109,7 @@ impl Dimension for DVec2 {
             }
             None => PoseHistory::at_rest(start, now),
         };
-        history.push(start + h, h, now);
-        if history.is_at_rest() {
-            (PosePath::Fixed(now), false)
-        } else {
-            (PosePath::Followed(history), true)
-        }
+        settle(history, now, start, h, PosePath::Fixed, PosePath::Followed)
     }
     fn set_pose(transform: &mut Transform, pose: Pose) {
         let origin = pose.origin.as_vec2();
@@ -160,8 +155,24 @@ impl Dimension for DVec3 {
             rotation: rotation.normalize(),
         })
     }
-    fn followed(_path: Option<SpacePath>, now: Pose3, _start: f64, _h: f64) -> (SpacePath, bool) {
-        (SpacePath::Fixed(now), false)
+    fn followed(path: Option<SpacePath>, now: Pose3, start: f64, h: f64) -> (SpacePath, bool) {
+        let history = match path {
+            Some(SpacePath::Fixed(at)) if at == now => return (SpacePath::Fixed(now), false),
+            Some(SpacePath::Fixed(at)) => SpaceHistory::at_rest(f64::NEG_INFINITY, at),
+            Some(SpacePath::Followed(history)) => history,
+            Some(path @ SpacePath::Prescribed { .. }) => {
+                SpaceHistory::at_rest(start, path.pose(start))
+            }
+            None => SpaceHistory::at_rest(start, now),
+        };
+        settle(
+            history,
+            now,
+            start,
+            h,
+            SpacePath::Fixed,
+            SpacePath::Followed,
+        )
     }
     fn set_pose(transform: &mut Transform, pose: Pose3) {
         let origin = pose.origin.as_vec3();
@@ -177,6 +188,25 @@ impl Dimension for DVec3 {
         if at.is_finite() {
             transform.translation = at;
         }
+    }
+}
+
+/// A followed wire's history after it took in `now` at the end of the step
+/// from `start` (of `h`): fixed there if the last poses are one (`fixed`),
+/// else followed (`followed`), and whether it still moves.
+fn settle<P: HistoryPose, Path>(
+    mut history: History<P>,
+    now: P::Pose,
+    start: f64,
+    h: f64,
+    fixed: impl FnOnce(P::Pose) -> Path,
+    followed: impl FnOnce(History<P>) -> Path,
+) -> (Path, bool) {
+    history.push(start + h, h, now);
+    if history.is_at_rest() {
+        (fixed(now), false)
+    } else {
+        (followed(history), true)
     }
 }
 

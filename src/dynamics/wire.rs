@@ -197,12 +197,11 @@ pub fn pose_of(transform: &Transform) -> Result<Pose, ParamError> {
 /// placed by the entity's `Transform` (translation and rotation; the wire
 /// should be a top-level entity), moved by a
 /// [`PrescribedMotion<DVec3>`](PrescribedMotion), whose velocity and
-/// acceleration its beads feel exactly. A `Transform` the game writes
-/// places the wire anew at each step, at rest there: its beads are carried
-/// along by their constraints, not by the wire's velocity (in the plane a
-/// game-moved wire's motion is followed from its last poses). Beads go on
-/// it with [`OnWire`]; a [`SpaceBead`](crate::SpaceBead) on it steps in an
-/// island of its own or with the beads it is joined to.
+/// acceleration its beads feel exactly. A wire whose `Transform` the game
+/// writes is followed, as in the plane: its motion is the quadratic through
+/// its last three poses (see [`SpaceHistory`](crate::geometry::SpaceHistory)).
+/// Beads go on it with [`OnWire`]; a [`SpaceBead`](crate::SpaceBead) on it
+/// steps in an island of its own or with the beads it is joined to.
 #[derive(Component, Clone, Debug)]
 #[require(Transform, WirePose<DVec3>)]
 pub struct SpaceWire {

@@ -23,6 +23,7 @@ mod coordinates;
 mod cycloid;
 mod ellipse;
 mod frames;
+mod history;
 mod line;
 mod motion;
 mod parabola;
@@ -33,6 +34,7 @@ mod space;
 mod spline;
 mod surface;
 mod traced;
+mod twist;
 mod wire_space;
 
 use bevy::math::{DMat2, DVec2};
@@ -42,11 +44,9 @@ pub(crate) use circle::circle_geometry;
 pub use coordinates::Coordinates;
 pub use cycloid::{Cycloid, CycloidArch};
 pub use ellipse::Ellipse;
+pub use history::{History, HistoryPose, PlanePose, PoseHistory, SpaceHistory, SpacePose};
 pub use line::Line;
-pub use motion::{
-    FixedTrack, MovingTrack, Oscillate, PoseHistory, PosePath, Rough, Spin, Track, Twist,
-    WireMotion,
-};
+pub use motion::{FixedTrack, MovingTrack, Oscillate, PosePath, Rough, Spin, Track, WireMotion};
 pub use parabola::Parabola;
 pub(crate) use pose::placed_geometry;
 pub use pose::{Placed, PlacedSurface, Placement, Pose, Pose3};
@@ -59,6 +59,7 @@ pub use space::{
 pub use spline::{CubicPath, Spline, SplineKind, SplineSpec};
 pub use surface::{Friction, Side, Surface};
 pub use traced::{HINT_WINDOW, Parametric, Traced};
+pub use twist::Twist;
 pub use wire_space::{SpaceRow, SpaceShape, WireSpace};
 
 /// The value, gradient and Hessian of a constraint at one point.

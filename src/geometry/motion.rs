@@ -1,4 +1,4 @@
-//! Wires that move: [`WireMotion`] (a prescribed motion), [`PoseHistory`]
+//! Wires that move: [`WireMotion`] (a prescribed motion), [`PoseHistory`](super::PoseHistory)
 //! (a motion known only from the poses a game writes), [`PosePath`] (either,
 //! or none) and [`Twist`], a rigid motion's velocity and acceleration at one
 //! instant. [`Track`] is what the solver asks of a wire at a time `t`:
@@ -25,48 +25,10 @@ use bevy::math::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use super::{
-    Coordinates, Geometry, ImplicitCurve, ImplicitSurface, Placed, Placement, Pose, Surface,
+    Coordinates, Geometry, ImplicitCurve, ImplicitSurface, Placed, Placement, Pose, PoseHistory,
+    Surface, Twist,
 };
 use crate::validate::{ParamError, finite, finite_vector, positive};
-
-/// A rigid motion at one instant, in the plane or in space: the velocity
-/// and acceleration of a reference point and the angular velocity and
-/// acceleration about it.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Twist<V: Coordinates = DVec2> {
-    /// The reference point (the wire's origin `p`).
-    pub origin: V,
-    /// `ṗ`.
-    pub velocity: V,
-    /// `ω`: counter-clockwise positive in the plane, along the axis
-    /// (right-handed) in space.
-    pub angular_velocity: V::Angular,
-    /// `p̈`.
-    pub acceleration: V,
-    /// `ω̇`.
-    pub angular_acceleration: V::Angular,
-}
-
-impl<V: Coordinates> Twist<V> {
-    /// The velocity `w(x) = ṗ + ω × (x − p)` of the moving frame's point
-    /// at `x` (`ω J (x − p)` in the plane).
-    #[inline]
-    pub fn velocity_at(&self, x: V) -> V {
-        self.velocity + V::turn(self.angular_velocity, x - self.origin)
-    }
-
-    /// `a_w = p̈ + ω̇ × r + ω × (ω × r) + 2ω × v_r` (`r = x − p`; in the
-    /// plane `p̈ + ω̇ J r − ω² r + 2ω J v_r`): the acceleration of the
-    /// frame's point at `x` plus the Coriolis term for a body moving at
-    /// `relative_velocity` in the frame.
-    #[inline]
-    pub fn acceleration_at(&self, x: V, relative_velocity: V) -> V {
-        let r = x - self.origin;
-        let w = self.angular_velocity;
-        self.acceleration + V::turn(self.angular_acceleration, r) - V::centripetal(w, r)
-            + V::turn(V::twice(w), relative_velocity)
-    }
-}
 
 /// A prescribed motion of a wire about its resting pose (scene field
 /// `motion`).
@@ -167,114 +129,6 @@ impl WireMotion {
                 (pose, twist)
             }
         }
-    }
-}
-
-/// The poses a wire had at the ends of the last steps, as a game wrote
-/// them into its `Transform`: the motion between them is the quadratic
-/// through the last three, so within a step the pose is interpolated to
-/// third order in the step, the velocity to second and the acceleration
-/// to first. With two poses the motion is linear, with one it is at rest.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PoseHistory {
-    /// The time of the newest pose.
-    time: f64,
-    /// The time between poses.
-    step: f64,
-    /// Origins, oldest first.
-    origins: [DVec2; 3],
-    /// Angles (unwrapped), oldest first.
-    angles: [f64; 3],
-    /// How many of the three are real (1 to 3).
-    known: u8,
-}
-
-impl PoseHistory {
-    /// A wire at rest at `pose` at time `time`.
-    pub fn at_rest(time: f64, pose: Pose) -> Self {
-        let angle = pose.rotation.to_angle();
-        Self {
-            time,
-            step: 0.0,
-            origins: [pose.origin; 3],
-            angles: [angle; 3],
-            known: 1,
-        }
-    }
-
-    /// The newest pose and its time.
-    pub fn newest(&self) -> (f64, Pose) {
-        (self.time, Pose::new(self.origins[2], self.angles[2]))
-    }
-
-    /// Takes in the pose at `time`, one step `step` after the newest. A
-    /// history whose newest pose is older than `time − step` is restarted
-    /// from that pose held at `time − step` (the wire did not move in
-    /// between).
-    pub fn push(&mut self, time: f64, step: f64, pose: Pose) {
-        let consecutive = ((self.time + step) - time).abs() <= 1e-9 * step.max(time.abs())
-            && (self.known == 1 || (self.step - step).abs() <= 1e-12 * step);
-        if !consecutive {
-            let (_, last) = self.newest();
-            *self = Self::at_rest(time - step, last);
-        }
-        self.step = step;
-        let previous = self.angles[2];
-        // The angle taken nearest to the previous one: no jump of 2π.
-        let angle = previous
-            + (pose.rotation.to_angle() - previous + std::f64::consts::PI).rem_euclid(TAU)
-            - std::f64::consts::PI;
-        self.origins = [self.origins[1], self.origins[2], pose.origin];
-        self.angles = [self.angles[1], self.angles[2], angle];
-        self.time = time;
-        self.known = (self.known + 1).min(3);
-        if self.known < 3 {
-            // Extend back linearly: no curvature until three are known.
-            self.origins[0] = 2.0 * self.origins[1] - self.origins[2];
-            self.angles[0] = 2.0 * self.angles[1] - self.angles[2];
-        }
-    }
-
-    /// Whether the last three poses are one: the wire is at rest.
-    pub fn is_at_rest(&self) -> bool {
-        self.known == 1
-            || (self.origins.iter().all(|o| *o == self.origins[2])
-                && self.angles.iter().all(|a| *a == self.angles[2]))
-    }
-
-    /// The interpolated pose and twist at `t` (meant for the last step,
-    /// `time − step ≤ t ≤ time`).
-    pub fn at(&self, t: f64) -> (Pose, Twist) {
-        if self.is_at_rest() || self.step <= 0.0 {
-            let (_, pose) = self.newest();
-            return (
-                pose,
-                Twist {
-                    origin: pose.origin,
-                    ..Twist::default()
-                },
-            );
-        }
-        let h = self.step;
-        let s = (t - self.time) / h;
-        let [o0, o1, o2] = self.origins;
-        let [a0, a1, a2] = self.angles;
-        let (do1, do2) = (o2 - o1, o2 - 2.0 * o1 + o0);
-        let (da1, da2) = (a2 - a1, a2 - 2.0 * a1 + a0);
-        let curve = 0.5 * s * (s + 1.0);
-        let rate = s + 0.5;
-        let origin = o2 + s * do1 + curve * do2;
-        let angle = a2 + s * da1 + curve * da2;
-        (
-            Pose::new(origin, angle),
-            Twist {
-                origin,
-                velocity: (do1 + rate * do2) / h,
-                angular_velocity: (da1 + rate * da2) / h,
-                acceleration: do2 / (h * h),
-                angular_acceleration: da2 / (h * h),
-            },
-        )
     }
 }
 

@@ -206,7 +206,7 @@ impl WireSpace for DVec3 {
     fn prescribed_base(path: &SpacePath) -> Option<Pose3> {
         match path {
             SpacePath::Prescribed { base, .. } => Some(*base),
-            SpacePath::Fixed(_) => None,
+            _ => None,
         }
     }
     fn validate_motion(motion: &SpaceMotion) -> Result<(), ParamError> {

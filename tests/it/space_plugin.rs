@@ -603,3 +603,46 @@ fn a_bead_leaves_a_one_sided_sphere_in_space_through_the_plugin() {
     let contact = app.world().get::<WireContact>(bead).expect("a contact");
     assert!(!contact.is_on(), "its contact still reads on the sphere");
 }
+
+/// The game turns a hoop by writing its `Transform` each step (about the
+/// vertical, at 4 rad/s): the hoop is followed from its last poses and its
+/// bead's trajectory is the prescribed spin's. A steady turn is a straight
+/// line in the turn's rotation vector, which the history's quadratic
+/// holds exactly, so after 2 s the two are apart by the `Transform`'s
+/// `f32` alone: less than 1e-6 at 1/100 s and at 1/200 s.
+#[test]
+fn a_hoop_the_game_turns_gives_the_prescribed_spins_trajectory() {
+    const OMEGA: f64 = 4.0;
+    fn turn_hoop(
+        clock: Res<wirebead::SimClock>,
+        params: Res<SimParams>,
+        mut wires: Query<&mut Transform, With<SpaceWire>>,
+    ) {
+        let t = clock.time + params.timestep;
+        for mut transform in &mut wires {
+            transform.rotation = Quat::from_axis_angle(Vec3::Y, (OMEGA * t) as f32);
+        }
+    }
+    let spun = |dt: f64, by_game: bool| {
+        let mut app = app(dt);
+        let (wire, spin) = spinning_hoop(&mut app, 1.0, OMEGA);
+        if by_game {
+            app.world_mut()
+                .entity_mut(wire)
+                .remove::<PrescribedMotion<DVec3>>();
+            app.add_systems(FixedUpdate, turn_hoop.before(WireBeadSystems::Prepare));
+        }
+        let start = DVec3::new(0.5, -0.75f64.sqrt(), 0.0);
+        let velocity = spin.at(Pose3::IDENTITY, 0.0).1.velocity_at(start);
+        let bead = spawn(&mut app, Some(wire), start, velocity);
+        run_for(&mut app, 2.0);
+        assert!(app.world().get::<Diverged>(bead).is_none());
+        space_bead_state(app.world(), bead)
+            .expect("a bead")
+            .position
+    };
+    for dt in [1.0 / 100.0, 1.0 / 200.0] {
+        let gap = (spun(dt, true) - spun(dt, false)).length();
+        assert!(gap < 1e-6, "the trajectories part by {gap:e} at {dt} s");
+    }
+}

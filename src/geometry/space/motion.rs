@@ -8,7 +8,7 @@ use bevy::math::{DQuat, DVec3};
 
 use super::ImplicitSurface;
 use crate::geometry::motion::carry;
-use crate::geometry::{Geometry, Oscillate, PlacedSurface, Pose3, Track, Twist};
+use crate::geometry::{Geometry, Oscillate, PlacedSurface, Pose3, SpaceHistory, Track, Twist};
 use crate::validate::{ParamError, finite, positive};
 
 /// A prescribed motion of a surface about its resting pose.
@@ -97,8 +97,9 @@ impl SpaceMotion {
     }
 }
 
-/// Where a surface is over time: at one pose, or moving by a prescribed
-/// motion about a resting pose.
+/// Where a wire in space is over time: at one pose, moving by a
+/// prescribed motion about a resting pose, or followed from the poses a
+/// game wrote.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SpacePath {
     /// At one pose.
@@ -110,6 +111,8 @@ pub enum SpacePath {
         /// The motion.
         motion: SpaceMotion,
     },
+    /// Interpolated from the last poses.
+    Followed(SpaceHistory),
 }
 
 impl SpacePath {
@@ -118,6 +121,7 @@ impl SpacePath {
         match self {
             Self::Fixed(pose) => SpaceMotion::Fixed.at(*pose, t),
             Self::Prescribed { base, motion } => motion.at(*base, t),
+            Self::Followed(history) => history.at(t),
         }
     }
 
@@ -134,7 +138,7 @@ impl SpacePath {
                 base,
                 motion: SpaceMotion::Fixed,
             } => Some(*base),
-            Self::Prescribed { .. } => None,
+            Self::Prescribed { .. } | Self::Followed(_) => None,
         }
     }
 }
