@@ -4,6 +4,11 @@
 //!   each a cart of 2 kg on its own horizontal rail and a 1 kg bob on a rod
 //!   of 1 m released 30° from the vertical, RATTLE at 1/60 s: N islands of
 //!   two beads. Throughput is bead-steps.
+//! - `spheres`: N spherical pendulums in space through the plugin
+//!   (single-threaded): a bead of 1 kg on a sphere of 0.8 m each, released
+//!   from rest at 90° from the bottom, RATTLE at 1/60 s. Every bead in
+//!   space steps in an island, here N islands of one bead and one row.
+//!   Throughput is bead-steps.
 //! - `chain`: a rope of N rods hanging from a pin (N + 1 beads of 1 kg,
 //!   the first held by the pin's two rows, links of 0.1 m, |g| = 10),
 //!   released horizontal, stepped by RATTLE through the pure `Island` (no
@@ -23,9 +28,12 @@ use std::time::Duration;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use wirebead::geometry::Sphere;
 use wirebead::headless::Headless;
 use wirebead::solver::{BeadState, Island, IslandWork, LinearForce, Method, StepSettings};
-use wirebead::{Bead, OnWire, ParallelStep, Rod, SimParams, Wire, WireBeadPlugin};
+use wirebead::{
+    Bead, OnWire, ParallelStep, Rod, SimParams, SpaceBead, SpaceWire, Wire, WireBeadPlugin,
+};
 
 #[path = "support/rope.rs"]
 mod rope;
@@ -143,17 +151,22 @@ fn chain(c: &mut Criterion) {
     group.finish();
 }
 
-/// `n` pendulums on carts, each on its own rail 3 m below the last.
-fn carts(n: usize) -> App {
+/// A single-threaded app stepping with RATTLE at 1/60 s.
+fn rattle_app() -> App {
     let params = SimParams {
         method: Method::Rattle,
         ..SimParams::default()
     };
     let plugin = WireBeadPlugin::new(params).expect("valid parameters");
-    let mut app = Headless::new(plugin)
+    Headless::new(plugin)
         .single_threaded()
         .parallel(ParallelStep::OFF)
-        .build();
+        .build()
+}
+
+/// `n` pendulums on carts, each on its own rail 3 m below the last.
+fn carts(n: usize) -> App {
+    let mut app = rattle_app();
     let world = app.world_mut();
     let swing = DVec2::new(30f64.to_radians().sin(), -30f64.to_radians().cos());
     for i in 0..n {
@@ -173,19 +186,49 @@ fn carts(n: usize) -> App {
 }
 
 fn islands(c: &mut Criterion) {
-    let mut group = c.benchmark_group("islands");
+    bench_apps(c, "islands", "cart-rattle-1/60", 2, carts);
+}
+
+/// `n` spherical pendulums in space, each on its own sphere 3 m from the
+/// last.
+fn spheres(n: usize) -> App {
+    let mut app = rattle_app();
+    let world = app.world_mut();
+    for i in 0..n {
+        let origin = Vec3::new(3.0 * i as f32, 0.0, 0.0);
+        let sphere = SpaceWire::surface_of(Sphere { radius: 0.8 });
+        let wire = world
+            .spawn((sphere, Transform::from_translation(origin)))
+            .id();
+        let start = origin.as_dvec3() + bevy::math::DVec3::new(0.8, 0.0, 0.0);
+        let bead = SpaceBead::at_rest(1.0, start).expect("valid bead");
+        world.spawn((bead, OnWire(wire)));
+    }
+    // The first step builds the islands.
+    app.world_mut().run_schedule(FixedUpdate);
+    app
+}
+
+fn spheres_in_space(c: &mut Criterion) {
+    bench_apps(c, "spheres", "sphere-rattle-1/60", 1, spheres);
+}
+
+/// Times one fixed step of the app `make(n)` makes for N = 100, 1,000 and
+/// 10,000, `beads` beads to each of the N, in group `group` as `name`.
+fn bench_apps(c: &mut Criterion, group: &str, name: &str, beads: u64, make: fn(usize) -> App) {
+    let mut group = c.benchmark_group(group);
     for n in [100, 1_000, 10_000] {
-        group.throughput(Throughput::Elements(2 * n as u64));
+        group.throughput(Throughput::Elements(beads * n as u64));
         group.sample_size(10);
         group.warm_up_time(Duration::from_millis(500));
         group.measurement_time(Duration::from_secs(5));
-        let mut app = carts(n);
-        group.bench_function(BenchmarkId::new("cart-rattle-1/60", n), |b| {
+        let mut app = make(n);
+        group.bench_function(BenchmarkId::new(name, n), |b| {
             b.iter(|| app.world_mut().run_schedule(FixedUpdate));
         });
     }
     group.finish();
 }
 
-criterion_group!(benches, islands, chain);
+criterion_group!(benches, islands, spheres_in_space, chain);
 criterion_main!(benches);
