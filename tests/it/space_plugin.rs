@@ -646,3 +646,46 @@ fn a_hoop_the_game_turns_gives_the_prescribed_spins_trajectory() {
         assert!(gap < 1e-6, "the trajectories part by {gap:e} at {dt} s");
     }
 }
+
+/// A level plane in space oscillating along the 3D amplitude
+/// (0.3, 0.2, −0.1) m at 1.5 Hz (`PrescribedMotion::in_space`), a bead on
+/// it started at rest relative to it: the plane pushes only along its
+/// normal, so over 2 s the bead's height is the plane's, `0.2 sin 2πft`,
+/// and across the plane it keeps the velocity it started with, each to
+/// 1e-9.
+#[test]
+fn a_bead_rides_a_plane_oscillating_in_space() {
+    use wirebead::geometry::{Oscillate, Plane};
+    let amplitude = DVec3::new(0.3, 0.2, -0.1);
+    let frequency = 1.5;
+    let shake = SpaceMotion::Oscillate(Oscillate {
+        amplitude,
+        frequency,
+    });
+    let mut app = app(1e-3);
+    let wire = app
+        .world_mut()
+        .spawn((
+            SpaceWire::surface_of(Plane),
+            PrescribedMotion::in_space(shake).expect("a shake"),
+        ))
+        .id();
+    let start = DVec3::new(0.5, 0.0, -0.25);
+    let velocity = shake.at(Pose3::IDENTITY, 0.0).1.velocity_at(start);
+    let bead = spawn(&mut app, Some(wire), start, velocity);
+    let mut worst = 0.0f64;
+    for _ in 0..20 {
+        run_for(&mut app, 0.1);
+        let t = app.world().resource::<wirebead::SimClock>().time;
+        let p = space_bead_state(app.world(), bead)
+            .expect("a bead")
+            .position;
+        let height = amplitude.y * (TAU * frequency * t).sin();
+        let across = start + DVec3::new(velocity.x, 0.0, velocity.z) * t;
+        worst = worst
+            .max((p.y - height).abs())
+            .max((p.x - across.x).abs())
+            .max((p.z - across.z).abs());
+    }
+    assert!(worst <= 1e-9, "off the plane's motion by {worst:e}");
+}
