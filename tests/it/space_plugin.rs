@@ -171,6 +171,19 @@ fn a_rope_in_space_hangs_from_a_pin() {
     assert_eq!(report.map(|r| (r.beads.len(), r.rows)), Some((5, 7)));
 }
 
+/// Runs `app` for `tenths` tenths of a second, handing `look` the app, the
+/// time and `bead`'s position after each.
+fn every_tenth(app: &mut App, bead: Entity, tenths: usize, mut look: impl FnMut(&App, f64, DVec3)) {
+    for _ in 0..tenths {
+        run_for(app, 0.1);
+        let t = app.world().resource::<wirebead::SimClock>().time;
+        let p = space_bead_state(app.world(), bead)
+            .expect("a bead")
+            .position;
+        look(app, t, p);
+    }
+}
+
 /// A vertical hoop of radius `r` spinning at `omega` about the y-axis,
 /// and its spin.
 fn spinning_hoop(app: &mut App, r: f64, omega: f64) -> (Entity, SpaceMotion) {
@@ -207,12 +220,7 @@ fn a_bead_on_a_spinning_hoop_wire_stays_at_its_equilibrium() {
     let velocity = path.at(0.0).1.velocity_at(local);
     let bead = spawn(&mut app, Some(wire), local, velocity);
     let mut worst = 0.0f64;
-    for _ in 0..20 {
-        run_for(&mut app, 0.1);
-        let t = app.world().resource::<wirebead::SimClock>().time;
-        let p = space_bead_state(app.world(), bead)
-            .expect("a bead")
-            .position;
+    every_tenth(&mut app, bead, 20, |app, t, p| {
         let local = path.at(t).0.to_local(p);
         worst = worst.max((local.x.atan2(-local.y) - star).abs());
         let turned = app.world().get::<Transform>(wire).expect("a wire").rotation;
@@ -221,7 +229,7 @@ fn a_bead_on_a_spinning_hoop_wire_stays_at_its_equilibrium() {
             turned.dot(expected).abs() > 1.0 - 1e-6,
             "the hoop is at {turned} at t = {t}, not {expected}"
         );
-    }
+    });
     assert!(worst <= 1e-6, "θ* = {star} wandered by {worst:e}");
 }
 
@@ -674,18 +682,13 @@ fn a_bead_rides_a_plane_oscillating_in_space() {
     let velocity = shake.at(Pose3::IDENTITY, 0.0).1.velocity_at(start);
     let bead = spawn(&mut app, Some(wire), start, velocity);
     let mut worst = 0.0f64;
-    for _ in 0..20 {
-        run_for(&mut app, 0.1);
-        let t = app.world().resource::<wirebead::SimClock>().time;
-        let p = space_bead_state(app.world(), bead)
-            .expect("a bead")
-            .position;
+    every_tenth(&mut app, bead, 20, |_, t, p| {
         let height = amplitude.y * (TAU * frequency * t).sin();
         let across = start + DVec3::new(velocity.x, 0.0, velocity.z) * t;
         worst = worst
             .max((p.y - height).abs())
             .max((p.x - across.x).abs())
             .max((p.z - across.z).abs());
-    }
+    });
     assert!(worst <= 1e-9, "off the plane's motion by {worst:e}");
 }
