@@ -101,12 +101,12 @@ impl Scene for ScenePreset {
             let pose = Pose::new(wire.position, wire.angle_degrees.to_radians());
             ((wire.shape.clone(), pose, wire.motion), wire.beads.len())
         });
-        Measure::new(
+        Ok(Measure::new(
             wires,
             self.links().map_err(|e| e.to_string())?,
             self.all_beads().map(|b| b.mass).collect(),
             self.params.gravity,
-        )
+        ))
     }
 }
 
@@ -131,12 +131,12 @@ impl Scene for SpaceScene {
             let check = (wire.shape.shape(), pose, wire.motion.motion());
             wires.push((check, wire.beads.len()));
         }
-        Measure::new(
+        Ok(Measure::new(
             wires.into_iter(),
             self.links().map_err(|e| e.to_string())?,
             self.all_beads().map(|b| b.mass).collect(),
             self.params.0.gravity_in_space(),
-        )
+        ))
     }
 }
 
@@ -173,7 +173,7 @@ impl<V: SceneSpace> Measure<V> {
         links: Vec<SceneLink<V>>,
         masses: Vec<f64>,
         gravity: V,
-    ) -> Result<Self, String> {
+    ) -> Self {
         let mut checks = Vec::new();
         let mut bead = 0;
         for (wire, count) in wires {
@@ -192,12 +192,12 @@ impl<V: SceneSpace> Measure<V> {
                 }
             }
         }
-        Ok(Self {
+        Self {
             checks,
             springs,
             masses,
             gravity,
-        })
+        }
     }
 
     /// The largest `|C|` at time `t` of every constraint, wires included

@@ -142,18 +142,7 @@ impl Dimension for DVec3 {
         SpaceBead::new(params)
     }
     fn pose_of(transform: &Transform) -> Result<Pose3, ParamError> {
-        let origin = transform.translation.as_dvec3();
-        let rotation = transform.rotation.as_dquat();
-        if !origin.is_finite() || !rotation.is_finite() || rotation.length_squared() == 0.0 {
-            return Err(ParamError::NotFinite {
-                name: "wire transform",
-                value: f64::NAN,
-            });
-        }
-        Ok(Pose3 {
-            origin,
-            rotation: rotation.normalize(),
-        })
+        Pose3::from_translation_rotation(transform.translation, transform.rotation)
     }
     fn followed(path: Option<SpacePath>, now: Pose3, start: f64, h: f64) -> (SpacePath, bool) {
         let history = match path {

@@ -56,14 +56,14 @@ impl RailOrientation {
 
     /// The rotation of a bead at `x` on `curve` placed by `pose`; none
     /// where the curve has no frame there (a singular point). The roll is
-    /// fixed the first time, where the bead started: at `start` on the
-    /// curve placed by `start_pose`.
+    /// fixed the first time, where the bead started: `start()` gives the
+    /// curve's pose then and the bead's position.
     pub(crate) fn orient(
         &mut self,
         curve: &(dyn SpaceCurve + Send + Sync),
         pose: &Pose3,
         x: DVec3,
-        (start_pose, start): (&Pose3, DVec3),
+        start: impl FnOnce() -> (Pose3, DVec3),
     ) -> Option<DQuat> {
         let local = pose.to_local(x);
         let frame = curve.frame(local, self.along);
@@ -71,6 +71,7 @@ impl RailOrientation {
             return None;
         }
         if self.roll.is_nan() {
+            let (start_pose, start) = start();
             let at = curve.frame(start_pose.to_local(start), self.along);
             self.roll = at.roll_toward(start_pose.rotation.inverse() * self.up);
         }

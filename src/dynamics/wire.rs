@@ -6,6 +6,7 @@ use std::sync::Arc;
 use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 
+use crate::geometry::not_placeable;
 use crate::geometry::{
     Circle, Coordinates, Ellipse, ImplicitCurve, ImplicitSurface, Line, Parabola, Pose, Sine,
     SpaceCurve, SpaceMotion, SpaceShape, Surface, WireMotion, WireShape, WireSpace,
@@ -24,7 +25,7 @@ use crate::validate::ParamError;
 pub struct Wire {
     shape: WireShape,
     /// None for a plain wire: most wires are, and stay small.
-    surface: Option<Box<Surface>>,
+    surface: SurfaceSlot,
 }
 
 impl Wire {
@@ -33,21 +34,20 @@ impl Wire {
         shape.validate()?;
         Ok(Self {
             shape,
-            surface: None,
+            surface: SurfaceSlot::default(),
         })
     }
 
     /// The wire with `surface`: one-sided, bouncy, rough or damped (see
     /// [`Surface`]), if its numbers are valid.
     pub fn with_surface(self, surface: Surface) -> Result<Self, ParamError> {
-        surface.validate()?;
-        let surface = (surface != Surface::PLAIN).then(|| Box::new(surface));
+        let surface = SurfaceSlot::new(surface)?;
         Ok(Self { surface, ..self })
     }
 
     /// What the wire does besides holding its beads.
     pub fn surface(&self) -> &Surface {
-        self.surface.as_deref().unwrap_or(&Surface::PLAIN)
+        self.surface.get()
     }
 
     /// The wire with `shape` in place of its own, its surface kept (the
@@ -73,7 +73,7 @@ impl Wire {
     pub fn line() -> Self {
         Self {
             shape: WireShape::Line(Line),
-            surface: None,
+            surface: SurfaceSlot::default(),
         }
     }
 
@@ -94,7 +94,7 @@ impl Wire {
     pub fn custom(curve: impl ImplicitCurve + Send + Sync + 'static) -> Self {
         Self {
             shape: WireShape::Custom(Arc::new(curve)),
-            surface: None,
+            surface: SurfaceSlot::default(),
         }
     }
 
@@ -179,10 +179,7 @@ impl<V: WireSpace> WirePose<V> {
 
     /// The path, or the error that the wire's transform is not finite.
     pub(crate) fn get(&self) -> Result<V::Path, ParamError> {
-        self.0.ok_or(ParamError::NotFinite {
-            name: "wire transform",
-            value: f64::NAN,
-        })
+        self.0.ok_or_else(not_placeable)
     }
 }
 
@@ -190,6 +187,24 @@ impl<V: WireSpace> WirePose<V> {
 /// finite.
 pub fn pose_of(transform: &Transform) -> Result<Pose, ParamError> {
     Pose::from_translation_rotation(transform.translation, transform.rotation)
+}
+
+/// A wire's surface, boxed and kept only where it is not plain (as on most
+/// wires), so that a wire stays small.
+#[derive(Clone, Debug, Default)]
+struct SurfaceSlot(Option<Box<Surface>>);
+
+impl SurfaceSlot {
+    /// `surface`, if its numbers are valid.
+    fn new(surface: Surface) -> Result<Self, ParamError> {
+        surface.validate()?;
+        Ok(Self((surface != Surface::PLAIN).then(|| Box::new(surface))))
+    }
+
+    /// The surface: plain where none was given.
+    fn get(&self) -> &Surface {
+        self.0.as_deref().unwrap_or(&Surface::PLAIN)
+    }
 }
 
 /// A wire in space: a surface ([`SpaceShape::Surface`], one constraint
@@ -206,7 +221,7 @@ pub fn pose_of(transform: &Transform) -> Result<Pose, ParamError> {
 #[require(Transform, WirePose<DVec3>)]
 pub struct SpaceWire {
     shape: SpaceShape,
-    surface: Option<Box<Surface>>,
+    surface: SurfaceSlot,
 }
 
 impl SpaceWire {
@@ -214,7 +229,7 @@ impl SpaceWire {
     pub fn new(shape: SpaceShape) -> Self {
         Self {
             shape,
-            surface: None,
+            surface: SurfaceSlot::default(),
         }
     }
 
@@ -230,14 +245,13 @@ impl SpaceWire {
 
     /// The wire with a surface (one-sided, rough, damped), if it is valid.
     pub fn with_surface(self, surface: Surface) -> Result<Self, ParamError> {
-        surface.validate()?;
-        let surface = (surface != Surface::PLAIN).then(|| Box::new(surface));
+        let surface = SurfaceSlot::new(surface)?;
         Ok(Self { surface, ..self })
     }
 
     /// The wire's surface.
     pub fn surface(&self) -> &Surface {
-        self.surface.as_deref().unwrap_or(&Surface::PLAIN)
+        self.surface.get()
     }
 
     /// The shape.

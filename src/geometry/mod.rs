@@ -48,8 +48,8 @@ pub use history::{History, HistoryPose, PlanePose, PoseHistory, SpaceHistory, Sp
 pub use line::Line;
 pub use motion::{FixedTrack, MovingTrack, Oscillate, PosePath, Rough, Spin, Track, WireMotion};
 pub use parabola::Parabola;
-pub(crate) use pose::placed_geometry;
 pub use pose::{Placed, PlacedSurface, Placement, Pose, Pose3};
+pub(crate) use pose::{not_placeable, placed_geometry};
 pub use shape::{WireKind, WireShape};
 pub use sine::Sine;
 pub use space::{

@@ -99,10 +99,7 @@ impl Pose {
         let origin = DVec2::new(f64::from(translation.x), f64::from(translation.y));
         let rotation = DVec2::new(f64::from(axis.x), f64::from(axis.y));
         if !origin.is_finite() || !rotation.is_finite() || rotation.length_squared() == 0.0 {
-            return Err(ParamError::NotFinite {
-                name: "wire transform",
-                value: f64::NAN,
-            });
+            return Err(not_placeable());
         }
         Ok(Self {
             origin,
@@ -174,12 +171,37 @@ impl Default for Pose3 {
     }
 }
 
+/// A `Transform` that places no wire: not finite.
+pub(crate) fn not_placeable() -> ParamError {
+    ParamError::NotFinite {
+        name: "wire transform",
+        value: f64::NAN,
+    }
+}
+
 impl Pose3 {
     /// No translation, no rotation.
     pub const IDENTITY: Self = Self {
         origin: DVec3::ZERO,
         rotation: DQuat::IDENTITY,
     };
+
+    /// A 3D placement (a `Transform`'s translation and rotation), the
+    /// rotation normalized. Returns an error if either is not finite.
+    pub fn from_translation_rotation(
+        translation: Vec3,
+        rotation: Quat,
+    ) -> Result<Self, ParamError> {
+        let origin = translation.as_dvec3();
+        let rotation = rotation.as_dquat();
+        if !origin.is_finite() || !rotation.is_finite() || rotation.length_squared() == 0.0 {
+            return Err(not_placeable());
+        }
+        Ok(Self {
+            origin,
+            rotation: rotation.normalize(),
+        })
+    }
 
     /// A pose turned right-handed by `angle` radians about `axis` (any
     /// length but zero) through `origin`. Returns an error if the axis is

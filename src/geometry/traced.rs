@@ -90,24 +90,18 @@ impl<V: Coordinates, P: Parametric<V>> Traced<P, V> {
     pub fn with_up(path: P, up: V) -> Self {
         let (start, end) = path.domain();
         let n = (((end - start) * SAMPLES_PER_UNIT).ceil() as usize).clamp(16, 1 << 16);
-        let samples: Vec<(f64, V)> = (0..=n)
-            .map(|i| {
-                let s = start + (end - start) * i as f64 / n as f64;
-                (s, path.eval(s)[0])
-            })
-            .collect();
+        let (mut samples, mut tangents) = (Vec::with_capacity(n + 1), Vec::with_capacity(n + 1));
+        for i in 0..=n {
+            let s = start + (end - start) * i as f64 / n as f64;
+            let [point, d1, _] = path.eval(s);
+            samples.push((s, point));
+            tangents.push(d1 / norm(d1).max(f64::MIN_POSITIVE));
+        }
         let gaps = || samples.windows(2).map(|w| norm(w[1].1 - w[0].1));
         let length: f64 = gaps().sum();
         let spacing = gaps().fold(0.0, f64::max);
         let scale = (length / (end - start).max(1.0)).max(f64::MIN_POSITIVE);
         let points: Vec<V> = samples.iter().map(|(_, p)| *p).collect();
-        let tangents: Vec<V> = samples
-            .iter()
-            .map(|&(s, _)| {
-                let d1 = path.eval(s)[1];
-                d1 / norm(d1).max(f64::MIN_POSITIVE)
-            })
-            .collect();
         let normals = rotation_minimizing(&points, &tangents, up, path.closed());
         Self {
             path,

@@ -81,7 +81,7 @@ fn orient_rails(
             continue;
         };
         let pose = DVec3::path_at(&path, clock.time).0;
-        let start = (&DVec3::path_at(&path, 0.0).0, params.initial_position);
+        let start = || (DVec3::path_at(&path, 0.0).0, params.initial_position);
         if let Some(rotation) = rail.orient(curve.as_ref(), &pose, position.0, start) {
             let rotation = rotation.as_quat();
             if rotation.is_finite() {
