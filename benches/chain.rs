@@ -6,9 +6,9 @@
 //!   two beads. Throughput is bead-steps.
 //! - `spheres`: N spherical pendulums in space through the plugin
 //!   (single-threaded): a bead of 1 kg on a sphere of 0.8 m each, released
-//!   from rest at 90° from the bottom, RATTLE at 1/60 s. Every bead in
-//!   space steps in an island, here N islands of one bead and one row.
-//!   Throughput is bead-steps.
+//!   from rest at 90° from the bottom, RATTLE at 1/60 s. Each bead,
+//!   alone on its sphere, takes the lone step, eight at a time in the
+//!   batched step. Throughput is bead-steps.
 //! - `chain`: a rope of N rods hanging from a pin (N + 1 beads of 1 kg,
 //!   the first held by the pin's two rows, links of 0.1 m, |g| = 10),
 //!   released horizontal, stepped by RATTLE through the pure `Island` (no
@@ -204,7 +204,7 @@ fn spheres(n: usize) -> App {
         let bead = SpaceBead::at_rest(1.0, start).expect("valid bead");
         world.spawn((bead, OnWire(wire)));
     }
-    // The first step builds the islands.
+    // The first step fills the wire table.
     app.world_mut().run_schedule(FixedUpdate);
     app
 }

@@ -36,18 +36,16 @@
 //!   `f32` values between steps. The sync only feeds rendering; the solver
 //!   works on `Position`/`Rotation` alone.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use avian2d::physics_transform::PhysicsTransformConfig;
 use avian2d::prelude::{
-    AngularInertia, DistanceJoint, Gravity, LinearVelocity, Mass, Physics, PhysicsPlugins,
-    Position, RigidBody, SleepingDisabled, SubstepCount, Substeps,
+    AngularInertia, DistanceJoint, LinearVelocity, Mass, Position, RigidBody, SleepingDisabled,
+    SubstepCount, Substeps,
 };
-use bevy::app::{App, PluginGroup, PluginsState, TaskPoolOptions, TaskPoolPlugin};
+use bevy::app::App;
 use bevy::math::DVec2;
-use bevy::prelude::{Component, Entity, MinimalPlugins};
-use bevy::tasks::ComputeTaskPool;
-use bevy::time::{Fixed, Time, TimeUpdateStrategy, Virtual};
+use bevy::prelude::{Component, Entity};
+use bevy::time::Time;
 
 /// Circle radius (the joint's fixed length), metres.
 const RADIUS: f64 = 0.8;
@@ -95,93 +93,160 @@ fn bead_state(app: &App, bead: Entity, anchor: DVec2) -> (DVec2, DVec2) {
     (position - anchor, velocity)
 }
 
-/// A headless app with avian2d and no bodies yet, ready for spawning and
-/// then [`warm_up`]: gravity `gravity`, `substeps` substeps per step
-/// (`None`: avian's default, 6), transform sync off (see the module docs),
-/// and exactly one physics step of `step` per [`App::update`].
-///
-/// # Stepping: exactly one physics step of `step` per `App::update`
-///
-/// - `Time<Fixed>` gets the timestep `step`, and
-///   `TimeUpdateStrategy::FixedTimesteps(1)` makes bevy's `time_system`
-///   advance `Time<Real>` by exactly `timestep * 1` per update, whatever the
-///   wall clock does (`bevy_time-0.19.1/src/lib.rs`, `time_system`).
-/// - `Time<Virtual>` follows with the same raw delta: at relative speed 1 it
-///   skips the `f64` rescaling, and `max_delta` (raised here to at least
-///   `2 * step`) does not clamp it (`bevy_time-0.19.1/src/virt.rs`,
-///   `advance_with_raw_delta`).
-/// - `run_fixed_main_schedule` adds that delta to the fixed overstep and
-///   runs `FixedMain` while a whole timestep can be taken off it; `Duration`
-///   is integer nanoseconds, so the overstep goes from 0 to exactly `step`
-///   and back to 0: one run of `FixedMain` (`bevy_time-0.19.1/src/fixed.rs`).
-/// - avian's `run_physics_schedule` sits in `FixedPostUpdate`; it advances
-///   `Time<Physics>` by the generic `Time` delta (there `Time<Fixed>`, i.e.
-///   `step`) and runs `PhysicsSchedule` once, which runs the substep
-///   schedule `SubstepCount` times (`avian2d-0.7.0/src/schedule/mod.rs`,
-///   `src/dynamics/solver/schedule.rs`).
-/// - The very first update takes no step: `Time<Real>::update_with_duration`
-///   only records its first instant, so the first delta is zero
-///   (`bevy_time-0.19.1/src/real.rs`). [`warm_up`] spends that update;
-///   avian's own integrator test does the same.
-///
-/// [`timed_step`] checks every later update against `Time<Physics>`.
-pub fn physics_app(
-    step: Duration,
-    threads: Option<usize>,
-    gravity: DVec2,
-    substeps: Option<u32>,
-) -> App {
-    let mut app = App::new();
+/// The app every avian job is built in, for one dimension: [`physics_app`],
+/// [`warm_up`] and [`timed_step`] over `$avian` (avian2d or avian3d), whose
+/// plugins, resources and clock have the same names in both.
+macro_rules! harness {
+    ($avian:ident, $vector:ty) => {
+        use std::time::{Duration, Instant};
 
-    // Bevy's task pools are process-wide and created once: a later
-    // `TaskPoolPlugin` with other options keeps the existing pools.
-    if let Some(k) = threads
-        && let Some(pool) = ComputeTaskPool::try_get()
-    {
-        eprintln!(
-            "warning: run_avian asked for {k} thread(s), but the task pools already exist \
-             (compute pool: {} threads) and will be reused",
-            pool.thread_num()
-        );
-    }
-    let minimal = match threads {
-        Some(k) => MinimalPlugins.set(TaskPoolPlugin {
-            task_pool_options: TaskPoolOptions::with_num_threads(k),
-        }),
-        None => MinimalPlugins.build(),
+        use $avian::physics_transform::PhysicsTransformConfig;
+        use $avian::prelude::{Gravity, Physics, PhysicsPlugins, SubstepCount};
+        use bevy::app::{App, PluginGroup, PluginsState, TaskPoolOptions, TaskPoolPlugin};
+        use bevy::prelude::MinimalPlugins;
+        use bevy::tasks::ComputeTaskPool;
+        use bevy::time::{Fixed, Time, TimeUpdateStrategy, Virtual};
+
+        /// A headless app with avian and no bodies yet, ready for spawning and
+        /// then [`warm_up`]: gravity `gravity`, `substeps` substeps per step
+        /// (`None`: avian's default, 6), transform sync off (see the module docs),
+        /// and exactly one physics step of `step` per [`App::update`].
+        ///
+        /// # Stepping: exactly one physics step of `step` per `App::update`
+        ///
+        /// - `Time<Fixed>` gets the timestep `step`, and
+        ///   `TimeUpdateStrategy::FixedTimesteps(1)` makes bevy's `time_system`
+        ///   advance `Time<Real>` by exactly `timestep * 1` per update, whatever the
+        ///   wall clock does (`bevy_time-0.19.1/src/lib.rs`, `time_system`).
+        /// - `Time<Virtual>` follows with the same raw delta: at relative speed 1 it
+        ///   skips the `f64` rescaling, and `max_delta` (raised here to at least
+        ///   `2 * step`) does not clamp it (`bevy_time-0.19.1/src/virt.rs`,
+        ///   `advance_with_raw_delta`).
+        /// - `run_fixed_main_schedule` adds that delta to the fixed overstep and
+        ///   runs `FixedMain` while a whole timestep can be taken off it; `Duration`
+        ///   is integer nanoseconds, so the overstep goes from 0 to exactly `step`
+        ///   and back to 0: one run of `FixedMain` (`bevy_time-0.19.1/src/fixed.rs`).
+        /// - avian's `run_physics_schedule` sits in `FixedPostUpdate`; it advances
+        ///   `Time<Physics>` by the generic `Time` delta (there `Time<Fixed>`, i.e.
+        ///   `step`) and runs `PhysicsSchedule` once, which runs the substep
+        ///   schedule `SubstepCount` times (`avian2d-0.7.0/src/schedule/mod.rs`,
+        ///   `src/dynamics/solver/schedule.rs`).
+        /// - The very first update takes no step: `Time<Real>::update_with_duration`
+        ///   only records its first instant, so the first delta is zero
+        ///   (`bevy_time-0.19.1/src/real.rs`). [`warm_up`] spends that update;
+        ///   avian's own integrator test does the same.
+        ///
+        /// [`timed_step`] checks every later update against `Time<Physics>`.
+        pub fn physics_app(
+            step: Duration,
+            threads: Option<usize>,
+            gravity: $vector,
+            substeps: Option<u32>,
+        ) -> App {
+            let mut app = App::new();
+
+            // Bevy's task pools are process-wide and created once: a later
+            // `TaskPoolPlugin` with other options keeps the existing pools.
+            if let Some(k) = threads
+                && let Some(pool) = ComputeTaskPool::try_get()
+            {
+                eprintln!(
+                    "warning: run_avian asked for {k} thread(s), but the task pools already exist \
+                     (compute pool: {} threads) and will be reused",
+                    pool.thread_num()
+                );
+            }
+            let minimal = match threads {
+                Some(k) => MinimalPlugins.set(TaskPoolPlugin {
+                    task_pool_options: TaskPoolOptions::with_num_threads(k),
+                }),
+                None => MinimalPlugins.build(),
+            };
+
+            // Must be in place before `PhysicsPlugins` is added: the plugin only
+            // `init_resource`s it, and reads `position_to_transform` at build time.
+            app.insert_resource(PhysicsTransformConfig {
+                propagate_before_physics: false,
+                transform_to_position: false,
+                position_to_transform: false,
+                transform_to_collider_scale: false,
+            });
+            app.add_plugins((minimal, PhysicsPlugins::default()));
+
+            app.insert_resource(Gravity(gravity));
+            if let Some(k) = substeps {
+                // Replaces the default that `SolverSchedulePlugin` `init_resource`d.
+                app.insert_resource(SubstepCount(k));
+            }
+            app.insert_resource(Time::<Fixed>::from_duration(step));
+            app.insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
+            {
+                let mut virtual_time = app.world_mut().resource_mut::<Time<Virtual>>();
+                let max_delta = virtual_time.max_delta().max(step * 2);
+                virtual_time.set_max_delta(max_delta);
+            }
+
+            // What `App::run` does through the schedule runner before the first update.
+            while app.plugins_state() == PluginsState::Adding {
+                bevy::tasks::tick_global_task_pools_on_main_thread();
+            }
+            app.finish();
+            app.cleanup();
+            app
+        }
+
+        /// The first update of an app from [`physics_app`], after the bodies are
+        /// spawned: runs the startup schedules and takes no physics step.
+        ///
+        /// # Panics
+        ///
+        /// If that update did step the physics.
+        pub fn warm_up(app: &mut App) {
+            app.update();
+            assert_eq!(
+                app.world().resource::<Time<Physics>>().elapsed(),
+                Duration::ZERO,
+                "the warm-up update must not step the physics"
+            );
+        }
+
+        /// Update `k` (counted from 1) of an app from [`physics_app`]: one physics
+        /// step of `step`. Returns the wall seconds of the `App::update` call alone.
+        ///
+        /// # Panics
+        ///
+        /// If the update did not advance the physics clock by one step.
+        pub fn timed_step(app: &mut App, step: Duration, k: usize) -> f64 {
+            let before = app.world().resource::<Time<Physics>>().elapsed();
+            let start = Instant::now();
+            app.update();
+            let seconds = start.elapsed().as_secs_f64();
+
+            // One update, one physics step: the physics clock moved by one
+            // timestep (give or take the nanosecond rounding avian's
+            // relative-speed scaling may add), not zero and not two.
+            let advanced = app.world().resource::<Time<Physics>>().elapsed() - before;
+            assert!(
+                advanced > step / 2 && advanced < step * 3 / 2,
+                "update {k} advanced the physics clock by {advanced:?}, expected one step of {step:?}"
+            );
+            seconds
+        }
     };
-
-    // Must be in place before `PhysicsPlugins` is added: the plugin only
-    // `init_resource`s it, and reads `position_to_transform` at build time.
-    app.insert_resource(PhysicsTransformConfig {
-        propagate_before_physics: false,
-        transform_to_position: false,
-        position_to_transform: false,
-        transform_to_collider_scale: false,
-    });
-    app.add_plugins((minimal, PhysicsPlugins::default()));
-
-    app.insert_resource(Gravity(gravity));
-    if let Some(k) = substeps {
-        // Replaces the default that `SolverSchedulePlugin` `init_resource`d.
-        app.insert_resource(SubstepCount(k));
-    }
-    app.insert_resource(Time::<Fixed>::from_duration(step));
-    app.insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
-    {
-        let mut virtual_time = app.world_mut().resource_mut::<Time<Virtual>>();
-        let max_delta = virtual_time.max_delta().max(step * 2);
-        virtual_time.set_max_delta(max_delta);
-    }
-
-    // What `App::run` does through the schedule runner before the first update.
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
-    app
 }
+
+/// The harness of avian3d's jobs.
+pub mod space {
+    use bevy::math::DVec3;
+    harness!(avian3d, DVec3);
+}
+
+/// The harness of avian2d's jobs.
+mod plane {
+    use bevy::math::DVec2;
+    harness!(avian2d, DVec2);
+}
+pub use plane::{physics_app, timed_step, warm_up};
 
 /// avian2d's default number of substeps per step (`impl Default for
 /// SubstepCount`, `src/dynamics/solver/schedule.rs`): 6.
@@ -208,44 +273,6 @@ pub fn positive(text: &str) -> Result<usize, String> {
         Ok(n) => Ok(n),
         Err(e) => Err(format!("{text:?} is not a whole number ({e})")),
     }
-}
-
-/// The first update of an app from [`physics_app`], after the bodies are
-/// spawned: runs the startup schedules and takes no physics step.
-///
-/// # Panics
-///
-/// If that update did step the physics.
-pub fn warm_up(app: &mut App) {
-    app.update();
-    assert_eq!(
-        app.world().resource::<Time<Physics>>().elapsed(),
-        Duration::ZERO,
-        "the warm-up update must not step the physics"
-    );
-}
-
-/// Update `k` (counted from 1) of an app from [`physics_app`]: one physics
-/// step of `step`. Returns the wall seconds of the `App::update` call alone.
-///
-/// # Panics
-///
-/// If the update did not advance the physics clock by one step.
-pub fn timed_step(app: &mut App, step: Duration, k: usize) -> f64 {
-    let before = app.world().resource::<Time<Physics>>().elapsed();
-    let start = Instant::now();
-    app.update();
-    let seconds = start.elapsed().as_secs_f64();
-
-    // One update, one physics step: the physics clock moved by one
-    // timestep (give or take the nanosecond rounding avian's
-    // relative-speed scaling may add), not zero and not two.
-    let advanced = app.world().resource::<Time<Physics>>().elapsed() - before;
-    assert!(
-        advanced > step / 2 && advanced < step * 3 / 2,
-        "update {k} advanced the physics clock by {advanced:?}, expected one step of {step:?}"
-    );
-    seconds
 }
 
 /// Builds a headless app with avian2d and `n` pendulums ([`physics_app`]

@@ -5,6 +5,7 @@
 //! cargo run --release -p wirebead-vs-avian -- circle [--steps 600] [--many 10000]
 //! cargo run --release -p wirebead-vs-avian -- rope [--steps 600] [--sizes 10,100,1000] [--substeps 20,50,100,200]
 //! cargo run --release -p wirebead-vs-avian -- carts [--steps 600] [--sizes 1000,10000] [--substeps 50] [--rail prismatic|locked]
+//! cargo run --release -p wirebead-vs-avian -- spheres [--steps 600] [--sizes 1,10000]
 //! ```
 //!
 //! - `circle` (the default, also without a subcommand): a bead on a circle
@@ -23,6 +24,10 @@
 //!   6 and 50 substeps (see [`carts`]). Prints ns per bead-step, rod and
 //!   rail errors and pendulum 0's energy change per run, and the time
 //!   ratios avian2d / ours.
+//! - `spheres`: N conical pendulums on spheres in space, our plugin with
+//!   each method against avian3d (a body on a `DistanceJoint`, see
+//!   [`spheres`]). Prints ns per bead-step, energy and height change and
+//!   the worst radial error.
 //!
 //! Every job uses Bevy's process-wide task pools with a compute thread per
 //! core, on both sides.
@@ -32,6 +37,7 @@
 mod avian_side;
 mod carts;
 mod rope;
+mod spheres;
 
 use std::time::Instant;
 
@@ -52,7 +58,7 @@ const GRAVITY: f64 = 10.0;
 /// The command line: a job, or the circle job's options alone.
 #[derive(Parser, Debug)]
 #[command(
-    about = "wirebead against avian2d: a bead on a circle, a hanging rope, pendulums on carts",
+    about = "wirebead against avian: a bead on a circle, a hanging rope, pendulums on carts, spherical pendulums",
     args_conflicts_with_subcommands = true
 )]
 struct Cli {
@@ -73,6 +79,8 @@ enum Job {
     Rope(rope::RopeArgs),
     /// N pendulums on carts, each cart on its own horizontal rail.
     Carts(carts::CartsArgs),
+    /// N spherical pendulums in space, against avian3d.
+    Spheres(spheres::SpheresArgs),
 }
 
 /// Options of the circle job.
@@ -179,6 +187,7 @@ fn main() {
         Some(Job::Circle(args)) => circle(&args),
         Some(Job::Rope(args)) => rope::run(&args),
         Some(Job::Carts(args)) => carts::run(&args),
+        Some(Job::Spheres(args)) => spheres::run(&args),
     }
 }
 

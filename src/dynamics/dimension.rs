@@ -9,7 +9,7 @@ use super::wire::WirePose;
 use super::{Bead, BeadBundle, BeadParams, SimParams, SpaceBead, SpaceBeadBundle, SpaceWire, Wire};
 use crate::geometry::{
     History, HistoryPose, Placement, Pose, Pose3, PoseHistory, PosePath, SpaceHistory, SpacePath,
-    Surface, WireSpace,
+    SpaceShape, Surface, WireSpace,
 };
 use crate::validate::ParamError;
 
@@ -28,10 +28,6 @@ pub trait Dimension:
     type Wire: Component + WireRows<Self>;
     /// The unit axes: a pin is a row along each.
     const AXES: &'static [Self];
-    /// Whether a bead on a wire and joined to nothing has a step of its
-    /// own (the plane's per-bead step, with its batched fast path); if not
-    /// (in space), it steps as an island of one.
-    const LONE_STEP: bool;
     /// Gravity in these coordinates.
     fn gravity(params: &SimParams) -> Self;
     /// A bead at its initial state, if its parameters are valid
@@ -64,6 +60,11 @@ pub trait WireRows<V: WireSpace> {
     fn rows(&self) -> Vec<V::Shape>;
     /// Its surface: one-sided, rough or damped.
     fn surface(&self) -> &Surface;
+    /// Whether a bead on it and joined to nothing takes a step of its own
+    /// (with the batched step on circles and spheres): on one row, any
+    /// wire in the plane and a surface in space. A bead on a curve in
+    /// space, two rows, steps as an island of one.
+    fn lone(&self) -> bool;
 }
 
 impl WireRows<DVec2> for Wire {
@@ -72,6 +73,9 @@ impl WireRows<DVec2> for Wire {
     }
     fn surface(&self) -> &Surface {
         Wire::surface(self)
+    }
+    fn lone(&self) -> bool {
+        true
     }
 }
 
@@ -82,6 +86,9 @@ impl WireRows<DVec3> for SpaceWire {
     fn surface(&self) -> &Surface {
         SpaceWire::surface(self)
     }
+    fn lone(&self) -> bool {
+        matches!(self.shape(), SpaceShape::Surface(_))
+    }
 }
 
 impl Dimension for DVec2 {
@@ -89,7 +96,6 @@ impl Dimension for DVec2 {
     type BeadBundle = BeadBundle;
     type Wire = Wire;
     const AXES: &'static [Self] = &[DVec2::X, DVec2::Y];
-    const LONE_STEP: bool = true;
     fn gravity(params: &SimParams) -> Self {
         params.gravity
     }
@@ -134,7 +140,6 @@ impl Dimension for DVec3 {
     type BeadBundle = SpaceBeadBundle;
     type Wire = SpaceWire;
     const AXES: &'static [Self] = &[DVec3::X, DVec3::Y, DVec3::Z];
-    const LONE_STEP: bool = false;
     fn gravity(params: &SimParams) -> Self {
         params.gravity_in_space()
     }

@@ -4,7 +4,7 @@ use bevy::math::{DMat2, DVec2};
 use serde::{Deserialize, Serialize};
 
 use super::{Geometry, ImplicitCurve};
-use crate::lane::{Lane, Sym2, V2, Vector};
+use crate::lane::{Lane, LaneSpace, Sym2, Vector};
 
 /// A circle of radius `r` about the local origin: `C = |x| - r`, the assignment's
 /// wire. Singular at the centre.
@@ -30,7 +30,7 @@ impl ImplicitCurve for Circle {
     }
     #[inline]
     fn geometry(&self, p: DVec2) -> Geometry {
-        let g = circle_geometry(p.into(), self.radius);
+        let g = round_geometry::<DVec2, f64>(p.one(), self.radius);
         if g.len == 0.0 {
             // ∇C is undefined at the centre; a zero normal is reported as singular.
             return Geometry {
@@ -42,24 +42,25 @@ impl ImplicitCurve for Circle {
         let Sym2 { xx, xy, yy } = g.hessian;
         Geometry {
             c: g.c,
-            normal: g.normal.into(),
+            normal: DVec2::from_one(g.normal),
             hessian: DMat2::from_cols(DVec2::new(xx, xy), DVec2::new(xy, yy)),
         }
     }
 }
 
-/// A circle's `C`, `∇C` and Hessian at `p` (relative to its centre), on
-/// lanes: one formula for [`Circle::geometry`] and the batched step.
+/// A circle's or a sphere's `C`, `∇C` and Hessian at `p` (relative to its
+/// centre), on lanes: one formula for [`Circle::geometry`], the sphere's
+/// and the batched step.
 #[derive(Clone, Copy)]
-pub(crate) struct CircleGeometry<T> {
+pub(crate) struct RoundGeometry<T, V, H> {
     /// `|p|`: zero at the centre, where nothing else means anything.
     pub(crate) len: T,
     /// `C = |p| - r`.
     pub(crate) c: T,
     /// `∇C = p / |p|`.
-    pub(crate) normal: V2<T>,
+    pub(crate) normal: V,
     /// `H = (I - n nᵀ) / |p|`.
-    pub(crate) hessian: Sym2<T>,
+    pub(crate) hessian: H,
 }
 
 /// `C = |p| − r` and `∇C = p / |p|` at `p` (relative to the centre) for a
@@ -91,25 +92,23 @@ pub(crate) fn round<T: Lane, V: Vector<T>>(p: V, radius: T) -> Round<T, V> {
     }
 }
 
-/// See [`CircleGeometry`].
+/// See [`RoundGeometry`].
 #[inline(always)]
-pub(crate) fn circle_geometry<T: Lane>(p: V2<T>, radius: T) -> CircleGeometry<T> {
+pub(crate) fn round_geometry<S: LaneSpace, T: Lane>(
+    p: S::Lanes<T>,
+    radius: T,
+) -> RoundGeometry<T, S::Lanes<T>, S::Sym<T>> {
     let Round {
         len,
         c,
-        normal: n,
-        inverse: inv,
+        normal,
+        inverse,
     } = round(p, radius);
-    let one = len.splat(1.0);
-    CircleGeometry {
+    RoundGeometry {
         len,
         c,
-        normal: n,
-        hessian: Sym2 {
-            xx: (one - n.x * n.x) * inv,
-            xy: (-n.x * n.y) * inv,
-            yy: (one - n.y * n.y) * inv,
-        },
+        normal,
+        hessian: S::round_hessian(normal, inverse),
     }
 }
 

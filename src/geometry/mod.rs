@@ -40,7 +40,7 @@ mod wire_space;
 use bevy::math::{DMat2, DVec2};
 
 pub use circle::Circle;
-pub(crate) use circle::circle_geometry;
+pub(crate) use circle::round_geometry;
 pub use coordinates::Coordinates;
 pub use cycloid::{Cycloid, CycloidArch};
 pub use ellipse::Ellipse;

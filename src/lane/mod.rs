@@ -331,6 +331,13 @@ impl From<V3<f64>> for bevy::math::DVec3 {
     }
 }
 
+/// A symmetric Hessian on lanes, applied to a vector as glam's matrix
+/// times a vector sums it.
+pub(crate) trait Symmetric<V>: Copy {
+    /// `H v`.
+    fn apply(self, v: V) -> V;
+}
+
 /// The symmetric 2×2 Hessian `H` of a constraint, as its three entries.
 #[derive(Clone, Copy)]
 pub(crate) struct Sym2<T> {
@@ -339,10 +346,163 @@ pub(crate) struct Sym2<T> {
     pub(crate) yy: T,
 }
 
-impl<T: Lane> Sym2<T> {
-    /// `H v`, as glam's `DMat2 * DVec2` sums it.
+impl<T: Lane> Symmetric<V2<T>> for Sym2<T> {
+    /// As glam's `DMat2 * DVec2` sums it.
     #[inline(always)]
-    pub(crate) fn apply(self, v: V2<T>) -> V2<T> {
+    fn apply(self, v: V2<T>) -> V2<T> {
         V2::new(self.xx * v.x + self.xy * v.y, self.xy * v.x + self.yy * v.y)
+    }
+}
+
+/// The symmetric 3×3 Hessian `H` of a constraint in space, as its six
+/// entries.
+#[derive(Clone, Copy)]
+pub(crate) struct Sym3<T> {
+    pub(crate) xx: T,
+    pub(crate) xy: T,
+    pub(crate) xz: T,
+    pub(crate) yy: T,
+    pub(crate) yz: T,
+    pub(crate) zz: T,
+}
+
+impl<T: Lane> Symmetric<V3<T>> for Sym3<T> {
+    /// As glam's `DMat3 * DVec3` sums it: column by column.
+    #[inline(always)]
+    fn apply(self, v: V3<T>) -> V3<T> {
+        V3::new(
+            self.xx * v.x + self.xy * v.y + self.xz * v.z,
+            self.xy * v.x + self.yy * v.y + self.yz * v.z,
+            self.xz * v.x + self.yz * v.y + self.zz * v.z,
+        )
+    }
+}
+
+/// The plane (`DVec2`) or space (`DVec3`) as the batched step takes it:
+/// a vector of lanes, a symmetric Hessian, and [`LANES`] vectors stored as
+/// one column of lanes per component, so that one batched step serves
+/// circles in the plane and spheres in space.
+pub(crate) trait LaneSpace: Vector<f64> + Copy {
+    /// A vector of lanes: [`V2`] or [`V3`].
+    type Lanes<T: Lane>: Vector<T>;
+    /// A symmetric Hessian on lanes: [`Sym2`] or [`Sym3`].
+    type Sym<T: Lane>: Symmetric<Self::Lanes<T>>;
+    /// [`LANES`] vectors, one column of lanes per component.
+    type Columns: Copy + Default + PartialEq + std::fmt::Debug + Send + Sync;
+    /// `t` in every component.
+    fn splat<T: Lane>(t: T) -> Self::Lanes<T>;
+    /// The vector as one lane.
+    fn one(self) -> Self::Lanes<f64>;
+    /// One lane's vector as glam's.
+    fn from_one(v: Self::Lanes<f64>) -> Self;
+    /// Puts `v` into lane `lane` of `columns`.
+    fn set(columns: &mut Self::Columns, lane: usize, v: Self);
+    /// Lane `lane` of `columns`.
+    fn get(columns: &Self::Columns, lane: usize) -> Self;
+    /// The columns as a vector of AVX2 lanes.
+    #[cfg(target_arch = "x86_64")]
+    fn load(simd: pulp::x86::V3, columns: &Self::Columns) -> Self::Lanes<F64x8>;
+    /// A vector of AVX2 lanes as columns.
+    #[cfg(target_arch = "x86_64")]
+    fn store(v: Self::Lanes<F64x8>) -> Self::Columns;
+    /// `(I − n nᵀ) s`: the Hessian of a circle or a sphere, `n` its unit
+    /// normal and `s` the reciprocal of the distance from its centre.
+    fn round_hessian<T: Lane>(n: Self::Lanes<T>, s: T) -> Self::Sym<T>;
+}
+
+impl LaneSpace for bevy::math::DVec2 {
+    type Lanes<T: Lane> = V2<T>;
+    type Sym<T: Lane> = Sym2<T>;
+    type Columns = [[f64; LANES]; 2];
+    #[inline(always)]
+    fn splat<T: Lane>(t: T) -> V2<T> {
+        V2::new(t, t)
+    }
+    #[inline(always)]
+    fn one(self) -> V2<f64> {
+        self.into()
+    }
+    #[inline(always)]
+    fn from_one(v: V2<f64>) -> Self {
+        v.into()
+    }
+    #[inline(always)]
+    fn set(columns: &mut Self::Columns, lane: usize, v: Self) {
+        (columns[0][lane], columns[1][lane]) = (v.x, v.y);
+    }
+    #[inline(always)]
+    fn get(columns: &Self::Columns, lane: usize) -> Self {
+        Self::new(columns[0][lane], columns[1][lane])
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn load(simd: pulp::x86::V3, [x, y]: &Self::Columns) -> V2<F64x8> {
+        V2::new(F64x8::load(simd, x), F64x8::load(simd, y))
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn store(v: V2<F64x8>) -> Self::Columns {
+        [v.x.store(), v.y.store()]
+    }
+    #[inline(always)]
+    fn round_hessian<T: Lane>(n: V2<T>, s: T) -> Sym2<T> {
+        let one = s.splat(1.0);
+        Sym2 {
+            xx: (one - n.x * n.x) * s,
+            xy: (-n.x * n.y) * s,
+            yy: (one - n.y * n.y) * s,
+        }
+    }
+}
+
+impl LaneSpace for bevy::math::DVec3 {
+    type Lanes<T: Lane> = V3<T>;
+    type Sym<T: Lane> = Sym3<T>;
+    type Columns = [[f64; LANES]; 3];
+    #[inline(always)]
+    fn splat<T: Lane>(t: T) -> V3<T> {
+        V3::new(t, t, t)
+    }
+    #[inline(always)]
+    fn one(self) -> V3<f64> {
+        self.into()
+    }
+    #[inline(always)]
+    fn from_one(v: V3<f64>) -> Self {
+        v.into()
+    }
+    #[inline(always)]
+    fn set(columns: &mut Self::Columns, lane: usize, v: Self) {
+        (columns[0][lane], columns[1][lane], columns[2][lane]) = (v.x, v.y, v.z);
+    }
+    #[inline(always)]
+    fn get(columns: &Self::Columns, lane: usize) -> Self {
+        Self::new(columns[0][lane], columns[1][lane], columns[2][lane])
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn load(simd: pulp::x86::V3, [x, y, z]: &Self::Columns) -> V3<F64x8> {
+        V3::new(
+            F64x8::load(simd, x),
+            F64x8::load(simd, y),
+            F64x8::load(simd, z),
+        )
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn store(v: V3<F64x8>) -> Self::Columns {
+        [v.x.store(), v.y.store(), v.z.store()]
+    }
+    #[inline(always)]
+    fn round_hessian<T: Lane>(n: V3<T>, s: T) -> Sym3<T> {
+        let one = s.splat(1.0);
+        Sym3 {
+            xx: (one - n.x * n.x) * s,
+            xy: (-n.x * n.y) * s,
+            xz: (-n.x * n.z) * s,
+            yy: (one - n.y * n.y) * s,
+            yz: (-n.y * n.z) * s,
+            zz: (one - n.z * n.z) * s,
+        }
     }
 }

@@ -10,6 +10,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::dynamics::{BeadDiverged, ContactChanged, Dimension, Diverged, DivergenceReason};
+use crate::geometry::Coordinates;
 use crate::solver::ContactEvent;
 
 /// Divergences found inside a (possibly parallel) loop, reported after it.
@@ -101,18 +102,23 @@ fn point<V: Dimension>(p: V) -> String {
 
 /// Changes of contact found inside a (possibly parallel) loop, sent after
 /// it.
-#[derive(Default)]
-pub(crate) struct FoundEvents(Mutex<Vec<(Entity, ContactEvent)>>);
+pub(crate) struct FoundEvents<V: Coordinates = DVec2>(Mutex<Vec<(Entity, ContactEvent<V>)>>);
 
-impl FoundEvents {
-    pub(crate) fn push(&self, bead: Entity, event: ContactEvent) {
+impl<V: Coordinates> Default for FoundEvents<V> {
+    fn default() -> Self {
+        Self(Mutex::default())
+    }
+}
+
+impl<V: Coordinates> FoundEvents<V> {
+    pub(crate) fn push(&self, bead: Entity, event: ContactEvent<V>) {
         self.0
             .lock()
             .unwrap_or_else(PoisonError::into_inner)
             .push((bead, event));
     }
 
-    pub(crate) fn take(&mut self) -> Vec<(Entity, ContactEvent)> {
+    pub(crate) fn take(&mut self) -> Vec<(Entity, ContactEvent<V>)> {
         std::mem::take(self.0.get_mut().unwrap_or_else(PoisonError::into_inner))
     }
 }

@@ -1,6 +1,8 @@
 //! [`WritebackPlugin`]: `f64` positions into `Transform`s, converted at
 //! this edge, in [`WireBeadSystems::Writeback`].
 
+use std::marker::PhantomData;
+
 use bevy::ecs::change_detection::Tick;
 use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
@@ -20,21 +22,36 @@ pub struct WritebackPlugin;
 
 impl Plugin for WritebackPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<LastStep>().add_systems(
-            FixedUpdate,
-            (
-                write_transforms::<DVec2>,
-                (write_transforms::<DVec3>, orient_rails).chain(),
-            )
-                .in_set(WireBeadSystems::Writeback),
-        );
+        app.init_resource::<LastStep<DVec2>>()
+            .init_resource::<LastStep<DVec3>>()
+            .add_systems(
+                FixedUpdate,
+                (
+                    write_transforms::<DVec2>,
+                    (write_transforms::<DVec3>, orient_rails).chain(),
+                )
+                    .in_set(WireBeadSystems::Writeback),
+            );
     }
 }
 
-/// The change tick of the last run of the step: it wrote the `Transform`
-/// of every bead it changed then.
-#[derive(Resource, Clone, Copy, Debug, Default)]
-pub(crate) struct LastStep(pub(crate) Tick);
+/// The change tick of the last run of the step of the beads in `V`'s
+/// dimension: it wrote the `Transform` of every bead it changed then.
+#[derive(Resource)]
+pub(crate) struct LastStep<V>(Tick, PhantomData<fn() -> V>);
+
+impl<V> Default for LastStep<V> {
+    fn default() -> Self {
+        Self(Tick::default(), PhantomData)
+    }
+}
+
+impl<V> LastStep<V> {
+    /// The step ran at `tick`.
+    pub(crate) fn set(&mut self, tick: Tick) {
+        self.0 = tick;
+    }
+}
 
 /// Writes each bead's position into its `Transform` (in the plane x and
 /// y, z kept; see [`Dimension::place`]) where the bead changed other than
@@ -42,7 +59,7 @@ pub(crate) struct LastStep(pub(crate) Tick);
 /// ones it steps. A non-finite position is never written.
 fn write_transforms<V: Dimension>(
     parallel: Res<ParallelStep>,
-    stepped: Res<LastStep>,
+    stepped: Res<LastStep<V>>,
     mut beads: Query<(Ref<BeadPosition<V>>, &mut Transform), Changed<BeadPosition<V>>>,
 ) {
     let write = |(position, mut transform): (Ref<BeadPosition<V>>, Mut<Transform>)| {

@@ -43,7 +43,7 @@ pub use coupled::{
     Constraint, Island, IslandError, IslandRow, IslandWork, RowKind, RowReport, SpringLink, islands,
 };
 pub use euler::{explicit_euler, semi_implicit_euler};
-pub(crate) use lanes::{CircleLanes, CircleSteps, LANES, step_on_circle_batches};
+pub(crate) use lanes::{LANES, RoundLanes, RoundSteps, step_on_round_batches};
 pub use method::{Integrator, Method, Stabilization};
 pub use projection::project;
 pub use rattle::rattle;

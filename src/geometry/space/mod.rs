@@ -64,6 +64,13 @@ pub trait ImplicitSurface {
     fn hessian(&self, p: DVec3) -> DMat3 {
         self.geometry(p).hessian
     }
+    /// The radius, if this is [`Sphere`] (`C = |x| − r` exactly as it
+    /// computes it): a bead alone on a sphere that stays put then takes
+    /// the batched step, eight beads at a time. None for any other
+    /// surface.
+    fn sphere_radius(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// `g(ρ, y)` and its derivatives at one point, for a surface of

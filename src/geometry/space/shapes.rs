@@ -5,8 +5,9 @@ use bevy::math::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 
 use super::{ImplicitSurface, Meridian, revolution};
-use crate::geometry::circle::round;
-use crate::geometry::{Coordinates, Geometry};
+use crate::geometry::Geometry;
+use crate::geometry::circle::round_geometry;
+use crate::lane::{LaneSpace, Sym3};
 
 /// The plane `y = 0` of the wire's local frame, its positive side `+y`:
 /// `C = y`.
@@ -35,10 +36,13 @@ impl ImplicitSurface for Sphere {
     fn scale(&self) -> f64 {
         self.radius
     }
+    fn sphere_radius(&self) -> Option<f64> {
+        Some(self.radius)
+    }
     /// `∇C = x/|x|`, `H = (I − n nᵀ)/|x|`: the circle's formula in
     /// space. At the centre the normal is zero (a singular point).
     fn geometry(&self, p: DVec3) -> Geometry<DVec3> {
-        let g = round(p, self.radius);
+        let g = round_geometry::<DVec3, f64>(p.one(), self.radius);
         if g.len == 0.0 {
             return Geometry {
                 c: -self.radius,
@@ -46,10 +50,22 @@ impl ImplicitSurface for Sphere {
                 hessian: DMat3::ZERO,
             };
         }
+        let Sym3 {
+            xx,
+            xy,
+            xz,
+            yy,
+            yz,
+            zz,
+        } = g.hessian;
         Geometry {
             c: g.c,
-            normal: g.normal,
-            hessian: (DMat3::IDENTITY - DVec3::outer(g.normal, g.normal)) * g.inverse,
+            normal: DVec3::from_one(g.normal),
+            hessian: DMat3::from_cols(
+                DVec3::new(xx, xy, xz),
+                DVec3::new(xy, yy, yz),
+                DVec3::new(xz, yz, zz),
+            ),
         }
     }
 }

@@ -161,7 +161,8 @@ pub(super) fn prepare_islands<V: Dimension>(
         }
     }
     // The beads in islands: every bead a link names, every bead on no
-    // wire, and in space every bead.
+    // wire, and every bead on a wire without a step of its own (a curve in
+    // space).
     let mut index: HashMap<Entity, usize> = HashMap::new();
     let mut members: Vec<Entity> = Vec::new();
     let mut join = |bead: Entity, members: &mut Vec<Entity>| {
@@ -181,7 +182,8 @@ pub(super) fn prepare_islands<V: Dimension>(
         }
     }
     for (entity, _, on_wire, _) in &beads {
-        if on_wire.is_none() || !V::LONE_STEP {
+        let lone = on_wire.is_some_and(|on| wires.get(on.0).map_or(true, |(w, _)| w.lone()));
+        if !lone {
             join(entity, &mut members);
         }
     }

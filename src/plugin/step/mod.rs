@@ -1,17 +1,21 @@
 //! [`BeadStepPlugin`]: steps each bead on a wire and joined to nothing, in
-//! [`WireBeadSystems::Step`]. The system only moves data between the ECS
-//! and [`solver`](crate::solver); the beads are walked table by table as
+//! [`WireBeadSystems::Step`]: in the plane on any curve, in space on a
+//! surface. The system only moves data between the ECS and
+//! [`solver`](crate::solver); the beads are walked table by table as
 //! slices, split over the compute task pool.
 //!
 //! | file | what it holds |
 //! |---|---|
+//! | `lone` | what each dimension's lone step needs: its shapes, circles or spheres, tracks |
 //! | `table` | the wire table: each wire's shape and pose, from change detection |
 //! | `run` | a run of beads stepped on one thread: batched and single-bead steps |
 
+mod lone;
 mod run;
 mod table;
 
 use bevy::ecs::system::SystemChangeTick;
+use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 
 use super::clock::SimClock;
@@ -22,8 +26,9 @@ use super::schedule::WireBeadSystems;
 use super::writeback::LastStep;
 use crate::dynamics::{
     BeadDiagnostics, BeadForce, BeadMass, BeadPosition, BeadVelocity, Diverged, OnWire, SimParams,
-    Wire, WireContact, WirePose,
+    WireContact, WirePose,
 };
+pub(crate) use lone::LoneStep;
 use run::{StepContext, split_table};
 use table::WireTable;
 
@@ -35,7 +40,10 @@ pub struct BeadStepPlugin;
 
 impl Plugin for BeadStepPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(FixedUpdate, step_beads.in_set(WireBeadSystems::Step));
+        app.add_systems(
+            FixedUpdate,
+            (step_beads::<DVec2>, step_beads::<DVec3>).in_set(WireBeadSystems::Step),
+        );
     }
 }
 
@@ -43,32 +51,32 @@ impl Plugin for BeadStepPlugin {
 /// diagnostics (see [`WireBeadSystems::Step`](crate::WireBeadSystems::Step)).
 /// Walks the beads table by table as slices, split over the compute task
 /// pool from [`ParallelStep::threshold`] beads up.
-fn step_beads(
+fn step_beads<V: LoneStep>(
     params: Res<SimParams>,
     clock: Res<SimClock>,
     parallel: Res<ParallelStep>,
-    mut wires: Local<WireTable>,
-    changed: Query<(Entity, &Wire, &WirePose), Or<(Changed<Wire>, Changed<WirePose>)>>,
-    mut removed_wires: RemovedComponents<Wire>,
-    mut removed_poses: RemovedComponents<WirePose>,
+    mut wires: Local<WireTable<V>>,
+    changed: Query<(Entity, &V::Wire, &WirePose<V>), Or<(Changed<V::Wire>, Changed<WirePose<V>>)>>,
+    mut removed_wires: RemovedComponents<V::Wire>,
+    mut removed_poses: RemovedComponents<WirePose<V>>,
     mut beads: Query<
         (
             Entity,
-            &mut BeadPosition,
-            &mut BeadVelocity,
+            &mut BeadPosition<V>,
+            &mut BeadVelocity<V>,
             &BeadMass,
-            &mut BeadForce,
+            &mut BeadForce<V>,
             &OnWire,
-            Option<&mut BeadDiagnostics>,
+            Option<&mut BeadDiagnostics<V>>,
             Option<&mut Transform>,
             Option<&mut WireContact>,
         ),
         (Without<Diverged>, Without<InIsland>),
     >,
     mut found: Local<FoundDivergences>,
-    mut events: Local<FoundEvents>,
-    mut changes: ContactReports,
-    mut stepped: ResMut<LastStep>,
+    mut events: Local<FoundEvents<V>>,
+    mut changes: ContactReports<V>,
+    mut stepped: ResMut<LastStep<V>>,
     mut split_report: ResMut<StepSplit>,
     ticks: SystemChangeTick,
     mut divergences: Divergences,
@@ -76,8 +84,8 @@ fn step_beads(
     let removed = removed_wires.read().chain(removed_poses.read());
     wires.refresh(removed, changed);
     let ctx = StepContext {
-        params: &params,
         settings: params.step_settings(),
+        gravity: V::gravity(&params),
         wires: &wires,
         found: &found,
         events: &events,
@@ -118,5 +126,5 @@ fn step_beads(
         }
         changes.report(bead, event);
     }
-    stepped.0 = ticks.this_run();
+    stepped.set(ticks.this_run());
 }

@@ -1,47 +1,27 @@
 //! The wire table the bead step reads: every wire's shape and pose, kept
-//! from change detection, and the plain circles the batched step takes.
+//! from change detection, and the plain circles or spheres the batched
+//! step takes.
 
-use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::dynamics::{DivergenceReason, OnWire, Wire, WirePose};
-use crate::geometry::{Pose, PosePath, Surface, WireShape};
-
-/// Runs `$body` with `$curve` bound to the shape's concrete curve, so the
-/// solver is inlined for each built-in shape.
-macro_rules! with_curve {
-    ($shape:expr, $curve:ident => $body:expr) => {
-        match $shape {
-            WireShape::Circle($curve) => $body,
-            WireShape::Ellipse($curve) => $body,
-            WireShape::Line($curve) => $body,
-            WireShape::Parabola($curve) => $body,
-            WireShape::Sine($curve) => $body,
-            WireShape::Cycloid($curve) => $body,
-            WireShape::Spline($curve) => $body,
-            WireShape::Custom(custom) => {
-                let $curve = custom.as_ref();
-                $body
-            }
-        }
-    };
-}
-pub(super) use with_curve;
+use super::lone::LoneStep;
+use crate::dynamics::{DivergenceReason, OnWire, WirePose, WireRows};
+use crate::geometry::{Placement, Surface};
 
 /// A wire as the step needs it: its shape and, for most wires, where it
 /// stays; a moving wire's path and a one-sided, rough or damped wire's
 /// surface behind one pointer, so the table stays small for the rest.
-pub(crate) struct TableWire {
-    pub(super) shape: WireShape,
+pub(crate) struct TableWire<V: LoneStep> {
+    pub(super) shape: V::Lone,
     /// Where a plain wire that stays put is (when `track` is none).
-    pub(super) pose: Pose,
+    pub(super) pose: V::Pose,
     /// The path and surface of the others.
-    pub(super) track: Option<Box<(PosePath, Surface)>>,
+    pub(super) track: Option<Box<(V::Path, Surface)>>,
 }
 
-impl TableWire {
-    fn new(shape: WireShape, path: PosePath, surface: Surface) -> Self {
-        match path.fixed() {
+impl<V: LoneStep> TableWire<V> {
+    fn new(shape: V::Lone, path: V::Path, surface: Surface) -> Self {
+        match V::path_fixed(&path) {
             Some(pose) if surface.is_plain() => Self {
                 shape,
                 pose,
@@ -49,7 +29,7 @@ impl TableWire {
             },
             _ => Self {
                 shape,
-                pose: Pose::IDENTITY,
+                pose: V::Pose::default(),
                 track: Some(Box::new((path, surface))),
             },
         }
@@ -57,10 +37,10 @@ impl TableWire {
 
     /// The path (a fixed one for a wire that stays put).
     #[inline]
-    pub(super) fn path(&self) -> PosePath {
+    pub(super) fn path(&self) -> V::Path {
         match &self.track {
             Some(track) => track.0,
-            None => PosePath::Fixed(self.pose),
+            None => V::fixed_path(self.pose),
         }
     }
 
@@ -72,32 +52,42 @@ impl TableWire {
 }
 
 /// A wire for the step, or why beads cannot be stepped on it.
-type PlacedWire = Result<TableWire, DivergenceReason>;
+type PlacedWire<V> = Result<TableWire<V>, DivergenceReason>;
 
 /// Every wire's shape and pose, kept by the bead step from change
 /// detection (a copy made when a wire changes, not each step), so a bead
 /// finds its wire with one indexed read instead of a query lookup. The
-/// plain circles that stay put unrotated (the batched step's wires) are
-/// also kept as a small record each, which is all the step reads for a
-/// bead on one.
-#[derive(Default)]
-pub(crate) struct WireTable {
+/// plain circles or spheres that stay put unrotated (the batched step's
+/// wires) are also kept as a small record each, which is all the step
+/// reads for a bead on one.
+pub(crate) struct WireTable<V: LoneStep> {
     /// Each wire's place in `wires` plus one, by entity index (0: none).
     slot: Vec<u32>,
     /// The wires, each with its entity.
-    wires: Vec<(Entity, PlacedWire)>,
-    /// For each wire, its entity and, where it is a plain circle that
-    /// stays put unrotated, its centre and radius (else a NaN radius).
-    circles: Vec<(Entity, DVec2, f64)>,
+    wires: Vec<(Entity, PlacedWire<V>)>,
+    /// For each wire, its entity and, where it is a plain circle or sphere
+    /// that stays put unrotated, its centre and radius (else a NaN
+    /// radius).
+    circles: Vec<(Entity, V, f64)>,
 }
 
-impl WireTable {
+impl<V: LoneStep> Default for WireTable<V> {
+    fn default() -> Self {
+        Self {
+            slot: Vec::new(),
+            wires: Vec::new(),
+            circles: Vec::new(),
+        }
+    }
+}
+
+impl<V: LoneStep> WireTable<V> {
     /// Takes in the wires that changed or were added since the last call,
     /// and drops the ones whose `Wire` or `WirePose` was removed.
     pub(super) fn refresh<'a>(
         &mut self,
         removed: impl IntoIterator<Item = Entity>,
-        changed: impl IntoIterator<Item = (Entity, &'a Wire, &'a WirePose)>,
+        changed: impl IntoIterator<Item = (Entity, &'a V::Wire, &'a WirePose<V>)>,
     ) {
         for entity in removed {
             if let Some(k) = self.place(entity) {
@@ -110,17 +100,23 @@ impl WireTable {
             }
         }
         for (entity, wire, pose) in changed {
-            let placed = pose
-                .get()
-                .map(|path| TableWire::new(wire.shape().clone(), path, *wire.surface()))
-                .map_err(|e| DivergenceReason::InvalidWire(e.to_string()));
+            let placed = match (pose.get(), V::lone_shape(wire)) {
+                (Ok(path), Some(shape)) => Ok(TableWire::new(shape, path, *wire.surface())),
+                (Err(e), _) => Err(DivergenceReason::InvalidWire(e.to_string())),
+                (_, None) => Err(DivergenceReason::InvalidWire(
+                    "a bead on a curve in space steps in an island".into(),
+                )),
+            };
             let circle = match &placed {
                 Ok(TableWire {
-                    shape: WireShape::Circle(circle),
+                    shape,
                     pose,
                     track: None,
-                }) if pose.is_unrotated() => (entity, pose.origin, circle.radius),
-                _ => (entity, DVec2::ZERO, f64::NAN),
+                }) if Placement::<V>::is_unrotated(pose) => match V::round(shape) {
+                    Some(radius) => (entity, Placement::<V>::origin(pose), radius),
+                    None => (entity, V::ZERO, f64::NAN),
+                },
+                _ => (entity, V::ZERO, f64::NAN),
             };
             let index = entity.index_u32() as usize;
             if index >= self.slot.len() {
@@ -150,7 +146,7 @@ impl WireTable {
 
     /// The wire a bead is on.
     #[inline]
-    pub(super) fn get(&self, on: &OnWire) -> Result<&TableWire, DivergenceReason> {
+    pub(super) fn get(&self, on: &OnWire) -> Result<&TableWire<V>, DivergenceReason> {
         match self.place(on.0) {
             Some(k) => self.wires[k].1.as_ref().map_err(Clone::clone),
             None => Err(DivergenceReason::InvalidWire(format!(
@@ -161,9 +157,9 @@ impl WireTable {
     }
 
     /// The centre and radius of the wire a bead is on, where it is a plain
-    /// circle that stays put unrotated.
+    /// circle or sphere that stays put unrotated.
     #[inline(always)]
-    pub(super) fn circle(&self, on: &OnWire) -> Option<(DVec2, f64)> {
+    pub(super) fn circle(&self, on: &OnWire) -> Option<(V, f64)> {
         let k = self.slot.get(on.0.index_u32() as usize)?.checked_sub(1)? as usize;
         let &(entity, centre, radius) = self.circles.get(k)?;
         (entity == on.0 && !radius.is_nan()).then_some((centre, radius))
@@ -173,6 +169,8 @@ impl WireTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dynamics::Wire;
+    use bevy::math::DVec2;
 
     /// A plain circle at `x` on the x axis.
     fn placed(x: f32) -> (Wire, WirePose) {
@@ -185,7 +183,7 @@ mod tests {
         let mut world = World::new();
         let wires: Vec<Entity> = (0..4).map(|_| world.spawn_empty().id()).collect();
         let data: Vec<_> = (0..4).map(|i| placed(i as f32)).collect();
-        let mut table = WireTable::default();
+        let mut table = WireTable::<DVec2>::default();
         table.refresh([], wires.iter().zip(&data).map(|(&e, (w, p))| (e, w, p)));
         // Wire 1 goes: the last one takes its place in the table.
         table.refresh([wires[1]], []);

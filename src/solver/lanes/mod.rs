@@ -1,15 +1,16 @@
-//! The batched step: [`LANES`] beads on unrotated circles at once. It runs
+//! The batched step: [`LANES`] beads on unrotated circles in the plane, or
+//! on spheres in space, at once. It runs
 //! the very functions [`step`] runs (eq. 3 in `solve`, the integrators,
 //! the circle's geometry), instantiated for eight lanes instead of one, so
 //! each lane's result is bit for bit what [`step`] returns.
 //!
 //! | file | what it holds |
 //! |---|---|
-//! | `mod` | the lanes' layout ([`CircleLanes`], [`CircleSteps`]), the entry points and the step's outline on the lanes |
-//! | `circle` | the solves on each lane's circle: eq. (3), the RK4 stages, RATTLE, projection and the restores of eqs. (10) and (11) |
+//! | `mod` | the lanes' layout ([`RoundLanes`], [`RoundSteps`]), the entry points and the step's outline on the lanes |
+//! | `circle` | the solves on each lane's circle or sphere: eq. (3), the RK4 stages, RATTLE, projection and the restores of eqs. (10) and (11) |
 
 #[cfg(target_arch = "x86_64")]
-use self::circle::{Advanced, CircleStages, OnCircles, solve_on_circles};
+use self::circle::{Advanced, OnRounds, RoundStages, solve_on_rounds};
 #[cfg(target_arch = "x86_64")]
 use super::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 #[cfg(target_arch = "x86_64")]
@@ -28,8 +29,9 @@ use super::step::drift_check;
 #[cfg(doc)]
 use super::step::step;
 pub use crate::lane::LANES;
+use crate::lane::LaneSpace;
 #[cfg(target_arch = "x86_64")]
-use crate::lane::{F64x8, Lane, V2, Vector, avx2};
+use crate::lane::{F64x8, Lane, Vector, avx2};
 use bevy::math::DVec2;
 #[cfg(target_arch = "x86_64")]
 use pulp::x86::V3;
@@ -38,80 +40,66 @@ mod circle;
 #[cfg(test)]
 mod tests;
 
-/// [`LANES`] beads on circles, as arrays of their scalars (one entry per
-/// bead), the layout the batched step vectorizes over.
+/// [`LANES`] beads on circles in the plane (`S = DVec2`) or on spheres in
+/// space (`S = DVec3`), as columns of their scalars (one entry per bead,
+/// one column per component), the layout the batched step vectorizes over.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct CircleLanes {
-    /// Position x.
-    pub x: [f64; LANES],
-    /// Position y.
-    pub y: [f64; LANES],
-    /// Velocity x.
-    pub vx: [f64; LANES],
-    /// Velocity y.
-    pub vy: [f64; LANES],
-    /// The external force's [`LinearForce::force`], x.
-    pub fx: [f64; LANES],
-    /// The external force's [`LinearForce::force`], y.
-    pub fy: [f64; LANES],
+pub(crate) struct RoundLanes<S: LaneSpace = DVec2> {
+    /// Position.
+    pub x: S::Columns,
+    /// Velocity.
+    pub v: S::Columns,
+    /// The external force's [`LinearForce::force`].
+    pub f: S::Columns,
     /// The external force's [`LinearForce::stiffness`].
     pub stiffness: [f64; LANES],
-    /// The external force's [`LinearForce::at`], x.
-    pub at_x: [f64; LANES],
-    /// The external force's [`LinearForce::at`], y.
-    pub at_y: [f64; LANES],
+    /// The external force's [`LinearForce::at`].
+    pub at: S::Columns,
     /// Mass.
     pub mass: [f64; LANES],
-    /// The circle's centre, x.
-    pub ox: [f64; LANES],
-    /// The circle's centre, y.
-    pub oy: [f64; LANES],
-    /// The circle's radius.
+    /// The circle's or sphere's centre.
+    pub centre: S::Columns,
+    /// Its radius.
     pub radius: [f64; LANES],
 }
 
-impl CircleLanes {
-    /// Puts bead `lane`'s state, force, mass and circle in place.
+impl<S: LaneSpace> RoundLanes<S> {
+    /// Puts bead `lane`'s state, force, mass and circle or sphere in
+    /// place.
     #[inline(always)]
     pub fn set(
         &mut self,
         lane: usize,
-        state: BeadState,
-        force: &LinearForce,
+        state: BeadState<S>,
+        force: &LinearForce<S>,
         mass: f64,
-        centre: DVec2,
+        centre: S,
         radius: f64,
     ) {
-        (self.x[lane], self.y[lane]) = (state.position.x, state.position.y);
-        (self.vx[lane], self.vy[lane]) = (state.velocity.x, state.velocity.y);
-        (self.fx[lane], self.fy[lane]) = (force.force.x, force.force.y);
+        S::set(&mut self.x, lane, state.position);
+        S::set(&mut self.v, lane, state.velocity);
+        S::set(&mut self.f, lane, force.force);
         self.stiffness[lane] = force.stiffness;
-        (self.at_x[lane], self.at_y[lane]) = (force.at.x, force.at.y);
+        S::set(&mut self.at, lane, force.at);
         self.mass[lane] = mass;
-        (self.ox[lane], self.oy[lane]) = (centre.x, centre.y);
+        S::set(&mut self.centre, lane, centre);
         self.radius[lane] = radius;
     }
 }
 
-/// What [`step_on_circles`] returns: each lane's step, as arrays of the
+/// What [`step_on_rounds`] returns: each lane's step, as columns of the
 /// fields of a [`StepOutput`] (one entry per bead), and which lanes it
 /// finished.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct CircleSteps {
-    /// New position x.
-    pub x: [f64; LANES],
-    /// New position y.
-    pub y: [f64; LANES],
-    /// New velocity x.
-    pub vx: [f64; LANES],
-    /// New velocity y.
-    pub vy: [f64; LANES],
+pub(crate) struct RoundSteps<S: LaneSpace = DVec2> {
+    /// New position.
+    pub x: S::Columns,
+    /// New velocity.
+    pub v: S::Columns,
     /// λ.
     pub lambda: [f64; LANES],
-    /// The constraint force `λN`, x.
-    pub fx: [f64; LANES],
-    /// The constraint force `λN`, y.
-    pub fy: [f64; LANES],
+    /// The constraint force `λN`.
+    pub constraint_force: S::Columns,
     /// `C` at the new state.
     pub c: [f64; LANES],
     /// `Ċ` at the new state.
@@ -121,25 +109,25 @@ pub struct CircleSteps {
     pub done: [bool; LANES],
 }
 
-impl CircleSteps {
+impl<S: LaneSpace> RoundSteps<S> {
     /// Lane `i`'s step, bit for bit what [`step`] returns, or `None` if the
     /// bead must go through [`step`].
     #[inline(always)]
-    pub fn lane(&self, i: usize) -> Option<StepOutput> {
+    pub fn lane(&self, i: usize) -> Option<StepOutput<S>> {
         self.done[i].then(|| self.lane_unchecked(i))
     }
 
     /// Lane `i`'s entries as a [`StepOutput`], whether or not the lane
     /// finished (check [`done`](Self::done) first).
     #[inline(always)]
-    pub fn lane_unchecked(&self, i: usize) -> StepOutput {
+    pub fn lane_unchecked(&self, i: usize) -> StepOutput<S> {
         StepOutput {
             state: BeadState {
-                position: DVec2::new(self.x[i], self.y[i]),
-                velocity: DVec2::new(self.vx[i], self.vy[i]),
+                position: S::get(&self.x, i),
+                velocity: S::get(&self.v, i),
             },
             lambda: self.lambda[i],
-            constraint_force: DVec2::new(self.fx[i], self.fy[i]),
+            constraint_force: S::get(&self.constraint_force, i),
             c: self.c[i],
             c_dot: self.c_dot[i],
         }
@@ -147,7 +135,8 @@ impl CircleSteps {
 }
 
 /// A step of eq. (3) for [`LANES`] beads on unrotated
-/// [`Circle`](crate::geometry::Circle)s at once, by any [`Method`] (RATTLE,
+/// [`Circle`](crate::geometry::Circle)s in the plane or on
+/// [`Sphere`](crate::geometry::Sphere)s in space at once, by any [`Method`] (RATTLE,
 /// RK4 and the Euler methods, with projection, Baumgarte stabilization or
 /// none), bit for bit what [`step`] returns for each.
 ///
@@ -156,31 +145,35 @@ impl CircleSteps {
 /// square roots and divisions of eight beads run side by side instead of
 /// one after another. A lane the batch cannot finish (a non-finite state,
 /// the circle's centre, a step past the drift bound) comes back not
-/// [`done`](CircleSteps::done): take that bead through [`step`], which
+/// [`done`](RoundSteps::done): take that bead through [`step`], which
 /// reports why. A processor without AVX2 finishes no lane. Each lane has
 /// its own mass; its drift bound is
 /// `settings.drift_bound` times its radius, as [`step`] takes it.
 ///
 /// The result goes into `out` (reused from call to call, so that nothing
 /// large is copied or cleared per call). Many batches go faster through
-/// [`step_on_circle_batches`].
+/// [`step_on_round_batches`].
 #[inline]
 #[cfg(test)]
-pub(super) fn step_on_circles(b: &CircleLanes, settings: &StepSettings, out: &mut CircleSteps) {
-    step_on_circle_batches(std::slice::from_ref(b), settings, std::slice::from_mut(out));
+pub(super) fn step_on_rounds<S: LaneSpace>(
+    b: &RoundLanes<S>,
+    settings: &StepSettings,
+    out: &mut RoundSteps<S>,
+) {
+    step_on_round_batches(std::slice::from_ref(b), settings, std::slice::from_mut(out));
 }
 
-/// [`step_on_circles`] for several batches in one call: `outs[i]` gets
+/// [`step_on_rounds`] for several batches in one call: `outs[i]` gets
 /// `batches[i]`'s step (a batch with no `outs` entry is not stepped; an
 /// `outs` entry with no batch is left as it was). One call enters the
 /// AVX2 code once for all of them, and reads each batch's lanes well
 /// after they were written one by one (loading a vector just after
 /// writing its lanes one at a time stalls the processor).
 #[inline]
-pub fn step_on_circle_batches(
-    batches: &[CircleLanes],
+pub(crate) fn step_on_round_batches<S: LaneSpace>(
+    batches: &[RoundLanes<S>],
     settings: &StepSettings,
-    outs: &mut [CircleSteps],
+    outs: &mut [RoundSteps<S>],
 ) {
     #[cfg(not(target_arch = "x86_64"))]
     {
@@ -210,15 +203,15 @@ pub fn step_on_circle_batches(
 /// closure is not always inlined, and outside that function each vector
 /// instruction would be a call).
 #[cfg(target_arch = "x86_64")]
-struct StepLanes<'a> {
+struct StepLanes<'a, S: LaneSpace> {
     simd: V3,
-    batches: &'a [CircleLanes],
+    batches: &'a [RoundLanes<S>],
     settings: &'a StepSettings,
-    outs: &'a mut [CircleSteps],
+    outs: &'a mut [RoundSteps<S>],
 }
 
 #[cfg(target_arch = "x86_64")]
-impl pulp::NullaryFnOnce for StepLanes<'_> {
+impl<S: LaneSpace> pulp::NullaryFnOnce for StepLanes<'_, S> {
     type Output = ();
     #[inline(always)]
     fn call(self) {
@@ -228,32 +221,37 @@ impl pulp::NullaryFnOnce for StepLanes<'_> {
     }
 }
 
-/// [`step_on_circles`] on the AVX2 lanes.
+/// [`step_on_rounds`] on the AVX2 lanes.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut CircleSteps) {
+fn step_lanes<S: LaneSpace>(
+    simd: V3,
+    b: &RoundLanes<S>,
+    settings: &StepSettings,
+    out: &mut RoundSteps<S>,
+) {
     let load = |a: &[f64; LANES]| F64x8::load(simd, a);
-    let x = V2::new(load(&b.x), load(&b.y));
-    let v = V2::new(load(&b.vx), load(&b.vy));
-    let centre = V2::new(load(&b.ox), load(&b.oy));
+    let x = S::load(simd, &b.x);
+    let v = S::load(simd, &b.v);
+    let centre = S::load(simd, &b.centre);
     let (radius, m) = (load(&b.radius), load(&b.mass));
     let force = LinearForceLanes {
-        force: V2::new(load(&b.fx), load(&b.fy)),
+        force: S::load(simd, &b.f),
         stiffness: load(&b.stiffness),
-        at: V2::new(load(&b.at_x), load(&b.at_y)),
+        at: S::load(simd, &b.at),
     };
     let h = m.splat(settings.dt);
-    let circle = OnCircles { centre, radius };
+    let circle = OnRounds::<F64x8, S> { centre, radius };
     let advanced = if settings.method == Method::Rattle {
         circle.rattle(x, v, &force, m, h)
     } else {
         let (first, normal, mut regular) =
-            solve_on_circles(x, v, centre, radius, &force, m, settings);
+            solve_on_rounds::<F64x8, S>(x, v, centre, radius, &force, m, settings);
         let a = first.acceleration;
         let (x1, v1) = match settings.method {
             Method::ExplicitEuler(_) => explicit_euler_lanes(x, v, a, h),
             Method::Rk4(_) => {
-                let mut stages = CircleStages {
+                let mut stages = RoundStages::<F64x8, S> {
                     centre,
                     radius,
                     force: &force,
@@ -309,14 +307,11 @@ fn step_lanes(simd: V3, b: &CircleLanes, settings: &StepSettings, out: &mut Circ
     } else {
         (x1, v1, end)
     };
-    *out = CircleSteps {
-        x: x1.x.store(),
-        y: x1.y.store(),
-        vx: v1.x.store(),
-        vy: v1.y.store(),
+    *out = RoundSteps {
+        x: S::store(x1),
+        v: S::store(v1),
         lambda: lambda.store(),
-        fx: constraint_force.x.store(),
-        fy: constraint_force.y.store(),
+        constraint_force: S::store(constraint_force),
         c: end.c.store(),
         c_dot: end.normal.dot(v1).store(),
         done: regular.store(),
