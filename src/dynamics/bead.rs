@@ -384,19 +384,20 @@ impl NextBeadParams {
 /// [`SimParams::drag_stiffness`](crate::SimParams::drag_stiffness). The
 /// assignment's mouse drag is one (the scene inserts it on grab, moves it
 /// with the cursor, removes it on release); a game may pull a bead anywhere
-/// with one.
+/// with one. `SpringAnchor` pulls a bead in the plane,
+/// `SpringAnchor<DVec3>` one in space.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
 #[reflect(Component)]
-pub struct SpringAnchor(DVec2);
+pub struct SpringAnchor<V: Coordinates + Reflect + TypePath = DVec2>(V);
 
-impl SpringAnchor {
+impl<V: Coordinates + Reflect + TypePath> SpringAnchor<V> {
     /// An anchor at `point`, if it is finite.
-    pub fn new(point: DVec2) -> Result<Self, ParamError> {
+    pub fn new(point: V) -> Result<Self, ParamError> {
         finite_vector("spring anchor", point).map(Self)
     }
 
     /// Where the spring pulls toward.
-    pub fn get(&self) -> DVec2 {
+    pub fn get(&self) -> V {
         self.0
     }
 }

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use bevy::ecs::system::SystemParam;
-use bevy::math::DVec2;
+use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
 use serde::{Deserialize, Serialize};
@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use crate::debug_render::{hatch_point, wire_points};
 use crate::geometry::Placed;
 use crate::gui::render::{FramedView, SceneCamera, hatch_length};
+use crate::gui::space::{SpaceCamera, WireDrawing};
 use crate::preset::ActivePreset;
 use crate::{BeadPosition, Diverged, Pin, Rod, SpringAnchor, Wire, WireContact, pose_of};
 
@@ -31,6 +32,20 @@ pub struct BeadReport {
     /// Whether it is in flight off a one-sided wire.
     #[serde(default)]
     pub in_flight: bool,
+}
+
+/// Where one bead in space is.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpaceBeadReport {
+    /// Simulated position.
+    pub world: [f64; 3],
+    /// Window position in physical pixels, from the top left, through the
+    /// 3D view's camera.
+    pub pixel: [f32; 2],
+    /// The drawn radius in physical pixels.
+    pub radius_px: f32,
+    /// Why it diverged, if it did.
+    pub diverged: Option<String>,
 }
 
 /// Where one wire is drawn.
@@ -80,6 +95,13 @@ pub struct FrameReport {
     /// Each pin's point, in physical pixels.
     #[serde(default)]
     pub pins: Vec<[f32; 2]>,
+    /// The beads in space.
+    #[serde(default)]
+    pub space_beads: Vec<SpaceBeadReport>,
+    /// Each curve in space: its drawn points inside the window, in
+    /// physical pixels.
+    #[serde(default)]
+    pub space_curves: Vec<Vec<[f32; 2]>>,
     /// The drag seen so far, if any.
     pub drag: Option<DragReport>,
     /// The preset running.
@@ -150,6 +172,17 @@ struct ReportView<'w, 's> {
         ),
     >,
     wires: Query<'w, 's, (&'static Wire, &'static Transform)>,
+    space_cameras: Query<'w, 's, (&'static Camera, &'static GlobalTransform), With<SpaceCamera>>,
+    space_beads: Query<
+        'w,
+        's,
+        (
+            &'static BeadPosition<DVec3>,
+            Option<&'static Diverged>,
+            &'static Transform,
+        ),
+    >,
+    space_wires: Query<'w, 's, (&'static WireDrawing, &'static Transform)>,
     rods: Query<'w, 's, &'static Rod>,
     pins: Query<'w, 's, &'static Pin>,
     transforms: Query<'w, 's, &'static Transform>,
@@ -244,11 +277,62 @@ impl ReportView<'_, '_> {
                 .iter()
                 .filter_map(|pin| to_pixel(pin.locate(&self.transforms)?))
                 .collect(),
+            space_beads: self.space_beads(scale),
+            space_curves: self.space_curves(scale, in_window),
             drag,
             preset: self.active.running.clone(),
             preset_error: self.active.error.clone(),
             mean_frame_ms,
         }
+    }
+}
+
+impl ReportView<'_, '_> {
+    /// A point in space in physical pixels through the 3D view's camera.
+    fn space_pixel(&self, scale: f32, p: Vec3) -> Option<Vec2> {
+        let (camera, transform) = self.space_cameras.iter().next()?;
+        Some(camera.world_to_viewport(transform, p).ok()? * scale)
+    }
+
+    /// Where each bead in space shows, and how large.
+    fn space_beads(&self, scale: f32) -> Vec<SpaceBeadReport> {
+        let right = self
+            .space_cameras
+            .iter()
+            .next()
+            .map_or(Vec3::X, |(_, t)| t.right().as_vec3());
+        self.space_beads
+            .iter()
+            .filter_map(|(bead, diverged, transform)| {
+                let at = bead.0.as_vec3();
+                let centre = self.space_pixel(scale, at)?;
+                let rim = self.space_pixel(scale, at + right * transform.scale.x)?;
+                Some(SpaceBeadReport {
+                    world: bead.0.to_array(),
+                    pixel: centre.to_array(),
+                    radius_px: centre.distance(rim),
+                    diverged: diverged.map(|d| d.reason.to_string()),
+                })
+            })
+            .collect()
+    }
+
+    /// Each curve in space's drawn points inside the window.
+    fn space_curves(&self, scale: f32, inside: impl Fn(&[f32; 2]) -> bool) -> Vec<Vec<[f32; 2]>> {
+        self.space_wires
+            .iter()
+            .filter_map(|(drawing, transform)| match drawing {
+                WireDrawing::Curve(points) => Some(
+                    points
+                        .iter()
+                        .filter_map(|&p| self.space_pixel(scale, transform.transform_point(p)))
+                        .map(|p| p.to_array())
+                        .filter(&inside)
+                        .collect(),
+                ),
+                WireDrawing::Surface(_) => None,
+            })
+            .collect()
     }
 }
 
@@ -293,7 +377,7 @@ impl AutomationState {
             let failure = format!("the scene preset {} never ran", active.path);
             self.failures.push(failure);
         }
-        if last.beads.is_empty() {
+        if last.beads.is_empty() && last.space_beads.is_empty() {
             self.failures
                 .push("there was no bead in the scene".to_owned());
         }

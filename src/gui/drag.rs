@@ -7,6 +7,7 @@
 //! whose drawn disc the press landed in (a forgiving grab for a small bead,
 //! and robust when the window's hover state was reset by the press).
 
+use bevy::math::DVec3;
 use bevy::prelude::*;
 
 use crate::gui::render::{SceneCamera, screen_to_world};
@@ -106,7 +107,7 @@ pub fn follow_drag(
     }
 }
 
-/// Releases the bead: the spring force ends.
+/// Releases the bead, in the plane or in space: the spring force ends.
 pub fn end_drag(
     _event: On<Pointer<DragEnd>>,
     mut grabbed: ResMut<Grabbed>,
@@ -115,6 +116,6 @@ pub fn end_drag(
     if let Some(bead) = grabbed.0.take()
         && let Ok(mut entity) = commands.get_entity(bead)
     {
-        entity.remove::<SpringAnchor>();
+        entity.remove::<(SpringAnchor, SpringAnchor<DVec3>)>();
     }
 }

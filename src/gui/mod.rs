@@ -6,6 +6,7 @@
 //! |---|---|
 //! | [`WireBeadGuiPlugin`] | everything below plus [`crate::ScenePresetPlugin`] and [`crate::KeyboardControlsPlugin`] |
 //! | [`SceneRenderPlugin`] | camera framing, wire gizmos, bead meshes, trails, force arrows |
+//! | [`SpaceViewPlugin`] | the 3D view of scenes in space: orbit camera, wires as lines and translucent surfaces, beads as spheres to drag |
 //! | [`BeadDragPlugin`] | mesh picking: drag a bead with the mouse (the assignment's spring) |
 //! | [`PanelPlugin`] | the egui panel and plots |
 //! | [`AutomationPlugin`] | run N frames, screenshot, reports, exit status |
@@ -18,15 +19,17 @@ pub mod automation;
 pub mod drag;
 pub mod panel;
 pub mod render;
+pub mod space;
 
 use bevy::picking::mesh_picking::MeshPickingPlugin;
 use bevy::prelude::*;
-use bevy_egui::EguiPlugin;
+use bevy_egui::{EguiGlobalSettings, EguiPlugin};
 
 pub use automation::{AutomationPlugin, FrameReport};
 pub use drag::BeadDragPlugin;
 pub use panel::{PanelPlugin, PresetCatalog};
 pub use render::{SceneCamera, SceneRenderPlugin, SceneStyle};
+pub use space::{SpaceCamera, SpaceViewPlugin};
 
 use crate::controls::KeyboardControlsPlugin;
 use crate::preset::ScenePresetPlugin;
@@ -40,6 +43,18 @@ impl Plugin for WireBeadGuiPlugin {
         if !app.is_plugin_added::<EguiPlugin>() {
             app.add_plugins(EguiPlugin::default());
         }
+        // The panel lives on the plane's camera, which stays on in both
+        // views (the space camera is off for scenes in the plane); it is
+        // given the panel's context itself.
+        match app.world_mut().get_resource_mut::<EguiGlobalSettings>() {
+            Some(mut settings) => settings.auto_create_primary_context = false,
+            None => {
+                app.insert_resource(EguiGlobalSettings {
+                    auto_create_primary_context: false,
+                    ..default()
+                });
+            }
+        }
         if !app.is_plugin_added::<MeshPickingPlugin>() {
             app.add_plugins(MeshPickingPlugin);
         }
@@ -49,6 +64,11 @@ impl Plugin for WireBeadGuiPlugin {
         if !app.is_plugin_added::<KeyboardControlsPlugin>() {
             app.add_plugins(KeyboardControlsPlugin);
         }
-        app.add_plugins((SceneRenderPlugin, BeadDragPlugin, PanelPlugin));
+        app.add_plugins((
+            SceneRenderPlugin,
+            SpaceViewPlugin,
+            BeadDragPlugin,
+            PanelPlugin,
+        ));
     }
 }

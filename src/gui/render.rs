@@ -8,6 +8,7 @@ use std::collections::{HashMap, VecDeque};
 use bevy::camera::ScalingMode;
 use bevy::math::DVec2;
 use bevy::prelude::*;
+use bevy_egui::PrimaryEguiContext;
 
 use crate::debug_render::{
     DebugRenderStyle, DebugRenderSystems, WireBeadDebugPlugin, wire_points, wire_pose,
@@ -166,6 +167,7 @@ fn spawn_camera(mut commands: Commands, style: Res<SceneStyle>) {
     commands.spawn((
         Camera2d,
         SceneCamera,
+        PrimaryEguiContext,
         Projection::Orthographic(OrthographicProjection {
             scaling_mode: ScalingMode::WindowSize,
             ..OrthographicProjection::default_2d()

@@ -91,9 +91,7 @@ pub enum PresetError {
     #[error("the scene has no bead")]
     Empty,
     /// A scene in space where one in the plane was asked for.
-    #[error(
-        "the scene is in space (dimension: 3); the window and this command take scenes in the plane"
-    )]
+    #[error("the scene is in space (dimension: 3); this takes scenes in the plane")]
     InSpace,
     /// A dimension other than 2 or 3.
     #[error("dimension must be 2 or 3, got {0}")]

@@ -162,7 +162,7 @@ impl WirePreset {
 }
 
 /// A whole scene: parameters, wires and beads.
-#[derive(Asset, TypePath, Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ScenePreset {
     /// A human-readable name.

@@ -50,9 +50,12 @@ pub use space::{
 };
 pub use spawn::FromPreset;
 
+use bevy::prelude::*;
+
 /// A scene file of either dimension, as its `dimension` says: in the
-/// plane (none, or `2`) or in space (`3`).
-#[derive(Clone, Debug)]
+/// plane (none, or `2`) or in space (`3`). The asset
+/// [`ScenePresetLoader`] loads.
+#[derive(Asset, TypePath, Clone, Debug)]
 pub enum SceneFile {
     /// A scene in the plane.
     Plane(ScenePreset),
@@ -79,6 +82,28 @@ impl SceneFile {
         match self {
             Self::Plane(scene) => &scene.name,
             Self::Space(scene) => &scene.name,
+        }
+    }
+
+    /// The scene's parameters.
+    pub fn params(&self) -> &crate::SimParams {
+        match self {
+            Self::Plane(scene) => &scene.params,
+            Self::Space(scene) => &scene.params.0,
+        }
+    }
+
+    /// Whether the scene is in space.
+    pub fn in_space(&self) -> bool {
+        matches!(self, Self::Space(_))
+    }
+
+    /// Spawns the scene: its wires, beads and links, each marked
+    /// [`FromPreset`]; the beads in the file's order.
+    pub fn spawn(&self, commands: &mut Commands) -> Vec<Entity> {
+        match self {
+            Self::Plane(scene) => scene.spawn(commands),
+            Self::Space(scene) => scene.spawn(commands),
         }
     }
 }

@@ -5,18 +5,19 @@ use bevy::asset::io::Reader;
 use bevy::asset::{AssetLoadError, AssetLoadFailedEvent, AssetLoader, LoadContext};
 use bevy::prelude::*;
 
+use super::SceneFile;
 use super::error::PresetError;
-use super::format::ScenePreset;
 use super::spawn::FromPreset;
 use crate::dynamics::{NextParams, OnWire};
 use crate::plugin::{Restart, WireBeadSystems};
 
-/// Loads `*.scene.ron` files as [`ScenePreset`]s, validating them.
+/// Loads `*.scene.ron` files of either dimension as [`SceneFile`]s,
+/// validating them.
 #[derive(Default, TypePath)]
 pub struct ScenePresetLoader;
 
 impl AssetLoader for ScenePresetLoader {
-    type Asset = ScenePreset;
+    type Asset = SceneFile;
     type Settings = ();
     type Error = PresetError;
 
@@ -25,11 +26,11 @@ impl AssetLoader for ScenePresetLoader {
         reader: &mut dyn Reader,
         _settings: &(),
         _load_context: &mut LoadContext<'_>,
-    ) -> Result<ScenePreset, PresetError> {
+    ) -> Result<SceneFile, PresetError> {
         let mut bytes = Vec::new();
         reader.read_to_end(&mut bytes).await?;
         let text = String::from_utf8_lossy(&bytes);
-        ScenePreset::from_ron(&text)
+        SceneFile::from_ron(&text)
     }
 
     fn extensions(&self) -> &[&str] {
@@ -41,11 +42,13 @@ impl AssetLoader for ScenePresetLoader {
 #[derive(Resource, Clone, Debug, Default)]
 pub struct ActivePreset {
     /// The preset's handle; set it (or send [`LoadPreset`]) to switch scenes.
-    pub handle: Handle<ScenePreset>,
+    pub handle: Handle<SceneFile>,
     /// The preset's asset path.
     pub path: String,
     /// The name of the preset now running.
     pub running: Option<String>,
+    /// Whether the preset now running is in space.
+    pub in_space: bool,
     /// Why the last load failed, if it did; cleared by a good load.
     pub error: Option<String>,
 }
@@ -61,7 +64,7 @@ pub struct ScenePresetPlugin;
 
 impl Plugin for ScenePresetPlugin {
     fn build(&self, app: &mut App) {
-        app.init_asset::<ScenePreset>()
+        app.init_asset::<SceneFile>()
             .register_asset_loader(ScenePresetLoader)
             .init_resource::<ActivePreset>()
             .add_message::<LoadPreset>()
@@ -93,7 +96,7 @@ pub fn load_requested_preset(
 /// Records and logs a failed load of the active preset; the scene keeps
 /// running.
 pub fn report_preset_errors(
-    mut failures: MessageReader<AssetLoadFailedEvent<ScenePreset>>,
+    mut failures: MessageReader<AssetLoadFailedEvent<SceneFile>>,
     mut active: ResMut<ActivePreset>,
 ) {
     for failure in failures.read() {
@@ -121,8 +124,8 @@ fn load_error_in_words(error: &AssetLoadError) -> String {
 
 /// Replaces the scene when the active preset loads or its file changes.
 pub fn apply_loaded_preset(
-    mut events: MessageReader<AssetEvent<ScenePreset>>,
-    presets: Res<Assets<ScenePreset>>,
+    mut events: MessageReader<AssetEvent<SceneFile>>,
+    presets: Res<Assets<SceneFile>>,
     mut active: ResMut<ActivePreset>,
     mut pending: ResMut<NextParams>,
     existing: Query<Entity, (With<FromPreset>, Without<OnWire>)>,
@@ -140,7 +143,7 @@ pub fn apply_loaded_preset(
     let Some(preset) = presets.get(id) else {
         return;
     };
-    if let Err(err) = pending.set(preset.params.clone()) {
+    if let Err(err) = pending.set(preset.params().clone()) {
         active.error = Some(err.to_string());
         return;
     }
@@ -149,8 +152,9 @@ pub fn apply_loaded_preset(
         commands.entity(entity).try_despawn();
     }
     preset.spawn(&mut commands);
-    active.running = Some(preset.name.clone());
+    active.running = Some(preset.name().to_owned());
+    active.in_space = preset.in_space();
     active.error = None;
-    info!("wirebead: running scene preset {:?}", preset.name);
+    info!("wirebead: running scene preset {:?}", preset.name());
     restarts.write(Restart);
 }

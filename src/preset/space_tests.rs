@@ -122,6 +122,6 @@ fn bad_scenes_in_space_are_refused_in_one_line_naming_the_item() {
     // A scene in space read as one in the plane is refused in words.
     assert_eq!(
         ScenePreset::from_ron(HOOP).unwrap_err().to_string(),
-        "the scene is in space (dimension: 3); the window and this command take scenes in the plane"
+        "the scene is in space (dimension: 3); this takes scenes in the plane"
     );
 }

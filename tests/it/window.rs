@@ -241,3 +241,68 @@ fn screenshot_of_the_roller_coaster_hatches_the_closed_side_of_its_track() {
         100.0 * open
     );
 }
+
+/// Whether a pixel within `radius` of `at` has the bead's hue: orange
+/// (the bead is lit, so its brightness varies across it; the trail's
+/// yellow has too much green).
+fn bead_hue_near(image: &RgbImage, at: [f32; 2], radius: i32) -> bool {
+    let (x0, y0) = (at[0].round() as i32, at[1].round() as i32);
+    (-radius..=radius).any(|dy| {
+        (-radius..=radius).any(|dx| {
+            let (x, y) = (x0 + dx, y0 + dy);
+            if x < 0 || y < 0 || x as u32 >= image.width() || y as u32 >= image.height() {
+                return false;
+            }
+            let [r, g, b] = image.get_pixel(x as u32, y as u32).0.map(f32::from);
+            r >= 80.0 && (0.3..0.75).contains(&(g / r)) && b / r < 0.35
+        })
+    })
+}
+
+#[test]
+#[ignore = "needs the screenshot .ci/run makes under Xvfb"]
+fn screenshot_in_space_shows_the_hoop_and_its_bead_where_simulated() {
+    let (image, report) = screenshot("space");
+    assert!(
+        report.beads.is_empty(),
+        "a scene in space has no bead in the plane"
+    );
+    assert_eq!(report.space_beads.len(), 1);
+    let bead = &report.space_beads[0];
+    assert!(
+        bead.radius_px >= 3.0,
+        "the bead is drawn {} px wide",
+        bead.radius_px
+    );
+    assert!(
+        bead_hue_near(&image, bead.pixel, (0.5 * bead.radius_px) as i32),
+        "no bead at {:?}",
+        bead.pixel
+    );
+    // The hoop is drawn where it is, through the 3D camera.
+    let wire_colour = rgb(wirebead::gui::SceneStyle::default().wire);
+    let [hoop] = report.space_curves.as_slice() else {
+        panic!("one curve in space, got {}", report.space_curves.len());
+    };
+    let away: Vec<&[f32; 2]> = hoop
+        .iter()
+        .filter(|p| {
+            let d = ((p[0] - bead.pixel[0]).powi(2) + (p[1] - bead.pixel[1]).powi(2)).sqrt();
+            d > 3.0 * bead.radius_px
+        })
+        .collect();
+    assert!(
+        away.len() > 50,
+        "too few points of the hoop in view: {}",
+        away.len()
+    );
+    let on = away
+        .iter()
+        .filter(|p| colour_near(&image, ***p, 3, wire_colour))
+        .count();
+    assert!(
+        on as f64 > 0.6 * away.len() as f64,
+        "the hoop's colour at only {on} of its {} points",
+        away.len()
+    );
+}

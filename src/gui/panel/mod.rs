@@ -10,6 +10,7 @@
 mod constraints;
 mod params;
 mod plots;
+mod space;
 mod view;
 mod window;
 
@@ -51,6 +52,24 @@ impl Default for PresetCatalog {
                 ("Bead on a spinning rod", "scenes/spinning_rod.scene.ron"),
                 ("Tautochrone race", "scenes/tautochrone.scene.ron"),
                 ("Roller coaster", "scenes/roller_coaster.scene.ron"),
+                (
+                    "In space: bead on a rotating hoop",
+                    "scenes/rotating_hoop.scene.ron",
+                ),
+                ("In space: bead on a helix", "scenes/helix.scene.ron"),
+                (
+                    "In space: spherical pendulum",
+                    "scenes/spherical_pendulum.scene.ron",
+                ),
+                ("In space: bead on a torus", "scenes/torus.scene.ron"),
+                (
+                    "In space: roller coaster",
+                    "scenes/coaster_in_space.scene.ron",
+                ),
+                (
+                    "In space: rope from a pin",
+                    "scenes/rope_in_space.scene.ron",
+                ),
             ]
             .into_iter()
             .map(|(a, b)| (a.to_owned(), b.to_owned()))
@@ -78,7 +97,10 @@ impl Plugin for PanelPlugin {
 }
 
 /// Selects the first bead when none (or a despawned one) is selected.
-pub fn keep_selection(mut selected: ResMut<SelectedBead>, beads: Query<Entity, With<Bead>>) {
+pub fn keep_selection(
+    mut selected: ResMut<SelectedBead>,
+    beads: Query<Entity, Or<(With<Bead>, With<crate::SpaceBead>)>>,
+) {
     if selected.0.is_none_or(|e| !beads.contains(e)) {
         selected.0 = beads.iter().min();
     }

@@ -210,8 +210,8 @@ fn wire_editor(ui: &mut egui::Ui, shape: &WireShape) -> Option<WireShape> {
     (format!("{edited:?}") != format!("{shape:?}")).then_some(edited)
 }
 
-/// The parameters every bead shares.
-pub(super) fn solver_section(ui: &mut egui::Ui, pending: &mut NextParams) -> Edit {
+/// The parameters every bead shares; gravity's third component in space.
+pub(super) fn solver_section(ui: &mut egui::Ui, pending: &mut NextParams, in_space: bool) -> Edit {
     ui.separator();
     ui.strong("Solver");
     let mut draft = pending.get().clone();
@@ -221,6 +221,9 @@ pub(super) fn solver_section(ui: &mut egui::Ui, pending: &mut NextParams) -> Edi
         number(ui, "damping constant β", &mut draft.beta, 0.1);
         number(ui, "drag scale k", &mut draft.drag_stiffness, 0.1);
         vector(ui, "gravity", &mut draft.gravity, 0.01);
+        if in_space {
+            number(ui, "gravity z", &mut draft.gravity_z, 0.01);
+        }
         ui.label("integrator");
         let mut integrator = draft.method.integrator();
         choice(

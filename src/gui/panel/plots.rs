@@ -3,6 +3,7 @@
 
 use std::collections::VecDeque;
 
+use bevy::math::DVec3;
 use bevy::prelude::*;
 use bevy_egui::egui;
 use egui_plot::{Line, Plot, PlotPoints};
@@ -43,18 +44,28 @@ impl Default for PlotHistory {
     }
 }
 
-/// Appends the selected bead's diagnostics to the plot history; for a
-/// bead joined to others, the energy is its island's (a rod does work on
-/// each of its beads, not on the two together).
+/// Appends the selected bead's diagnostics (in the plane or in space) to
+/// the plot history; for a bead joined to others, the energy is its
+/// island's (a rod does work on each of its beads, not on the two
+/// together).
 pub fn record_history(
     selected: Res<SelectedBead>,
     clock: Res<SimClock>,
     beads: Query<&BeadDiagnostics>,
+    space_beads: Query<&BeadDiagnostics<DVec3>>,
     islands: Res<Islands>,
+    space_islands: Res<Islands<DVec3>>,
     mut history: ResMut<PlotHistory>,
 ) {
     let Some(entity) = selected.0 else { return };
-    let Ok(d) = beads.get(entity) else { return };
+    let plane = beads.get(entity).ok().map(|d| (d.c, d.lambda, d.energy()));
+    let space = || {
+        let d = space_beads.get(entity).ok()?;
+        Some((d.c, d.lambda, d.energy()))
+    };
+    let Some((c, lambda, own)) = plane.or_else(space) else {
+        return;
+    };
     let t = clock.time;
     if history.bead != Some(entity) || history.samples.back().is_some_and(|s| s.t > t) {
         history.samples.clear();
@@ -62,13 +73,14 @@ pub fn record_history(
     }
     let energy = islands
         .of(entity)
+        .or_else(|| space_islands.of(entity))
         .filter(|island| island.rows > 0)
-        .map_or(d.energy(), |island| island.energy);
+        .map_or(own, |island| island.energy);
     history.samples.push_back(PlotSample {
         t,
-        c: d.c,
+        c,
         energy,
-        lambda: d.lambda,
+        lambda,
     });
     let horizon = t - history.seconds;
     while history.samples.front().is_some_and(|s| s.t < horizon) {

@@ -2,6 +2,7 @@
 //! gathered as system parameters the sections share.
 
 use bevy::ecs::system::SystemParam;
+use bevy::math::DVec3;
 use bevy::prelude::*;
 
 use super::PresetCatalog;
@@ -13,7 +14,7 @@ use crate::preset::{ActivePreset, LoadPreset};
 use crate::{
     BeadDiagnostics, BeadParams, ConstraintDiagnostics, Diverged, Islands, NextBeadParams,
     NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, Restart, Rod, SimClock, SimParams,
-    Wire, WireContact,
+    SpaceWire, Wire, WireContact,
 };
 
 /// The read-only state the panel shows.
@@ -48,6 +49,19 @@ pub struct PanelView<'w, 's> {
             Option<&'static PrescribedMotion>,
         ),
     >,
+    pub(super) space_beads: Query<
+        'w,
+        's,
+        (
+            Entity,
+            &'static BeadParams<DVec3>,
+            Option<&'static BeadDiagnostics<DVec3>>,
+            Option<&'static OnWire>,
+            Option<&'static Diverged>,
+        ),
+    >,
+    pub(super) space_wires:
+        Query<'w, 's, (&'static SpaceWire, Option<&'static PrescribedMotion<DVec3>>)>,
     pub(super) contacts: Query<'w, 's, &'static WireContact>,
     pub(super) rods: Query<'w, 's, (&'static Rod, &'static ConstraintDiagnostics)>,
     pub(super) pins: Query<'w, 's, (&'static Pin, &'static ConstraintDiagnostics)>,

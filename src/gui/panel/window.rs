@@ -7,6 +7,7 @@ use bevy_egui::{EguiContexts, egui};
 use super::constraints::constraints_section;
 use super::params::{Edit, bead_section, solver_section};
 use super::plots::plots_section;
+use super::space::space_bead_section;
 use super::view::{PanelActions, PanelView};
 use crate::Restart;
 use crate::controls::ControlKeys;
@@ -38,9 +39,13 @@ pub fn panel(
         .vscroll(true)
         .show(ctx, |ui| {
             scene_section(ui, &view, &mut actions, refused.as_deref());
-            let bead = bead_section(ui, &view, &mut actions.commands);
+            let bead = bead_section(ui, &view, &mut actions.commands).or(space_bead_section(
+                ui,
+                &view,
+                &mut actions.commands,
+            ));
             constraints_section(ui, &view);
-            let solver = solver_section(ui, &mut actions.pending);
+            let solver = solver_section(ui, &mut actions.pending, view.active.in_space);
             outcome = solver.or(bead);
             plots_section(ui, &view.history);
         });
@@ -123,7 +128,9 @@ fn scene_section(
     if edits_pending {
         ui.colored_label(PENDING_ORANGE, "● Edits pending: press Space to apply");
     }
-    for (entity, _, _, _, _, diverged) in &view.beads {
+    let diverged = view.beads.iter().map(|(entity, .., d)| (entity, d));
+    let in_space = view.space_beads.iter().map(|(entity, .., d)| (entity, d));
+    for (entity, diverged) in diverged.chain(in_space) {
         if let Some(d) = diverged {
             ui.colored_label(
                 ERROR_RED,

@@ -1,0 +1,116 @@
+//! The selected bead in space: its mass and start in three components, its
+//! wire (a spinning wire's ω edited live), and its `C`, `Ċ`, λ and
+//! energy.
+
+use bevy::math::DVec3;
+use bevy::prelude::*;
+use bevy_egui::egui;
+
+use super::params::Edit;
+use super::view::PanelView;
+use crate::PrescribedMotion;
+use crate::geometry::{SpaceMotion, SpaceShape};
+
+/// A vector's three components, read-only.
+fn components(ui: &mut egui::Ui, label: &str, value: DVec3) {
+    ui.label(label);
+    ui.monospace(format!("({:.3}, {:.3}, {:.3})", value.x, value.y, value.z));
+    ui.end_row();
+}
+
+/// The selected bead in space, if one is selected.
+pub(super) fn space_bead_section(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    commands: &mut Commands,
+) -> Edit {
+    let (entity, bead, diagnostics, on_wire, _) =
+        view.selected.0.and_then(|e| view.space_beads.get(e).ok())?;
+    ui.separator();
+    ui.strong(format!("Bead {} (in space)", view.name(entity)));
+    egui::Grid::new("space-bead").num_columns(2).show(ui, |ui| {
+        ui.label("mass");
+        ui.monospace(format!("{:.3} kg", bead.mass));
+        ui.end_row();
+        components(ui, "initial position", bead.initial_position);
+        components(ui, "initial velocity", bead.initial_velocity);
+    });
+    let mut outcome = None;
+    if let Some(on_wire) = on_wire
+        && let Ok((wire, motion)) = view.space_wires.get(on_wire.0)
+    {
+        ui.strong("Wire");
+        ui.label(match wire.shape() {
+            SpaceShape::Curve(_) => "a curve: two rows, the offset along two normals",
+            SpaceShape::Surface(_) => "a surface: one row, its value",
+        });
+        let surface = wire.surface();
+        if surface.side.sign() != 0.0 {
+            ui.label(format!(
+                "pushes one way ({} side), restitution {:.2}",
+                surface.side.name(),
+                surface.restitution
+            ));
+        }
+        match motion.map(PrescribedMotion::motion) {
+            Some(SpaceMotion::Spin {
+                angular_velocity,
+                axis,
+            }) => {
+                let mut omega = angular_velocity;
+                ui.horizontal(|ui| {
+                    ui.label("spins at ω");
+                    ui.add(
+                        egui::DragValue::new(&mut omega)
+                            .speed(0.05)
+                            .suffix(" rad/s")
+                            .max_decimals(3),
+                    );
+                });
+                ui.label(format!(
+                    "about ({:.2}, {:.2}, {:.2}); a change applies at once",
+                    axis.x, axis.y, axis.z
+                ));
+                if omega != angular_velocity {
+                    let spin = SpaceMotion::Spin {
+                        angular_velocity: omega,
+                        axis,
+                    };
+                    outcome = Some(PrescribedMotion::in_space(spin).map(|motion| {
+                        commands.entity(on_wire.0).insert(motion);
+                    }));
+                }
+            }
+            Some(SpaceMotion::Oscillate(o)) => {
+                ui.label(format!(
+                    "oscillates by ({:.2}, {:.2}, {:.2}) at {:.2} Hz",
+                    o.amplitude.x, o.amplitude.y, o.amplitude.z, o.frequency
+                ));
+            }
+            Some(SpaceMotion::Fixed) | None => {}
+        }
+    }
+    ui.separator();
+    egui::Grid::new("space-values")
+        .num_columns(4)
+        .show(ui, |ui| {
+            if let Some(d) = diagnostics {
+                ui.label("C");
+                ui.monospace(format!("{:+.3e}", d.c));
+                ui.label("Ċ");
+                ui.monospace(format!("{:+.3e}", d.c_dot));
+                ui.end_row();
+                ui.label("λ");
+                ui.monospace(format!("{:+.3e}", d.lambda));
+                ui.label("E");
+                ui.monospace(format!("{:+.4}", d.energy()));
+                ui.end_row();
+            }
+            ui.label("t");
+            ui.monospace(format!("{:.2} s", view.clock.time));
+            ui.label("steps");
+            ui.monospace(format!("{}", view.clock.steps));
+            ui.end_row();
+        });
+    outcome
+}
