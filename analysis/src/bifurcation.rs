@@ -106,6 +106,7 @@ impl HoopSweep {
                 restitution: 0.0,
                 friction: Friction::NONE,
                 damping: self.damping,
+                rail: None,
                 beads: vec![BeadPreset {
                     name: "b".to_owned(),
                     mass: 1.0,

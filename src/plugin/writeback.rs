@@ -11,7 +11,8 @@ use super::clock::SimClock;
 use super::parallel::ParallelStep;
 use super::schedule::WireBeadSystems;
 use crate::dynamics::{
-    BeadParams, BeadPosition, Dimension, OnWire, RailOrientation, SpaceWire, WirePose,
+    Bead, BeadParams, BeadPosition, Dimension, OnWire, RailOrientation, SpaceBead, SpaceWire,
+    WirePose,
 };
 use crate::geometry::{SpaceShape, WireSpace};
 
@@ -26,9 +27,15 @@ impl Plugin for WritebackPlugin {
             .init_resource::<LastStep<DVec3>>()
             .add_systems(
                 FixedUpdate,
+                // Each skipped, not run empty, while there is nothing to
+                // write.
                 (
-                    write_transforms::<DVec2>,
-                    (write_transforms::<DVec3>, orient_rails).chain(),
+                    write_transforms::<DVec2>.run_if(any_with_component::<Bead>),
+                    (
+                        write_transforms::<DVec3>.run_if(any_with_component::<SpaceBead>),
+                        orient_rails.run_if(any_with_component::<RailOrientation>),
+                    )
+                        .chain(),
                 )
                     .in_set(WireBeadSystems::Writeback),
             );

@@ -45,8 +45,8 @@ pub use plugin::{
     load_requested_preset, report_preset_errors,
 };
 pub use space::{
-    ConePreset, RotationPreset, SpaceMotionPreset, SpaceScene, SpaceShapePreset, SpaceWirePreset,
-    SpinPreset,
+    ConePreset, RailPreset, RotationPreset, SpaceMotionPreset, SpaceScene, SpaceShapePreset,
+    SpaceWirePreset, SpinPreset,
 };
 pub use spawn::FromPreset;
 

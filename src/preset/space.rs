@@ -11,7 +11,7 @@ use super::format::{
     BeadPreset, ConstraintPreset, SceneLink, SpringPreset, check_beads_and_links, names_of,
 };
 use super::spawn::{FromPreset, spawn_beads_and_links};
-use crate::dynamics::{PrescribedMotion, SpaceParams, SpaceWire};
+use crate::dynamics::{PrescribedMotion, RailOrientation, SpaceParams, SpaceWire};
 use crate::geometry::{
     Circle, Cone, Cycloid, Cylinder, Ellipse, Friction, Helix, Line, OnPlane, Oscillate, Parabola,
     Plane, Pose3, Side, Sine, SpaceMotion, SpaceShape, Sphere, Spline, Surface, Torus, WireShape,
@@ -237,9 +237,45 @@ pub struct SpaceWirePreset {
     /// Viscous damping along it, N·s/m.
     #[serde(default)]
     pub damping: f64,
+    /// On a curve, a rail: each bead on it turns with the track as a cart
+    /// does, up as near this `up` as the track allows where it starts
+    /// (see [`RailOrientation`]).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "written_rail",
+        deserialize_with = "given_rail"
+    )]
+    pub rail: Option<RailPreset>,
     /// The beads on it.
     #[serde(default)]
     pub beads: Vec<BeadPreset<DVec3>>,
+}
+
+/// A rail as a file writes it: `rail: (up: …)`, not `Some((up: …))`.
+fn written_rail<S: serde::Serializer>(
+    rail: &Option<RailPreset>,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    match rail {
+        Some(rail) => rail.serialize(serializer),
+        None => serializer.serialize_none(),
+    }
+}
+
+/// A rail as a file gives it: present, or left out.
+fn given_rail<'de, D: serde::Deserializer<'de>>(
+    deserializer: D,
+) -> Result<Option<RailPreset>, D::Error> {
+    RailPreset::deserialize(deserializer).map(Some)
+}
+
+/// A wire's rail: `rail: (up: (0.0, 1.0, 0.0))`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RailPreset {
+    /// The direction a cart's up is rolled toward where it starts.
+    pub up: DVec3,
 }
 
 impl SpaceWirePreset {
@@ -262,11 +298,19 @@ impl SpaceWirePreset {
         })
     }
 
-    /// Checks its shape, pose, motion and surface.
+    /// Checks its shape, pose, motion, surface and rail.
     fn validate(&self) -> Result<(), ParamError> {
         self.shape.validate()?;
         self.pose()?;
         self.motion.motion().validate()?;
+        if let Some(rail) = self.rail {
+            if matches!(self.shape.shape(), SpaceShape::Surface(_)) {
+                return Err(ParamError::Incompatible(
+                    "a rail is a curve: a surface has no track to turn with",
+                ));
+            }
+            RailOrientation::new(rail.up)?;
+        }
         self.surface().validate()
     }
 }
@@ -356,6 +400,19 @@ impl SpaceScene {
             wires.push((wire_entity, twist, wire.beads.as_slice()));
         }
         let links = self.links().unwrap_or_default();
-        spawn_beads_and_links(&wires, &self.beads, links, self.bead_names(), commands)
+        let beads = spawn_beads_and_links(&wires, &self.beads, links, self.bead_names(), commands);
+        // The beads of a rail turn with it.
+        let mut first = 0;
+        for wire in &self.wires {
+            let on = &beads[first..first + wire.beads.len()];
+            first += wire.beads.len();
+            let Some(Ok(rail)) = wire.rail.map(|r| RailOrientation::new(r.up)) else {
+                continue;
+            };
+            for &bead in on.iter().filter(|b| **b != Entity::PLACEHOLDER) {
+                commands.entity(bead).insert(rail);
+            }
+        }
+        beads
     }
 }

@@ -49,6 +49,10 @@ fn the_rotating_hoop_scene_parses() {
         }
     );
     assert_eq!(scene.bead_names(), ["b"]);
+    assert_eq!(scene.wires[0].rail, None);
+    // A rail: its beads turn with the track.
+    let rail = space(&HOOP.replace("beads:", "rail: (up: (0.0, 1.0, 0.0)), beads:"));
+    assert_eq!(rail.wires[0].rail, Some(super::RailPreset { up: DVec3::Y }));
     // A spin with no axis turns about z, as in the plane.
     let default_axis = space(&HOOP.replace(", axis: (0.0, 1.0, 0.0)))", "))"));
     assert_eq!(
@@ -104,6 +108,15 @@ fn bad_scenes_in_space_are_refused_in_one_line_naming_the_item() {
         (
             HOOP.replace("gravity: (0.0, -9.81, 0.0)", "gravity: (0.0, NaN, 0.0)"),
             "gravity must be finite, got (0, NaN, 0)",
+        ),
+        (
+            HOOP.replace("beads:", "rail: (up: (0.0, 0.0, 0.0)), beads:"),
+            "wire 0: a rail's up must not be zero",
+        ),
+        (
+            HOOP.replace("Circle((radius: 1.0))", "Sphere((radius: 1.0))")
+                .replace("beads:", "rail: (up: (0.0, 1.0, 0.0)), beads:"),
+            "wire 0: a rail is a curve: a surface has no track to turn with",
         ),
         (
             HOOP.replace("mass: 1.0", "mass: NaN"),

@@ -17,8 +17,8 @@ use super::{Orbit, SPACE_LAYER, SpaceGizmos};
 use crate::geometry::{Side, SpaceShape};
 use crate::gui::render::SceneStyle;
 use crate::{
-    BeadDiagnostics, BeadMass, BeadParams, BeadPosition, Diverged, OnWire, Pin, Restart, Rod,
-    SimParams, SpaceBead, SpaceWire, Spring, SpringAnchor, WireContact,
+    BeadDiagnostics, BeadMass, BeadParams, BeadPosition, Diverged, OnWire, Pin, RailOrientation,
+    Restart, Rod, SimParams, SpaceBead, SpaceWire, Spring, SpringAnchor, WireContact,
 };
 
 /// What the view draws of a wire in space, in its local frame: a curve's
@@ -133,17 +133,23 @@ pub fn add_wire_drawings(
     }
 }
 
-/// Gives new beads in space a sphere, a material and a trail.
+/// Gives new beads in space a sphere (a cart, a box long along its
+/// forward `−z`, where it turns with its rail), a material and a trail.
 pub fn add_bead_visuals(
-    beads: Query<Entity, (With<SpaceBead>, Without<SpaceBeadVisual>)>,
+    beads: Query<(Entity, Has<RailOrientation>), (With<SpaceBead>, Without<SpaceBeadVisual>)>,
     style: Res<SceneStyle>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
     mut commands: Commands,
 ) {
-    for entity in &beads {
+    for (entity, cart) in &beads {
+        let mesh = if cart {
+            meshes.add(Cuboid::new(1.4, 0.9, 2.4))
+        } else {
+            meshes.add(Sphere::new(1.0).mesh().uv(24, 12))
+        };
         commands.entity(entity).insert((
-            Mesh3d(meshes.add(Sphere::new(1.0).mesh().uv(24, 12))),
+            Mesh3d(mesh),
             MeshMaterial3d(materials.add(StandardMaterial {
                 base_color: style.bead,
                 perceptual_roughness: 0.5,

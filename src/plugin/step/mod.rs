@@ -25,8 +25,8 @@ use super::report::{ContactReports, Divergences, FoundDivergences, FoundEvents};
 use super::schedule::WireBeadSystems;
 use super::writeback::LastStep;
 use crate::dynamics::{
-    BeadDiagnostics, BeadForce, BeadMass, BeadPosition, BeadVelocity, Diverged, OnWire, SimParams,
-    WireContact, WirePose,
+    Bead, BeadDiagnostics, BeadForce, BeadMass, BeadPosition, BeadVelocity, Diverged, OnWire,
+    SimParams, SpaceBead, WireContact, WirePose,
 };
 pub(crate) use lone::LoneStep;
 use run::{StepContext, split_table};
@@ -42,7 +42,12 @@ impl Plugin for BeadStepPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             FixedUpdate,
-            (step_beads::<DVec2>, step_beads::<DVec3>).in_set(WireBeadSystems::Step),
+            // Each skipped, not run empty, while its dimension has no bead.
+            (
+                step_beads::<DVec2>.run_if(any_with_component::<Bead>),
+                step_beads::<DVec3>.run_if(any_with_component::<SpaceBead>),
+            )
+                .in_set(WireBeadSystems::Step),
         );
     }
 }
