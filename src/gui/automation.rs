@@ -65,13 +65,13 @@ pub struct WireReport {
     pub open_side: Vec<[f32; 2]>,
 }
 
-/// What a mouse drag did.
+/// What a mouse drag did, in the plane (`z = 0`) or in space.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DragReport {
     /// The bead's position when the drag began.
-    pub bead_start: [f64; 2],
+    pub bead_start: [f64; 3],
     /// The last drag target (where the cursor was released).
-    pub target: [f64; 2],
+    pub target: [f64; 3],
     /// The distance from the bead's start to that target.
     pub start_distance: f64,
     /// The bead's closest approach to that target while dragged.
@@ -133,9 +133,10 @@ struct AutomationState {
     timed_frames: u32,
     timed_seconds: f64,
     ready_written: bool,
-    /// The bead's positions while dragged, and the last drag target.
-    drag_path: Vec<DVec2>,
-    drag_target: Option<DVec2>,
+    /// The bead's positions while dragged, and the last drag target (in
+    /// the plane at `z = 0`).
+    drag_path: Vec<DVec3>,
+    drag_target: Option<DVec3>,
     failures: Vec<String>,
 }
 
@@ -180,6 +181,7 @@ struct ReportView<'w, 's> {
             &'static BeadPosition<DVec3>,
             Option<&'static Diverged>,
             &'static Transform,
+            Option<&'static SpringAnchor<DVec3>>,
         ),
     >,
     space_wires: Query<'w, 's, (&'static WireDrawing, &'static Transform)>,
@@ -303,7 +305,7 @@ impl ReportView<'_, '_> {
             .map_or(Vec3::X, |(_, t)| t.right().as_vec3());
         self.space_beads
             .iter()
-            .filter_map(|(bead, diverged, transform)| {
+            .filter_map(|(bead, diverged, transform, _)| {
                 let at = bead.0.as_vec3();
                 let centre = self.space_pixel(scale, at)?;
                 let rim = self.space_pixel(scale, at + right * transform.scale.x)?;
@@ -338,13 +340,10 @@ impl ReportView<'_, '_> {
 
 impl AutomationState {
     /// Records the dragged beads' positions and the drag target.
-    fn follow_drag<'a>(
-        &mut self,
-        dragged: impl Iterator<Item = (&'a BeadPosition, &'a SpringAnchor)>,
-    ) {
+    fn follow_drag(&mut self, dragged: impl Iterator<Item = (DVec3, DVec3)>) {
         for (bead, target) in dragged {
-            self.drag_path.push(bead.0);
-            self.drag_target = Some(target.get());
+            self.drag_path.push(bead);
+            self.drag_target = Some(target);
         }
     }
 
@@ -400,12 +399,15 @@ fn automation(
         state.timed_frames += 1;
         state.timed_seconds += real.delta_secs_f64();
     }
-    state.follow_drag(
-        scene
-            .beads
-            .iter()
-            .filter_map(|(bead, target, ..)| Some((bead, target?))),
-    );
+    let in_plane = scene
+        .beads
+        .iter()
+        .filter_map(|(bead, target, ..)| Some((bead.0.extend(0.0), target?.get().extend(0.0))));
+    let in_space = scene
+        .space_beads
+        .iter()
+        .filter_map(|(bead, _, _, target)| Some((bead.0, target?.get())));
+    state.follow_drag(in_plane.chain(in_space));
     let report =
         |state: &AutomationState| scene.report(frame, state.drag_report(), state.mean_frame_ms());
 

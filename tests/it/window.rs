@@ -144,6 +144,23 @@ fn a_real_mouse_drag_pulls_the_bead_toward_the_cursor() {
 }
 
 #[test]
+#[ignore = "needs the xdotool drag .ci/run makes under Xvfb"]
+fn a_real_mouse_drag_pulls_a_bead_in_space_toward_the_cursor() {
+    let ready = report("space_drag_ready.ron");
+    assert_eq!(ready.preset.as_deref(), Some("Bead in a bowl"));
+    assert_eq!(ready.space_beads.len(), 1);
+    let drag = report("space_drag.ron")
+        .drag
+        .expect("the drag reached the bead in space through picking");
+    assert!(
+        drag.closest_distance < 0.5 * drag.start_distance,
+        "the bead came no closer than {:.3} to the cursor (from {:.3})",
+        drag.closest_distance,
+        drag.start_distance
+    );
+}
+
+#[test]
 #[ignore = "needs the hot-reload run .ci/run makes under Xvfb"]
 fn editing_the_running_preset_reloads_it() {
     let ready = report("reload_ready.ron");

@@ -70,6 +70,7 @@ impl Default for PresetCatalog {
                     "In space: rope from a pin",
                     "scenes/rope_in_space.scene.ron",
                 ),
+                ("In space: bead in a bowl", "scenes/bowl.scene.ron"),
             ]
             .into_iter()
             .map(|(a, b)| (a.to_owned(), b.to_owned()))
