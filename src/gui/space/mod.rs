@@ -1,6 +1,6 @@
 //! The 3D view (feature `gui`): scenes in space open in a perspective
-//! camera that orbits the scene (drag empty space or with the right button
-//! to turn, the wheel to zoom); wires in space are drawn as lines (curves)
+//! camera that orbits the scene (drag empty space, or anything with a
+//! button other than the first, to turn; the wheel to zoom); wires in space are drawn as lines (curves)
 //! or translucent meshes (surfaces, the open side of a one-sided one in
 //! the wire's colour and the closed side darker), beads as spheres the
 //! mouse can drag, with trails, rods, pins, springs and the constraint
@@ -104,7 +104,7 @@ impl Plugin for SpaceViewPlugin {
                     draw::add_wire_drawings,
                     draw::add_bead_visuals,
                     draw::frame_scene,
-                    orbit,
+                    zoom,
                     draw::size_and_colour_beads,
                     draw::draw_wires,
                     draw::draw_links,
@@ -113,7 +113,8 @@ impl Plugin for SpaceViewPlugin {
                     .chain(),
             )
             .add_observer(start_drag)
-            .add_observer(follow_drag);
+            .add_observer(follow_drag)
+            .add_observer(turn);
     }
 }
 
@@ -182,25 +183,32 @@ fn show_view(
     }
 }
 
-/// Turns the camera with a drag of empty space (any button) or with the
-/// right button anywhere outside the panel, and zooms with the wheel.
-fn orbit(
-    buttons: Res<ButtonInput<MouseButton>>,
-    motion: Res<bevy::input::mouse::AccumulatedMouseMotion>,
+/// Turns the camera with a drag of empty space (any button), or of
+/// anything with a button other than the first; the panel takes the
+/// pointer over itself, so a drag there turns nothing.
+fn turn(
+    event: On<Pointer<Drag>>,
+    windows: Query<(), With<Window>>,
+    grabbed: Res<Grabbed>,
+    mut orbit: ResMut<Orbit>,
+) {
+    let empty = windows.contains(event.entity);
+    if grabbed.0.is_none() && (empty || event.event.button != PointerButton::Primary) {
+        orbit.yaw -= event.event.delta.x * 0.006;
+        orbit.pitch = (orbit.pitch + event.event.delta.y * 0.006).clamp(-1.5, 1.5);
+    }
+}
+
+/// Zooms with the wheel outside the panel, and puts the camera where the
+/// orbit says.
+fn zoom(
     scroll: Res<AccumulatedMouseScroll>,
     egui: Option<Res<EguiWantsInput>>,
-    grabbed: Res<Grabbed>,
     mut orbit: ResMut<Orbit>,
     mut cameras: Query<&mut Transform, With<SpaceCamera>>,
 ) {
     let over_panel = egui.is_some_and(|e| e.wants_any_pointer_input());
     if !over_panel {
-        let turning = grabbed.0.is_none()
-            && (buttons.pressed(MouseButton::Right) || buttons.pressed(MouseButton::Left));
-        if turning && motion.delta != Vec2::ZERO {
-            orbit.yaw -= motion.delta.x * 0.006;
-            orbit.pitch = (orbit.pitch + motion.delta.y * 0.006).clamp(-1.5, 1.5);
-        }
         let lines = match scroll.unit {
             MouseScrollUnit::Line => scroll.delta.y,
             MouseScrollUnit::Pixel => scroll.delta.y / 60.0,
@@ -235,11 +243,21 @@ fn drag_target(
 type SpaceCameras<'w, 's> =
     Query<'w, 's, (&'static Camera, &'static GlobalTransform), With<SpaceCamera>>;
 
+/// How far `p` lies from the ray.
+fn off_ray(ray: Ray3d, p: Vec3) -> f32 {
+    let along = (p - ray.origin).dot(*ray.direction).max(0.0);
+    p.distance(ray.get_point(along))
+}
+
 /// Grabs a bead in space the pointer pressed on: selects it and sets its
-/// drag target on the plane through it facing the camera.
+/// drag target on the plane through it facing the camera. A press that
+/// hit nothing (a small bead, or the press came before the pointer's
+/// hover) takes the nearest bead whose drawn sphere the pointer's ray
+/// passes through, with some slack.
 fn start_drag(
     event: On<Pointer<DragStart>>,
-    beads: Query<&crate::BeadPosition<DVec3>, With<SpaceBead>>,
+    beads: Query<(Entity, &crate::BeadPosition<DVec3>, &Transform), With<SpaceBead>>,
+    windows: Query<(), With<Window>>,
     cameras: SpaceCameras,
     mut grabbed: ResMut<Grabbed>,
     mut selected: ResMut<super::drag::SelectedBead>,
@@ -248,15 +266,34 @@ fn start_drag(
     if event.event.button != PointerButton::Primary || grabbed.0.is_some() {
         return;
     }
-    let (Ok(bead), Some(camera)) = (beads.get(event.entity), cameras.iter().next()) else {
+    let Some((camera, transform)) = cameras.iter().next() else {
         return;
     };
-    let Some(target) = drag_target(camera, event.pointer_location.position, bead.0) else {
+    let pointer = event.pointer_location.position;
+    let bead = if beads.contains(event.entity) {
+        Some(event.entity)
+    } else if windows.contains(event.entity) {
+        let Ok(ray) = camera.viewport_to_world(transform, pointer) else {
+            return;
+        };
+        beads
+            .iter()
+            .map(|(e, b, t)| (e, off_ray(ray, b.0.as_vec3()) / t.scale.x.max(1e-6)))
+            .filter(|(_, d)| *d <= 1.5)
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(e, _)| e)
+    } else {
+        None
+    };
+    let Some((bead, position, _)) = bead.and_then(|b| beads.get(b).ok()) else {
         return;
     };
-    grabbed.0 = Some(event.entity);
-    selected.0 = Some(event.entity);
-    commands.entity(event.entity).insert(target);
+    let Some(target) = drag_target((camera, transform), pointer, position.0) else {
+        return;
+    };
+    grabbed.0 = Some(bead);
+    selected.0 = Some(bead);
+    commands.entity(bead).insert(target);
 }
 
 /// Moves the drag target of the bead in space being dragged with the
