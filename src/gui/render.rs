@@ -311,30 +311,53 @@ fn size_and_colour_beads(
     mut materials: ResMut<Assets<ColorMaterial>>,
 ) {
     let radius = style.bead_radius * view.size.y;
-    let mut shortest: HashMap<Entity, f32> = HashMap::new();
-    for rod in &rods {
-        for bead in rod.beads() {
-            let limit = shortest.entry(bead).or_insert(f32::INFINITY);
-            *limit = limit.min(0.4 * rod.length() as f32);
-        }
-    }
+    let limits = BeadSizes::new(&rods);
     for (entity, mut transform, material, diverged, contact) in &mut beads {
-        let r = shortest
-            .get(&entity)
-            .map_or(radius, |&limit| radius.min(limit));
-        transform.scale = Vec3::splat(r);
+        transform.scale = Vec3::splat(limits.radius(entity, radius));
         transform.translation.z = 1.0;
         if let Some(mut m) = materials.get_mut(&material.0) {
-            let colour = if diverged {
-                style.diverged
-            } else if contact.is_some_and(|c| !c.is_on()) {
-                style.flight
-            } else {
-                style.bead
-            };
+            let colour = style.bead_colour(diverged, contact);
             if m.color != colour {
                 m.color = colour;
             }
+        }
+    }
+}
+
+/// How wide each bead hanging on rods may be drawn: no wider than 40 % of
+/// the shortest rod it hangs on, so that a rope of short rods reads as a
+/// rope.
+pub(crate) struct BeadSizes(HashMap<Entity, f32>);
+
+impl BeadSizes {
+    /// The limits the rods set.
+    pub(crate) fn new(rods: &Query<&Rod>) -> Self {
+        let mut shortest: HashMap<Entity, f32> = HashMap::new();
+        for rod in rods {
+            for bead in rod.beads() {
+                let limit = shortest.entry(bead).or_insert(f32::INFINITY);
+                *limit = limit.min(0.4 * rod.length() as f32);
+            }
+        }
+        Self(shortest)
+    }
+
+    /// The radius `bead` is drawn at, `radius` at most.
+    pub(crate) fn radius(&self, bead: Entity, radius: f32) -> f32 {
+        self.0.get(&bead).map_or(radius, |&limit| radius.min(limit))
+    }
+}
+
+impl SceneStyle {
+    /// A bead's colour: diverged, in flight off its one-sided wire, or on
+    /// it.
+    pub fn bead_colour(&self, diverged: bool, contact: Option<&WireContact>) -> Color {
+        if diverged {
+            self.diverged
+        } else if contact.is_some_and(|c| !c.is_on()) {
+            self.flight
+        } else {
+            self.bead
         }
     }
 }

@@ -9,8 +9,8 @@ use super::view::PanelView;
 use crate::geometry::Cycloid;
 use crate::{
     BeadParams, Integrator, NextBeadParams, NextParams, NextWireShape, ParamError,
-    PrescribedMotion, Side, Stabilization, Surface, WireContact, WireKind, WireMotion, WireShape,
-    pose_of,
+    PrescribedMotion, Side, SimClock, Stabilization, Surface, WireContact, WireKind, WireMotion,
+    WireShape, pose_of,
 };
 
 /// The result of an edit: `None` where nothing was edited.
@@ -89,23 +89,14 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
     }
 
     ui.separator();
-    let clock = &view.clock;
     egui::Grid::new("values").num_columns(4).show(ui, |ui| {
-        ui.label("C");
-        ui.monospace(format!("{:+.3e}", diagnostics.c));
-        ui.label("Ċ");
-        ui.monospace(format!("{:+.3e}", diagnostics.c_dot));
-        ui.end_row();
-        ui.label("λ");
-        ui.monospace(format!("{:+.3e}", diagnostics.lambda));
-        ui.label("E");
-        ui.monospace(format!("{:+.4}", diagnostics.energy()));
-        ui.end_row();
-        ui.label("t");
-        ui.monospace(format!("{:.2} s", clock.time));
-        ui.label("steps");
-        ui.monospace(format!("{}", clock.steps));
-        ui.end_row();
+        let row = RowValues {
+            c: diagnostics.c,
+            c_dot: diagnostics.c_dot,
+            lambda: diagnostics.lambda,
+            energy: diagnostics.energy(),
+        };
+        value_rows(ui, Some(row), &view.clock);
         if let Some(island) = view.islands.of(entity).filter(|i| i.rows > 0) {
             ui.label("island E");
             ui.monospace(format!("{:+.4}", island.energy));
@@ -115,6 +106,36 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
         }
     });
     outcome
+}
+
+/// A bead's wire row and energy, as the panel shows them.
+pub(super) struct RowValues {
+    pub(super) c: f64,
+    pub(super) c_dot: f64,
+    pub(super) lambda: f64,
+    pub(super) energy: f64,
+}
+
+/// The rows of a bead's values in a four-column grid: `C` and `Ċ`, λ and
+/// the energy (where there are any), then the time and the steps.
+pub(super) fn value_rows(ui: &mut egui::Ui, row: Option<RowValues>, clock: &SimClock) {
+    if let Some(row) = row {
+        ui.label("C");
+        ui.monospace(format!("{:+.3e}", row.c));
+        ui.label("Ċ");
+        ui.monospace(format!("{:+.3e}", row.c_dot));
+        ui.end_row();
+        ui.label("λ");
+        ui.monospace(format!("{:+.3e}", row.lambda));
+        ui.label("E");
+        ui.monospace(format!("{:+.4}", row.energy));
+        ui.end_row();
+    }
+    ui.label("t");
+    ui.monospace(format!("{:.2} s", clock.time));
+    ui.label("steps");
+    ui.monospace(format!("{}", clock.steps));
+    ui.end_row();
 }
 
 /// What the wire does besides holding the bead, in words: its motion, its

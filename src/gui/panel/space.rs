@@ -6,7 +6,7 @@ use bevy::math::DVec3;
 use bevy::prelude::*;
 use bevy_egui::egui;
 
-use super::params::Edit;
+use super::params::{Edit, RowValues, value_rows};
 use super::view::PanelView;
 use crate::PrescribedMotion;
 use crate::geometry::{SpaceMotion, SpaceShape};
@@ -94,23 +94,13 @@ pub(super) fn space_bead_section(
     egui::Grid::new("space-values")
         .num_columns(4)
         .show(ui, |ui| {
-            if let Some(d) = diagnostics {
-                ui.label("C");
-                ui.monospace(format!("{:+.3e}", d.c));
-                ui.label("Ċ");
-                ui.monospace(format!("{:+.3e}", d.c_dot));
-                ui.end_row();
-                ui.label("λ");
-                ui.monospace(format!("{:+.3e}", d.lambda));
-                ui.label("E");
-                ui.monospace(format!("{:+.4}", d.energy()));
-                ui.end_row();
-            }
-            ui.label("t");
-            ui.monospace(format!("{:.2} s", view.clock.time));
-            ui.label("steps");
-            ui.monospace(format!("{}", view.clock.steps));
-            ui.end_row();
+            let row = diagnostics.map(|d| RowValues {
+                c: d.c,
+                c_dot: d.c_dot,
+                lambda: d.lambda,
+                energy: d.energy(),
+            });
+            value_rows(ui, row, &view.clock);
         });
     outcome
 }

@@ -3,7 +3,7 @@
 //! trails, rods, pins, springs, the constraint force and the drag spring.
 //! `f64` becomes `f32` here, at the edge.
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::VecDeque;
 
 use bevy::asset::RenderAssetUsages;
 use bevy::camera::visibility::RenderLayers;
@@ -15,7 +15,7 @@ use bevy::render::render_resource::Face;
 use super::shapes::{curve_points, fitted_surface_mesh};
 use super::{Orbit, SPACE_LAYER, SpaceGizmos};
 use crate::geometry::{Side, SpaceShape};
-use crate::gui::render::SceneStyle;
+use crate::gui::render::{BeadSizes, SceneStyle};
 use crate::{
     BeadDiagnostics, BeadMass, BeadParams, BeadPosition, Diverged, OnWire, Pin, RailOrientation,
     Restart, Rod, SimParams, SpaceBead, SpaceWire, Spring, SpringAnchor, WireContact,
@@ -252,27 +252,13 @@ pub fn size_and_colour_beads(
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
     let radius = 1.6 * style.bead_radius * orbit.size;
-    let mut shortest: HashMap<Entity, f32> = HashMap::new();
-    for rod in &rods {
-        for bead in rod.beads() {
-            let limit = shortest.entry(bead).or_insert(f32::INFINITY);
-            *limit = limit.min(0.4 * rod.length() as f32);
-        }
-    }
+    let limits = BeadSizes::new(&rods);
     for (entity, mut transform, material, diverged, contact) in &mut beads {
-        let r = shortest
-            .get(&entity)
-            .map_or(radius, |&limit| radius.min(limit));
+        let r = limits.radius(entity, radius);
         if transform.scale != Vec3::splat(r) {
             transform.scale = Vec3::splat(r);
         }
-        let colour = if diverged {
-            style.diverged
-        } else if contact.is_some_and(|c| !c.is_on()) {
-            style.flight
-        } else {
-            style.bead
-        };
+        let colour = style.bead_colour(diverged, contact);
         if let Some(mut m) = materials.get_mut(&material.0)
             && m.base_color != colour
         {
