@@ -89,9 +89,37 @@ pub struct SceneCamera;
 pub struct BeadVisual;
 
 /// A bead's recent positions, newest last, each with whether the bead was
-/// in flight off its wire there.
-#[derive(Component, Clone, Debug, Default)]
-pub struct Trail(pub VecDeque<(Vec2, bool)>);
+/// in flight off its wire there: `Trail` in the plane, `Trail<Vec3>` in
+/// space.
+#[derive(Component, Clone, Debug)]
+pub struct Trail<P = Vec2>(pub VecDeque<(P, bool)>);
+
+impl<P> Default for Trail<P> {
+    fn default() -> Self {
+        Self(VecDeque::new())
+    }
+}
+
+impl<P: Copy> Trail<P> {
+    /// Appends where the bead is (in flight or not) and drops what is more
+    /// than `keep` points old (keeping two at least).
+    pub fn record(&mut self, at: P, flying: bool, keep: usize) {
+        self.0.push_back((at, flying));
+        while self.0.len() > keep.max(2) {
+            self.0.pop_front();
+        }
+    }
+
+    /// Its points, each in the trail's colour (the flight colour where the
+    /// bead was off its wire) fading with age.
+    pub fn coloured<'a>(&'a self, style: &'a SceneStyle) -> impl Iterator<Item = (P, Color)> + 'a {
+        let n = self.0.len().max(1) as f32;
+        self.0.iter().enumerate().map(move |(i, &(p, flying))| {
+            let colour = if flying { style.flight } else { style.trail };
+            (p, colour.with_alpha((i as f32 + 1.0) / n))
+        })
+    }
+}
 
 /// The world rectangle the camera frames (center, size), updated each frame.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
@@ -119,7 +147,7 @@ impl Plugin for SceneRenderPlugin {
                 Update,
                 (
                     add_bead_visuals,
-                    clear_trails_on_restart,
+                    clear_trails_on_restart::<Vec2>,
                     frame_camera,
                     size_and_colour_beads,
                     style_debug_render,
@@ -192,7 +220,7 @@ pub fn add_bead_visuals(
         commands.entity(entity).insert((
             Mesh2d(meshes.add(Circle::new(1.0))),
             MeshMaterial2d(materials.add(ColorMaterial::from_color(style.bead))),
-            Trail::default(),
+            Trail::<Vec2>::default(),
             BeadVisual,
         ));
     }
@@ -204,17 +232,17 @@ pub fn record_trails(
     style: Res<SceneStyle>,
     mut beads: Query<(&BeadPosition, &mut Trail, Option<&WireContact>)>,
 ) {
-    let keep = (style.trail_seconds / params.timestep).ceil() as usize;
+    let keep = style.trail_points(params.timestep);
     for (bead, mut trail, contact) in &mut beads {
-        let flying = contact.is_some_and(|c| !c.is_on());
-        trail.0.push_back((bead.as_vec2(), flying));
-        while trail.0.len() > keep.max(2) {
-            trail.0.pop_front();
-        }
+        trail.record(bead.as_vec2(), contact.is_some_and(|c| !c.is_on()), keep);
     }
 }
 
-fn clear_trails_on_restart(mut restarts: MessageReader<Restart>, mut trails: Query<&mut Trail>) {
+/// Empties every trail (in the plane or in space) when the run restarts.
+pub(crate) fn clear_trails_on_restart<P: Send + Sync + 'static>(
+    mut restarts: MessageReader<Restart>,
+    mut trails: Query<&mut Trail<P>>,
+) {
     if restarts.read().count() > 0 {
         for mut trail in &mut trails {
             trail.0.clear();
@@ -349,6 +377,11 @@ impl BeadSizes {
 }
 
 impl SceneStyle {
+    /// How many points of a trail are kept: its seconds at `timestep`.
+    pub fn trail_points(&self, timestep: f64) -> usize {
+        (self.trail_seconds / timestep).ceil() as usize
+    }
+
     /// A bead's colour: diverged, in flight off its one-sided wire, or on
     /// it.
     pub fn bead_colour(&self, diverged: bool, contact: Option<&WireContact>) -> Color {
@@ -366,11 +399,7 @@ impl SceneStyle {
 /// was off its wire.
 fn draw_trails(beads: Query<&Trail>, style: Res<SceneStyle>, mut gizmos: Gizmos) {
     for trail in &beads {
-        let n = trail.0.len().max(1) as f32;
-        gizmos.linestrip_gradient_2d(trail.0.iter().enumerate().map(|(i, (p, flying))| {
-            let colour = if *flying { style.flight } else { style.trail };
-            (*p, colour.with_alpha((i as f32 + 1.0) / n))
-        }));
+        gizmos.linestrip_gradient_2d(trail.coloured(&style));
     }
 }
 

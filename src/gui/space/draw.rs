@@ -3,8 +3,6 @@
 //! trails, rods, pins, springs, the constraint force and the drag spring.
 //! `f64` becomes `f32` here, at the edge.
 
-use std::collections::VecDeque;
-
 use bevy::asset::RenderAssetUsages;
 use bevy::camera::visibility::RenderLayers;
 use bevy::math::DVec3;
@@ -15,10 +13,10 @@ use bevy::render::render_resource::Face;
 use super::shapes::{curve_points, fitted_surface_mesh};
 use super::{Orbit, SPACE_LAYER, SpaceGizmos};
 use crate::geometry::{Side, SpaceShape};
-use crate::gui::render::{BeadSizes, SceneStyle};
+use crate::gui::render::{BeadSizes, SceneStyle, Trail};
 use crate::{
     BeadDiagnostics, BeadMass, BeadParams, BeadPosition, Diverged, OnWire, Pin, RailOrientation,
-    Restart, Rod, SimParams, SpaceBead, SpaceWire, Spring, SpringAnchor, WireContact,
+    Rod, SimParams, SpaceBead, SpaceWire, Spring, SpringAnchor, WireContact,
 };
 
 /// What the view draws of a wire in space, in its local frame: a curve's
@@ -39,11 +37,6 @@ impl WireDrawing {
         }
     }
 }
-
-/// A bead in space's recent positions, newest last, each with whether it
-/// was in flight off its wire there.
-#[derive(Component, Clone, Debug, Default)]
-pub struct SpaceTrail(pub VecDeque<(Vec3, bool)>);
 
 /// Marks a bead in space's visuals as added.
 #[derive(Component, Clone, Copy, Debug, Default)]
@@ -157,7 +150,7 @@ pub fn add_bead_visuals(
             })),
             Visibility::default(),
             RenderLayers::layer(SPACE_LAYER),
-            SpaceTrail::default(),
+            Trail::<Vec3>::default(),
             SpaceBeadVisual,
         ));
     }
@@ -339,39 +332,26 @@ pub fn draw_links(
 }
 
 /// Appends each bead in space's position to its trail and drops what is
-/// too old; a restart clears them.
+/// too old.
 pub fn record_trails(
     params: Res<SimParams>,
     style: Res<SceneStyle>,
-    mut restarts: MessageReader<Restart>,
-    mut beads: Query<(&BeadPosition<DVec3>, &mut SpaceTrail, Option<&WireContact>)>,
+    mut beads: Query<(&BeadPosition<DVec3>, &mut Trail<Vec3>, Option<&WireContact>)>,
 ) {
-    let restarted = restarts.read().count() > 0;
-    let keep = (style.trail_seconds / params.timestep).ceil() as usize;
+    let keep = style.trail_points(params.timestep);
     for (bead, mut trail, contact) in &mut beads {
-        if restarted {
-            trail.0.clear();
-        }
-        let flying = contact.is_some_and(|c| !c.is_on());
-        trail.0.push_back((bead.0.as_vec3(), flying));
-        while trail.0.len() > keep.max(2) {
-            trail.0.pop_front();
-        }
+        trail.record(bead.0.as_vec3(), contact.is_some_and(|c| !c.is_on()), keep);
     }
 }
 
 /// Draws each trail fading with age, in the flight colour where the bead
 /// was off its wire.
 pub fn draw_trails(
-    beads: Query<&SpaceTrail>,
+    beads: Query<&Trail<Vec3>>,
     style: Res<SceneStyle>,
     mut gizmos: Gizmos<SpaceGizmos>,
 ) {
     for trail in &beads {
-        let n = trail.0.len().max(1) as f32;
-        gizmos.linestrip_gradient(trail.0.iter().enumerate().map(|(i, (p, flying))| {
-            let colour = if *flying { style.flight } else { style.trail };
-            (*p, colour.with_alpha((i as f32 + 1.0) / n))
-        }));
+        gizmos.linestrip_gradient(trail.coloured(&style));
     }
 }

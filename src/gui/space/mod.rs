@@ -23,9 +23,9 @@ use bevy::prelude::*;
 use bevy_egui::input::EguiWantsInput;
 
 use super::drag::Grabbed;
-use super::render::{SceneCamera, SceneStyle};
+use super::render::{SceneCamera, SceneStyle, clear_trails_on_restart};
 use crate::{SpaceBead, SpaceWire, SpringAnchor};
-pub use draw::{SpaceTrail, WireDrawing};
+pub use draw::WireDrawing;
 
 /// The render layer of everything the 3D view draws, so that the plane's
 /// camera does not draw it and the space camera draws nothing of the
@@ -101,6 +101,7 @@ impl Plugin for SpaceViewPlugin {
                 Update,
                 (
                     show_view,
+                    clear_trails_on_restart::<Vec3>,
                     draw::add_wire_drawings,
                     draw::add_bead_visuals,
                     draw::frame_scene,

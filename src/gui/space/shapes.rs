@@ -104,13 +104,18 @@ pub struct SurfaceMesh {
 /// of padding on each side.
 type Grid = ConstShape3u32<50, 50, 50>;
 
+/// The spacing of the grid in a cube of half-size `half`.
+fn cell(half: f64) -> f64 {
+    2.0 * half / f64::from(Grid::ARRAY[0] - 1)
+}
+
 /// `surface` meshed where it crosses the cube of half-size `half` about
 /// `centre` (local coordinates), by surface nets on a 50³ grid of its
 /// values; the vertices' normals from its gradient. Empty where it does
 /// not cross the cube; an unbounded surface is cut at the cube's faces.
 pub fn surface_mesh(surface: &dyn ImplicitSurface, centre: DVec3, half: f64) -> SurfaceMesh {
     let n = Grid::ARRAY[0];
-    let cell = 2.0 * half / f64::from(n - 1);
+    let cell = cell(half);
     let lo = centre - DVec3::splat(half);
     let at =
         |g: [f32; 3]| lo + DVec3::new(f64::from(g[0]), f64::from(g[1]), f64::from(g[2])) * cell;
@@ -148,17 +153,16 @@ pub fn surface_mesh(surface: &dyn ImplicitSurface, centre: DVec3, half: f64) -> 
 /// cube (a torus larger than its beads' reach), in that: a bounded surface
 /// is drawn whole, an unbounded one cut at the smaller cube.
 pub fn fitted_surface_mesh(surface: &dyn ImplicitSurface, half: f64) -> SurfaceMesh {
-    let cell = 2.0 * half / f64::from(Grid::ARRAY[0] - 1);
-    let touches = |mesh: &SurfaceMesh, half: f64, cell: f64| {
+    let touches = |mesh: &SurfaceMesh, half: f64| {
         mesh.positions.iter().any(|p| {
             let reach = p.iter().fold(0.0f64, |m, c| m.max(f64::from(c.abs())));
-            reach >= half - 1.5 * cell
+            reach >= half - 1.5 * cell(half)
         })
     };
     let mesh = surface_mesh(surface, DVec3::ZERO, half);
-    if touches(&mesh, half, cell) {
+    if touches(&mesh, half) {
         let larger = surface_mesh(surface, DVec3::ZERO, 2.0 * half);
-        if !larger.positions.is_empty() && !touches(&larger, 2.0 * half, 2.0 * cell) {
+        if !larger.positions.is_empty() && !touches(&larger, 2.0 * half) {
             return larger;
         }
     }
