@@ -98,17 +98,25 @@ pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, ParamError> 
 pub trait Components: Copy {
     /// `[x, y]` or `[x, y, z]`.
     fn components(&self) -> Vec<f64>;
+    /// The components to edit in place, in the same order.
+    fn components_mut(&mut self) -> Vec<&mut f64>;
 }
 
 impl Components for DVec2 {
     fn components(&self) -> Vec<f64> {
         self.to_array().to_vec()
     }
+    fn components_mut(&mut self) -> Vec<&mut f64> {
+        vec![&mut self.x, &mut self.y]
+    }
 }
 
 impl Components for DVec3 {
     fn components(&self) -> Vec<f64> {
         self.to_array().to_vec()
+    }
+    fn components_mut(&mut self) -> Vec<&mut f64> {
+        vec![&mut self.x, &mut self.y, &mut self.z]
     }
 }
 

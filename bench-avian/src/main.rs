@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release -p wirebead-vs-avian
-//! cargo run --release -p wirebead-vs-avian -- circle [--steps 600] [--many 10000]
+//! cargo run --release -p wirebead-vs-avian -- circle [--steps 600] [--many 10000] [--warm-up 1]
 //! cargo run --release -p wirebead-vs-avian -- rope [--steps 600] [--sizes 10,100,1000] [--substeps 20,50,100,200]
 //! cargo run --release -p wirebead-vs-avian -- carts [--steps 600] [--sizes 1000,10000] [--substeps 50] [--rail prismatic|locked]
 //! cargo run --release -p wirebead-vs-avian -- spheres [--steps 600] [--sizes 1,10000]
@@ -92,6 +92,11 @@ struct CircleArgs {
     /// Pendulums in the timing run.
     #[arg(long, default_value_t = 10_000)]
     many: usize,
+    /// Untimed runs of the timing run's size before the first timed row, so
+    /// that no row pays for the process's start (its allocator's first
+    /// growth, the threads' first wake-ups).
+    #[arg(long, default_value_t = 1)]
+    warm_up: usize,
 }
 
 /// What one run measured.
@@ -195,6 +200,9 @@ fn main() {
 fn circle(args: &CircleArgs) {
     let dt = 1.0 / 60.0;
     let exact = pendulum_period(RADIUS, GRAVITY, std::f64::consts::FRAC_PI_2);
+    for _ in 0..args.warm_up {
+        run_ours(args.many, Method::ALL[0], dt, args.steps);
+    }
     let mut rows = Vec::new();
     for method in Method::ALL {
         let (de, radial, period, one) = run_ours(1, method, dt, args.steps);

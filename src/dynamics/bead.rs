@@ -356,25 +356,40 @@ impl<V: Coordinates + Reflect + TypePath> BeadMotionReadOnlyItem<'_, '_, V> {
 
 /// Edited [`BeadParams`] for one bead, applied (and removed) by the next
 /// [`Restart`](crate::Restart). Construct it with [`NextBeadParams::new`] so that
-/// an invalid edit never gets into the world.
+/// an invalid edit never gets into the world. `NextBeadParams` edits a bead
+/// in the plane, `NextBeadParams<DVec3>` one in space.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
 #[reflect(Component)]
-pub struct NextBeadParams(BeadParams);
+pub struct NextBeadParams<V: Coordinates + Reflect + TypePath = DVec2>(BeadParams<V>);
 
 impl NextBeadParams {
-    /// A pending edit, if `params` is valid.
+    /// A pending edit of a bead in the plane, if `params` is valid.
     pub fn new(params: BeadParams) -> Result<Self, ParamError> {
+        Self::validated(params)
+    }
+}
+
+impl NextBeadParams<DVec3> {
+    /// A pending edit of a bead in space, if `params` is valid.
+    pub fn in_space(params: BeadParams<DVec3>) -> Result<Self, ParamError> {
+        Self::validated(params)
+    }
+}
+
+impl<V: Coordinates + Reflect + TypePath> NextBeadParams<V> {
+    /// A pending edit, if `params` is valid.
+    pub(crate) fn validated(params: BeadParams<V>) -> Result<Self, ParamError> {
         params.validate()?;
         Ok(Self(params))
     }
 
     /// The edited parameters.
-    pub fn get(&self) -> &BeadParams {
+    pub fn get(&self) -> &BeadParams<V> {
         &self.0
     }
 
     /// Edits in place; kept only if the result is valid.
-    pub fn update(&mut self, edit: impl FnOnce(&mut BeadParams)) -> Result<(), ParamError> {
+    pub fn update(&mut self, edit: impl FnOnce(&mut BeadParams<V>)) -> Result<(), ParamError> {
         super::params::edit_validated(&mut self.0, edit, BeadParams::validate)
     }
 }

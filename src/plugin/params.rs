@@ -93,6 +93,7 @@ impl Plugin for ParamsPlugin {
             .register_type::<BeadParams<DVec3>>()
             .register_type::<BeadDiagnostics<DVec3>>()
             .register_type::<NextBeadParams>()
+            .register_type::<NextBeadParams<DVec3>>()
             .register_type::<SimParams>()
             .register_type::<ParallelStep>()
             .register_type::<NextParams>();

@@ -97,13 +97,16 @@ fn apply_restart(
     time.discard_overstep(overstep);
     *clock = SimClock::default();
     for (entity, mut bead, mut bead_params, diagnostics, contact, on_wire, edit) in &mut beads {
-        if let Some(edit) = edit {
-            bead_params.set_if_neq(*edit.get());
-        }
-        if !reset_bead(entity, &mut bead, &bead_params, contact, &mut commands) {
+        if !reset_bead(
+            entity,
+            &mut bead,
+            &mut bead_params,
+            edit,
+            contact,
+            &mut commands,
+        ) {
             continue;
         }
-        commands.entity(entity).remove::<NextBeadParams>();
         let wire = on_wire.and_then(|on| wires.get(on.0).ok());
         let Some((_, wire, _, pose, ..)) = wire else {
             if let Some(mut diagnostics) = diagnostics {
@@ -142,16 +145,22 @@ fn rest_wire<V: Dimension>(
     }
 }
 
-/// A bead back at its [`BeadParams`], its contact and divergence cleared;
-/// false, with a one-line warning, if its parameters are invalid (written
-/// directly, not through [`NextBeadParams`]): it keeps its state.
+/// A bead back at its [`BeadParams`], its pending [`NextBeadParams`]
+/// applied first, its contact and divergence cleared; false, with a
+/// one-line warning, if its parameters are invalid (written directly, not
+/// through [`NextBeadParams`]): it keeps its state.
 fn reset_bead<V: Dimension>(
     entity: Entity,
     bead: &mut BeadMotionItem<V>,
-    params: &BeadParams<V>,
+    params: &mut Mut<BeadParams<V>>,
+    edit: Option<&NextBeadParams<V>>,
     contact: Option<Mut<WireContact>>,
     commands: &mut Commands,
 ) -> bool {
+    if let Some(edit) = edit {
+        params.set_if_neq(*edit.get());
+        commands.entity(entity).remove::<NextBeadParams<V>>();
+    }
     if let Err(err) = params.validate() {
         warn!(
             "wirebead: bead {entity} was not restarted: its BeadParams are invalid ({err}); it keeps its state"
@@ -168,7 +177,8 @@ fn reset_bead<V: Dimension>(
 
 /// Handles [`Restart`] for beads and wires in space, after
 /// [`apply_restart`] applied the parameters: each wire at its resting
-/// pose, each bead at its [`BeadParams<DVec3>`](BeadParams) (its initial
+/// pose, each bead at its [`BeadParams<DVec3>`](BeadParams), its pending
+/// [`NextBeadParams<DVec3>`](NextBeadParams) applied first (its initial
 /// velocity relative to its wire's own at t = 0), its diagnostics those of
 /// its new state until the first step fills in its rows.
 fn restart_in_space(
@@ -182,7 +192,8 @@ fn restart_in_space(
     mut beads: Query<(
         Entity,
         BeadMotion<DVec3>,
-        &BeadParams<DVec3>,
+        &mut BeadParams<DVec3>,
+        Option<&NextBeadParams<DVec3>>,
         Option<&mut BeadDiagnostics<DVec3>>,
         Option<&mut WireContact>,
         Option<&OnWire>,
@@ -199,8 +210,16 @@ fn restart_in_space(
         rest_wire(motion, &mut transform, &mut pose);
     }
     let gravity = DVec3::gravity(&params);
-    for (entity, mut bead, bead_params, diagnostics, contact, on_wire, rail) in &mut beads {
-        if !reset_bead(entity, &mut bead, bead_params, contact, &mut commands) {
+    for (entity, mut bead, mut bead_params, edit, diagnostics, contact, on_wire, rail) in &mut beads
+    {
+        if !reset_bead(
+            entity,
+            &mut bead,
+            &mut bead_params,
+            edit,
+            contact,
+            &mut commands,
+        ) {
             continue;
         }
         if let Some(mut rail) = rail {

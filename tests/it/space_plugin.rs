@@ -8,7 +8,7 @@ use bevy::prelude::*;
 use wirebead::geometry::{Circle, Helix, OnPlane, Pose3, SpaceMotion, SpacePath, Sphere};
 use wirebead::headless::{Headless, run_for, space_bead_state};
 use wirebead::prelude::*;
-use wirebead::{ConstraintDiagnostics, Islands, SpaceBead, SpaceWire};
+use wirebead::{BeadMass, ConstraintDiagnostics, Islands, NextBeadParams, SpaceBead, SpaceWire};
 
 use crate::space::conical_start;
 
@@ -270,6 +270,53 @@ fn a_restart_returns_beads_in_space_to_their_start() {
         (again.position, again.velocity),
         (first.position, first.velocity)
     );
+}
+
+/// An edit of a bead in space waits for the restart, as in the plane: a
+/// `NextBeadParams<DVec3>` changes nothing while the run goes on; the
+/// restart applies its mass and start (the velocity relative to the
+/// spinning hoop), removes it, and keeps it as the bead's `BeadParams`.
+#[test]
+fn a_restart_applies_an_edit_of_a_bead_in_space() {
+    let (r, omega) = (1.0, 4.0);
+    let mut app = app(1e-3);
+    let (wire, spin) = spinning_hoop(&mut app, r, omega);
+    let start = DVec3::new(0.0, -r, 0.0);
+    let bead = spawn(&mut app, Some(wire), start, DVec3::ZERO);
+    run_for(&mut app, 0.1);
+    let edited = BeadParams::<DVec3> {
+        mass: 2.5,
+        initial_position: DVec3::new(r * 0.6, -r * 0.8, 0.0),
+        // Along the hoop's tangent there.
+        initial_velocity: DVec3::new(0.4, 0.3, 0.0),
+    };
+    app.world_mut()
+        .entity_mut(bead)
+        .insert(NextBeadParams::in_space(edited).expect("a valid edit"));
+    let before = space_bead_state(app.world(), bead).expect("a bead");
+    wirebead::headless::idle(&mut app);
+    let pending = space_bead_state(app.world(), bead).expect("a bead");
+    assert_eq!(pending, before, "an edit moved the bead before the restart");
+    assert_eq!(
+        app.world().get::<BeadMass>(bead).map(BeadMass::get),
+        Some(1.0)
+    );
+
+    app.world_mut().write_message(Restart);
+    wirebead::headless::idle(&mut app);
+    let restarted = space_bead_state(app.world(), bead).expect("a bead");
+    let hoop_velocity = spin
+        .at(Pose3::IDENTITY, 0.0)
+        .1
+        .velocity_at(edited.initial_position);
+    assert_eq!(restarted.position, edited.initial_position);
+    assert_eq!(restarted.velocity, edited.initial_velocity + hoop_velocity);
+    assert_eq!(
+        app.world().get::<BeadMass>(bead).map(BeadMass::get),
+        Some(2.5)
+    );
+    assert_eq!(app.world().get::<BeadParams<DVec3>>(bead), Some(&edited));
+    assert!(app.world().get::<NextBeadParams<DVec3>>(bead).is_none());
 }
 
 /// A bead in space at a singular point of its wire (a sphere's centre)

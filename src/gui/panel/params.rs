@@ -1,12 +1,11 @@
 //! Editing the parameters: the selected bead's, its wire's shape, and the
 //! solver's, each through the plugin's validating setters.
 
-use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_egui::egui;
 
 use super::view::PanelView;
-use crate::geometry::Cycloid;
+use crate::geometry::{Coordinates, Cycloid};
 use crate::{
     BeadParams, Integrator, NextBeadParams, NextParams, NextWireShape, ParamError,
     PrescribedMotion, Side, SimClock, Stabilization, Surface, WireContact, WireKind, WireMotion,
@@ -39,13 +38,49 @@ fn choice<T: Copy + PartialEq>(
         });
 }
 
-fn vector(ui: &mut egui::Ui, label: &str, value: &mut DVec2, speed: f64) {
+/// A vector's components, each edited by dragging, labelled x, y (and z).
+fn vector<V: Coordinates>(ui: &mut egui::Ui, label: &str, value: &mut V, speed: f64) {
     ui.label(label);
     ui.horizontal(|ui| {
-        ui.add(egui::DragValue::new(&mut value.x).speed(speed).prefix("x "));
-        ui.add(egui::DragValue::new(&mut value.y).speed(speed).prefix("y "));
+        for (axis, component) in ["x ", "y ", "z "].into_iter().zip(value.components_mut()) {
+            ui.add(egui::DragValue::new(component).speed(speed).prefix(axis));
+        }
     });
     ui.end_row();
+}
+
+/// A bead's mass and start in a grid, edited as a draft of its pending
+/// [`NextBeadParams`] (or its [`BeadParams`] where none is pending); the
+/// edit, if the draft changed and is valid, is inserted for the next
+/// restart. The draft is returned so that an edit of the wire can move
+/// the start before it is kept.
+pub(super) fn bead_start_editor<V: Coordinates + Reflect + TypePath>(
+    ui: &mut egui::Ui,
+    id: &str,
+    params: &BeadParams<V>,
+    pending: Option<&NextBeadParams<V>>,
+) -> BeadParams<V> {
+    let mut draft = pending.map_or(*params, |p| *p.get());
+    egui::Grid::new(id).num_columns(2).show(ui, |ui| {
+        number(ui, "mass", &mut draft.mass, 0.01);
+        vector(ui, "initial position", &mut draft.initial_position, 0.01);
+        vector(ui, "initial velocity", &mut draft.initial_velocity, 0.01);
+    });
+    draft
+}
+
+/// Keeps `draft` as the bead's pending edit if it differs from `before`.
+pub(super) fn keep_bead_edit<V: Coordinates + Reflect + TypePath>(
+    commands: &mut Commands,
+    entity: Entity,
+    before: BeadParams<V>,
+    draft: BeadParams<V>,
+) -> Edit {
+    (draft != before).then(|| {
+        NextBeadParams::validated(draft).map(|edit| {
+            commands.entity(entity).insert(edit);
+        })
+    })
 }
 
 /// The selected bead's parameters, its wire's shape, and its diagnostics.
@@ -54,13 +89,8 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
         view.selected.0.and_then(|e| view.beads.get(e).ok())?;
     ui.separator();
     ui.strong(format!("Bead {}", view.name(entity)));
-    let mut draft: BeadParams = pending_bead.map_or(*bead, |p| *p.get());
-    let before = draft;
-    egui::Grid::new("bead").num_columns(2).show(ui, |ui| {
-        number(ui, "mass", &mut draft.mass, 0.01);
-        vector(ui, "initial position", &mut draft.initial_position, 0.01);
-        vector(ui, "initial velocity", &mut draft.initial_velocity, 0.01);
-    });
+    let before = pending_bead.map_or(*bead, |p| *p.get());
+    let mut draft = bead_start_editor(ui, "bead", bead, pending_bead);
     let mut outcome = None;
     if let Some(on_wire) = on_wire
         && let Ok((wire, transform, pending_wire, motion)) = view.wires.get(on_wire.0)
@@ -82,10 +112,8 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
             contact,
         );
     }
-    if draft != before {
-        outcome = Some(NextBeadParams::new(draft).map(|edit| {
-            commands.entity(entity).insert(edit);
-        }));
+    if let Some(kept) = keep_bead_edit(commands, entity, before, draft) {
+        outcome = Some(kept);
     }
 
     ui.separator();

@@ -1,22 +1,14 @@
-//! The selected bead in space: its mass and start in three components, its
-//! wire (a spinning wire's ω edited live), and its `C`, `Ċ`, λ and
-//! energy.
+//! The selected bead in space: its mass and start in three components
+//! (edited for the next restart, as in the plane), its wire (a spinning
+//! wire's ω edited live), and its `C`, `Ċ`, λ and energy.
 
-use bevy::math::DVec3;
 use bevy::prelude::*;
 use bevy_egui::egui;
 
-use super::params::{Edit, RowValues, value_rows};
+use super::params::{Edit, RowValues, bead_start_editor, keep_bead_edit, value_rows};
 use super::view::PanelView;
 use crate::PrescribedMotion;
 use crate::geometry::{SpaceMotion, SpaceShape};
-
-/// A vector's three components, read-only.
-fn components(ui: &mut egui::Ui, label: &str, value: DVec3) {
-    ui.label(label);
-    ui.monospace(format!("({:.3}, {:.3}, {:.3})", value.x, value.y, value.z));
-    ui.end_row();
-}
 
 /// The selected bead in space, if one is selected.
 pub(super) fn space_bead_section(
@@ -24,18 +16,13 @@ pub(super) fn space_bead_section(
     view: &PanelView,
     commands: &mut Commands,
 ) -> Edit {
-    let (entity, bead, diagnostics, on_wire, _) =
+    let (entity, bead, diagnostics, on_wire, pending, _) =
         view.selected.0.and_then(|e| view.space_beads.get(e).ok())?;
     ui.separator();
     ui.strong(format!("Bead {} (in space)", view.name(entity)));
-    egui::Grid::new("space-bead").num_columns(2).show(ui, |ui| {
-        ui.label("mass");
-        ui.monospace(format!("{:.3} kg", bead.mass));
-        ui.end_row();
-        components(ui, "initial position", bead.initial_position);
-        components(ui, "initial velocity", bead.initial_velocity);
-    });
-    let mut outcome = None;
+    let before = pending.map_or(*bead, |p| *p.get());
+    let draft = bead_start_editor(ui, "space-bead", bead, pending);
+    let mut outcome = keep_bead_edit(commands, entity, before, draft);
     if let Some(on_wire) = on_wire
         && let Ok((wire, motion)) = view.space_wires.get(on_wire.0)
     {

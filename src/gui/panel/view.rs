@@ -57,6 +57,7 @@ pub struct PanelView<'w, 's> {
             &'static BeadParams<DVec3>,
             Option<&'static BeadDiagnostics<DVec3>>,
             Option<&'static OnWire>,
+            Option<&'static NextBeadParams<DVec3>>,
             Option<&'static Diverged>,
         ),
     >,
@@ -67,7 +68,8 @@ pub struct PanelView<'w, 's> {
     pub(super) pins: Query<'w, 's, (&'static Pin, &'static ConstraintDiagnostics)>,
     pub(super) names: Query<'w, 's, &'static Name>,
     pub(super) islands: Res<'w, Islands>,
-    pub(super) pending_beads: Query<'w, 's, (), With<NextBeadParams>>,
+    pub(super) pending_beads:
+        Query<'w, 's, (), Or<(With<NextBeadParams>, With<NextBeadParams<DVec3>>)>>,
     pub(super) pending_wires: Query<'w, 's, (), With<NextWireShape>>,
     pub(super) clock: Res<'w, SimClock>,
 }
