@@ -14,6 +14,7 @@
 //! | `newton` | Newton's method on `C` and its stopping test, for RATTLE and projection |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
 //! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eqs. (16)–(17): on the wire, in flight, where an event falls |
+//! | `impact` | [`resolve_impacts`]: strikes between beads that touch, eq. (18), one pair at a time |
 //! | `lanes/` (`circle`) | the batched step: eight beads on circles at once, bit for bit [`step`](fn@step), many such batches in one call; the solves on each lane's circle (crate-private) |
 //! | `coupled/` (`island/`, `normal/`, …) | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (12)–(14) |
 //!
@@ -25,6 +26,7 @@ mod contact;
 mod coupled;
 mod euler;
 mod friction;
+mod impact;
 mod lanes;
 mod method;
 mod newton;
@@ -43,6 +45,9 @@ pub use coupled::{
     Constraint, Island, IslandError, IslandRow, IslandWork, RowKind, RowReport, SpringLink, islands,
 };
 pub use euler::{explicit_euler, semi_implicit_euler};
+pub use impact::{
+    Freedom, ImpactBead, ImpactError, MAX_STRIKES_PER_TOUCH, Strike, Touch, resolve_impacts, strike,
+};
 pub(crate) use lanes::{LANES, RoundLanes, RoundSteps, step_on_round_batches};
 pub use method::{Integrator, Method, Stabilization};
 pub use projection::project;

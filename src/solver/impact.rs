@@ -1,0 +1,612 @@
+//! Impacts between beads that touch, eq. (18): the impulse of one strike
+//! between two beads, each free or held to its wire, and the rule that
+//! resolves simultaneous and chained strikes one pair at a time.
+//!
+//! Two beads of radii `r_a` and `r_b` touch when `|x_b − x_a| = r_a + r_b`.
+//! With `n̂` the unit vector from `a`'s centre to `b`'s, the pair closes at
+//! `u = n̂·(v_b − v_a) < 0`. A strike is an impulse `p n̂` on `b` and
+//! `−p n̂` on `a`; each bead takes of it only what its wire lets it take,
+//! the projection `P` onto the directions it may move in ([`Freedom`]):
+//!
+//! ```text
+//! w = n̂·P_a n̂ / m_a + n̂·P_b n̂ / m_b,   p = −(1 + e) u / w,
+//! v_a ← v_a − (p / m_a) P_a n̂,          v_b ← v_b + (p / m_b) P_b n̂,
+//! ```
+//!
+//! which leaves the pair separating at `−e u` and, `P` being an orthogonal
+//! projection, keeps the kinetic energy at `e = 1` and loses
+//! `½ (1 − e²) u² / w` below it.
+//!
+//! **Simultaneous and chained strikes** ([`resolve_impacts`]) are resolved
+//! as sequential pairwise impacts: while a touching pair closes, the one
+//! closing fastest (the first in the list among equals) strikes alone, and
+//! the others see its result. A row of touching equal balls at `e = 1` so
+//! passes one ball's momentum from pair to pair to the last ball, and
+//! Newton's cradle sends out as many balls as came in, which one impulse
+//! solved for every touching pair at once does not. Three equal balls, the
+//! outer two striking the middle one at once from both sides at speed `v`,
+//! end with the outer two leaving at `v` and the middle one at rest: the
+//! first pair exchanges, the middle ball carries `v` into the third, and
+//! the first ball takes the middle one's rebound.
+//!
+//! A pair closing slower than the speed one step's forces give it
+//! (`rest_speed`) strikes with `e = 0`: it stays in touch, as a bead
+//! landing slowly on a one-sided wire stays on it (eq. 16).
+
+use bevy::math::DVec2;
+use thiserror::Error;
+
+use crate::geometry::Coordinates;
+
+/// Closing speeds at or below this fraction of the fastest bead's speed in
+/// the touching pairs count as zero: what rounding leaves of a strike
+/// that stopped the pair.
+const SLACK: f64 = 1e-12;
+
+/// How many strikes per touching pair [`resolve_impacts`] allows by
+/// default before it reports that the strikes did not settle.
+pub const MAX_STRIKES_PER_TOUCH: usize = 256;
+
+/// Why impacts could not be resolved, in words.
+#[derive(Clone, Copy, Debug, Error, PartialEq)]
+pub enum ImpactError {
+    /// Two beads' centres are at one point (or not finite): the line
+    /// between them has no direction.
+    #[error(
+        "beads {a} and {b} have their centres at one point, so the line between them has no direction"
+    )]
+    Coincident {
+        /// The first bead.
+        a: usize,
+        /// The second bead.
+        b: usize,
+    },
+    /// A direction a bead is held to is zero or not finite.
+    #[error("a bead's wire direction must be a finite vector that is not zero")]
+    NoDirection,
+    /// The pairs kept striking each other past the allowed count.
+    #[error("the impacts did not settle after {strikes} strikes between touching beads")]
+    DidNotSettle {
+        /// How many strikes were made.
+        strikes: usize,
+    },
+    /// An index names no bead.
+    #[error("a touching pair names bead {bead}, and there are {beads} beads")]
+    MissingBead {
+        /// The index.
+        bead: usize,
+        /// How many beads there are.
+        beads: usize,
+    },
+}
+
+/// The directions a bead's velocity may change in at a strike: any (a free
+/// bead), along one line (a bead on a curve), or across one direction (a
+/// bead on a surface in space; a bead on a rod from a fixed pin).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Freedom<V = DVec2> {
+    kind: FreedomKind,
+    axis: V,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+enum FreedomKind {
+    #[default]
+    Free,
+    Along,
+    Across,
+}
+
+impl<V: Coordinates> Freedom<V> {
+    /// A free bead: it takes a strike in full.
+    pub fn free() -> Self {
+        Self {
+            kind: FreedomKind::Free,
+            axis: V::ZERO,
+        }
+    }
+
+    /// A bead that moves along `tangent` only (its length does not matter).
+    pub fn along(tangent: V) -> Result<Self, ImpactError> {
+        Ok(Self {
+            kind: FreedomKind::Along,
+            axis: unit(tangent)?,
+        })
+    }
+
+    /// A bead that moves in every direction but `normal`'s (its length
+    /// does not matter).
+    pub fn across(normal: V) -> Result<Self, ImpactError> {
+        Ok(Self {
+            kind: FreedomKind::Across,
+            axis: unit(normal)?,
+        })
+    }
+
+    /// The part of `v` the bead can take: `P v`.
+    pub fn project(&self, v: V) -> V {
+        match self.kind {
+            FreedomKind::Free => v,
+            FreedomKind::Along => self.axis * self.axis.dot(v),
+            FreedomKind::Across => v - self.axis * self.axis.dot(v),
+        }
+    }
+}
+
+/// `v / |v|`, if `v` is finite and not zero.
+fn unit<V: Coordinates>(v: V) -> Result<V, ImpactError> {
+    let length = v.dot(v).sqrt();
+    if length.is_finite() && length > 0.0 {
+        Ok(v / length)
+    } else {
+        Err(ImpactError::NoDirection)
+    }
+}
+
+/// A bead as a strike sees it: its inverse mass and its [`Freedom`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImpactBead<V = DVec2> {
+    /// `1 / m`.
+    pub inverse_mass: f64,
+    /// The directions it may move in.
+    pub freedom: Freedom<V>,
+}
+
+/// Two beads that touch (or overlap): their indices, the unit vector from
+/// `a`'s centre to `b`'s, the gap between their surfaces and the
+/// restitution of a strike between them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Touch<V = DVec2> {
+    a: usize,
+    b: usize,
+    normal: V,
+    gap: f64,
+    restitution: f64,
+}
+
+impl<V: Coordinates> Touch<V> {
+    /// Beads `a` at `xa` of radius `ra` and `b` at `xb` of radius `rb`,
+    /// striking with `restitution`: their normal and gap
+    /// `|x_b − x_a| − (r_a + r_b)`. Refused if the centres coincide.
+    pub fn between(
+        (a, xa, ra): (usize, V, f64),
+        (b, xb, rb): (usize, V, f64),
+        restitution: f64,
+    ) -> Result<Self, ImpactError> {
+        let d = xb - xa;
+        let distance = d.dot(d).sqrt();
+        let normal = unit(d).map_err(|_| ImpactError::Coincident { a, b })?;
+        Ok(Self {
+            a,
+            b,
+            normal,
+            gap: distance - (ra + rb),
+            restitution,
+        })
+    }
+
+    /// The two beads.
+    pub fn beads(&self) -> (usize, usize) {
+        (self.a, self.b)
+    }
+
+    /// The unit vector from `a`'s centre to `b`'s.
+    pub fn normal(&self) -> V {
+        self.normal
+    }
+
+    /// The gap between the surfaces: negative where they overlap.
+    pub fn gap(&self) -> f64 {
+        self.gap
+    }
+
+    /// The rate the gap opens at, `n̂·(v_b − v_a)`: negative while the
+    /// pair closes.
+    pub fn normal_speed(&self, velocities: &[V]) -> f64 {
+        self.normal.dot(velocities[self.b] - velocities[self.a])
+    }
+}
+
+/// One strike that [`resolve_impacts`] made.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Strike {
+    /// The index of the touching pair in the list given.
+    pub touch: usize,
+    /// The impulse `p` (N s) along the pair's normal.
+    pub impulse: f64,
+    /// How fast the pair closed before it (m/s, positive).
+    pub closing_speed: f64,
+    /// Whether it bounced (struck with its restitution) or stayed in
+    /// touch (closed slower than the rest speed, struck with `e = 0`).
+    pub bounced: bool,
+}
+
+/// Strikes `touch` with restitution `e`: the impulse of eq. (18) applied
+/// to the two beads' `velocities`. Returns the impulse, zero where
+/// neither bead can move along the normal.
+pub fn strike<V: Coordinates>(
+    touch: &Touch<V>,
+    e: f64,
+    beads: &[ImpactBead<V>],
+    velocities: &mut [V],
+) -> f64 {
+    let (a, b) = (&beads[touch.a], &beads[touch.b]);
+    let n = touch.normal;
+    let pa = a.freedom.project(n) * a.inverse_mass;
+    let pb = b.freedom.project(n) * b.inverse_mass;
+    let w = n.dot(pa) + n.dot(pb);
+    // A NaN weight, like zero, strikes nothing.
+    if w.is_nan() || w <= 0.0 {
+        return 0.0;
+    }
+    let p = -(1.0 + e) * touch.normal_speed(velocities) / w;
+    velocities[touch.a] -= pa * p;
+    velocities[touch.b] += pb * p;
+    p
+}
+
+/// Resolves the strikes among touching beads by sequential pairwise
+/// impacts (see the module's documentation): while a pair in `touches`
+/// closes, the fastest closing one strikes, with its restitution if it
+/// closes faster than `rest_speed`, with `e = 0` otherwise. Each strike is
+/// appended to `strikes`.
+///
+/// Stops with [`ImpactError::DidNotSettle`] after
+/// [`MAX_STRIKES_PER_TOUCH`] strikes per pair, the velocities as the last
+/// strike left them.
+pub fn resolve_impacts<V: Coordinates>(
+    touches: &[Touch<V>],
+    beads: &[ImpactBead<V>],
+    velocities: &mut [V],
+    rest_speed: f64,
+    strikes: &mut Vec<Strike>,
+) -> Result<(), ImpactError> {
+    let count = beads.len().min(velocities.len());
+    if let Some(bead) = touches
+        .iter()
+        .flat_map(|t| [t.a, t.b])
+        .find(|&i| i >= count)
+    {
+        return Err(ImpactError::MissingBead { bead, beads: count });
+    }
+    let fastest = touches
+        .iter()
+        .flat_map(|t| [t.a, t.b])
+        .map(|i| velocities[i].dot(velocities[i]).sqrt())
+        .fold(0.0, f64::max);
+    let slack = SLACK * fastest;
+    let limit = MAX_STRIKES_PER_TOUCH * touches.len();
+    for made in 0.. {
+        let closing = touches
+            .iter()
+            .enumerate()
+            .map(|(i, t)| (i, -t.normal_speed(velocities)))
+            .filter(|&(_, speed)| speed > slack)
+            .fold(None, |best: Option<(usize, f64)>, (i, speed)| match best {
+                Some((_, s)) if s >= speed => best,
+                _ => Some((i, speed)),
+            });
+        let Some((i, closing_speed)) = closing else {
+            return Ok(());
+        };
+        if made == limit {
+            return Err(ImpactError::DidNotSettle { strikes: made });
+        }
+        let touch = &touches[i];
+        let bounced = closing_speed > rest_speed && touch.restitution > 0.0;
+        let e = if bounced { touch.restitution } else { 0.0 };
+        let impulse = strike(touch, e, beads, velocities);
+        if impulse == 0.0 {
+            // Neither bead can move along the line between them: what
+            // closes them there is not theirs to stop.
+            return Ok(());
+        }
+        strikes.push(Strike {
+            touch: i,
+            impulse,
+            closing_speed,
+            bounced,
+        });
+    }
+    unreachable!("the loop returns")
+}
+
+#[cfg(test)]
+mod tests {
+    use bevy::math::{DVec2, DVec3};
+
+    use super::*;
+
+    /// Free beads in a row along x, `spacing` apart, each of radius
+    /// `spacing / 2`, so that neighbours touch.
+    fn row(masses: &[f64], spacing: f64, e: f64) -> (Vec<ImpactBead>, Vec<Touch>) {
+        let beads = masses
+            .iter()
+            .map(|m| ImpactBead {
+                inverse_mass: 1.0 / m,
+                freedom: Freedom::free(),
+            })
+            .collect();
+        let at = |i: usize| DVec2::new(spacing * i as f64, 0.0);
+        let touches = (1..masses.len())
+            .map(|i| {
+                Touch::between(
+                    (i - 1, at(i - 1), spacing / 2.0),
+                    (i, at(i), spacing / 2.0),
+                    e,
+                )
+                .expect("apart")
+            })
+            .collect();
+        (beads, touches)
+    }
+
+    fn energy<V: Coordinates>(beads: &[ImpactBead<V>], v: &[V]) -> f64 {
+        beads
+            .iter()
+            .zip(v)
+            .map(|(b, v)| 0.5 * v.dot(*v) / b.inverse_mass)
+            .sum()
+    }
+
+    fn momentum(beads: &[ImpactBead], v: &[DVec2]) -> DVec2 {
+        beads.iter().zip(v).map(|(b, v)| *v / b.inverse_mass).sum()
+    }
+
+    fn resolve(beads: &[ImpactBead], touches: &[Touch], v: &mut [DVec2]) -> Vec<Strike> {
+        let mut strikes = Vec::new();
+        resolve_impacts(touches, beads, v, 0.0, &mut strikes).expect("settles");
+        strikes
+    }
+
+    #[test]
+    fn equal_masses_exchange_velocities_and_masses_one_and_three_part_as_in_one_dimension() {
+        let (beads, touches) = row(&[1.0, 1.0], 0.1, 1.0);
+        let mut v = [DVec2::new(2.0, 0.0), DVec2::new(-0.5, 0.0)];
+        resolve(&beads, &touches, &mut v);
+        assert!((v[0] - DVec2::new(-0.5, 0.0)).length() <= 1e-12, "{v:?}");
+        assert!((v[1] - DVec2::new(2.0, 0.0)).length() <= 1e-12, "{v:?}");
+
+        let (m1, m2, u1, u2) = (1.0, 3.0, 2.0, -0.5);
+        let (beads, touches) = row(&[m1, m2], 0.1, 1.0);
+        let mut v = [DVec2::new(u1, 0.0), DVec2::new(u2, 0.0)];
+        resolve(&beads, &touches, &mut v);
+        let v1 = ((m1 - m2) * u1 + 2.0 * m2 * u2) / (m1 + m2);
+        let v2 = ((m2 - m1) * u2 + 2.0 * m1 * u1) / (m1 + m2);
+        assert!((v[0].x - v1).abs() <= 1e-12, "{} against {v1}", v[0].x);
+        assert!((v[1].x - v2).abs() <= 1e-12, "{} against {v2}", v[1].x);
+    }
+
+    #[test]
+    fn at_restitution_zero_the_pair_moves_on_together_losing_half_mu_v_squared() {
+        let (m1, m2, u1, u2) = (1.0, 3.0, 2.0, -0.5);
+        let (beads, touches) = row(&[m1, m2], 0.1, 0.0);
+        let mut v = [DVec2::new(u1, 0.0), DVec2::new(u2, 0.0)];
+        let before = energy(&beads, &v);
+        let strikes = resolve(&beads, &touches, &mut v);
+        let common = (m1 * u1 + m2 * u2) / (m1 + m2);
+        assert!((v[0].x - common).abs() <= 1e-12 && (v[1].x - common).abs() <= 1e-12);
+        let mu = m1 * m2 / (m1 + m2);
+        let lost = before - energy(&beads, &v);
+        let expected = 0.5 * mu * (u1 - u2) * (u1 - u2);
+        assert!(
+            (lost - expected).abs() <= 1e-12,
+            "{lost} against {expected}"
+        );
+        assert_eq!(strikes.len(), 1);
+        assert!(!strikes[0].bounced);
+    }
+
+    /// Newton's cradle of five equal balls at `e = 1`: `k` balls in at `v`
+    /// send exactly `k` out at `v`, the rest at rest, momentum and energy
+    /// kept to 1e-12.
+    #[test]
+    fn the_cradle_sends_out_as_many_balls_as_came_in() {
+        let v0 = 1.3;
+        for k in 1..=4 {
+            let (beads, touches) = row(&[1.0; 5], 0.05, 1.0);
+            let mut v: Vec<DVec2> = (0..5)
+                .map(|i| DVec2::new(if i < k { v0 } else { 0.0 }, 0.0))
+                .collect();
+            let (p0, e0) = (momentum(&beads, &v), energy(&beads, &v));
+            resolve(&beads, &touches, &mut v);
+            for (i, v) in v.iter().enumerate() {
+                let expected = if i >= 5 - k { v0 } else { 0.0 };
+                assert!(
+                    (v.x - expected).abs() <= 1e-12 * v0 && v.y == 0.0,
+                    "{k} in: ball {i} leaves at {v}, not {expected}"
+                );
+            }
+            assert!((momentum(&beads, &v) - p0).length() <= 1e-12);
+            assert!((energy(&beads, &v) - e0).abs() <= 1e-12);
+        }
+    }
+
+    #[test]
+    fn three_balls_struck_at_once_from_both_sides_send_the_outer_two_away() {
+        let v0 = 2.0;
+        let (beads, touches) = row(&[1.0; 3], 0.05, 1.0);
+        let mut v = vec![DVec2::new(v0, 0.0), DVec2::ZERO, DVec2::new(-v0, 0.0)];
+        let strikes = resolve(&beads, &touches, &mut v);
+        assert!((v[0].x + v0).abs() <= 1e-12, "{v:?}");
+        assert!(v[1].x.abs() <= 1e-12, "{v:?}");
+        assert!((v[2].x - v0).abs() <= 1e-12, "{v:?}");
+        assert_eq!(strikes.len(), 3, "{strikes:?}");
+    }
+
+    /// Beads held to lines at angles to the line between them, in the
+    /// plane and in space: at `e = 1` the pair separates at the speed it
+    /// closed with and the energy is kept, at `e = ½` it separates at half
+    /// that speed; each bead's velocity stays along its line.
+    #[test]
+    fn beads_held_to_their_wires_strike_with_the_speed_along_the_normal_they_can_take() {
+        for (k, e) in [(0, 1.0), (1, 0.5), (2, 1.0), (3, 0.0)] {
+            let angle = 0.3 + 0.4 * k as f64;
+            let ta = DVec3::new(angle.cos(), angle.sin(), 0.2 * k as f64);
+            let tb = DVec3::new(-0.2, 1.0, angle);
+            let beads = [
+                ImpactBead {
+                    inverse_mass: 1.0 / 1.5,
+                    freedom: Freedom::along(ta).expect("a tangent"),
+                },
+                ImpactBead {
+                    inverse_mass: 1.0 / 0.7,
+                    freedom: Freedom::across(tb).expect("a normal"),
+                },
+            ];
+            let xa = DVec3::ZERO;
+            let xb = DVec3::new(0.3, 0.1, -0.05);
+            let r = xb.length() / 2.0;
+            let touch = Touch::between((0, xa, r), (1, xb, r), e).expect("apart");
+            let mut v = [
+                beads[0].freedom.project(DVec3::new(2.0, 1.0, 0.5)),
+                beads[1].freedom.project(DVec3::new(-1.0, 0.3, 0.2)),
+            ];
+            let u = touch.normal_speed(&v);
+            assert!(u < 0.0, "the pair must close");
+            let before = energy(&beads, &v);
+            let mut strikes = Vec::new();
+            resolve_impacts(&[touch], &beads, &mut v, 0.0, &mut strikes).expect("settles");
+            assert!((touch.normal_speed(&v) + e * u).abs() <= 1e-12, "e = {e}");
+            assert!((beads[0].freedom.project(v[0]) - v[0]).length() <= 1e-12);
+            assert!((beads[1].freedom.project(v[1]) - v[1]).length() <= 1e-12);
+            if e == 1.0 {
+                assert!((energy(&beads, &v) - before).abs() <= 1e-12 * before);
+            } else {
+                assert!(energy(&beads, &v) < before);
+            }
+        }
+    }
+
+    /// Equal free balls in space, one at rest: at `e = 1` they leave at
+    /// right angles, the struck one along the line of centres.
+    #[test]
+    fn an_oblique_strike_of_equal_balls_sends_them_off_at_right_angles() {
+        let beads = [ImpactBead {
+            inverse_mass: 1.0,
+            freedom: Freedom::<DVec3>::free(),
+        }; 2];
+        let xb = DVec3::new(0.08, 0.05, 0.03);
+        let touch = Touch::between((0, DVec3::ZERO, 0.05), (1, xb, xb.length() - 0.05), 1.0)
+            .expect("apart");
+        let mut v = [DVec3::new(3.0, 0.0, 0.0), DVec3::ZERO];
+        let mut strikes = Vec::new();
+        resolve_impacts(&[touch], &beads, &mut v, 0.0, &mut strikes).expect("settles");
+        assert!(v[0].dot(v[1]).abs() <= 1e-12, "{v:?}");
+        assert!(v[1].normalize().cross(touch.normal()).length() <= 1e-12);
+        assert!((v[0] + v[1] - DVec3::new(3.0, 0.0, 0.0)).length() <= 1e-12);
+    }
+
+    #[test]
+    fn a_slow_pair_stays_in_touch_and_a_pair_that_opens_is_left_alone() {
+        let (beads, touches) = row(&[1.0, 1.0], 0.1, 1.0);
+        let mut v = [DVec2::new(0.01, 0.0), DVec2::ZERO];
+        let mut strikes = Vec::new();
+        resolve_impacts(&touches, &beads, &mut v, 0.05, &mut strikes).expect("settles");
+        assert_eq!(v[0], v[1], "they move on together at the same speed");
+        assert!(!strikes[0].bounced);
+
+        let mut v = [DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0)];
+        strikes.clear();
+        resolve_impacts(&touches, &beads, &mut v, 0.0, &mut strikes).expect("settles");
+        assert_eq!(v, [DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0)]);
+        assert!(strikes.is_empty());
+    }
+
+    #[test]
+    fn bad_pairs_are_refused_in_words() {
+        let err = Touch::between((3, DVec2::ONE, 0.1), (4, DVec2::ONE, 0.1), 1.0).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "beads 3 and 4 have their centres at one point, so the line between them has no direction"
+        );
+        assert_eq!(Freedom::along(DVec2::ZERO), Err(ImpactError::NoDirection));
+        let (beads, touches) = row(&[1.0, 1.0], 0.1, 1.0);
+        let mut v = [DVec2::X];
+        let err = resolve_impacts(&touches, &beads, &mut v, 0.0, &mut Vec::new()).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "a touching pair names bead 1, and there are 1 beads"
+        );
+    }
+
+    /// A ball caught between two walls of infinite mass (beads that cannot
+    /// move along the line) at `e = 1` would strike forever: the count is
+    /// bounded and the failure reported.
+    #[test]
+    fn strikes_that_never_settle_are_reported() {
+        let fixed = ImpactBead {
+            inverse_mass: 0.0,
+            freedom: Freedom::free(),
+        };
+        let ball = ImpactBead {
+            inverse_mass: 1.0,
+            freedom: Freedom::free(),
+        };
+        let beads = [fixed, ball, fixed];
+        let at = |x: f64| DVec2::new(x, 0.0);
+        let touches = [
+            Touch::between((0, at(0.0), 0.05), (1, at(0.1), 0.05), 1.0).expect("apart"),
+            Touch::between((1, at(0.1), 0.05), (2, at(0.2), 0.05), 1.0).expect("apart"),
+        ];
+        let mut v = [DVec2::ZERO, at(1.0), DVec2::ZERO];
+        let err = resolve_impacts(&touches, &beads, &mut v, 0.0, &mut Vec::new()).unwrap_err();
+        assert_eq!(
+            err,
+            ImpactError::DidNotSettle {
+                strikes: 2 * MAX_STRIKES_PER_TOUCH
+            }
+        );
+    }
+
+    fn vector() -> impl proptest::strategy::Strategy<Value = DVec3> {
+        use proptest::prelude::*;
+        (-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z))
+    }
+
+    fn freedom() -> impl proptest::strategy::Strategy<Value = Freedom<DVec3>> {
+        use proptest::prelude::*;
+        (0..3usize, vector()).prop_map(|(kind, axis)| match kind {
+            0 => Freedom::free(),
+            1 => Freedom::along(axis).unwrap_or_default(),
+            _ => Freedom::across(axis).unwrap_or_default(),
+        })
+    }
+
+    proptest::proptest! {
+        /// Any two beads, free or held, of any masses, struck at any
+        /// restitution: the pair opens at `−e u` (where either can move
+        /// along the normal), no bead leaves its freedom, the energy never
+        /// grows, and struck at `e = 1` it is kept.
+        #[test]
+        fn a_strike_opens_the_pair_at_minus_e_u_and_never_adds_energy(
+            (ma, mb) in (0.05..20.0f64, 0.05..20.0f64),
+            (fa, fb) in (freedom(), freedom()),
+            (xb, va, vb) in (vector(), vector(), vector()),
+            e in 0.0..=1.0f64,
+        ) {
+            let beads = [
+                ImpactBead { inverse_mass: 1.0 / ma, freedom: fa },
+                ImpactBead { inverse_mass: 1.0 / mb, freedom: fb },
+            ];
+            proptest::prop_assume!(xb.length() > 1e-3);
+            let touch = Touch::between((0, DVec3::ZERO, 0.0), (1, xb, xb.length()), e)
+                .expect("apart");
+            let mut v = [fa.project(va), fb.project(vb)];
+            let (u, before) = (touch.normal_speed(&v), energy(&beads, &v));
+            let impulse = strike(&touch, e, &beads, &mut v);
+            let after = energy(&beads, &v);
+            let scale = 1e-12 * (1.0 + va.length() + vb.length());
+            if impulse != 0.0 {
+                proptest::prop_assert!((touch.normal_speed(&v) + e * u).abs() <= scale);
+            }
+            proptest::prop_assert!((fa.project(v[0]) - v[0]).length() <= scale);
+            proptest::prop_assert!((fb.project(v[1]) - v[1]).length() <= scale);
+            proptest::prop_assert!(after <= before * (1.0 + 1e-12) + 1e-300);
+            let mut elastic = [fa.project(va), fb.project(vb)];
+            strike(&touch, 1.0, &beads, &mut elastic);
+            let kept = energy(&beads, &elastic);
+            proptest::prop_assert!((kept - before).abs() <= 1e-12 * before.max(1e-300));
+        }
+    }
+}
