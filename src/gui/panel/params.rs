@@ -50,23 +50,23 @@ fn vector<V: Coordinates>(ui: &mut egui::Ui, label: &str, value: &mut V, speed: 
 }
 
 /// A bead's mass and start in a grid, edited as a draft of its pending
-/// [`NextBeadParams`] (or its [`BeadParams`] where none is pending); the
-/// edit, if the draft changed and is valid, is inserted for the next
-/// restart. The draft is returned so that an edit of the wire can move
-/// the start before it is kept.
+/// [`NextBeadParams`] (or its [`BeadParams`] where none is pending).
+/// Returns what was shown and the draft, for [`keep_bead_edit`]; an edit of
+/// the wire may move the draft's start before it is kept.
 pub(super) fn bead_start_editor<V: Coordinates + Reflect + TypePath>(
     ui: &mut egui::Ui,
     id: &str,
     params: &BeadParams<V>,
     pending: Option<&NextBeadParams<V>>,
-) -> BeadParams<V> {
-    let mut draft = pending.map_or(*params, |p| *p.get());
+) -> (BeadParams<V>, BeadParams<V>) {
+    let shown = pending.map_or(*params, |p| *p.get());
+    let mut draft = shown;
     egui::Grid::new(id).num_columns(2).show(ui, |ui| {
         number(ui, "mass", &mut draft.mass, 0.01);
         vector(ui, "initial position", &mut draft.initial_position, 0.01);
         vector(ui, "initial velocity", &mut draft.initial_velocity, 0.01);
     });
-    draft
+    (shown, draft)
 }
 
 /// Keeps `draft` as the bead's pending edit if it differs from `before`.
@@ -89,8 +89,7 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
         view.selected.0.and_then(|e| view.beads.get(e).ok())?;
     ui.separator();
     ui.strong(format!("Bead {}", view.name(entity)));
-    let before = pending_bead.map_or(*bead, |p| *p.get());
-    let mut draft = bead_start_editor(ui, "bead", bead, pending_bead);
+    let (before, mut draft) = bead_start_editor(ui, "bead", bead, pending_bead);
     let mut outcome = None;
     if let Some(on_wire) = on_wire
         && let Ok((wire, transform, pending_wire, motion)) = view.wires.get(on_wire.0)

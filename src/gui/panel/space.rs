@@ -20,8 +20,7 @@ pub(super) fn space_bead_section(
         view.selected.0.and_then(|e| view.space_beads.get(e).ok())?;
     ui.separator();
     ui.strong(format!("Bead {} (in space)", view.name(entity)));
-    let before = pending.map_or(*bead, |p| *p.get());
-    let draft = bead_start_editor(ui, "space-bead", bead, pending);
+    let (before, draft) = bead_start_editor(ui, "space-bead", bead, pending);
     let mut outcome = keep_bead_edit(commands, entity, before, draft);
     if let Some(on_wire) = on_wire
         && let Ok((wire, motion)) = view.space_wires.get(on_wire.0)
