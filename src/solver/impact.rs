@@ -276,8 +276,9 @@ pub fn resolve_impacts<V: Coordinates>(
         .fold(0.0, f64::max);
     let slack = SLACK * fastest;
     let limit = MAX_STRIKES_PER_TOUCH * touches.len();
-    for made in 0.. {
-        let closing = touches
+    // The pair closing fastest, the first listed among equals.
+    let closing = |velocities: &[V]| {
+        touches
             .iter()
             .enumerate()
             .map(|(i, t)| (i, -t.normal_speed(velocities)))
@@ -285,13 +286,12 @@ pub fn resolve_impacts<V: Coordinates>(
             .fold(None, |best: Option<(usize, f64)>, (i, speed)| match best {
                 Some((_, s)) if s >= speed => best,
                 _ => Some((i, speed)),
-            });
-        let Some((i, closing_speed)) = closing else {
+            })
+    };
+    for _ in 0..limit {
+        let Some((i, closing_speed)) = closing(velocities) else {
             return Ok(());
         };
-        if made == limit {
-            return Err(ImpactError::DidNotSettle { strikes: made });
-        }
         let touch = &touches[i];
         let bounced = closing_speed > rest_speed && touch.restitution > 0.0;
         let e = if bounced { touch.restitution } else { 0.0 };
@@ -308,7 +308,10 @@ pub fn resolve_impacts<V: Coordinates>(
             bounced,
         });
     }
-    unreachable!("the loop returns")
+    match closing(velocities) {
+        None => Ok(()),
+        Some(_) => Err(ImpactError::DidNotSettle { strikes: limit }),
+    }
 }
 
 #[cfg(test)]

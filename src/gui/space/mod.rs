@@ -1,10 +1,11 @@
 //! The 3D view (feature `gui`): scenes in space open in a perspective
 //! camera that orbits the scene (drag empty space, or anything with a
-//! button other than the first, to turn; the wheel to zoom); wires in space are drawn as lines (curves)
-//! or translucent meshes (surfaces, the open side of a one-sided one in
-//! the wire's colour and the closed side darker), beads as spheres the
-//! mouse can drag, with trails, rods, pins, springs and the constraint
-//! force `λ∇C` as arrows. Scenes in the plane keep the 2D view.
+//! button other than the first, to turn; the wheel to zoom); wires in
+//! space are drawn as lines (curves) or translucent meshes (surfaces, the
+//! open side of a one-sided one in the wire's colour and the closed side
+//! darker), beads as spheres the mouse can drag, with trails, rods, pins,
+//! springs and the constraint force `λ∇C` as arrows. Scenes in the plane
+//! keep the 2D view.
 //!
 //! | file | what it holds |
 //! |---|---|
