@@ -96,11 +96,11 @@ mod validate;
 pub use controls::KeyboardControlsPlugin;
 pub use dynamics::{
     Bead, BeadBundle, BeadDiagnostics, BeadDiverged, BeadForce, BeadForces, BeadForcesItem,
-    BeadMass, BeadParams, BeadPosition, BeadVelocity, ConstraintDiagnostics, ContactChanged,
-    Dimension, Diverged, DivergenceReason, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams,
-    NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, RailOrientation, Rod, SimParams,
-    SpaceBead, SpaceBeadBundle, SpaceParams, SpaceWire, Spring, SpringAnchor, Wire, WireBeads,
-    WireContact, WireRows, pose_of,
+    BeadMass, BeadParams, BeadPosition, BeadRadius, BeadVelocity, BeadsStruck,
+    ConstraintDiagnostics, ContactChanged, Contacts, Dimension, Diverged, DivergenceReason, Joint,
+    MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams, NextParams, NextWireShape, OnWire, Pin,
+    PrescribedMotion, RailOrientation, Restitution, Rod, SimParams, SpaceBead, SpaceBeadBundle,
+    SpaceParams, SpaceWire, Spring, SpringAnchor, Wire, WireBeads, WireContact, WireRows, pose_of,
 };
 pub use geometry::{
     Friction, ImplicitCurve, Oscillate, Side, Spin, Surface, WireKind, WireMotion, WireShape,
@@ -131,9 +131,9 @@ pub type PendingWire = NextWireShape;
 /// is at the crate root (`wirebead::Islands`, `wirebead::NextParams`, …).
 pub mod prelude {
     pub use crate::{
-        Bead, BeadDiagnostics, BeadForces, BeadMass, BeadParams, BeadPosition, BeadVelocity,
-        Diverged, Method, OnWire, Pin, PrescribedMotion, Restart, Rod, SimParams, Spring, Wire,
-        WireBeadPlugin, WireBeadSystems, WireShape,
+        Bead, BeadDiagnostics, BeadForces, BeadMass, BeadParams, BeadPosition, BeadRadius,
+        BeadVelocity, BeadsStruck, Contacts, Diverged, Method, OnWire, Pin, PrescribedMotion,
+        Restart, Rod, SimParams, Spring, Wire, WireBeadPlugin, WireBeadSystems, WireShape,
     };
 }
 

@@ -112,11 +112,13 @@ impl HoopSweep {
                     mass: 1.0,
                     initial_position: DVec3::new(self.radius * s, -self.radius * c, 0.0),
                     initial_velocity: DVec3::ZERO,
+                    radius: 0.0,
                 }],
             }],
             beads: Vec::new(),
             constraints: Vec::new(),
             springs: Vec::new(),
+            contacts: Default::default(),
         }
     }
 

@@ -76,6 +76,9 @@ pub enum DivergenceReason {
     /// The constraints and springs that join the bead to others cannot be
     /// solved together (a mass or a value out of range).
     InvalidConstraint(String),
+    /// Beads that touch kept striking within one step, or a step cut at
+    /// an impact failed.
+    Touch(String),
 }
 
 impl fmt::Display for DivergenceReason {
@@ -85,6 +88,7 @@ impl fmt::Display for DivergenceReason {
             Self::NonFiniteState => f.write_str("its position or velocity is not finite"),
             Self::InvalidWire(why) => write!(f, "its wire is invalid: {why}"),
             Self::InvalidConstraint(why) => write!(f, "its island is invalid: {why}"),
+            Self::Touch(why) => write!(f, "its strikes did not settle: {why}"),
         }
     }
 }

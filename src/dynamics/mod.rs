@@ -10,6 +10,7 @@ mod dimension;
 mod links;
 mod params;
 mod rail;
+mod touch;
 mod wire;
 
 pub use bead::{
@@ -22,6 +23,7 @@ pub use dimension::{Dimension, WireRows};
 pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
 pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, NextParams, SimParams, SpaceParams};
 pub use rail::RailOrientation;
+pub use touch::{BeadRadius, BeadsStruck, Contacts, Restitution};
 pub(crate) use wire::WirePose;
 pub use wire::{
     ContactChanged, NextWireShape, OnWire, PrescribedMotion, SpaceWire, Wire, WireBeads,

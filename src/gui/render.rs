@@ -15,7 +15,8 @@ use crate::debug_render::{
 };
 use crate::geometry::{Pose, WireShape};
 use crate::{
-    Bead, BeadParams, BeadPosition, OnWire, Restart, Rod, Wire, WireBeadSystems, WireContact,
+    Bead, BeadParams, BeadPosition, BeadRadius, OnWire, Restart, Rod, Wire, WireBeadSystems,
+    WireContact,
 };
 
 /// Colours and sizes of the scene.
@@ -320,8 +321,8 @@ pub fn frame_camera(
 }
 
 /// Sizes each bead to the view, no wider than 40 % of the shortest rod it
-/// hangs on (so a rope of short rods reads as a rope), and colours the
-/// diverged ones.
+/// hangs on (so a rope of short rods reads as a rope), a bead with a
+/// radius at its radius, and colours the diverged ones.
 fn size_and_colour_beads(
     view: Res<FramedView>,
     style: Res<SceneStyle>,
@@ -333,6 +334,7 @@ fn size_and_colour_beads(
             &MeshMaterial2d<ColorMaterial>,
             Has<crate::Diverged>,
             Option<&WireContact>,
+            Option<&BeadRadius>,
         ),
         With<Bead>,
     >,
@@ -340,8 +342,8 @@ fn size_and_colour_beads(
 ) {
     let radius = style.bead_radius * view.size.y;
     let limits = BeadSizes::new(&rods);
-    for (entity, mut transform, material, diverged, contact) in &mut beads {
-        transform.scale = Vec3::splat(limits.radius(entity, radius));
+    for (entity, mut transform, material, diverged, contact, own) in &mut beads {
+        transform.scale = Vec3::splat(limits.drawn(entity, own, radius));
         transform.translation.z = 1.0;
         if let Some(mut m) = materials.get_mut(&material.0) {
             let colour = style.bead_colour(diverged, contact);
@@ -373,6 +375,15 @@ impl BeadSizes {
     /// The radius `bead` is drawn at, `radius` at most.
     pub(crate) fn radius(&self, bead: Entity, radius: f32) -> f32 {
         self.0.get(&bead).map_or(radius, |&limit| radius.min(limit))
+    }
+
+    /// The radius `bead` is drawn at: its own where it has one (beads that
+    /// touch are drawn touching), else [`BeadSizes::radius`].
+    pub(crate) fn drawn(&self, bead: Entity, own: Option<&BeadRadius>, radius: f32) -> f32 {
+        match own.map(BeadRadius::get) {
+            Some(r) if r > 0.0 => r as f32,
+            _ => self.radius(bead, radius),
+        }
     }
 }
 

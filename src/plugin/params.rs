@@ -1,5 +1,6 @@
 //! [`ParamsPlugin`]: what every other plugin of the group reads: the
-//! applied and pending parameters, the order of the step's sets, the
+//! applied and pending parameters, how beads that touch strike
+//! ([`Contacts`]), the order of the step's sets, the
 //! compute-pool setting, and what a bead brings along.
 
 use bevy::math::DVec3;
@@ -8,8 +9,9 @@ use bevy::prelude::*;
 use super::parallel::{ParallelStep, StepSplit};
 use super::schedule;
 use crate::dynamics::{
-    Bead, BeadDiagnostics, BeadDiverged, BeadForce, BeadMass, BeadParams, BeadPosition,
-    BeadVelocity, ContactChanged, NextBeadParams, NextParams, SimParams, SpaceBead,
+    Bead, BeadDiagnostics, BeadDiverged, BeadForce, BeadMass, BeadParams, BeadPosition, BeadRadius,
+    BeadVelocity, BeadsStruck, ContactChanged, Contacts, NextBeadParams, NextParams, Restitution,
+    SimParams, SpaceBead,
 };
 
 /// The parameters ([`SimParams`], [`NextParams`]), the step's sets in
@@ -76,6 +78,11 @@ impl Plugin for ParamsPlugin {
         app.init_resource::<ParallelStep>()
             .init_resource::<StepSplit>()
             .register_type::<StepSplit>()
+            .init_resource::<Contacts>()
+            .register_type::<Contacts>()
+            .register_type::<BeadRadius>()
+            .register_type::<Restitution>()
+            .add_message::<BeadsStruck>()
             .add_message::<BeadDiverged>()
             .add_message::<ContactChanged>()
             .add_message::<ContactChanged<DVec3>>()

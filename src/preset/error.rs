@@ -79,6 +79,21 @@ pub enum PresetError {
     /// Two beads have one name.
     #[error("two beads are named {0:?}")]
     DuplicateName(String),
+    /// The contacts' parameters are invalid.
+    #[error("contacts: {0}")]
+    Contacts(ParamError),
+    /// Two beads with radii overlap where they start.
+    #[error(
+        "beads {a:?} and {b:?} overlap by {by:.3e} m where they start; beads with radii may touch but not overlap"
+    )]
+    Overlap {
+        /// The first bead's name.
+        a: String,
+        /// The second's.
+        b: String,
+        /// By how much (m).
+        by: f64,
+    },
     /// A constraint or spring is invalid.
     #[error("{item}: {problem}")]
     Link {

@@ -6,7 +6,7 @@ use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::error::PresetError;
-use crate::dynamics::{BeadParams, SimParams};
+use crate::dynamics::{BeadParams, BeadRadius, Contacts, SimParams};
 use crate::geometry::{Coordinates, Friction, Side, Surface, WireMotion, WireShape};
 use crate::validate::{ParamError, finite, finite_vector, non_negative, positive};
 
@@ -28,6 +28,15 @@ pub struct BeadPreset<V: Coordinates = DVec2> {
     pub initial_position: V,
     /// The velocity a restart gives it.
     pub initial_velocity: V,
+    /// Its radius (see [`BeadRadius`](crate::BeadRadius)): 0, the
+    /// default, touches nothing.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub radius: f64,
+}
+
+/// Whether a value is zero (and goes unwritten).
+fn is_zero(value: &f64) -> bool {
+    *value == 0.0
 }
 
 impl<V: Coordinates> Default for BeadPreset<V> {
@@ -38,6 +47,7 @@ impl<V: Coordinates> Default for BeadPreset<V> {
             mass: params.mass,
             initial_position: params.initial_position,
             initial_velocity: params.initial_velocity,
+            radius: 0.0,
         }
     }
 }
@@ -50,6 +60,42 @@ impl<V: Coordinates> BeadPreset<V> {
             initial_position: self.initial_position,
             initial_velocity: self.initial_velocity,
         }
+    }
+
+    /// Checks its parameters and radius.
+    fn validate(&self) -> Result<(), ParamError> {
+        self.params().validate()?;
+        BeadRadius::new(self.radius).map(drop)
+    }
+}
+
+/// How a scene's beads strike when they touch: `contacts: (restitution:
+/// e)`, elastic (`e = 1`) by default.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[serde(default)]
+pub struct ContactsPreset {
+    /// The restitution of a strike, from 0 (the pair stays together) to 1.
+    pub restitution: f64,
+}
+
+impl Default for ContactsPreset {
+    fn default() -> Self {
+        Self {
+            restitution: Contacts::default().restitution(),
+        }
+    }
+}
+
+impl ContactsPreset {
+    /// As the resource, if valid.
+    pub fn contacts(&self) -> Result<Contacts, PresetError> {
+        Contacts::new(self.restitution).map_err(PresetError::Contacts)
+    }
+
+    /// Whether it is the default (and goes unwritten).
+    pub(super) fn is_default(&self) -> bool {
+        *self == Self::default()
     }
 }
 
@@ -186,6 +232,9 @@ pub struct ScenePreset {
     /// Springs between beads.
     #[serde(default)]
     pub springs: Vec<SpringPreset>,
+    /// How beads with radii strike.
+    #[serde(default, skip_serializing_if = "ContactsPreset::is_default")]
+    pub contacts: ContactsPreset,
 }
 
 impl ScenePreset {
@@ -210,6 +259,7 @@ impl ScenePreset {
             other => return Err(PresetError::Dimension(other)),
         }
         self.params.validate().map_err(PresetError::Params)?;
+        self.contacts.contacts()?;
         for (index, wire) in self.wires.iter().enumerate() {
             wire.shape
                 .validate()
@@ -306,25 +356,20 @@ pub(super) fn check_beads_and_links<V: Coordinates>(
 ) -> Result<Vec<SceneLink<V>>, PresetError> {
     for (index, beads) in wires.iter().enumerate() {
         for (bead, preset) in beads.iter().enumerate() {
-            preset
-                .params()
-                .validate()
-                .map_err(|source| PresetError::Bead {
-                    wire: index,
-                    bead,
-                    source,
-                })?;
+            preset.validate().map_err(|source| PresetError::Bead {
+                wire: index,
+                bead,
+                source,
+            })?;
         }
     }
     let names = names_of(wires.iter().copied().flatten().chain(free));
     let free_names = &names[names.len() - free.len()..];
     for (bead, name) in free.iter().zip(free_names) {
-        bead.params()
-            .validate()
-            .map_err(|source| PresetError::FreeBead {
-                name: name.clone(),
-                source,
-            })?;
+        bead.validate().map_err(|source| PresetError::FreeBead {
+            name: name.clone(),
+            source,
+        })?;
     }
     for (i, name) in names.iter().enumerate() {
         if names[..i].contains(name) {
@@ -335,7 +380,35 @@ pub(super) fn check_beads_and_links<V: Coordinates>(
     if names.is_empty() {
         return Err(PresetError::Empty);
     }
+    let all: Vec<&BeadPreset<V>> = wires.iter().copied().flatten().chain(free).collect();
+    if let Some((a, b, by)) = first_overlap(&all) {
+        return Err(PresetError::Overlap {
+            a: names[a].clone(),
+            b: names[b].clone(),
+            by,
+        });
+    }
     Ok(links)
+}
+
+/// The first two beads with radii that overlap where they start (by more
+/// than rounding), and by how much.
+fn first_overlap<V: Coordinates>(beads: &[&BeadPreset<V>]) -> Option<(usize, usize, f64)> {
+    let round: Vec<usize> = (0..beads.len())
+        .filter(|&i| beads[i].radius > 0.0)
+        .collect();
+    for (k, &i) in round.iter().enumerate() {
+        for &j in &round[k + 1..] {
+            let (a, b) = (beads[i], beads[j]);
+            let d = b.initial_position - a.initial_position;
+            let reach = a.radius + b.radius;
+            let by = reach - d.dot(d).sqrt();
+            if by > crate::solver::TOUCHING * reach {
+                return Some((i, j, by));
+            }
+        }
+    }
+    None
 }
 
 /// The constraints, then the springs, with the beads they name as indices

@@ -37,8 +37,8 @@ mod tests;
 
 pub use error::PresetError;
 pub use format::{
-    BeadPreset, ConstraintPreset, PinPreset, RodPreset, SceneLink, ScenePreset, SpringPreset,
-    WirePreset,
+    BeadPreset, ConstraintPreset, ContactsPreset, PinPreset, RodPreset, SceneLink, ScenePreset,
+    SpringPreset, WirePreset,
 };
 pub use plugin::{
     ActivePreset, LoadPreset, ScenePresetLoader, ScenePresetPlugin, apply_loaded_preset,

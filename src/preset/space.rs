@@ -8,7 +8,8 @@ use serde::{Deserialize, Serialize};
 
 use super::error::PresetError;
 use super::format::{
-    BeadPreset, ConstraintPreset, SceneLink, SpringPreset, check_beads_and_links, names_of,
+    BeadPreset, ConstraintPreset, ContactsPreset, SceneLink, SpringPreset, check_beads_and_links,
+    names_of,
 };
 use super::spawn::{FromPreset, spawn_beads_and_links};
 use crate::dynamics::{PrescribedMotion, RailOrientation, SpaceParams, SpaceWire};
@@ -339,6 +340,9 @@ pub struct SpaceScene {
     /// Springs between beads.
     #[serde(default)]
     pub springs: Vec<SpringPreset>,
+    /// How beads with radii strike.
+    #[serde(default, skip_serializing_if = "ContactsPreset::is_default")]
+    pub contacts: ContactsPreset,
 }
 
 impl SpaceScene {
@@ -351,6 +355,7 @@ impl SpaceScene {
         }
         finite_vector("gravity", self.params.0.gravity_in_space()).map_err(PresetError::Params)?;
         self.params.0.validate().map_err(PresetError::Params)?;
+        self.contacts.contacts()?;
         for (index, wire) in self.wires.iter().enumerate() {
             wire.validate()
                 .map_err(|source| PresetError::Wire { index, source })?;
@@ -400,6 +405,9 @@ impl SpaceScene {
             wires.push((wire_entity, twist, wire.beads.as_slice()));
         }
         let links = self.links().unwrap_or_default();
+        if let Ok(contacts) = self.contacts.contacts() {
+            commands.insert_resource(contacts);
+        }
         let beads = spawn_beads_and_links(&wires, &self.beads, links, self.bead_names(), commands);
         // The beads of a rail turn with it.
         let mut first = 0;

@@ -4,7 +4,9 @@
 use bevy::prelude::*;
 
 use super::format::{BeadPreset, SceneLink, ScenePreset};
-use crate::dynamics::{BeadVelocity, Dimension, OnWire, Pin, PrescribedMotion, Rod, Spring, Wire};
+use crate::dynamics::{
+    BeadRadius, BeadVelocity, Dimension, OnWire, Pin, PrescribedMotion, Rod, Spring, Wire,
+};
 use crate::geometry::{Pose, Twist};
 
 /// Marks the wires and beads spawned from a preset, which the next preset
@@ -37,6 +39,9 @@ impl ScenePreset {
             wires.push((wire_entity, twist, wire.beads.as_slice()));
         }
         let links = self.links().unwrap_or_default();
+        if let Ok(contacts) = self.contacts.contacts() {
+            commands.insert_resource(contacts);
+        }
         spawn_beads_and_links(&wires, &self.beads, links, self.bead_names(), commands)
     }
 }
@@ -80,6 +85,11 @@ pub(super) fn spawn_bead<V: Dimension>(
         return Entity::PLACEHOLDER;
     };
     let mut entity = commands.spawn((bead, Name::new(name.unwrap_or_default()), FromPreset));
+    if let Ok(radius) = BeadRadius::new(preset.radius)
+        && preset.radius > 0.0
+    {
+        entity.insert(radius);
+    }
     if let Some((wire, twist)) = wire {
         let velocity = BeadVelocity(params.initial_velocity_on(&twist));
         entity.insert((OnWire(wire), velocity));

@@ -17,6 +17,13 @@
 //! projection, keeps the kinetic energy at `e = 1` and loses
 //! `½ (1 − e²) u² / w` below it.
 //!
+//! A bead joined to others answers with its whole island: the impulse
+//! `W Jᵀ p` projected onto the island's constraints in the kinetic-energy
+//! norm, `Δv = P W Jᵀ p` with `P = I − W Jᵀ (J W Jᵀ)⁻¹ J`. A [`Response`]
+//! holds that answer per unit impulse for one touching pair (each bead's
+//! velocity change), and `w = n̂·(Δv_b − Δv_a)`: [`Freedom`] is the same
+//! projection for a bead held by its own rows alone.
+//!
 //! **Simultaneous and chained strikes** ([`resolve_impacts`]) are resolved
 //! as sequential pairwise impacts: while a touching pair closes, the one
 //! closing fastest (the first in the list among equals) strikes alone, and
@@ -29,9 +36,10 @@
 //! first pair exchanges, the middle ball carries `v` into the third, and
 //! the first ball takes the middle one's rebound.
 //!
-//! A pair closing slower than the speed one step's forces give it
-//! (`rest_speed`) strikes with `e = 0`: it stays in touch, as a bead
-//! landing slowly on a one-sided wire stays on it (eq. 16).
+//! A pair whose bounce `e u` would be slower than the speed one step's
+//! forces give it along the normal (its rest speed, [`Touch::resting_below`])
+//! strikes with `e = 0`: it stays in touch, as a bead landing slowly on a
+//! one-sided wire stays on it (eq. 16).
 
 use bevy::math::DVec2;
 use thiserror::Error;
@@ -162,6 +170,7 @@ pub struct Touch<V = DVec2> {
     normal: V,
     gap: f64,
     restitution: f64,
+    rest_speed: f64,
 }
 
 impl<V: Coordinates> Touch<V> {
@@ -182,7 +191,18 @@ impl<V: Coordinates> Touch<V> {
             normal,
             gap: distance - (ra + rb),
             restitution,
+            rest_speed: 0.0,
         })
+    }
+
+    /// The pair stays in touch (strikes with `e = 0`) where its bounce
+    /// `e u` would be no faster than `speed`: what one step of the forces
+    /// pressing it together gives (eq. 16's rule). Zero by default.
+    pub fn resting_below(self, speed: f64) -> Self {
+        Self {
+            rest_speed: speed,
+            ..self
+        }
     }
 
     /// The two beads.
@@ -205,6 +225,68 @@ impl<V: Coordinates> Touch<V> {
     pub fn normal_speed(&self, velocities: &[V]) -> f64 {
         self.normal.dot(velocities[self.b] - velocities[self.a])
     }
+
+    /// The restitution it strikes with when closing at `closing_speed`:
+    /// its own, or zero where the bounce would not outrun its rest speed.
+    fn restitution_at(&self, closing_speed: f64) -> f64 {
+        if self.restitution * closing_speed > self.rest_speed {
+            self.restitution
+        } else {
+            0.0
+        }
+    }
+}
+
+/// How the beads' velocities answer a unit impulse on one touching pair
+/// (`−n̂` on `a`, `+n̂` on `b`): each bead's velocity change, and the
+/// pair's weight `w = n̂·(Δv_b − Δv_a)`, the inverse of its effective mass
+/// along the normal.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Response<V = DVec2> {
+    changes: Vec<(usize, V)>,
+    weight: f64,
+}
+
+impl<V: Coordinates> Response<V> {
+    /// The answer `changes` (bead, velocity change per unit impulse; a
+    /// bead may be listed more than once, its changes add) to a unit
+    /// impulse on `touch`.
+    pub fn new(touch: &Touch<V>, changes: Vec<(usize, V)>) -> Self {
+        let of = |bead: usize| {
+            changes
+                .iter()
+                .filter(|(i, _)| *i == bead)
+                .fold(V::ZERO, |sum, (_, dv)| sum + *dv)
+        };
+        let weight = touch.normal.dot(of(touch.b) - of(touch.a));
+        Self { changes, weight }
+    }
+
+    /// The answer of two beads each held by its own rows alone (free, or
+    /// by its [`Freedom`]): `∓P n̂ / m`.
+    pub fn through(touch: &Touch<V>, beads: &[ImpactBead<V>]) -> Result<Self, ImpactError> {
+        let bead = |i: usize| {
+            beads.get(i).ok_or(ImpactError::MissingBead {
+                bead: i,
+                beads: beads.len(),
+            })
+        };
+        let (a, b) = (bead(touch.a)?, bead(touch.b)?);
+        let n = touch.normal;
+        Ok(Self::new(
+            touch,
+            vec![
+                (touch.a, -a.freedom.project(n) * a.inverse_mass),
+                (touch.b, b.freedom.project(n) * b.inverse_mass),
+            ],
+        ))
+    }
+
+    /// `w = n̂·(Δv_b − Δv_a)` per unit impulse: zero where neither bead
+    /// can move along the normal.
+    pub fn weight(&self) -> f64 {
+        self.weight
+    }
 }
 
 /// One strike that [`resolve_impacts`] made.
@@ -221,34 +303,33 @@ pub struct Strike {
     pub bounced: bool,
 }
 
-/// Strikes `touch` with restitution `e`: the impulse of eq. (18) applied
-/// to the two beads' `velocities`. Returns the impulse, zero where
-/// neither bead can move along the normal.
+/// Strikes `touch` with restitution `e`: the impulse of eq. (18),
+/// `p = −(1 + e) u / w`, applied to the `velocities` through the pair's
+/// `response`. Returns the impulse, zero where neither bead can move
+/// along the normal.
 pub fn strike<V: Coordinates>(
     touch: &Touch<V>,
     e: f64,
-    beads: &[ImpactBead<V>],
+    response: &Response<V>,
     velocities: &mut [V],
 ) -> f64 {
-    let (a, b) = (&beads[touch.a], &beads[touch.b]);
-    let n = touch.normal;
-    let pa = a.freedom.project(n) * a.inverse_mass;
-    let pb = b.freedom.project(n) * b.inverse_mass;
-    let w = n.dot(pa) + n.dot(pb);
+    let w = response.weight;
     // A NaN weight, like zero, strikes nothing.
     if w.is_nan() || w <= 0.0 {
         return 0.0;
     }
     let p = -(1.0 + e) * touch.normal_speed(velocities) / w;
-    velocities[touch.a] -= pa * p;
-    velocities[touch.b] += pb * p;
+    for &(i, dv) in &response.changes {
+        velocities[i] += dv * p;
+    }
     p
 }
 
 /// Resolves the strikes among touching beads by sequential pairwise
 /// impacts (see the module's documentation): while a pair in `touches`
-/// closes, the fastest closing one strikes, with its restitution if it
-/// closes faster than `rest_speed`, with `e = 0` otherwise. Each strike is
+/// closes, the fastest closing one strikes through its response (the
+/// same index in `responses`), with its restitution where its bounce
+/// outruns its rest speed, with `e = 0` otherwise. Each strike is
 /// appended to `strikes`.
 ///
 /// Stops with [`ImpactError::DidNotSettle`] after
@@ -256,29 +337,30 @@ pub fn strike<V: Coordinates>(
 /// strike left them.
 pub fn resolve_impacts<V: Coordinates>(
     touches: &[Touch<V>],
-    beads: &[ImpactBead<V>],
+    responses: &[Response<V>],
     velocities: &mut [V],
-    rest_speed: f64,
     strikes: &mut Vec<Strike>,
 ) -> Result<(), ImpactError> {
-    let count = beads.len().min(velocities.len());
-    if let Some(bead) = touches
-        .iter()
-        .flat_map(|t| [t.a, t.b])
-        .find(|&i| i >= count)
-    {
+    let count = velocities.len();
+    let named = || {
+        touches.iter().flat_map(|t| [t.a, t.b]).chain(
+            responses
+                .iter()
+                .flat_map(|r| r.changes.iter().map(|(i, _)| *i)),
+        )
+    };
+    if let Some(bead) = named().find(|&i| i >= count) {
         return Err(ImpactError::MissingBead { bead, beads: count });
     }
-    let fastest = touches
-        .iter()
-        .flat_map(|t| [t.a, t.b])
+    let fastest = named()
         .map(|i| velocities[i].dot(velocities[i]).sqrt())
         .fold(0.0, f64::max);
     let slack = SLACK * fastest;
-    let limit = MAX_STRIKES_PER_TOUCH * touches.len();
+    let pairs = touches.len().min(responses.len());
+    let limit = MAX_STRIKES_PER_TOUCH * pairs;
     // The pair closing fastest, the first listed among equals.
     let closing = |velocities: &[V]| {
-        touches
+        touches[..pairs]
             .iter()
             .enumerate()
             .map(|(i, t)| (i, -t.normal_speed(velocities)))
@@ -293,9 +375,8 @@ pub fn resolve_impacts<V: Coordinates>(
             return Ok(());
         };
         let touch = &touches[i];
-        let bounced = closing_speed > rest_speed && touch.restitution > 0.0;
-        let e = if bounced { touch.restitution } else { 0.0 };
-        let impulse = strike(touch, e, beads, velocities);
+        let e = touch.restitution_at(closing_speed);
+        let impulse = strike(touch, e, &responses[i], velocities);
         if impulse == 0.0 {
             // Neither bead can move along the line between them: what
             // closes them there is not theirs to stop.
@@ -305,7 +386,7 @@ pub fn resolve_impacts<V: Coordinates>(
             touch: i,
             impulse,
             closing_speed,
-            bounced,
+            bounced: e > 0.0,
         });
     }
     match closing(velocities) {
@@ -356,10 +437,29 @@ mod tests {
         beads.iter().zip(v).map(|(b, v)| *v / b.inverse_mass).sum()
     }
 
-    fn resolve(beads: &[ImpactBead], touches: &[Touch], v: &mut [DVec2]) -> Vec<Strike> {
+    /// The responses of `touches` between beads held by their freedoms.
+    fn responses<V: Coordinates>(
+        beads: &[ImpactBead<V>],
+        touches: &[Touch<V>],
+    ) -> Vec<Response<V>> {
+        touches
+            .iter()
+            .map(|t| Response::through(t, beads).expect("beads named"))
+            .collect()
+    }
+
+    fn resolve_all<V: Coordinates>(
+        beads: &[ImpactBead<V>],
+        touches: &[Touch<V>],
+        v: &mut [V],
+    ) -> Result<Vec<Strike>, ImpactError> {
         let mut strikes = Vec::new();
-        resolve_impacts(touches, beads, v, 0.0, &mut strikes).expect("settles");
-        strikes
+        resolve_impacts(touches, &responses(beads, touches), v, &mut strikes)?;
+        Ok(strikes)
+    }
+
+    fn resolve(beads: &[ImpactBead], touches: &[Touch], v: &mut [DVec2]) -> Vec<Strike> {
+        resolve_all(beads, touches, v).expect("settles")
     }
 
     #[test]
@@ -468,8 +568,7 @@ mod tests {
             let u = touch.normal_speed(&v);
             assert!(u < 0.0, "the pair must close");
             let before = energy(&beads, &v);
-            let mut strikes = Vec::new();
-            resolve_impacts(&[touch], &beads, &mut v, 0.0, &mut strikes).expect("settles");
+            resolve_all(&beads, &[touch], &mut v).expect("settles");
             assert!((touch.normal_speed(&v) + e * u).abs() <= 1e-12, "e = {e}");
             assert!((beads[0].freedom.project(v[0]) - v[0]).length() <= 1e-12);
             assert!((beads[1].freedom.project(v[1]) - v[1]).length() <= 1e-12);
@@ -493,8 +592,7 @@ mod tests {
         let touch = Touch::between((0, DVec3::ZERO, 0.05), (1, xb, xb.length() - 0.05), 1.0)
             .expect("apart");
         let mut v = [DVec3::new(3.0, 0.0, 0.0), DVec3::ZERO];
-        let mut strikes = Vec::new();
-        resolve_impacts(&[touch], &beads, &mut v, 0.0, &mut strikes).expect("settles");
+        resolve_all(&beads, &[touch], &mut v).expect("settles");
         assert!(v[0].dot(v[1]).abs() <= 1e-12, "{v:?}");
         assert!(v[1].normalize().cross(touch.normal()).length() <= 1e-12);
         assert!((v[0] + v[1] - DVec3::new(3.0, 0.0, 0.0)).length() <= 1e-12);
@@ -503,15 +601,14 @@ mod tests {
     #[test]
     fn a_slow_pair_stays_in_touch_and_a_pair_that_opens_is_left_alone() {
         let (beads, touches) = row(&[1.0, 1.0], 0.1, 1.0);
+        let slow = [touches[0].resting_below(0.05)];
         let mut v = [DVec2::new(0.01, 0.0), DVec2::ZERO];
-        let mut strikes = Vec::new();
-        resolve_impacts(&touches, &beads, &mut v, 0.05, &mut strikes).expect("settles");
+        let strikes = resolve(&beads, &slow, &mut v);
         assert_eq!(v[0], v[1], "they move on together at the same speed");
         assert!(!strikes[0].bounced);
 
         let mut v = [DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0)];
-        strikes.clear();
-        resolve_impacts(&touches, &beads, &mut v, 0.0, &mut strikes).expect("settles");
+        let strikes = resolve(&beads, &touches, &mut v);
         assert_eq!(v, [DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0)]);
         assert!(strikes.is_empty());
     }
@@ -525,8 +622,14 @@ mod tests {
         );
         assert_eq!(Freedom::along(DVec2::ZERO), Err(ImpactError::NoDirection));
         let (beads, touches) = row(&[1.0, 1.0], 0.1, 1.0);
+        let err = Response::through(&touches[0], &beads[..1]).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "a touching pair names bead 1, and there are 1 beads"
+        );
+        let answers = responses(&beads, &touches);
         let mut v = [DVec2::X];
-        let err = resolve_impacts(&touches, &beads, &mut v, 0.0, &mut Vec::new()).unwrap_err();
+        let err = resolve_impacts(&touches, &answers, &mut v, &mut Vec::new()).unwrap_err();
         assert_eq!(
             err.to_string(),
             "a touching pair names bead 1, and there are 1 beads"
@@ -553,7 +656,7 @@ mod tests {
             Touch::between((1, at(0.1), 0.05), (2, at(0.2), 0.05), 1.0).expect("apart"),
         ];
         let mut v = [DVec2::ZERO, at(1.0), DVec2::ZERO];
-        let err = resolve_impacts(&touches, &beads, &mut v, 0.0, &mut Vec::new()).unwrap_err();
+        let err = resolve_all(&beads, &touches, &mut v).unwrap_err();
         assert_eq!(
             err,
             ImpactError::DidNotSettle {
@@ -597,7 +700,8 @@ mod tests {
                 .expect("apart");
             let mut v = [fa.project(va), fb.project(vb)];
             let (u, before) = (touch.normal_speed(&v), energy(&beads, &v));
-            let impulse = strike(&touch, e, &beads, &mut v);
+            let response = Response::through(&touch, &beads).expect("two beads");
+            let impulse = strike(&touch, e, &response, &mut v);
             let after = energy(&beads, &v);
             let scale = 1e-12 * (1.0 + va.length() + vb.length());
             if impulse != 0.0 {
@@ -607,7 +711,7 @@ mod tests {
             proptest::prop_assert!((fb.project(v[1]) - v[1]).length() <= scale);
             proptest::prop_assert!(after <= before * (1.0 + 1e-12) + 1e-300);
             let mut elastic = [fa.project(va), fb.project(vb)];
-            strike(&touch, 1.0, &beads, &mut elastic);
+            strike(&touch, 1.0, &response, &mut elastic);
             let kept = energy(&beads, &elastic);
             proptest::prop_assert!((kept - before).abs() <= 1e-12 * before.max(1e-300));
         }

@@ -15,6 +15,7 @@
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
 //! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eqs. (16)–(17): on the wire, in flight, where an event falls |
 //! | `impact` | [`resolve_impacts`]: strikes between beads that touch, eq. (18), one pair at a time |
+//! | `touch` | [`settle_touches`]: where within a step beads meet (broad phase, regula falsi), the step cut there |
 //! | `lanes/` (`circle`) | the batched step: eight beads on circles at once, bit for bit [`step`](fn@step), many such batches in one call; the solves on each lane's circle (crate-private) |
 //! | `coupled/` (`island/`, `normal/`, …) | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (12)–(14) |
 //!
@@ -38,15 +39,18 @@ mod settings;
 mod solve;
 mod state;
 mod step;
+mod touch;
 mod wire_normal;
 
 pub use contact::{Contact, ContactEvent, SurfaceStep, free_step, step_surface};
 pub use coupled::{
-    Constraint, Island, IslandError, IslandRow, IslandWork, RowKind, RowReport, SpringLink, islands,
+    Constraint, Island, IslandError, IslandMark, IslandRow, IslandWork, RowKind, RowReport,
+    SpringLink, islands,
 };
 pub use euler::{explicit_euler, semi_implicit_euler};
 pub use impact::{
-    Freedom, ImpactBead, ImpactError, MAX_STRIKES_PER_TOUCH, Strike, Touch, resolve_impacts, strike,
+    Freedom, ImpactBead, ImpactError, MAX_STRIKES_PER_TOUCH, Response, Strike, Touch,
+    resolve_impacts, strike,
 };
 pub(crate) use lanes::{LANES, RoundLanes, RoundSteps, step_on_round_batches};
 pub use method::{Integrator, Method, Stabilization};
@@ -57,6 +61,10 @@ pub use settings::{Gains, StepSettings};
 pub use solve::{SolveError, Solved, lambda, solve};
 pub use state::{Advance, BeadState, LinearForce};
 pub use step::{StepOutput, constraint_state, constraint_state_on, step, step_on};
+pub use touch::{
+    MAX_IMPACTS_PER_STEP, SHORT_PART, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody,
+    TouchError, overlapping, settle_touches,
+};
 
 /// What the solver's unit tests share.
 #[cfg(test)]

@@ -28,6 +28,9 @@ pub(crate) const SHIPPED: &[&str] = &[
     "spinning_rod.scene.ron",
     "tautochrone.scene.ron",
     "roller_coaster.scene.ron",
+    "newtons_cradle.scene.ron",
+    "air_track.scene.ron",
+    "air_track_sticky.scene.ron",
 ];
 
 /// The shipped presets that join beads.
@@ -37,6 +40,7 @@ const COUPLED: &[&str] = &[
     "rope.scene.ron",
     "ring.scene.ron",
     "spring_pair.scene.ron",
+    "newtons_cradle.scene.ron",
 ];
 
 /// The shipped presets, found at run time: a test binary reused from another

@@ -52,6 +52,9 @@ impl Default for PresetCatalog {
                 ("Bead on a spinning rod", "scenes/spinning_rod.scene.ron"),
                 ("Tautochrone race", "scenes/tautochrone.scene.ron"),
                 ("Roller coaster", "scenes/roller_coaster.scene.ron"),
+                ("Newton's cradle", "scenes/newtons_cradle.scene.ron"),
+                ("Air track, elastic", "scenes/air_track.scene.ron"),
+                ("Air track, sticky", "scenes/air_track_sticky.scene.ron"),
                 (
                     "In space: bead on a rotating hoop",
                     "scenes/rotating_hoop.scene.ron",

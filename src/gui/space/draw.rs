@@ -15,8 +15,8 @@ use super::{Orbit, SPACE_LAYER, SpaceGizmos};
 use crate::geometry::{Side, SpaceShape};
 use crate::gui::render::{BeadSizes, SceneStyle, Trail};
 use crate::{
-    BeadDiagnostics, BeadMass, BeadParams, BeadPosition, Diverged, OnWire, Pin, RailOrientation,
-    Rod, SimParams, SpaceBead, SpaceWire, Spring, SpringAnchor, WireContact,
+    BeadDiagnostics, BeadMass, BeadParams, BeadPosition, BeadRadius, Diverged, OnWire, Pin,
+    RailOrientation, Rod, SimParams, SpaceBead, SpaceWire, Spring, SpringAnchor, WireContact,
 };
 
 /// What the view draws of a wire in space, in its local frame: a curve's
@@ -239,6 +239,7 @@ pub fn size_and_colour_beads(
             &MeshMaterial3d<StandardMaterial>,
             Has<Diverged>,
             Option<&WireContact>,
+            Option<&BeadRadius>,
         ),
         With<SpaceBead>,
     >,
@@ -246,8 +247,8 @@ pub fn size_and_colour_beads(
 ) {
     let radius = 1.6 * style.bead_radius * orbit.size;
     let limits = BeadSizes::new(&rods);
-    for (entity, mut transform, material, diverged, contact) in &mut beads {
-        let r = limits.radius(entity, radius);
+    for (entity, mut transform, material, diverged, contact, own) in &mut beads {
+        let r = limits.drawn(entity, own, radius);
         if transform.scale != Vec3::splat(r) {
             transform.scale = Vec3::splat(r);
         }

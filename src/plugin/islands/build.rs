@@ -8,8 +8,8 @@ use bevy::prelude::*;
 
 use super::{CachedIsland, InIsland, IslandReport, Islands, LinkRows, WireRow};
 use crate::dynamics::{
-    Bead, BeadMotion, Dimension, DivergenceReason, Joint, OnWire, Pin, Rod, SpaceBead, Spring,
-    WirePose, WireRows,
+    Bead, BeadMotion, BeadRadius, Dimension, DivergenceReason, Joint, OnWire, Pin, Rod, SpaceBead,
+    Spring, WirePose, WireRows,
 };
 use crate::plugin::clock::SimClock;
 use crate::plugin::report::Divergences;
@@ -26,6 +26,16 @@ pub(super) struct Links<'w, 's, V: Dimension> {
     /// other dimension is that dimension's, not a link to nothing.
     any_bead: Query<'w, 's, (), Or<(With<Bead>, With<SpaceBead>)>>,
 }
+
+/// What the rebuild reads and writes of each bead: its motion, wire,
+/// marker, and whether it has a radius (and so steps in an island).
+type BuildBead<V> = (
+    Entity,
+    BeadMotion<V>,
+    Option<&'static OnWire>,
+    Has<InIsland>,
+    Has<BeadRadius>,
+);
 
 /// A link while the islands are built: its rows and the beads it names.
 struct Pending<V: Dimension> {
@@ -54,7 +64,7 @@ fn pin_rows<V: Dimension>(at: V) -> Vec<IslandRow<V>> {
 pub(super) fn prepare_islands<V: Dimension>(
     mut islands: ResMut<Islands<V>>,
     links: Links<V>,
-    mut beads: Query<(Entity, BeadMotion<V>, Option<&OnWire>, Has<InIsland>)>,
+    mut beads: Query<BuildBead<V>>,
     wires: Query<(&V::Wire, &WirePose<V>)>,
     transforms: Query<&Transform>,
     mut commands: Commands,
@@ -161,8 +171,9 @@ pub(super) fn prepare_islands<V: Dimension>(
         }
     }
     // The beads in islands: every bead a link names, every bead on no
-    // wire, and every bead on a wire without a step of its own (a curve in
-    // space).
+    // wire, every bead on a wire without a step of its own (a curve in
+    // space), and every bead with a radius (its step may be cut where it
+    // meets another).
     let mut index: HashMap<Entity, usize> = HashMap::new();
     let mut members: Vec<Entity> = Vec::new();
     let mut join = |bead: Entity, members: &mut Vec<Entity>| {
@@ -181,9 +192,9 @@ pub(super) fn prepare_islands<V: Dimension>(
             join(b, &mut members);
         }
     }
-    for (entity, _, on_wire, _) in &beads {
+    for (entity, _, on_wire, _, touches) in &beads {
         let lone = on_wire.is_some_and(|on| wires.get(on.0).map_or(true, |(w, _)| w.lone()));
-        if !lone {
+        if !lone || touches {
             join(entity, &mut members);
         }
     }
@@ -232,7 +243,7 @@ pub(super) fn prepare_islands<V: Dimension>(
         let mut invalid = None;
         let mut sides = Vec::new();
         for (local, &entity) in entities.iter().enumerate() {
-            let Ok((_, bead, on_wire, _)) = beads.get(entity) else {
+            let Ok((_, bead, on_wire, ..)) = beads.get(entity) else {
                 invalid = Some(format!("entity {entity} is no longer a bead"));
                 break;
             };
@@ -342,6 +353,9 @@ pub(super) fn prepare_islands<V: Dimension>(
                     wire_rows,
                     anchored,
                     outcome: None,
+                    touching: Vec::new(),
+                    start: Vec::new(),
+                    mark: default(),
                 });
             }
             Err(reason) => {
@@ -351,7 +365,7 @@ pub(super) fn prepare_islands<V: Dimension>(
             }
         }
     }
-    for (entity, _, _, marked) in &beads {
+    for (entity, _, _, marked, _) in &beads {
         match (index.contains_key(&entity), marked) {
             (true, false) => {
                 commands.entity(entity).try_insert(InIsland);
@@ -373,7 +387,7 @@ fn start_island<V: Dimension>(
     entities: &[Entity],
     wire_rows: &[WireRow],
     wires: &Query<(&V::Wire, &WirePose<V>)>,
-    beads: &mut Query<(Entity, BeadMotion<V>, Option<&OnWire>, Has<InIsland>)>,
+    beads: &mut Query<BuildBead<V>>,
     clock: &SimClock,
 ) -> IslandWork<V> {
     for wire_row in wire_rows {

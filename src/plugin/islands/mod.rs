@@ -8,9 +8,11 @@
 //! |---|---|
 //! | `build` | rebuilding the islands when the topology changes |
 //! | `step` | stepping them: gather, solve (in parallel), write back |
+//! | `touch` | beads that touch: the steps cut where they meet, the strikes |
 
 mod build;
 mod step;
+mod touch;
 
 use bevy::ecs::lifecycle::{Add, Insert, Remove};
 use bevy::math::{DVec2, DVec3};
@@ -19,8 +21,10 @@ use bevy::prelude::*;
 use super::clock::advance_clock;
 use super::schedule::WireBeadSystems;
 use super::wires::place_wires;
-use crate::dynamics::{ConstraintDiagnostics, Dimension, Joint, OnWire, Pin, Rod, Spring};
-use crate::solver::{BeadState, Island, IslandWork, LinearForce, SolveError};
+use crate::dynamics::{
+    BeadRadius, ConstraintDiagnostics, Dimension, Joint, OnWire, Pin, Rod, Spring,
+};
+use crate::solver::{BeadState, Island, IslandMark, IslandWork, LinearForce, SolveError};
 
 /// Builds and steps the [`Islands`]: beads joined by links, and free beads,
 /// in the plane (`Islands`) and in space (`Islands<DVec3>`, where every
@@ -59,6 +63,8 @@ fn add_islands<V: Dimension>(app: &mut App) {
         .add_observer(topology_changed::<Remove, Spring, V>)
         .add_observer(topology_changed::<Insert, Joint<V>, V>)
         .add_observer(topology_changed::<Remove, Joint<V>, V>)
+        .add_observer(topology_changed::<Insert, BeadRadius, V>)
+        .add_observer(topology_changed::<Remove, BeadRadius, V>)
         .add_systems(
             PreUpdate,
             build::prepare_islands::<V>
@@ -139,6 +145,12 @@ struct CachedIsland<V: Dimension> {
     /// What this step did: not stepped (a bead of it has stopped), or the
     /// step's result.
     outcome: Option<Result<(), SolveError>>,
+    /// Its beads with a radius, gathered each step (see `touch`).
+    touching: touch::Touching,
+    /// Where the step started and what its work carried into it, kept
+    /// while it has beads that touch.
+    start: Vec<BeadState<V>>,
+    mark: IslandMark<V>,
 }
 
 /// The islands of the current topology: beads joined by constraints and

@@ -4,10 +4,11 @@
 
 use bevy::prelude::*;
 
-use super::{CachedIsland, InIsland, Islands, LinkRows};
+use super::{CachedIsland, InIsland, Islands, LinkRows, touch};
 use crate::dynamics::{
-    BeadDiagnostics, BeadForce, BeadMotion, BeadPosition, BeadVelocity, ConstraintDiagnostics,
-    Dimension, Diverged, DivergenceReason, Pin, SimParams, WireContact, WirePose, WireRows,
+    BeadDiagnostics, BeadForce, BeadMotion, BeadPosition, BeadRadius, BeadVelocity, BeadsStruck,
+    ConstraintDiagnostics, Contacts, Dimension, Diverged, DivergenceReason, Pin, Restitution,
+    SimParams, WireContact, WirePose, WireRows,
 };
 use crate::plugin::clock::SimClock;
 use crate::plugin::parallel::{ParallelStep, StepSplit};
@@ -23,13 +24,26 @@ type Stepped = (With<InIsland>, Without<Diverged>);
 /// task pool from [`ParallelStep::threshold`] beads in islands up), writes
 /// back the states, the diagnostics and the `Transform`s. An island whose
 /// step fails stops as a whole, each of its beads marked [`Diverged`].
+/// Between the step and the write-back, the steps of islands whose beads
+/// met are cut where they met and the strikes made (`touch`).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn step_islands<V: Dimension>(
     params: Res<SimParams>,
+    contacts: Res<Contacts>,
     clock: Res<SimClock>,
     parallel: Res<ParallelStep>,
     mut islands: ResMut<Islands<V>>,
     mut beads: ParamSet<(
-        Query<(&BeadPosition<V>, &BeadVelocity<V>, &BeadForce<V>), Stepped>,
+        Query<
+            (
+                &BeadPosition<V>,
+                &BeadVelocity<V>,
+                &BeadForce<V>,
+                Option<&BeadRadius>,
+                Option<&Restitution>,
+            ),
+            Stepped,
+        >,
         Query<
             (
                 BeadMotion<V>,
@@ -47,6 +61,7 @@ pub(super) fn step_islands<V: Dimension>(
     mut diagnostics: Query<&mut ConstraintDiagnostics>,
     mut divergences: Divergences,
     mut split: ResMut<StepSplit>,
+    mut struck: MessageWriter<BeadsStruck>,
 ) {
     let settings = params.step_settings();
     let gravity = V::gravity(&params);
@@ -58,14 +73,19 @@ pub(super) fn step_islands<V: Dimension>(
         cached.outcome = None;
         cached.states.clear();
         cached.forces.clear();
+        cached.touching.clear();
         for &entity in &cached.report.beads {
-            let Ok((position, velocity, force)) = motion.get(entity) else {
+            let Ok((position, velocity, force, radius, restitution)) = motion.get(entity) else {
                 continue 'gather; // a bead of it stopped: so does the island
             };
             let state = BeadState {
                 position: position.0,
                 velocity: velocity.0,
             };
+            if let Some(radius) = radius.filter(|r| r.get() > 0.0) {
+                let e = restitution.map_or(contacts.restitution(), Restitution::get);
+                cached.touching.push((cached.states.len(), radius.get(), e));
+            }
             let mass = cached.masses[cached.states.len()];
             cached.states.push(state);
             cached
@@ -120,6 +140,13 @@ pub(super) fn step_islands<V: Dimension>(
             }
         }
     }
+    touch::settle(
+        &mut islands.cached,
+        time,
+        &settings,
+        &mut struck,
+        &mut divergences,
+    );
     for cached in &mut islands.cached {
         match cached.outcome {
             None => continue,
@@ -205,6 +232,10 @@ fn pin_report(rows: &[RowReport]) -> ConstraintDiagnostics {
 fn step_island<V: Dimension>(cached: &mut CachedIsland<V>, time: f64, settings: &StepSettings) {
     if cached.outcome.is_none() {
         return;
+    }
+    if !cached.touching.is_empty() {
+        cached.start.clone_from(&cached.states);
+        cached.mark = cached.work.mark();
     }
     cached.outcome = Some(cached.island.step_at(
         time,

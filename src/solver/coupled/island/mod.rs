@@ -145,7 +145,41 @@ pub struct IslandWork<V: WireSpace = DVec2> {
     start: Vec<BeadState<V>>,
 }
 
+/// What of an island's [`IslandWork`] carries from one step into the
+/// next: which rows are set aside, where the beads were along their wires,
+/// where friction holds them, how finely the last step was cut. Kept
+/// before a step ([`IslandWork::mark`]) so that a part of the step can be
+/// taken again from its start ([`IslandWork::rewind`]).
+#[derive(Clone, Debug, Default)]
+pub struct IslandMark<V: WireSpace = DVec2> {
+    inactive: Vec<bool>,
+    hints: Vec<f64>,
+    sticks: Vec<Option<(V, f64)>>,
+    level: u32,
+    calm: u32,
+}
+
 impl<V: WireSpace> IslandWork<V> {
+    /// What carries into the next step, as it is now.
+    pub fn mark(&self) -> IslandMark<V> {
+        IslandMark {
+            inactive: self.inactive.clone(),
+            hints: self.hints.clone(),
+            sticks: self.sticks.clone(),
+            level: self.level,
+            calm: self.calm,
+        }
+    }
+
+    /// Back to what `mark` kept, without allocating where the lengths
+    /// agree.
+    pub fn rewind(&mut self, mark: &IslandMark<V>) {
+        self.inactive.clone_from(&mark.inactive);
+        self.hints.clone_from(&mark.hints);
+        self.sticks.clone_from(&mark.sticks);
+        (self.level, self.calm) = (mark.level, mark.calm);
+    }
+
     /// Takes `states` in as the current positions and velocities
     /// (`x`, `v`).
     pub(super) fn load(&mut self, states: &[BeadState<V>]) {

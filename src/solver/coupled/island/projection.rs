@@ -71,6 +71,41 @@ impl<V: WireSpace> Island<V> {
         Ok((before, kinetic(states)))
     }
 
+    /// How the beads' velocities answer an `impulse` on bead `bead` at
+    /// `states` and `time`: `Δv = P W f`, the impulse's kick projected in
+    /// the kinetic-energy norm onto the rows that hold now (rods, pins,
+    /// joints, friction holding a bead still, and the wires the beads are
+    /// on, not a one-sided wire a bead has left). A moving wire's own
+    /// velocity does not enter: the answer is linear in the impulse, one
+    /// velocity change per bead (eq. 18 for a bead joined to others).
+    pub fn respond<'w>(
+        &self,
+        time: f64,
+        states: &[BeadState<V>],
+        bead: usize,
+        impulse: V,
+        work: &'w mut IslandWork<V>,
+    ) -> Result<&'w [V], SolveError> {
+        if states.len() != self.beads() || bead >= self.beads() {
+            return Err(SolveError::WrongLength {
+                beads: self.beads(),
+                states: states.len(),
+                forces: usize::from(bead < self.beads()),
+            });
+        }
+        if work.inactive.len() != self.rows() {
+            self.start_rows(time, states, work);
+        }
+        work.time = time;
+        work.load(states);
+        self.evaluate_at_new(work);
+        work.bias.fill(0.0);
+        work.v.fill(V::ZERO);
+        work.v[bead] = impulse * self.inverse_mass[bead];
+        self.project_velocity(work)?;
+        Ok(&work.v)
+    }
+
     /// Removes the velocity's component off the constraints:
     /// `v ← v − W Jᵀ (J W Jᵀ)⁻¹ J v` at `work.x` (rows evaluated there).
     /// Returns with the multipliers (of `−J v`) in `work.rhs`.

@@ -1,0 +1,129 @@
+//! Beads that touch: a bead's [`BeadRadius`] and [`Restitution`], the
+//! scene-wide [`Contacts`], and the [`BeadsStruck`] message.
+
+use bevy::prelude::*;
+
+use crate::validate::{ParamError, non_negative};
+
+/// A bead's radius in metres: beads with radii touch when their centres
+/// are the sum of their radii apart, and may not come closer. The centre
+/// rides the wire; the radius does not move it off. Zero touches nothing.
+///
+/// A bead with a radius steps in an island (alone, if joined to nothing),
+/// whose step is cut where it meets another.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
+#[reflect(Component)]
+pub struct BeadRadius(f64);
+
+impl BeadRadius {
+    /// A radius, if it is zero or more and finite.
+    pub fn new(radius: f64) -> Result<Self, ParamError> {
+        non_negative("radius", radius).map(Self)
+    }
+
+    /// The radius in metres.
+    pub fn get(&self) -> f64 {
+        self.0
+    }
+}
+
+/// A bead's own restitution, for the pairs it strikes in: the pair takes
+/// the smaller of its two beads' (a bead without one takes
+/// [`Contacts::restitution`]). The smaller, because a soft ball is soft
+/// against anything.
+#[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Component)]
+pub struct Restitution(f64);
+
+impl Restitution {
+    /// A restitution, if it is between 0 (they stay together) and 1 (no
+    /// energy lost).
+    pub fn new(e: f64) -> Result<Self, ParamError> {
+        restitution(e).map(Self)
+    }
+
+    /// The coefficient.
+    pub fn get(&self) -> f64 {
+        self.0
+    }
+}
+
+/// `e`, if it is a restitution: between 0 and 1.
+fn restitution(e: f64) -> Result<f64, ParamError> {
+    if (0.0..=1.0).contains(&e) {
+        Ok(e)
+    } else {
+        Err(ParamError::OutOfRange {
+            name: "restitution",
+            min: 0.0,
+            max: 1.0,
+            value: e,
+        })
+    }
+}
+
+/// How beads that touch strike, scene-wide.
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Resource)]
+pub struct Contacts {
+    restitution: f64,
+}
+
+impl Default for Contacts {
+    /// Elastic: `e = 1`.
+    fn default() -> Self {
+        Self { restitution: 1.0 }
+    }
+}
+
+impl Contacts {
+    /// Strikes with restitution `e` (between 0 and 1).
+    pub fn new(restitution: f64) -> Result<Self, ParamError> {
+        self::restitution(restitution).map(|restitution| Self { restitution })
+    }
+
+    /// The restitution of a pair whose beads have none of their own.
+    pub fn restitution(&self) -> f64 {
+        self.restitution
+    }
+}
+
+/// Sent when two beads strike (also logged, one line).
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct BeadsStruck {
+    /// One bead.
+    pub a: Entity,
+    /// The other.
+    pub b: Entity,
+    /// When, in simulated seconds.
+    pub time: f64,
+    /// The impulse along the line from `a`'s centre to `b`'s (N s).
+    pub impulse: f64,
+    /// How fast they closed (m/s).
+    pub closing_speed: f64,
+    /// Whether they bounced apart, or stayed in touch (`e = 0`, or too
+    /// slow to bounce).
+    pub bounced: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bad_radii_and_restitutions_are_refused_in_words() {
+        assert_eq!(
+            BeadRadius::new(-0.1).unwrap_err().to_string(),
+            "radius must be zero or more and finite, got -0.1"
+        );
+        assert!(BeadRadius::new(f64::NAN).is_err());
+        assert_eq!(BeadRadius::new(0.25).map(|r| r.get()), Ok(0.25));
+        assert_eq!(
+            Contacts::new(1.5).unwrap_err().to_string(),
+            "restitution must be between 0 and 1, got 1.5"
+        );
+        assert!(Restitution::new(f64::NAN).is_err());
+        assert!(Contacts::new(-0.1).is_err());
+        assert_eq!(Restitution::new(0.0).map(|e| e.get()), Ok(0.0));
+    }
+}

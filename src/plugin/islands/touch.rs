@@ -1,0 +1,183 @@
+//! Beads that touch, in the island step: each island with a bead of a
+//! [`BeadRadius`](crate::BeadRadius) keeps where its step started, and
+//! after every island has stepped, [`solver::settle_touches`] cuts the
+//! steps of those whose beads met and makes the strikes. This file only
+//! moves data between the islands and the solver.
+
+use bevy::prelude::*;
+
+use super::CachedIsland;
+use crate::dynamics::{BeadsStruck, Dimension, DivergenceReason};
+use crate::plugin::report::Divergences;
+use crate::solver::{
+    self, BeadState, Integrator, Method, SolveError, Stabilization, StepSettings, StepSpan,
+    StruckPair, TouchBead, TouchBody, TouchError,
+};
+
+/// What an island keeps of its beads that touch: each one's index in the
+/// island, radius and restitution.
+pub(super) type Touching = Vec<(usize, f64, f64)>;
+
+/// One island as the touch settlement steps it.
+struct IslandBody<'a, V: Dimension> {
+    cached: &'a mut CachedIsland<V>,
+    settings: StepSettings,
+}
+
+impl<V: Dimension> TouchBody<V> for IslandBody<'_, V> {
+    fn start(&self) -> &[BeadState<V>] {
+        &self.cached.start
+    }
+
+    fn end(&self) -> &[BeadState<V>] {
+        &self.cached.states
+    }
+
+    fn advance(
+        &mut self,
+        time: f64,
+        h: f64,
+        states: &mut [BeadState<V>],
+    ) -> Result<(), SolveError> {
+        let cached = &mut *self.cached;
+        cached.work.rewind(&cached.mark);
+        let method = if h < solver::SHORT_PART * self.settings.dt {
+            Method::new(Integrator::Rk4, Some(Stabilization::Projection)).unwrap_or_default()
+        } else {
+            self.settings.method
+        };
+        let settings = StepSettings {
+            dt: h,
+            method,
+            ..self.settings
+        };
+        cached
+            .island
+            .step_at(time, states, &cached.forces, &settings, &mut cached.work)
+    }
+
+    fn keep(&mut self) {
+        self.cached.mark = self.cached.work.mark();
+    }
+
+    fn respond(
+        &mut self,
+        time: f64,
+        states: &[BeadState<V>],
+        bead: usize,
+        impulse: V,
+    ) -> Result<Vec<V>, SolveError> {
+        let cached = &mut *self.cached;
+        let answer = cached
+            .island
+            .respond(time, states, bead, impulse, &mut cached.work)?
+            .to_vec();
+        // The rows were evaluated for the answer: back to where the step
+        // carries on from.
+        cached.work.rewind(&cached.mark);
+        Ok(answer)
+    }
+
+    fn push(&self, bead: usize) -> V {
+        let cached = &*self.cached;
+        cached.forces[bead].at(cached.states[bead].position) / cached.masses[bead]
+    }
+
+    fn finish(&mut self, states: &[BeadState<V>]) {
+        self.cached.states.clear();
+        self.cached.states.extend_from_slice(states);
+    }
+}
+
+/// Settles the touches of the step that started at `time` (see
+/// [`solver::settle_touches`]): the islands that stepped and have beads
+/// with radii take part; each strike is sent as [`BeadsStruck`] and
+/// logged, and a failure stops the touching beads, reported in words.
+pub(super) fn settle<V: Dimension>(
+    cached: &mut [CachedIsland<V>],
+    time: f64,
+    settings: &StepSettings,
+    struck: &mut MessageWriter<BeadsStruck>,
+    divergences: &mut Divergences,
+) {
+    let mut beads = Vec::new();
+    let mut entities = Vec::new();
+    for (body, island) in cached.iter().enumerate() {
+        if island.outcome != Some(Ok(())) {
+            continue;
+        }
+        for &(bead, radius, restitution) in &island.touching {
+            beads.push(TouchBead {
+                body,
+                bead,
+                radius,
+                restitution,
+            });
+            entities.push(island.report.beads[bead]);
+        }
+    }
+    if beads.len() < 2 {
+        return;
+    }
+    let mut bodies: Vec<IslandBody<V>> = cached
+        .iter_mut()
+        .map(|cached| IslandBody {
+            cached,
+            settings: *settings,
+        })
+        .collect();
+    let span = StepSpan {
+        time,
+        dt: settings.dt,
+    };
+    let mut pairs = Vec::new();
+    let settled = solver::settle_touches(span, &mut bodies, &beads, &mut pairs);
+    for pair in &pairs {
+        report(pair, &entities, struck);
+    }
+    if let Err(e) = settled {
+        let why = match e {
+            TouchError::TooManyImpacts { a, b } => format!(
+                "beads {} and {} were still striking after {} instants of impact within one step",
+                entities[a],
+                entities[b],
+                solver::MAX_IMPACTS_PER_STEP
+            ),
+            e => e.to_string(),
+        };
+        for &bead in &entities {
+            divergences.report(
+                bead,
+                DivergenceReason::Touch(why.clone()),
+                time + settings.dt,
+            );
+        }
+    }
+}
+
+/// Sends one strike and logs it in one line: a bounce as information, a
+/// pair that stays in touch at the debug level (a resting pile strikes
+/// every step).
+fn report(pair: &StruckPair, entities: &[Entity], struck: &mut MessageWriter<BeadsStruck>) {
+    let (a, b) = (entities[pair.a], entities[pair.b]);
+    let s = pair.strike;
+    if s.bounced {
+        info!(
+            "wirebead: beads {a} and {b} struck at t = {:.4} s, closing at {:.3} m/s, and bounced apart with an impulse of {:.4} N s",
+            pair.time, s.closing_speed, s.impulse
+        );
+    } else {
+        debug!(
+            "wirebead: beads {a} and {b} met at t = {:.4} s, closing at {:.3} m/s, and stayed in touch",
+            pair.time, s.closing_speed
+        );
+    }
+    struck.write(BeadsStruck {
+        a,
+        b,
+        time: pair.time,
+        impulse: s.impulse,
+        closing_speed: s.closing_speed,
+        bounced: s.bounced,
+    });
+}

@@ -1,0 +1,496 @@
+//! Beads that touch, through the plugin: gliders on an air track, balls
+//! too fast for a step, Newton's cradle.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use wirebead::headless::{Headless, bead_state, run_steps};
+use wirebead::prelude::*;
+use wirebead::{Integrator, Islands, Restitution, ScenePreset};
+
+/// A headless app at `dt` with RATTLE, no gravity along the track.
+fn app(dt: f64, e: f64) -> App {
+    let params = SimParams {
+        timestep: dt,
+        method: Method::new(Integrator::Rattle, None).expect("RATTLE"),
+        ..SimParams::default()
+    };
+    let plugin = WireBeadPlugin::new(params).expect("valid params");
+    let mut app = Headless::new(plugin).single_threaded().build();
+    app.insert_resource(Contacts::new(e).expect("a restitution"));
+    app
+}
+
+/// A glider of mass `m` and radius `r` on `track` at `x` moving at `v`.
+fn glider(app: &mut App, track: Entity, m: f64, x: f64, v: f64, r: f64) -> Entity {
+    let params = BeadParams {
+        mass: m,
+        initial_position: DVec2::new(x, 0.0),
+        initial_velocity: DVec2::new(v, 0.0),
+    };
+    app.world_mut()
+        .spawn((
+            Bead::new(params).expect("a bead"),
+            OnWire(track),
+            BeadRadius::new(r).expect("a radius"),
+        ))
+        .id()
+}
+
+fn velocity(app: &App, bead: Entity) -> f64 {
+    bead_state(app.world(), bead).expect("a bead").velocity.x
+}
+
+fn position(app: &App, bead: Entity) -> f64 {
+    bead_state(app.world(), bead).expect("a bead").position.x
+}
+
+/// Two gliders of masses `ma`, `mb` from 0 and 1 m at `ua`, `ub`, radii
+/// 0.1 m, on a level track, run for 1 s at 1/60 s: their final velocities
+/// and positions, and when they met.
+fn air_track(ma: f64, mb: f64, ua: f64, ub: f64, e: f64) -> ([f64; 2], [f64; 2], App) {
+    let mut app = app(1.0 / 60.0, e);
+    let track = app.world_mut().spawn(Wire::line()).id();
+    let a = glider(&mut app, track, ma, 0.0, ua, 0.1);
+    let b = glider(&mut app, track, mb, 1.0, ub, 0.1);
+    run_steps(&mut app, 60);
+    let v = [velocity(&app, a), velocity(&app, b)];
+    let x = [position(&app, a), position(&app, b)];
+    (v, x, app)
+}
+
+#[test]
+fn equal_gliders_exchange_velocities_at_the_instant_they_meet() {
+    let (ua, ub) = (2.0, -0.5);
+    let (v, x, _) = air_track(1.0, 1.0, ua, ub, 1.0);
+    assert!((v[0] - ub).abs() <= 1e-12, "{v:?}");
+    assert!((v[1] - ua).abs() <= 1e-12, "{v:?}");
+    // They meet when the 0.8 m gap closes at 2.5 m/s: at 0.32 s, within
+    // the twentieth step; each then moves on at the other's speed.
+    let meet = 0.8 / (ua - ub);
+    let xa = ua * meet + ub * (1.0 - meet);
+    let xb = 1.0 + ub * meet + ua * (1.0 - meet);
+    assert!((x[0] - xa).abs() <= 1e-12, "{} against {xa}", x[0]);
+    assert!((x[1] - xb).abs() <= 1e-12, "{} against {xb}", x[1]);
+}
+
+#[test]
+fn gliders_of_masses_one_and_three_leave_with_the_elastic_velocities() {
+    let (m1, m2, u1, u2) = (1.0, 3.0, 2.0, -0.5);
+    let (v, _, _) = air_track(m1, m2, u1, u2, 1.0);
+    let v1 = ((m1 - m2) * u1 + 2.0 * m2 * u2) / (m1 + m2);
+    let v2 = ((m2 - m1) * u2 + 2.0 * m1 * u1) / (m1 + m2);
+    assert!((v[0] - v1).abs() <= 1e-12, "{} against {v1}", v[0]);
+    assert!((v[1] - v2).abs() <= 1e-12, "{} against {v2}", v[1]);
+}
+
+#[test]
+fn gliders_at_restitution_zero_move_on_together_losing_half_mu_v_squared() {
+    let (m1, m2, u1, u2) = (1.0, 3.0, 2.0, -0.5);
+    let (v, x, _) = air_track(m1, m2, u1, u2, 0.0);
+    let common = (m1 * u1 + m2 * u2) / (m1 + m2);
+    assert!(
+        (v[0] - common).abs() <= 1e-12 && (v[1] - common).abs() <= 1e-12,
+        "{v:?}"
+    );
+    let before = 0.5 * m1 * u1 * u1 + 0.5 * m2 * u2 * u2;
+    let after = 0.5 * (m1 + m2) * common * common;
+    let mu = m1 * m2 / (m1 + m2);
+    let lost = 0.5 * mu * (u1 - u2) * (u1 - u2);
+    assert!((before - after - lost).abs() <= 1e-12);
+    let after_run = 0.5 * m1 * v[0] * v[0] + 0.5 * m2 * v[1] * v[1];
+    assert!(
+        (before - after_run - lost).abs() <= 1e-12,
+        "lost {}",
+        before - after_run
+    );
+    assert!(
+        (x[1] - x[0] - 0.2).abs() <= 1e-12,
+        "they stay in touch: {x:?}"
+    );
+}
+
+/// A pair closing at 600 m/s covers ten metres a step: it still meets at
+/// the instant the gap closes, and neither passes the other.
+#[test]
+fn gliders_too_fast_for_a_step_still_meet_and_never_pass() {
+    let (v, x, _) = air_track(1.0, 1.0, 300.0, -300.0, 1.0);
+    assert!(
+        (v[0] + 300.0).abs() <= 1e-9 && (v[1] - 300.0).abs() <= 1e-9,
+        "{v:?}"
+    );
+    let meet = 0.8 / 600.0;
+    let xa = 300.0 * meet - 300.0 * (1.0 - meet);
+    assert!((x[0] - xa).abs() <= 1e-9, "{} against {xa}", x[0]);
+    assert!(x[0] < x[1]);
+}
+
+/// A bead's own restitution: the pair takes the smaller.
+#[test]
+fn a_pair_strikes_with_the_smaller_restitution_of_its_two_beads() {
+    let mut app = app(1.0 / 60.0, 1.0);
+    let track = app.world_mut().spawn(Wire::line()).id();
+    let a = glider(&mut app, track, 1.0, 0.0, 1.0, 0.1);
+    let b = glider(&mut app, track, 1.0, 0.5, 0.0, 0.1);
+    app.world_mut()
+        .entity_mut(b)
+        .insert(Restitution::new(0.5).expect("a restitution"));
+    run_steps(&mut app, 60);
+    // Equal masses at e = ½: the pair opens at half the 1 m/s it closed at.
+    let (va, vb) = (velocity(&app, a), velocity(&app, b));
+    assert!(
+        (va - 0.25).abs() <= 1e-12 && (vb - 0.75).abs() <= 1e-12,
+        "{va}, {vb}"
+    );
+}
+
+/// Newton's cradle: five balls of radius 5 cm hanging touching from pins
+/// 10 cm apart on rods of 1 m, RATTLE at 1/600 s. Returns the app, the
+/// balls, and the first `k` released from 30°.
+fn cradle(k: usize) -> (App, Vec<Entity>) {
+    let mut app = app(1.0 / 600.0, 1.0);
+    let (length, radius, angle) = (1.0, 0.05, 30f64.to_radians());
+    let mut balls = Vec::new();
+    for i in 0..5 {
+        let top = DVec2::new(2.0 * radius * i as f64, length);
+        let at = if i < k {
+            top + DVec2::new(-angle.sin(), -angle.cos()) * length
+        } else {
+            top - DVec2::Y * length
+        };
+        let pivot = app
+            .world_mut()
+            .spawn(Bead::at_rest(1.0, top).expect("a pivot"))
+            .id();
+        app.world_mut().spawn(Pin::new(pivot, top).expect("a pin"));
+        let ball = app
+            .world_mut()
+            .spawn((
+                Bead::at_rest(1.0, at).expect("a ball"),
+                BeadRadius::new(radius).expect("a radius"),
+            ))
+            .id();
+        app.world_mut()
+            .spawn(Rod::new(pivot, ball, length).expect("a rod"));
+        balls.push(ball);
+    }
+    (app, balls)
+}
+
+/// `k` balls released from 30° send out `k`: the ones struck last rise
+/// to the release height within 1e-3 of it (measured: 2.2e-6 of it), the
+/// rest move less than 1e-6 of the impact speed through the first half
+/// swing (measured: 1e-18 of it); the energy through the strikes' step
+/// is kept to 1e-9 J (measured: 3.3e-10 J).
+#[test]
+fn the_cradle_sends_out_as_many_balls_as_came_in() {
+    let g = 9.81;
+    let rise = 1.0 - 30f64.to_radians().cos();
+    let impact_speed = (2.0 * g * rise).sqrt();
+    for k in 1..=2 {
+        let (mut app, balls) = cradle(k);
+        let state = |app: &App, i: usize| bead_state(app.world(), balls[i]).expect("a ball");
+        // Until the first strike: a quarter swing, about 0.5 s.
+        let energy = |app: &App| -> f64 {
+            let islands = app.world().resource::<Islands>();
+            islands.iter().map(|r| r.energy).sum()
+        };
+        let mut steps = 0;
+        let mut before = 0.0;
+        while state(&app, 4).velocity.length() == 0.0 {
+            before = energy(&app);
+            run_steps(&mut app, 1);
+            steps += 1;
+            assert!(steps < 600, "{k} in: no strike within a second");
+        }
+        // Through the step of the strikes, the energy is kept to 1e-9 J
+        // (the swinging balls carry 1.3 J per ball) ...
+        let change = energy(&app) - before;
+        assert!(
+            change.abs() <= 1e-9,
+            "{k} in: the energy changed by {change} J"
+        );
+        // ... and each strike passes on one ball's momentum: along the
+        // row, the impulses are all m v, to 1e-9 of it.
+        let messages = app.world().resource::<Messages<BeadsStruck>>();
+        let struck: Vec<BeadsStruck> = messages.get_cursor().read(messages).copied().collect();
+        let passed = struck[0].impulse;
+        assert!(struck.len() >= 4, "{struck:?}");
+        for s in &struck {
+            assert!(
+                s.bounced && (s.impulse - passed).abs() <= 1e-9 * passed,
+                "{struck:?}"
+            );
+        }
+        let mut highest = [f64::MIN; 5];
+        let mut fastest = [0f64; 5];
+        // The first half swing out: 1 s.
+        for _ in 0..600 {
+            run_steps(&mut app, 1);
+            for i in 0..5 {
+                let s = state(&app, i);
+                highest[i] = highest[i].max(s.position.y);
+                fastest[i] = fastest[i].max(s.velocity.length());
+            }
+        }
+        for i in 0..5 {
+            if i >= 5 - k {
+                let risen = highest[i];
+                assert!(
+                    (risen - rise).abs() <= 1e-3 * rise,
+                    "{k} in: ball {i} rises to {risen}, not {rise}"
+                );
+            } else {
+                assert!(
+                    fastest[i] <= 1e-6 * impact_speed,
+                    "{k} in: ball {i} moves at {} after the strike",
+                    fastest[i]
+                );
+            }
+        }
+    }
+}
+
+/// A shipped scene, spawned into a headless app with its parameters and
+/// contacts.
+fn shipped(name: &str) -> (App, Vec<Entity>, ScenePreset) {
+    let text = std::fs::read_to_string(crate::presets::shipped_dir().join(name)).expect(name);
+    let preset = ScenePreset::from_ron(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let plugin = WireBeadPlugin::new(preset.params.clone()).expect("valid params");
+    let mut app = Headless::new(plugin).single_threaded().build();
+    let beads = preset.spawn(&mut app.world_mut().commands());
+    app.world_mut().flush();
+    (app, beads, preset)
+}
+
+/// The worst overlap of any two beads with radii, as a share of the
+/// smaller radius (negative while every pair is apart).
+fn worst_overlap(app: &mut App) -> f64 {
+    let world = app.world_mut();
+    let mut query = world.query::<(&BeadPosition, &BeadRadius)>();
+    let beads: Vec<(DVec2, f64)> = query.iter(world).map(|(p, r)| (p.0, r.get())).collect();
+    let mut worst = f64::MIN;
+    for (i, &(a, ra)) in beads.iter().enumerate() {
+        for &(b, rb) in &beads[i + 1..] {
+            if ra > 0.0 && rb > 0.0 {
+                worst = worst.max((ra + rb - (b - a).length()) / ra.min(rb));
+            }
+        }
+    }
+    worst
+}
+
+/// Every preset with beads that touch, ten seconds: no two beads ever
+/// overlap by more than 1e-9 of a radius, and no bead stops.
+#[test]
+fn no_preset_lets_beads_overlap() {
+    for name in [
+        "newtons_cradle.scene.ron",
+        "air_track.scene.ron",
+        "air_track_sticky.scene.ron",
+    ] {
+        let (mut app, _, preset) = shipped(name);
+        let steps = (10.0 / preset.params.timestep).round() as u32;
+        let mut worst = f64::MIN;
+        for _ in 0..steps {
+            run_steps(&mut app, 1);
+            worst = worst.max(worst_overlap(&mut app));
+        }
+        assert!(
+            worst <= 1e-9,
+            "{name}: beads overlap by {worst:e} of a radius"
+        );
+        let world = app.world_mut();
+        assert_eq!(world.query::<&Diverged>().iter(world).count(), 0, "{name}");
+    }
+}
+
+/// The air track presets end as their files say: elastic, 1 kg back at
+/// 1.75 m/s and 3 kg on at 0.75 m/s; sticky, both at 0.125 m/s having
+/// lost 2.34375 J (to 1e-12).
+#[test]
+fn the_air_track_presets_end_as_their_files_say() {
+    for (name, light, heavy) in [
+        ("air_track.scene.ron", -1.75, 0.75),
+        ("air_track_sticky.scene.ron", 0.125, 0.125),
+    ] {
+        let (mut app, beads, _) = shipped(name);
+        run_steps(&mut app, 120);
+        let (a, b) = (velocity(&app, beads[0]), velocity(&app, beads[1]));
+        assert!(
+            (a - light).abs() <= 1e-12 && (b - heavy).abs() <= 1e-12,
+            "{name}: {a}, {b}"
+        );
+        let energy = 0.5 * a * a + 1.5 * b * b;
+        let expected = if light == heavy {
+            2.375 - 2.34375
+        } else {
+            2.375
+        };
+        assert!((energy - expected).abs() <= 1e-12, "{name}: {energy} J");
+    }
+}
+
+#[test]
+fn bad_radii_restitutions_and_overlaps_are_refused_in_one_line() {
+    let scene = |bead_a: &str, contacts: &str| {
+        format!(
+            "(name: \"t\", {contacts} wires: [(shape: Line(()), beads: [{bead_a}, (name: \"b\", radius: 0.1, initial_position: (1.0, 0.0))])])"
+        )
+    };
+    let refused = |text: String| ScenePreset::from_ron(&text).unwrap_err().to_string();
+    assert_eq!(
+        refused(scene(
+            "(name: \"a\", radius: -0.1, initial_position: (0.0, 0.0))",
+            ""
+        )),
+        "wire 0, bead 0: radius must be zero or more and finite, got -0.1"
+    );
+    assert_eq!(
+        refused(scene(
+            "(name: \"a\", radius: NaN, initial_position: (0.0, 0.0))",
+            ""
+        )),
+        "wire 0, bead 0: radius must be zero or more and finite, got NaN"
+    );
+    assert_eq!(
+        refused(scene(
+            "(name: \"a\", radius: 0.1, initial_position: (0.0, 0.0))",
+            "contacts: (restitution: 1.5),"
+        )),
+        "contacts: restitution must be between 0 and 1, got 1.5"
+    );
+    assert_eq!(
+        refused(scene(
+            "(name: \"a\", radius: 0.1, initial_position: (0.0, 0.0))",
+            "contacts: (restitution: -0.5),"
+        )),
+        "contacts: restitution must be between 0 and 1, got -0.5"
+    );
+    assert_eq!(
+        refused(scene(
+            "(name: \"a\", radius: 0.95, initial_position: (0.0, 0.0))",
+            ""
+        )),
+        "beads \"a\" and \"b\" overlap by 5.000e-2 m where they start; beads with radii may touch but not overlap"
+    );
+    // Touching is not overlapping.
+    let touching = scene(
+        "(name: \"a\", radius: 0.9, initial_position: (0.0, 0.0))",
+        "",
+    );
+    assert!(ScenePreset::from_ron(&touching).is_ok());
+}
+
+/// An abacus of 20 lines of 10 beads each, beads pushed to and fro at
+/// different speeds; with the island step split over threads or not.
+fn abacus(parallel: wirebead::ParallelStep) -> (App, Vec<Entity>) {
+    let params = SimParams {
+        method: Method::new(Integrator::Rattle, None).expect("RATTLE"),
+        ..SimParams::default()
+    };
+    let plugin = WireBeadPlugin::new(params).expect("valid params");
+    let mut app = Headless::new(plugin).parallel(parallel).build();
+    let mut beads = Vec::new();
+    for line in 0..20 {
+        let y = 0.3 * line as f64;
+        let track = app
+            .world_mut()
+            .spawn((Wire::line(), Transform::from_xyz(0.0, y as f32, 0.0)))
+            .id();
+        for k in 0..10 {
+            let speed = ((line * 7 + k * 3) % 11) as f64 - 5.0;
+            let params = BeadParams {
+                mass: 1.0 + (k % 3) as f64,
+                initial_position: DVec2::new(0.25 * k as f64, y),
+                initial_velocity: DVec2::new(speed, 0.0),
+            };
+            beads.push(
+                app.world_mut()
+                    .spawn((
+                        Bead::new(params).expect("a bead"),
+                        OnWire(track),
+                        BeadRadius::new(0.1).expect("a radius"),
+                    ))
+                    .id(),
+            );
+        }
+    }
+    (app, beads)
+}
+
+/// Strikes settle the same, bit for bit, whether the islands step on one
+/// thread or many; no two beads of the abacus ever overlap by more than
+/// 1e-9 of a radius.
+#[test]
+fn strikes_are_bit_identical_sequential_and_parallel() {
+    let (mut one, beads_one) = abacus(wirebead::ParallelStep::OFF);
+    let (mut many, beads_many) = abacus(wirebead::ParallelStep { threshold: 0 });
+    let mut worst = f64::MIN;
+    for _ in 0..300 {
+        run_steps(&mut one, 1);
+        worst = worst.max(worst_overlap(&mut one));
+    }
+    run_steps(&mut many, 300);
+    assert!(worst <= 1e-9, "beads overlap by {worst:e} of a radius");
+    let mut moved = 0;
+    for (&a, &b) in beads_one.iter().zip(&beads_many) {
+        let (sa, sb) = (
+            bead_state(one.world(), a).expect("a bead"),
+            bead_state(many.world(), b).expect("a bead"),
+        );
+        for (va, vb) in [(sa.position, sb.position), (sa.velocity, sb.velocity)] {
+            assert_eq!(
+                va.to_array().map(f64::to_bits),
+                vb.to_array().map(f64::to_bits)
+            );
+        }
+        moved += usize::from(sa.velocity.x != 0.0);
+    }
+    assert!(moved > 150, "{moved} beads moving");
+    let world = one.world_mut();
+    assert_eq!(world.query::<&Diverged>().iter(world).count(), 0);
+}
+
+/// Two equal free balls in space with no gravity, one struck off centre:
+/// they leave at right angles, momentum and energy kept to 1e-12.
+#[test]
+fn free_balls_in_space_struck_off_centre_leave_at_right_angles() {
+    use bevy::math::DVec3;
+    use wirebead::SpaceBead;
+    use wirebead::headless::space_bead_state;
+    let params = SimParams {
+        gravity: DVec2::ZERO,
+        method: Method::new(Integrator::Rattle, None).expect("RATTLE"),
+        ..SimParams::default()
+    };
+    let plugin = WireBeadPlugin::new(params).expect("valid params");
+    let mut app = Headless::new(plugin).single_threaded().build();
+    let u = DVec3::new(3.0, 0.0, 0.0);
+    let mut spawn = |at: DVec3, v: DVec3| {
+        let params = BeadParams {
+            mass: 1.0,
+            initial_position: at,
+            initial_velocity: v,
+        };
+        app.world_mut()
+            .spawn((
+                SpaceBead::new(params).expect("a bead"),
+                BeadRadius::new(0.1).expect("a radius"),
+            ))
+            .id()
+    };
+    let a = spawn(DVec3::ZERO, u);
+    let b = spawn(DVec3::new(1.0, 0.08, 0.06), DVec3::ZERO);
+    run_steps(&mut app, 60);
+    let (sa, sb) = (
+        space_bead_state(app.world(), a).expect("a bead"),
+        space_bead_state(app.world(), b).expect("a bead"),
+    );
+    let (va, vb) = (sa.velocity, sb.velocity);
+    assert!(vb.length() > 1.0, "the struck ball moves: {vb}");
+    assert!(va.dot(vb).abs() <= 1e-12, "{va} · {vb}");
+    assert!((va + vb - u).length() <= 1e-12, "momentum: {}", va + vb);
+    let energy = 0.5 * (va.length_squared() + vb.length_squared());
+    assert!((energy - 4.5).abs() <= 1e-12, "{energy} J");
+    assert!((sb.position - sa.position).length() > 0.2);
+}
