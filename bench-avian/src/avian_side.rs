@@ -275,6 +275,15 @@ pub fn positive(text: &str) -> Result<usize, String> {
     }
 }
 
+/// A command-line number that must be positive and finite.
+pub fn positive_f64(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        Ok(x) => Err(format!("must be positive and finite, got {x}")),
+        Err(e) => Err(format!("{text:?} is not a number ({e})")),
+    }
+}
+
 /// Builds a headless app with avian2d and `n` pendulums ([`physics_app`]
 /// at avian's default substeps), warmed up. Returns the app and the first
 /// pendulum's bead.

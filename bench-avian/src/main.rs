@@ -6,6 +6,7 @@
 //! cargo run --release -p wirebead-vs-avian -- rope [--steps 600] [--sizes 10,100,1000] [--substeps 20,50,100,200]
 //! cargo run --release -p wirebead-vs-avian -- carts [--steps 600] [--sizes 1000,10000] [--substeps 50] [--rail prismatic|locked]
 //! cargo run --release -p wirebead-vs-avian -- spheres [--steps 600] [--sizes 1,10000]
+//! cargo run --release -p wirebead-vs-avian -- touch [--dt 0.016667] [--steps 120] [--substeps 50]
 //! ```
 //!
 //! - `circle` (the default, also without a subcommand): a bead on a circle
@@ -28,6 +29,11 @@
 //!   each method against avian3d (a body on a `DistanceJoint`, see
 //!   [`spheres`]). Prints ns per bead-step, energy and height change and
 //!   the worst radial error.
+//! - `touch`: beads that strike, Newton's cradle and the air track, our
+//!   plugin against avian2d's circle colliders with restitution (see
+//!   [`touch`]). Prints how many balls the cradle sends out and how high,
+//!   the momentum and energy across the strikes, the gliders' velocities
+//!   against the formulas, and ns per step.
 //!
 //! Every job uses Bevy's process-wide task pools with a compute thread per
 //! core, on both sides.
@@ -38,6 +44,7 @@ mod avian_side;
 mod carts;
 mod rope;
 mod spheres;
+mod touch;
 
 use std::time::Instant;
 
@@ -58,7 +65,7 @@ const GRAVITY: f64 = 10.0;
 /// The command line: a job, or the circle job's options alone.
 #[derive(Parser, Debug)]
 #[command(
-    about = "wirebead against avian: a bead on a circle, a hanging rope, pendulums on carts, spherical pendulums",
+    about = "wirebead against avian: a bead on a circle, a hanging rope, pendulums on carts, spherical pendulums, beads that strike",
     args_conflicts_with_subcommands = true
 )]
 struct Cli {
@@ -81,6 +88,8 @@ enum Job {
     Carts(carts::CartsArgs),
     /// N spherical pendulums in space, against avian3d.
     Spheres(spheres::SpheresArgs),
+    /// Newton's cradle and the air track, against avian2d's colliders.
+    Touch(touch::TouchArgs),
 }
 
 /// Options of the circle job.
@@ -193,6 +202,7 @@ fn main() {
         Some(Job::Rope(args)) => rope::run(&args),
         Some(Job::Carts(args)) => carts::run(&args),
         Some(Job::Spheres(args)) => spheres::run(&args),
+        Some(Job::Touch(args)) => touch::run(&args),
     }
 }
 

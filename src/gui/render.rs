@@ -261,6 +261,25 @@ pub fn wire_bounds(shape: &WireShape, pose: &Pose) -> (DVec2, DVec2) {
     )
 }
 
+/// The longest total length of `rods` joined into one chain (or tree):
+/// how far a bead at one end may swing from the other.
+fn longest_chain<'a>(rods: impl Iterator<Item = &'a Rod>) -> f64 {
+    let mut chains: Vec<(Vec<Entity>, f64)> = Vec::new();
+    for rod in rods {
+        let touching: Vec<usize> = (0..chains.len())
+            .filter(|&c| rod.beads().iter().any(|b| chains[c].0.contains(b)))
+            .collect();
+        let mut joined = (rod.beads().to_vec(), rod.length());
+        for &c in touching.iter().rev() {
+            let (beads, length) = chains.swap_remove(c);
+            joined.0.extend(beads);
+            joined.1 += length;
+        }
+        chains.push(joined);
+    }
+    chains.iter().map(|c| c.1).fold(0.0, f64::max)
+}
+
 /// Frames every wire (and every bead's start) in the part of the window
 /// left of the panel, whatever their size.
 pub fn frame_camera(
@@ -284,13 +303,13 @@ pub fn frame_camera(
         lo = lo.min(bead.initial_position);
         hi = hi.max(bead.initial_position);
     }
-    // Beads hanging on rods swing out as far as the rods reach: a rod
-    // with a bead on no wire widens the view by its length.
-    let reach: f64 = rods
-        .iter()
-        .filter(|rod| rod.beads().iter().any(|b| !on_wire.contains(*b)))
-        .map(Rod::length)
-        .sum();
+    // Beads hanging on rods swing out as far as the rods reach: the
+    // longest chain of rods with a bead on no wire widens the view by its
+    // length.
+    let reach = longest_chain(
+        rods.iter()
+            .filter(|rod| rod.beads().iter().any(|b| !on_wire.contains(*b))),
+    );
     lo -= DVec2::splat(reach);
     hi += DVec2::splat(reach);
     if !(lo.is_finite() && hi.is_finite()) {
@@ -327,6 +346,7 @@ fn size_and_colour_beads(
     view: Res<FramedView>,
     style: Res<SceneStyle>,
     rods: Query<&Rod>,
+    radii: Query<&BeadRadius>,
     mut beads: Query<
         (
             Entity,
@@ -341,7 +361,7 @@ fn size_and_colour_beads(
     mut materials: ResMut<Assets<ColorMaterial>>,
 ) {
     let radius = style.bead_radius * view.size.y;
-    let limits = BeadSizes::new(&rods);
+    let limits = BeadSizes::new(&rods, radii.iter());
     for (entity, mut transform, material, diverged, contact, own) in &mut beads {
         transform.scale = Vec3::splat(limits.drawn(entity, own, radius));
         transform.translation.z = 1.0;
@@ -354,14 +374,21 @@ fn size_and_colour_beads(
     }
 }
 
-/// How wide each bead hanging on rods may be drawn: no wider than 40 % of
-/// the shortest rod it hangs on, so that a rope of short rods reads as a
-/// rope.
-pub(crate) struct BeadSizes(HashMap<Entity, f32>);
+/// How wide each bead may be drawn: no wider than 40 % of the shortest rod
+/// it hangs on, so that a rope of short rods reads as a rope, and, where
+/// beads have radii, a bead without one no wider than the smallest of
+/// them, so that the beads that touch read as the balls.
+pub(crate) struct BeadSizes {
+    shortest: HashMap<Entity, f32>,
+    smallest: f32,
+}
 
 impl BeadSizes {
-    /// The limits the rods set.
-    pub(crate) fn new(rods: &Query<&Rod>) -> Self {
+    /// The limits the rods and the radii set.
+    pub(crate) fn new<'a>(
+        rods: &Query<&Rod>,
+        radii: impl IntoIterator<Item = &'a BeadRadius>,
+    ) -> Self {
         let mut shortest: HashMap<Entity, f32> = HashMap::new();
         for rod in rods {
             for bead in rod.beads() {
@@ -369,20 +396,28 @@ impl BeadSizes {
                 *limit = limit.min(0.4 * rod.length() as f32);
             }
         }
-        Self(shortest)
+        let smallest = radii
+            .into_iter()
+            .map(|r| r.get() as f32)
+            .filter(|&r| r > 0.0)
+            .fold(f32::INFINITY, f32::min);
+        Self { shortest, smallest }
     }
 
     /// The radius `bead` is drawn at, `radius` at most.
     pub(crate) fn radius(&self, bead: Entity, radius: f32) -> f32 {
-        self.0.get(&bead).map_or(radius, |&limit| radius.min(limit))
+        self.shortest
+            .get(&bead)
+            .map_or(radius, |&limit| radius.min(limit))
     }
 
     /// The radius `bead` is drawn at: its own where it has one (beads that
-    /// touch are drawn touching), else [`BeadSizes::radius`].
+    /// touch are drawn touching), else [`BeadSizes::radius`], no wider
+    /// than the smallest bead that has one.
     pub(crate) fn drawn(&self, bead: Entity, own: Option<&BeadRadius>, radius: f32) -> f32 {
         match own.map(BeadRadius::get) {
             Some(r) if r > 0.0 => r as f32,
-            _ => self.radius(bead, radius),
+            _ => self.radius(bead, radius).min(self.smallest),
         }
     }
 }

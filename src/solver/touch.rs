@@ -296,6 +296,9 @@ fn groups(beads: &[TouchBead], bodies: usize, pairs: &[(usize, usize)]) -> Vec<V
     found.into_iter().map(|(_, b)| b).collect()
 }
 
+/// A bead (its index) with the box it sweeps.
+type Boxed = (usize, (DVec3, DVec3));
+
 /// One group of bodies being settled: where each is now and where its
 /// step ends from there.
 struct Group<'a, V: Coordinates> {
@@ -349,19 +352,8 @@ impl<'a, V: Coordinates> Group<'a, V> {
     /// The pairs of the group's beads whose boxes from now to the end
     /// overlap, and the beads of `outside` (with their boxes) that
     /// overlap one of the group's.
-    fn find_pairs(&self, outside: &[(usize, (DVec3, DVec3))]) -> (Vec<(usize, usize)>, Vec<usize>) {
-        let mut boxes: Vec<(DVec3, DVec3)> = self
-            .members
-            .iter()
-            .map(|&i| {
-                let t = &self.beads[i];
-                swept(
-                    t,
-                    self.state(i, false).position,
-                    self.state(i, true).position,
-                )
-            })
-            .collect();
+    fn find_pairs(&self, outside: &[Boxed]) -> (Vec<(usize, usize)>, Vec<usize>) {
+        let mut boxes: Vec<(DVec3, DVec3)> = self.members.iter().map(|&i| self.swept(i)).collect();
         let mine = boxes.len();
         boxes.extend(outside.iter().map(|(_, b)| *b));
         let mut pairs = Vec::new();
@@ -386,9 +378,15 @@ impl<'a, V: Coordinates> Group<'a, V> {
         bodies: &mut [B],
         pool: &mut Pool,
     ) -> Result<(), SolveError> {
-        let outside: Vec<(usize, (DVec3, DVec3))> = (0..self.beads.len())
+        // Only the beads whose boxes meet the box about the whole group's.
+        let (low, high) = self.members.iter().map(|&i| self.swept(i)).fold(
+            (DVec3::INFINITY, DVec3::NEG_INFINITY),
+            |(low, high), (a, b)| (low.min(a), high.max(b)),
+        );
+        let outside: Vec<Boxed> = (0..self.beads.len())
             .filter(|&j| pool.free[self.beads[j].body])
             .map(|j| (j, pool.boxes[j]))
+            .filter(|(_, (a, b))| a.cmple(high).all() && low.cmple(*b).all())
             .collect();
         let (_, met) = self.find_pairs(&outside);
         for j in met {
@@ -439,6 +437,12 @@ impl<'a, V: Coordinates> Group<'a, V> {
             &self.now[slot]
         };
         states[self.beads[i].bead]
+    }
+
+    /// The box bead `i` sweeps from now to the step's end.
+    fn swept(&self, i: usize) -> (DVec3, DVec3) {
+        let (from, to) = (self.state(i, false), self.state(i, true));
+        swept(&self.beads[i], from.position, to.position)
     }
 
     /// The gap of pair `(i, j)` between the positions `xa` and `xb`.

@@ -226,12 +226,13 @@ pub fn frame_scene(
 }
 
 /// Sizes each bead in space to the scene, no wider than 40 % of the
-/// shortest rod it hangs on, and colours it: diverged, in flight, or
-/// on its wire.
+/// shortest rod it hangs on (a bead with a radius at its radius), and
+/// colours it: diverged, in flight, or on its wire.
 pub fn size_and_colour_beads(
     orbit: Res<Orbit>,
     style: Res<SceneStyle>,
     rods: Query<&Rod>,
+    radii: Query<&BeadRadius>,
     mut beads: Query<
         (
             Entity,
@@ -246,7 +247,7 @@ pub fn size_and_colour_beads(
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
     let radius = 1.6 * style.bead_radius * orbit.size;
-    let limits = BeadSizes::new(&rods);
+    let limits = BeadSizes::new(&rods, radii.iter());
     for (entity, mut transform, material, diverged, contact, own) in &mut beads {
         let r = limits.drawn(entity, own, radius);
         if transform.scale != Vec3::splat(r) {

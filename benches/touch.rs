@@ -1,0 +1,87 @@
+//! The cost of beads that touch: `cargo bench --bench touch`.
+//!
+//! - `abacus`: 1,000 beads of radius 0.1 m on 100 rings of radius 1 m,
+//!   ten to a ring, with no gravity, each set going at its own speed, so
+//!   that they keep striking each other round their rings (elastic,
+//!   RATTLE, dt = 1/60 s), against the same beads without radii (they
+//!   pass through each other, each stepping alone). Throughput is
+//!   bead-steps per second. The plugin as a game gets it: Bevy's
+//!   executor, parallel loops from `ParallelStep::default()`.
+
+use std::time::Duration;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use wirebead::headless::Headless;
+use wirebead::prelude::*;
+use wirebead::{BeadRadius, Integrator, SimClock};
+
+/// Rings in the abacus.
+const RINGS: usize = 100;
+/// Beads on each ring.
+const PER_RING: usize = 10;
+
+/// The abacus, its beads with radii or not, stepped once so that its
+/// islands are built.
+fn abacus(touching: bool) -> App {
+    let params = SimParams {
+        gravity: DVec2::ZERO,
+        method: Method::new(Integrator::Rattle, None).expect("RATTLE"),
+        ..SimParams::default()
+    };
+    let mut app = Headless::new(WireBeadPlugin::new(params).expect("valid parameters")).build();
+    let world = app.world_mut();
+    for ring in 0..RINGS {
+        let centre = DVec2::new(3.0 * (ring % 10) as f64, 3.0 * (ring / 10) as f64);
+        let wire = world
+            .spawn((
+                Wire::circle(1.0).expect("a ring"),
+                Transform::from_xyz(centre.x as f32, centre.y as f32, 0.0),
+            ))
+            .id();
+        for k in 0..PER_RING {
+            let angle = std::f64::consts::TAU * k as f64 / PER_RING as f64;
+            let (along, out) = (
+                DVec2::new(-angle.sin(), angle.cos()),
+                DVec2::from_angle(angle),
+            );
+            let speed = ((ring * 7 + k * 3) % 11) as f64 - 5.0;
+            let params = BeadParams {
+                mass: 1.0 + (k % 3) as f64,
+                initial_position: centre + out,
+                initial_velocity: along * speed,
+            };
+            let mut bead = world.spawn((Bead::new(params).expect("a bead"), OnWire(wire)));
+            if touching {
+                bead.insert(BeadRadius::new(0.1).expect("a radius"));
+            }
+        }
+    }
+    app.world_mut().run_schedule(FixedUpdate);
+    app
+}
+
+fn abacus_group(c: &mut Criterion) {
+    let mut group = c.benchmark_group("abacus");
+    let n = RINGS * PER_RING;
+    group.throughput(Throughput::Elements(n as u64));
+    group.sample_size(20);
+    group.warm_up_time(Duration::from_secs(1));
+    group.measurement_time(Duration::from_secs(4));
+    for (name, touching) in [("touching", true), ("passing-through", false)] {
+        let mut app = abacus(touching);
+        group.bench_function(BenchmarkId::new(name, n), |b| {
+            b.iter(|| app.world_mut().run_schedule(FixedUpdate));
+        });
+        let world = app.world_mut();
+        let stopped = world.query::<&Diverged>().iter(world).count();
+        let steps = world.resource::<SimClock>().steps;
+        eprintln!("abacus/{name}: {steps} steps, {stopped} beads stopped");
+        assert_eq!(stopped, 0, "no bead may stop");
+    }
+    group.finish();
+}
+
+criterion_group!(benches, abacus_group);
+criterion_main!(benches);
