@@ -1,9 +1,41 @@
-//! The list of rods and pins with each one's drift and multiplier.
+//! The list of rods and pins with each one's drift and multiplier, and
+//! the last strikes between beads that touch (recorded in `plots`).
 
 use bevy_egui::egui;
 
 use super::view::PanelView;
 use crate::ConstraintDiagnostics;
+
+/// The last strikes: which beads, when, how fast they closed, the impulse
+/// and whether they bounced apart or stayed in touch.
+pub(super) fn strikes_section(ui: &mut egui::Ui, view: &PanelView) {
+    if view.strikes.0.is_empty() {
+        return;
+    }
+    ui.separator();
+    egui::CollapsingHeader::new("Strikes")
+        .default_open(true)
+        .show(ui, |ui| {
+            egui::Grid::new("strikes")
+                .num_columns(4)
+                .striped(true)
+                .show(ui, |ui| {
+                    ui.strong("");
+                    ui.strong("t (s)");
+                    ui.strong("closing (m/s)");
+                    ui.strong("impulse (N s)");
+                    ui.end_row();
+                    for s in &view.strikes.0 {
+                        let how = if s.bounced { "bounced" } else { "stayed" };
+                        ui.label(format!("{}–{} {how}", view.name(s.a), view.name(s.b)));
+                        ui.monospace(format!("{:.4}", s.time));
+                        ui.monospace(format!("{:.4}", s.closing_speed));
+                        ui.monospace(format!("{:.4}", s.impulse));
+                        ui.end_row();
+                    }
+                });
+        });
+}
 
 /// Every rod and pin with its drift `C` and multiplier λ (a rod under
 /// tension pulls: λ < 0).

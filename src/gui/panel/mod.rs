@@ -1,7 +1,7 @@
 //! The egui panel: every parameter of the assignment's panel plus gravity, wire
 //! shape and size, integrator and stabilization; a marker while edits are
-//! pending; live plots of `C`, energy and λ; divergence and scene-file
-//! errors in plain words.
+//! pending; live plots of `C`, energy and λ; the last strikes between
+//! beads that touch; divergence and scene-file errors in plain words.
 //!
 //! Edits go through the plugin's validating setters: an invalid value is
 //! refused with the plugin's error message and never reaches the
@@ -17,7 +17,7 @@ mod window;
 use bevy::prelude::*;
 use bevy_egui::EguiPrimaryContextPass;
 
-pub use plots::{PlotHistory, PlotSample, record_history};
+pub use plots::{PlotHistory, PlotSample, RecentStrikes, record_history, record_strikes};
 pub use view::{PanelActions, PanelView};
 pub use window::panel;
 
@@ -91,9 +91,10 @@ impl Plugin for PanelPlugin {
         app.init_resource::<PresetCatalog>()
             .init_resource::<PlotHistory>()
             .init_resource::<SelectedBead>()
+            .init_resource::<RecentStrikes>()
             .add_systems(
                 FixedUpdate,
-                record_history.after(WireBeadSystems::Writeback),
+                (record_history, record_strikes).after(WireBeadSystems::Writeback),
             )
             .add_systems(Update, keep_selection)
             .add_systems(EguiPrimaryContextPass, panel);

@@ -1,5 +1,6 @@
 //! The selected bead's last seconds of drift, energy and λ: recorded each
-//! step and plotted with labelled axes.
+//! step and plotted with labelled axes; and the last strikes between beads,
+//! recorded for the panel's list.
 
 use std::collections::VecDeque;
 
@@ -9,7 +10,7 @@ use bevy_egui::egui;
 use egui_plot::{Line, Plot, PlotPoints};
 
 use crate::gui::drag::SelectedBead;
-use crate::{BeadDiagnostics, Islands, SimClock};
+use crate::{BeadDiagnostics, BeadsStruck, Islands, SimClock};
 
 /// One plotted sample of the selected bead.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -138,4 +139,27 @@ pub(super) fn plots_section(ui: &mut egui::Ui, history: &PlotHistory) {
             colour,
         );
     }
+}
+
+/// How many of the last strikes the panel lists.
+const STRIKES_SHOWN: usize = 6;
+
+/// The last strikes between beads, newest first, for the panel.
+#[derive(Resource, Default)]
+pub struct RecentStrikes(pub(super) VecDeque<BeadsStruck>);
+
+/// Keeps the last six strikes; forgets them when the run
+/// starts again (the clock went back).
+pub fn record_strikes(
+    mut struck: MessageReader<BeadsStruck>,
+    clock: Res<SimClock>,
+    mut recent: ResMut<RecentStrikes>,
+) {
+    if recent.0.front().is_some_and(|s| s.time > clock.time) {
+        recent.0.clear();
+    }
+    for strike in struck.read() {
+        recent.0.push_front(*strike);
+    }
+    recent.0.truncate(STRIKES_SHOWN);
 }

@@ -6,7 +6,7 @@ use bevy::math::DVec3;
 use bevy::prelude::*;
 
 use super::PresetCatalog;
-use super::plots::PlotHistory;
+use super::plots::{PlotHistory, RecentStrikes};
 use crate::controls::{ControlKeys, StepRequests};
 use crate::gui::drag::SelectedBead;
 use crate::gui::render::SceneStyle;
@@ -72,6 +72,7 @@ pub struct PanelView<'w, 's> {
         Query<'w, 's, (), Or<(With<NextBeadParams>, With<NextBeadParams<DVec3>>)>>,
     pub(super) pending_wires: Query<'w, 's, (), With<NextWireShape>>,
     pub(super) clock: Res<'w, SimClock>,
+    pub(super) strikes: Res<'w, RecentStrikes>,
 }
 
 /// What the panel's controls ask of the world this frame.

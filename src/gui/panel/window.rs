@@ -4,7 +4,7 @@
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, egui};
 
-use super::constraints::constraints_section;
+use super::constraints::{constraints_section, strikes_section};
 use super::params::{Edit, bead_section, solver_section};
 use super::plots::plots_section;
 use super::space::space_bead_section;
@@ -45,6 +45,7 @@ pub fn panel(
                 &mut actions.commands,
             ));
             constraints_section(ui, &view);
+            strikes_section(ui, &view);
             let solver = solver_section(ui, &mut actions.pending, view.active.in_space);
             outcome = solver.or(bead);
             plots_section(ui, &view.history);
