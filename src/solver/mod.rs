@@ -15,7 +15,7 @@
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
 //! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eqs. (16)–(17): on the wire, in flight, where an event falls |
 //! | `impact` | [`resolve_impacts`]: strikes between beads that touch, eq. (18), one pair at a time |
-//! | `touch` | [`settle_touches`]: where within a step beads meet (broad phase, regula falsi), the step cut there |
+//! | `touch/` (`group`) | [`settle_touches`]: where within a step beads meet (broad phase, regula falsi), the step cut there |
 //! | `lanes/` (`circle`) | the batched step: eight beads on circles at once, bit for bit [`step`](fn@step), many such batches in one call; the solves on each lane's circle (crate-private) |
 //! | `coupled/` (`island/`, `normal/`, …) | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (12)–(14) |
 //!

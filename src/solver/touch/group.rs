@@ -1,0 +1,419 @@
+//! One group of bodies being settled: the step cut at each instant its
+//! beads meet, the strikes made there, and the bodies taken in whose boxes
+//! come to meet the group's.
+
+use bevy::math::DVec3;
+
+use super::{
+    CLOSING, MAX_IMPACTS_PER_STEP, Pool, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody,
+    TouchError, overlapping, swept,
+};
+use crate::geometry::Coordinates;
+use crate::solver::contact::locate;
+use crate::solver::impact::{Response, Touch, resolve_impacts};
+use crate::solver::solve::SolveError;
+use crate::solver::state::BeadState;
+
+/// A bead (its index) with the box it sweeps.
+type Boxed = (usize, (DVec3, DVec3));
+
+/// One group of bodies being settled: where each is now and where its
+/// step ends from there.
+pub(super) struct Group<'a, V: Coordinates> {
+    span: StepSpan,
+    beads: &'a [TouchBead],
+    bodies: Vec<usize>,
+    /// The beads (indices into `beads`) of the group's bodies.
+    members: Vec<usize>,
+    pairs: Vec<(usize, usize)>,
+    /// When the group is now.
+    time: f64,
+    /// Each body's states now and at the step's end, by the body's place
+    /// in `bodies`.
+    now: Vec<Vec<BeadState<V>>>,
+    end: Vec<Vec<BeadState<V>>>,
+    /// Whether a body's last step was a trial, not its end.
+    tried: Vec<bool>,
+    /// Whether the group was cut at all.
+    cut: bool,
+}
+
+impl<'a, V: Coordinates> Group<'a, V> {
+    pub(super) fn new<B: TouchBody<V>>(
+        span: StepSpan,
+        all: &[B],
+        beads: &'a [TouchBead],
+        bodies: Vec<usize>,
+    ) -> Self {
+        let now = bodies.iter().map(|&b| all[b].start().to_vec()).collect();
+        let end = bodies.iter().map(|&b| all[b].end().to_vec()).collect();
+        let tried = vec![false; bodies.len()];
+        let members = (0..beads.len())
+            .filter(|&i| bodies.contains(&beads[i].body))
+            .collect();
+        let mut group = Self {
+            span,
+            beads,
+            bodies,
+            members,
+            pairs: Vec::new(),
+            time: span.time,
+            now,
+            end,
+            tried,
+            cut: false,
+        };
+        group.pairs = group.find_pairs(&[]).0;
+        group
+    }
+
+    /// The pairs of the group's beads whose boxes from now to the end
+    /// overlap, and the beads of `outside` (with their boxes) that
+    /// overlap one of the group's.
+    fn find_pairs(&self, outside: &[Boxed]) -> (Vec<(usize, usize)>, Vec<usize>) {
+        let mut boxes: Vec<(DVec3, DVec3)> = self.members.iter().map(|&i| self.swept(i)).collect();
+        let mine = boxes.len();
+        boxes.extend(outside.iter().map(|(_, b)| *b));
+        let mut pairs = Vec::new();
+        let mut met = Vec::new();
+        for (p, q) in overlapping(&boxes) {
+            match (p < mine, q < mine) {
+                (true, true) => pairs.push((self.members[p], self.members[q])),
+                (true, false) => met.push(outside[q - mine].0),
+                (false, true) => met.push(outside[p - mine].0),
+                (false, false) => {}
+            }
+        }
+        (pairs, met)
+    }
+
+    /// Takes into the group the bodies not yet settled whose beads' boxes
+    /// meet its beads' boxes from now on (with the rest of the group the
+    /// broad phase first put them in), each stepped to now; then finds
+    /// the group's pairs again.
+    fn absorb<B: TouchBody<V>>(
+        &mut self,
+        bodies: &mut [B],
+        pool: &mut Pool,
+    ) -> Result<(), SolveError> {
+        // Only the beads whose boxes meet the box about the whole group's.
+        let (low, high) = self.members.iter().map(|&i| self.swept(i)).fold(
+            (DVec3::INFINITY, DVec3::NEG_INFINITY),
+            |(low, high), (a, b)| (low.min(a), high.max(b)),
+        );
+        let outside: Vec<Boxed> = (0..self.beads.len())
+            .filter(|&j| pool.free[self.beads[j].body])
+            .map(|j| (j, pool.boxes[j]))
+            .filter(|(_, (a, b))| a.cmple(high).all() && low.cmple(*b).all())
+            .collect();
+        let (_, met) = self.find_pairs(&outside);
+        for j in met {
+            let body = self.beads[j].body;
+            if !pool.free[body] {
+                continue;
+            }
+            let taken = match pool.group_of[body] {
+                usize::MAX => {
+                    pool.free[body] = false;
+                    vec![body]
+                }
+                g => pool.take(g),
+            };
+            for body in taken {
+                let mut now = bodies[body].start().to_vec();
+                let since = self.time - self.span.time;
+                if since > 0.0 {
+                    bodies[body].advance(self.span.time, since, &mut now)?;
+                    bodies[body].keep();
+                }
+                let mut end = now.clone();
+                bodies[body].advance(self.time, self.left(), &mut end)?;
+                self.bodies.push(body);
+                self.now.push(now);
+                self.end.push(end);
+                self.tried.push(false);
+                self.members
+                    .extend((0..self.beads.len()).filter(|&i| self.beads[i].body == body));
+            }
+        }
+        self.pairs = self.find_pairs(&[]).0;
+        Ok(())
+    }
+
+    /// The place of bead `i`'s body in the group.
+    fn slot(&self, i: usize) -> usize {
+        let body = self.beads[i].body;
+        self.bodies.iter().position(|&b| b == body).unwrap_or(0)
+    }
+
+    /// Bead `i`'s state now, or at the step's end.
+    fn state(&self, i: usize, at_end: bool) -> BeadState<V> {
+        let slot = self.slot(i);
+        let states = if at_end {
+            &self.end[slot]
+        } else {
+            &self.now[slot]
+        };
+        states[self.beads[i].bead]
+    }
+
+    /// The box bead `i` sweeps from now to the step's end.
+    fn swept(&self, i: usize) -> (DVec3, DVec3) {
+        let (from, to) = (self.state(i, false), self.state(i, true));
+        swept(&self.beads[i], from.position, to.position)
+    }
+
+    /// The gap of pair `(i, j)` between the positions `xa` and `xb`.
+    fn gap(&self, (i, j): (usize, usize), xa: V, xb: V) -> f64 {
+        let d = xb - xa;
+        d.dot(d).sqrt() - (self.beads[i].radius + self.beads[j].radius)
+    }
+
+    /// How far the group's end is from now.
+    fn left(&self) -> f64 {
+        self.span.time + self.span.dt - self.time
+    }
+
+    /// Cuts the step at each instant of impact in turn, then finishes the
+    /// bodies it cut.
+    pub(super) fn settle<B: TouchBody<V>>(
+        mut self,
+        bodies: &mut [B],
+        pool: &mut Pool,
+        struck: &mut Vec<StruckPair>,
+    ) -> Result<(), TouchError> {
+        let mut last = (0, 0);
+        for _ in 0..MAX_IMPACTS_PER_STEP {
+            let Some((tau, pair)) = self.first_meeting(bodies)? else {
+                return self.finish(bodies);
+            };
+            last = pair;
+            self.cut = true;
+            self.step_all(bodies, tau, true)?;
+            self.strike(bodies, struck)?;
+            self.step_all(bodies, self.left(), false)?;
+            self.absorb(bodies, pool)?;
+        }
+        Err(TouchError::TooManyImpacts {
+            a: last.0,
+            b: last.1,
+        })
+    }
+
+    /// The first instant (from now) a pair that is apart meets, and the
+    /// pair; none if no pair meets before the step's end.
+    fn first_meeting<B: TouchBody<V>>(
+        &mut self,
+        bodies: &mut [B],
+    ) -> Result<Option<(f64, (usize, usize))>, TouchError> {
+        let h = self.left();
+        let mut first: Option<(f64, (usize, usize))> = None;
+        for k in 0..self.pairs.len() {
+            let pair = self.pairs[k];
+            let (a0, b0) = (self.state(pair.0, false), self.state(pair.1, false));
+            let (a1, b1) = (self.state(pair.0, true), self.state(pair.1, true));
+            let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
+            let g0 = self.gap(pair, a0.position, b0.position);
+            if g0 <= TOUCHING * r {
+                // In touch: struck now if it closes, else left resting.
+                let n = b0.position - a0.position;
+                let u = n.dot(b0.velocity - a0.velocity) / n.dot(n).sqrt();
+                let speeds =
+                    a0.velocity.dot(a0.velocity).sqrt() + b0.velocity.dot(b0.velocity).sqrt();
+                if -u > CLOSING * speeds {
+                    return Ok(Some((0.0, pair)));
+                }
+                continue;
+            }
+            if h <= 0.0 {
+                continue;
+            }
+            let within = first.map_or(h, |(tau, _)| tau);
+            let Some(bracket) = self.bracket(bodies, pair, [a0, b0, a1, b1], h)? else {
+                continue;
+            };
+            if bracket > within {
+                // Meets, but after a pair already found: still look for
+                // the instant if it may come first.
+                let trial = self.trial_gap(bodies, pair, within)?;
+                if trial > 0.0 {
+                    continue;
+                }
+            }
+            let hi = bracket.min(within);
+            let tau = locate(hi, g0, |tau| self.trial_gap(bodies, pair, tau))?;
+            if first.is_none_or(|(t, _)| tau < t) {
+                first = Some((tau, pair));
+            }
+        }
+        Ok(first)
+    }
+
+    /// A part `τ ≤ h` at whose end the pair's gap is closed, if it meets:
+    /// `h` where it ends closed, else the instant its straight paths come
+    /// closest, where they come closer than the radii and the bodies'
+    /// own paths close the gap there too.
+    fn bracket<B: TouchBody<V>>(
+        &mut self,
+        bodies: &mut [B],
+        pair: (usize, usize),
+        [a0, b0, a1, b1]: [BeadState<V>; 4],
+        h: f64,
+    ) -> Result<Option<f64>, TouchError> {
+        if self.gap(pair, a1.position, b1.position) <= 0.0 {
+            return Ok(Some(h));
+        }
+        let d0 = b0.position - a0.position;
+        let change = (b1.position - a1.position) - d0;
+        let length = change.dot(change);
+        if length.is_nan() || length <= 0.0 {
+            return Ok(None);
+        }
+        let s = (-d0.dot(change) / length).clamp(0.0, 1.0);
+        let closest = d0 + change * s;
+        let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
+        if s <= 0.0 || s >= 1.0 || closest.dot(closest).sqrt() >= r {
+            return Ok(None);
+        }
+        let tau = s * h;
+        Ok((self.trial_gap(bodies, pair, tau)? <= 0.0).then_some(tau))
+    }
+
+    /// The pair's gap after stepping its bodies from now by `tau`.
+    fn trial_gap<B: TouchBody<V>>(
+        &mut self,
+        bodies: &mut [B],
+        pair: (usize, usize),
+        tau: f64,
+    ) -> Result<f64, SolveError> {
+        let (sa, sb) = (self.slot(pair.0), self.slot(pair.1));
+        let mut xa = self.now[sa].clone();
+        bodies[self.bodies[sa]].advance(self.time, tau, &mut xa)?;
+        self.tried[sa] = true;
+        let pa = xa[self.beads[pair.0].bead].position;
+        let pb = if sb == sa {
+            xa[self.beads[pair.1].bead].position
+        } else {
+            let mut xb = self.now[sb].clone();
+            bodies[self.bodies[sb]].advance(self.time, tau, &mut xb)?;
+            self.tried[sb] = true;
+            xb[self.beads[pair.1].bead].position
+        };
+        Ok(self.gap(pair, pa, pb))
+    }
+
+    /// Steps every body of the group from now by `h`: to a new now (kept
+    /// by each body), or to the step's end.
+    fn step_all<B: TouchBody<V>>(
+        &mut self,
+        bodies: &mut [B],
+        h: f64,
+        to_now: bool,
+    ) -> Result<(), TouchError> {
+        for slot in 0..self.bodies.len() {
+            let body = &mut bodies[self.bodies[slot]];
+            let mut states = self.now[slot].clone();
+            if h > 0.0 {
+                body.advance(self.time, h, &mut states)?;
+            }
+            self.tried[slot] = false;
+            if to_now {
+                body.keep();
+                self.now[slot] = states;
+            } else {
+                self.end[slot] = states;
+            }
+        }
+        if to_now {
+            self.time += h;
+        }
+        Ok(())
+    }
+
+    /// Strikes every pair touching now (eq. 18, pair by pair).
+    fn strike<B: TouchBody<V>>(
+        &mut self,
+        bodies: &mut [B],
+        struck: &mut Vec<StruckPair>,
+    ) -> Result<(), TouchError> {
+        // The group's velocities side by side, each body's from its offset.
+        let mut offsets = Vec::with_capacity(self.bodies.len());
+        let mut velocities = Vec::new();
+        for states in &self.now {
+            offsets.push(velocities.len());
+            velocities.extend(states.iter().map(|s| s.velocity));
+        }
+        let flat = |group: &Self, i: usize| offsets[group.slot(i)] + group.beads[i].bead;
+        let mut touches = Vec::new();
+        let mut responses = Vec::new();
+        let mut named = Vec::new();
+        for &pair in &self.pairs {
+            let (a, b) = (self.state(pair.0, false), self.state(pair.1, false));
+            let (ta, tb) = (self.beads[pair.0], self.beads[pair.1]);
+            let r = ta.radius + tb.radius;
+            if self.gap(pair, a.position, b.position) > TOUCHING * r {
+                continue;
+            }
+            let (fa, fb) = (flat(self, pair.0), flat(self, pair.1));
+            let e = ta.restitution.min(tb.restitution);
+            let touch =
+                Touch::between((fa, a.position, ta.radius), (fb, b.position, tb.radius), e)?;
+            let n = touch.normal();
+            let (sa, sb) = (self.slot(pair.0), self.slot(pair.1));
+            let push =
+                bodies[self.bodies[sb]].push(tb.bead) - bodies[self.bodies[sa]].push(ta.bead);
+            let touch = touch.resting_below(n.dot(push).abs() * self.span.dt);
+            let mut changes = Vec::new();
+            for (slot, bead, sign) in [(sa, ta.bead, -1.0), (sb, tb.bead, 1.0)] {
+                let answer = bodies[self.bodies[slot]].respond(
+                    self.time,
+                    &self.now[slot],
+                    bead,
+                    n * sign,
+                )?;
+                changes.extend(
+                    answer
+                        .into_iter()
+                        .enumerate()
+                        .map(|(k, dv)| (offsets[slot] + k, dv)),
+                );
+            }
+            responses.push(Response::new(&touch, changes));
+            touches.push(touch);
+            named.push(pair);
+        }
+        let mut strikes = Vec::new();
+        resolve_impacts(&touches, &responses, &mut velocities, &mut strikes)?;
+        for strike in strikes {
+            let (a, b) = named[strike.touch];
+            struck.push(StruckPair {
+                a,
+                b,
+                time: self.time,
+                strike,
+            });
+        }
+        for (states, &offset) in self.now.iter_mut().zip(&offsets) {
+            for (k, state) in states.iter_mut().enumerate() {
+                state.velocity = velocities[offset + k];
+            }
+        }
+        Ok(())
+    }
+
+    /// Hands each body its new end, if the group was cut; a body whose
+    /// last step was a trial is stepped to its end once more, so that what
+    /// it reports is its end's.
+    fn finish<B: TouchBody<V>>(mut self, bodies: &mut [B]) -> Result<(), TouchError> {
+        if !self.cut && !self.tried.iter().any(|&t| t) {
+            return Ok(());
+        }
+        if self.tried.iter().any(|&t| t) {
+            self.step_all(bodies, self.left(), false)?;
+        }
+        for (slot, &body) in self.bodies.iter().enumerate() {
+            bodies[body].finish(&self.end[slot]);
+        }
+        Ok(())
+    }
+}

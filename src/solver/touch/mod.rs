@@ -1,0 +1,308 @@
+//! Beads that touch within a step: where they first meet, and the step
+//! cut there, so that eq. (18)'s strikes happen at the instant of impact
+//! and no bead passes through another, however fast.
+//!
+//! The step has been taken as if nothing touched. Then:
+//!
+//! 1. **Broad phase.** Each bead with a radius sweeps a box from where it
+//!    started to where it ended, grown by its radius; sweep and prune on
+//!    the boxes' lowest `x` finds the pairs whose boxes overlap. Beads on
+//!    one wire, on different wires, free or joined: all the same.
+//! 2. The bodies (islands) that such pairs join are settled together, each
+//!    group of them apart from the others.
+//! 3. **Where they meet.** A pair whose gap `|x_b − x_a| − (r_a + r_b)` is
+//!    open where the group is now and closed at the step's end, or whose
+//!    straight paths pass closer than the radii within the step (a fast
+//!    pair that ends on the far side), is followed by re-stepping its two
+//!    bodies from now for a part `τ` of what is left: regula falsi on `τ`
+//!    brackets the gap's zero to 1e-13 of the step.
+//! 4. The group is stepped to the first such instant; every pair touching
+//!    there strikes ([`resolve_impacts`](crate::solver::resolve_impacts)),
+//!    each bead answering through its body (a
+//!    [`Response`](crate::solver::Response)); the rest of the step is taken
+//!    again from the struck state, and 3 repeats.
+//!
+//! A pair already touching that does not close (beads hanging side by
+//! side, or moving on together after a strike at `e = 0`) is left in
+//! touch.
+//!
+//! | file | what it holds |
+//! |---|---|
+//! | `mod` | [`TouchBody`], [`TouchBead`], [`settle_touches`], the broad phase ([`overlapping`]) and the groups it finds |
+//! | `group` | one group settled: where its pairs meet, the steps to and from each instant, the strikes, the bodies it takes in |
+
+use bevy::math::DVec3;
+use thiserror::Error;
+
+use super::impact::{ImpactError, Strike};
+use super::solve::SolveError;
+use super::state::BeadState;
+use crate::geometry::Coordinates;
+
+mod group;
+#[cfg(test)]
+mod tests;
+
+use group::Group;
+
+/// Two beads whose gap is at most this fraction of their radii touch.
+pub const TOUCHING: f64 = 1e-10;
+
+/// A pair in touch closes (and strikes at once) where it closes faster
+/// than this fraction of its two beads' speeds: slower is rounding.
+const CLOSING: f64 = 1e-9;
+
+/// A part of a step shorter than this fraction of the step is best taken
+/// by a method whose velocity does not come from a position difference
+/// over the part (RK4 with projection): RATTLE's loses the digits the
+/// part is short by.
+pub const SHORT_PART: f64 = 1e-3;
+
+/// How many instants of impact one group of bodies may be cut at within
+/// one step before the step is reported as not settling.
+pub const MAX_IMPACTS_PER_STEP: usize = 64;
+
+/// Something that steps a few beads together (an island): what settling
+/// touches needs of it.
+pub trait TouchBody<V: Coordinates> {
+    /// The beads' states where the step started.
+    fn start(&self) -> &[BeadState<V>];
+    /// The beads' states where the step ended as taken so far.
+    fn end(&self) -> &[BeadState<V>];
+    /// Steps `states`, at `time`, on by `h`, from what the body kept at
+    /// the last [`TouchBody::keep`] (or before the step). A part shorter
+    /// than [`SHORT_PART`] of the step wants a method whose velocity does
+    /// not come from a position difference.
+    fn advance(&mut self, time: f64, h: f64, states: &mut [BeadState<V>])
+    -> Result<(), SolveError>;
+    /// Keeps what the body carries into its next step as it is now: the
+    /// next [`TouchBody::advance`] starts from here.
+    fn keep(&mut self);
+    /// The velocity change of each of its beads per unit `impulse` on
+    /// bead `bead`, at `states` and `time`.
+    fn respond(
+        &mut self,
+        time: f64,
+        states: &[BeadState<V>],
+        bead: usize,
+        impulse: V,
+    ) -> Result<Vec<V>, SolveError>;
+    /// The acceleration the applied forces give bead `bead` (its push,
+    /// for the rest speed of a touching pair).
+    fn push(&self, bead: usize) -> V;
+    /// Takes `states` as where the step ends.
+    fn finish(&mut self, states: &[BeadState<V>]);
+}
+
+/// A bead that may touch others: its body, its index there, its radius
+/// and its restitution.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TouchBead {
+    /// The body (island) it steps in.
+    pub body: usize,
+    /// Its index among the body's beads.
+    pub bead: usize,
+    /// Its radius (positive).
+    pub radius: f64,
+    /// Its restitution: a pair strikes with the smaller of its two.
+    pub restitution: f64,
+}
+
+/// One strike within a step: the two beads (indices into the list of
+/// [`TouchBead`]s), when, and what it did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StruckPair {
+    /// The first bead.
+    pub a: usize,
+    /// The second bead.
+    pub b: usize,
+    /// When it struck.
+    pub time: f64,
+    /// The strike: impulse along the normal from `a` to `b`, closing
+    /// speed, bounce.
+    pub strike: Strike,
+}
+
+/// Why the touches of a step could not be settled, in words.
+#[derive(Clone, Copy, Debug, Error, PartialEq)]
+pub enum TouchError {
+    /// A body's step failed while the step was cut.
+    #[error("{0}")]
+    Solve(#[from] SolveError),
+    /// The strikes failed.
+    #[error("{0}")]
+    Impact(#[from] ImpactError),
+    /// A group met more instants of impact within one step than allowed.
+    #[error(
+        "beads {a} and {b} were still striking after {MAX_IMPACTS_PER_STEP} instants of impact within one step"
+    )]
+    TooManyImpacts {
+        /// The first bead of the last pair.
+        a: usize,
+        /// The second bead of the last pair.
+        b: usize,
+    },
+    /// A bead names a body or a bead of a body that is not there.
+    #[error("touching bead {bead} names a body or a bead that is not there")]
+    Missing {
+        /// The bead.
+        bead: usize,
+    },
+}
+
+/// The step `[time, time + dt]` the bodies were stepped over.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepSpan {
+    /// When it starts.
+    pub time: f64,
+    /// How long it is.
+    pub dt: f64,
+}
+
+/// Settles the touches of one step (see the module's documentation):
+/// `bodies` were stepped over `span` as if nothing touched; where beads in
+/// `beads` met within it, the step is cut and the strikes made, and each
+/// body that took part is [`finish`](TouchBody::finish)ed at its new end.
+/// Each strike is appended to `struck`.
+pub fn settle_touches<V: Coordinates, B: TouchBody<V>>(
+    span: StepSpan,
+    bodies: &mut [B],
+    beads: &[TouchBead],
+    struck: &mut Vec<StruckPair>,
+) -> Result<(), TouchError> {
+    for (i, bead) in beads.iter().enumerate() {
+        let known = bodies
+            .get(bead.body)
+            .is_some_and(|b| bead.bead < b.start().len().min(b.end().len()));
+        if !known {
+            return Err(TouchError::Missing { bead: i });
+        }
+    }
+    let boxes: Vec<(DVec3, DVec3)> = beads
+        .iter()
+        .map(|t| {
+            let body = &bodies[t.body];
+            swept(
+                t,
+                body.start()[t.bead].position,
+                body.end()[t.bead].position,
+            )
+        })
+        .collect();
+    let pairs = overlapping(&boxes);
+    let found = groups(beads, bodies.len(), &pairs);
+    let mut pool = Pool {
+        boxes,
+        group_of: vec![usize::MAX; bodies.len()],
+        free: vec![true; bodies.len()],
+        groups: found,
+    };
+    for (g, group) in pool.groups.iter().enumerate() {
+        for &body in group {
+            pool.group_of[body] = g;
+        }
+    }
+    for g in 0..pool.groups.len() {
+        let Some(first) = pool.groups[g].first() else {
+            continue;
+        };
+        if !pool.free[*first] {
+            continue; // taken in by a group settled before it
+        }
+        let group = pool.take(g);
+        Group::new(span, bodies, beads, group).settle(bodies, &mut pool, struck)?;
+    }
+    Ok(())
+}
+
+/// The box bead `t` sweeps between `from` and `to`, grown by its radius
+/// and what counts as touching.
+fn swept<V: Coordinates>(t: &TouchBead, from: V, to: V) -> (DVec3, DVec3) {
+    let (a, b) = (from.xyz(), to.xyz());
+    let grown = t.radius * (1.0 + 4.0 * TOUCHING);
+    (a.min(b) - grown, a.max(b) + grown)
+}
+
+/// The bodies not yet settled this step, in the groups the broad phase
+/// first put them in, and each bead's box from the step's start to its
+/// end.
+struct Pool {
+    boxes: Vec<(DVec3, DVec3)>,
+    group_of: Vec<usize>,
+    free: Vec<bool>,
+    groups: Vec<Vec<usize>>,
+}
+
+impl Pool {
+    /// Takes the free bodies of group `g`.
+    fn take(&mut self, g: usize) -> Vec<usize> {
+        let bodies: Vec<usize> = self.groups[g]
+            .iter()
+            .copied()
+            .filter(|&b| self.free[b])
+            .collect();
+        for &b in &bodies {
+            self.free[b] = false;
+        }
+        bodies
+    }
+}
+
+/// The pairs of boxes `(lowest, highest corner)` that overlap, by sweep
+/// and prune along `x`, each as `(i, j)` with `i < j`.
+pub fn overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
+    let mut order: Vec<usize> = (0..boxes.len()).collect();
+    order.sort_by(|&i, &j| boxes[i].0.x.total_cmp(&boxes[j].0.x));
+    let mut open: Vec<usize> = Vec::new();
+    let mut pairs = Vec::new();
+    for &i in &order {
+        let (low, high) = boxes[i];
+        open.retain(|&j| boxes[j].1.x >= low.x);
+        for &j in &open {
+            let (other_low, other_high) = boxes[j];
+            if low.cmple(other_high).all() && other_low.cmple(high).all() {
+                pairs.push((i.min(j), i.max(j)));
+            }
+        }
+        open.push(i);
+    }
+    pairs.sort_unstable();
+    pairs
+}
+
+/// The bodies the pairs join, grouped (union–find), in the order of
+/// their first pair.
+fn groups(beads: &[TouchBead], bodies: usize, pairs: &[(usize, usize)]) -> Vec<Vec<usize>> {
+    let mut parent: Vec<usize> = (0..bodies).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for &(i, j) in pairs {
+        let (a, b) = (
+            root(&mut parent, beads[i].body),
+            root(&mut parent, beads[j].body),
+        );
+        parent[a.max(b)] = a.min(b);
+    }
+    let mut found: Vec<(usize, Vec<usize>)> = Vec::new();
+    for &(i, j) in pairs {
+        let r = root(&mut parent, beads[i].body);
+        let at = match found.iter().position(|g| g.0 == r) {
+            Some(at) => at,
+            None => {
+                found.push((r, Vec::new()));
+                found.len() - 1
+            }
+        };
+        for body in [beads[i].body, beads[j].body] {
+            if !found[at].1.contains(&body) {
+                found[at].1.push(body);
+            }
+        }
+    }
+    found.into_iter().map(|(_, b)| b).collect()
+}

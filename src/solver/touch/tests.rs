@@ -1,0 +1,218 @@
+//! Settling touches on beads that coast, whose meetings are known in
+//! closed form, and the broad phase against testing every pair.
+
+use bevy::math::{DVec2, DVec3};
+
+use super::*;
+
+/// Free beads of unit mass coasting at constant velocity: exact, so
+/// that where they meet is known in closed form.
+struct Coasting {
+    start: Vec<BeadState>,
+    end: Vec<BeadState>,
+    steps: usize,
+}
+
+impl Coasting {
+    fn new(states: &[(f64, f64)], dt: f64) -> Self {
+        let start: Vec<BeadState> = states
+            .iter()
+            .map(|&(x, v)| BeadState {
+                position: DVec2::new(x, 0.0),
+                velocity: DVec2::new(v, 0.0),
+            })
+            .collect();
+        let mut end = start.clone();
+        for s in &mut end {
+            s.position += s.velocity * dt;
+        }
+        Self {
+            start,
+            end,
+            steps: 0,
+        }
+    }
+}
+
+impl TouchBody<DVec2> for Coasting {
+    fn start(&self) -> &[BeadState] {
+        &self.start
+    }
+    fn end(&self) -> &[BeadState] {
+        &self.end
+    }
+    fn advance(&mut self, _: f64, h: f64, states: &mut [BeadState]) -> Result<(), SolveError> {
+        self.steps += 1;
+        for s in states {
+            s.position += s.velocity * h;
+        }
+        Ok(())
+    }
+    fn keep(&mut self) {}
+    fn respond(
+        &mut self,
+        _: f64,
+        states: &[BeadState],
+        bead: usize,
+        impulse: DVec2,
+    ) -> Result<Vec<DVec2>, SolveError> {
+        let mut answer = vec![DVec2::ZERO; states.len()];
+        answer[bead] = impulse;
+        Ok(answer)
+    }
+    fn push(&self, _: usize) -> DVec2 {
+        DVec2::ZERO
+    }
+    fn finish(&mut self, states: &[BeadState]) {
+        self.end = states.to_vec();
+    }
+}
+
+fn beads(bodies: usize, radius: f64) -> Vec<TouchBead> {
+    (0..bodies)
+        .map(|body| TouchBead {
+            body,
+            bead: 0,
+            radius,
+            restitution: 1.0,
+        })
+        .collect()
+}
+
+/// Two equal beads that would pass right through each other within one
+/// step meet at the instant their gap closes and exchange velocities:
+/// their ends are the exact ones to 1e-12.
+#[test]
+fn a_pair_that_would_pass_through_in_one_step_meets_and_exchanges() {
+    let dt = 0.1;
+    // Gap 0.4 closing at 12 m/s: they meet at 1/30 s, and would be
+    // 0.8 past each other at the step's end.
+    let mut bodies = vec![
+        Coasting::new(&[(0.0, 6.0)], dt),
+        Coasting::new(&[(0.5, -6.0)], dt),
+    ];
+    let span = StepSpan { time: 2.0, dt };
+    let mut struck = Vec::new();
+    settle_touches(span, &mut bodies, &beads(2, 0.05), &mut struck).expect("settles");
+    assert_eq!(struck.len(), 1, "{struck:?}");
+    let meet = 0.4 / 12.0;
+    assert!(
+        (struck[0].time - (2.0 + meet)).abs() <= 1e-12,
+        "{}",
+        struck[0].time
+    );
+    let (a, b) = (bodies[0].end[0], bodies[1].end[0]);
+    let xa = 6.0 * meet - 6.0 * (dt - meet);
+    let xb = 0.5 - 6.0 * meet + 6.0 * (dt - meet);
+    assert!(
+        (a.position.x - xa).abs() <= 1e-12,
+        "{} against {xa}",
+        a.position.x
+    );
+    assert!(
+        (b.position.x - xb).abs() <= 1e-12,
+        "{} against {xb}",
+        b.position.x
+    );
+    assert!((a.velocity.x + 6.0).abs() <= 1e-12 && (b.velocity.x - 6.0).abs() <= 1e-12);
+}
+
+/// Five equal balls, four touching at rest and one coming in: exactly
+/// one leaves, at the speed that came in, and the rest stay touching
+/// at rest.
+#[test]
+fn one_ball_into_a_touching_row_sends_out_one() {
+    let (dt, r, v) = (0.01, 0.05, 3.0);
+    let mut bodies = vec![Coasting::new(&[(-0.02, v)], dt)];
+    for k in 1..5 {
+        bodies.push(Coasting::new(&[(0.1 * k as f64, 0.0)], dt));
+    }
+    let mut struck = Vec::new();
+    let span = StepSpan { time: 0.0, dt };
+    settle_touches(span, &mut bodies, &beads(5, r), &mut struck).expect("settles");
+    assert_eq!(struck.len(), 4, "one strike down the row: {struck:?}");
+    for (k, body) in bodies.iter().enumerate() {
+        let expected = if k == 4 { v } else { 0.0 };
+        assert!(
+            (body.end[0].velocity.x - expected).abs() <= 1e-12,
+            "ball {k}"
+        );
+    }
+    assert!((bodies[0].end[0].position.x - 0.0).abs() <= 1e-12);
+}
+
+/// A pair that starts touching and closing strikes at once; pairs that
+/// are apart and never meet, or touch without closing, cost no step.
+#[test]
+fn a_closing_pair_in_touch_strikes_at_once_and_pairs_that_never_meet_are_left() {
+    let dt = 0.01;
+    let mut bodies = vec![
+        Coasting::new(&[(0.0, 1.0)], dt),
+        Coasting::new(&[(0.1, 0.0)], dt),
+    ];
+    let mut struck = Vec::new();
+    let span = StepSpan { time: 0.0, dt };
+    settle_touches(span, &mut bodies, &beads(2, 0.05), &mut struck).expect("settles");
+    assert_eq!(struck.len(), 1);
+    assert_eq!(struck[0].time, 0.0);
+    assert!((bodies[1].end[0].position.x - (0.1 + dt)).abs() <= 1e-15);
+
+    let mut apart = vec![
+        Coasting::new(&[(0.0, 0.0)], dt),
+        Coasting::new(&[(0.1, 1.0)], dt),
+        Coasting::new(&[(5.0, 1.0)], dt),
+    ];
+    struck.clear();
+    settle_touches(span, &mut apart, &beads(3, 0.05), &mut struck).expect("settles");
+    assert!(struck.is_empty());
+    assert!(apart.iter().all(|b| b.steps == 0), "no pair needed a step");
+}
+
+#[test]
+fn a_bead_naming_a_missing_body_is_refused_in_words() {
+    let mut bodies = vec![Coasting::new(&[(0.0, 0.0)], 0.01)];
+    let err = settle_touches(
+        StepSpan {
+            time: 0.0,
+            dt: 0.01,
+        },
+        &mut bodies,
+        &beads(2, 0.1),
+        &mut Vec::new(),
+    )
+    .unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "touching bead 1 names a body or a bead that is not there"
+    );
+}
+
+proptest::proptest! {
+    /// Sweep and prune finds exactly the overlapping pairs that
+    /// testing every pair finds.
+    #[test]
+    fn sweep_and_prune_finds_every_overlapping_pair(
+        boxes in proptest::collection::vec(
+            ((-5.0..5.0f64, -5.0..5.0f64, -5.0..5.0f64), (0.0..2.0f64, 0.0..2.0f64, 0.0..2.0f64)),
+            0..40,
+        ),
+    ) {
+        let boxes: Vec<(DVec3, DVec3)> = boxes
+            .into_iter()
+            .map(|((x, y, z), (w, h, d))| {
+                let low = DVec3::new(x, y, z);
+                (low, low + DVec3::new(w, h, d))
+            })
+            .collect();
+        let mut every = Vec::new();
+        for i in 0..boxes.len() {
+            for j in i + 1..boxes.len() {
+                let (a, b) = (boxes[i], boxes[j]);
+                if a.0.cmple(b.1).all() && b.0.cmple(a.1).all() {
+                    every.push((i, j));
+                }
+            }
+        }
+        proptest::prop_assert_eq!(overlapping(&boxes), every);
+    }
+}
