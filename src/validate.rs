@@ -76,6 +76,22 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64, ParamError
     }
 }
 
+/// `e`, if it is a restitution: finite, between 0 (nothing comes back)
+/// and 1 (no energy lost).
+pub(crate) fn restitution(e: f64) -> Result<f64, ParamError> {
+    let e = finite("restitution", e)?;
+    if (0.0..=1.0).contains(&e) {
+        Ok(e)
+    } else {
+        Err(ParamError::OutOfRange {
+            name: "restitution",
+            min: 0.0,
+            max: 1.0,
+            value: e,
+        })
+    }
+}
+
 /// `value`, if it is zero or more and finite.
 pub(crate) fn non_negative(name: &'static str, value: f64) -> Result<f64, ParamError> {
     if value.is_finite() && value >= 0.0 {

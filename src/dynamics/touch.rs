@@ -3,7 +3,7 @@
 
 use bevy::prelude::*;
 
-use crate::validate::{ParamError, non_negative};
+use crate::validate::{ParamError, non_negative, restitution};
 
 /// A bead's radius in metres: beads with radii touch when their centres
 /// are the sum of their radii apart, and may not come closer. The centre
@@ -45,20 +45,6 @@ impl Restitution {
     /// The coefficient.
     pub fn get(&self) -> f64 {
         self.0
-    }
-}
-
-/// `e`, if it is a restitution: between 0 and 1.
-fn restitution(e: f64) -> Result<f64, ParamError> {
-    if (0.0..=1.0).contains(&e) {
-        Ok(e)
-    } else {
-        Err(ParamError::OutOfRange {
-            name: "restitution",
-            min: 0.0,
-            max: 1.0,
-            value: e,
-        })
     }
 }
 

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::validate::{ParamError, finite, non_negative};
+use crate::validate::{ParamError, non_negative, restitution};
 
 /// Which way a wire may push its bead (scene field `side`).
 ///
@@ -126,15 +126,7 @@ impl Surface {
     /// Checks every number: restitution in `[0, 1]`, friction as
     /// [`Friction::new`], damping not negative.
     pub fn validate(&self) -> Result<(), ParamError> {
-        let e = finite("restitution", self.restitution)?;
-        if !(0.0..=1.0).contains(&e) {
-            return Err(ParamError::OutOfRange {
-                name: "restitution",
-                min: 0.0,
-                max: 1.0,
-                value: e,
-            });
-        }
+        restitution(self.restitution)?;
         self.friction.validate()?;
         non_negative("damping along the wire", self.damping).map(drop)
     }

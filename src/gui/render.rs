@@ -262,22 +262,31 @@ pub fn wire_bounds(shape: &WireShape, pose: &Pose) -> (DVec2, DVec2) {
 }
 
 /// The longest total length of `rods` joined into one chain (or tree):
-/// how far a bead at one end may swing from the other.
+/// how far a bead at one end may swing from the other. The rods are
+/// grouped as the islands group links ([`islands`](crate::solver::islands)).
 fn longest_chain<'a>(rods: impl Iterator<Item = &'a Rod>) -> f64 {
-    let mut chains: Vec<(Vec<Entity>, f64)> = Vec::new();
-    for rod in rods {
-        let touching: Vec<usize> = (0..chains.len())
-            .filter(|&c| rod.beads().iter().any(|b| chains[c].0.contains(b)))
-            .collect();
-        let mut joined = (rod.beads().to_vec(), rod.length());
-        for &c in touching.iter().rev() {
-            let (beads, length) = chains.swap_remove(c);
-            joined.0.extend(beads);
-            joined.1 += length;
+    let mut index: HashMap<Entity, usize> = HashMap::new();
+    let rods: Vec<(f64, [usize; 2])> = rods
+        .map(|rod| {
+            let ends = rod.beads().map(|bead| {
+                let next = index.len();
+                *index.entry(bead).or_insert(next)
+            });
+            (rod.length(), ends)
+        })
+        .collect();
+    let groups = crate::solver::islands(index.len(), rods.iter().map(|(_, ends)| &ends[..]));
+    let mut group_of = vec![0; index.len()];
+    for (g, beads) in groups.iter().enumerate() {
+        for &bead in beads {
+            group_of[bead] = g;
         }
-        chains.push(joined);
     }
-    chains.iter().map(|c| c.1).fold(0.0, f64::max)
+    let mut lengths = vec![0.0; groups.len()];
+    for (length, ends) in &rods {
+        lengths[group_of[ends[0]]] += length;
+    }
+    lengths.into_iter().fold(0.0, f64::max)
 }
 
 /// Frames every wire (and every bead's start) in the part of the window

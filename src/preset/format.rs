@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::error::PresetError;
 use crate::dynamics::{BeadParams, BeadRadius, Contacts, SimParams};
 use crate::geometry::{Coordinates, Friction, Side, Surface, WireMotion, WireShape};
+use crate::solver::{TOUCHING, overlapping};
 use crate::validate::{ParamError, finite, finite_vector, non_negative, positive};
 
 /// A bead of a scene file: its name (optional) and its parameters.
@@ -392,23 +393,27 @@ pub(super) fn check_beads_and_links<V: Coordinates>(
 }
 
 /// The first two beads with radii that overlap where they start (by more
-/// than rounding), and by how much.
+/// than rounding), and by how much: the pairs the broad phase finds among
+/// the balls they would fill, measured.
 fn first_overlap<V: Coordinates>(beads: &[&BeadPreset<V>]) -> Option<(usize, usize, f64)> {
     let round: Vec<usize> = (0..beads.len())
         .filter(|&i| beads[i].radius > 0.0)
         .collect();
-    for (k, &i) in round.iter().enumerate() {
-        for &j in &round[k + 1..] {
-            let (a, b) = (beads[i], beads[j]);
-            let d = b.initial_position - a.initial_position;
-            let reach = a.radius + b.radius;
-            let by = reach - d.dot(d).sqrt();
-            if by > crate::solver::TOUCHING * reach {
-                return Some((i, j, by));
-            }
-        }
-    }
-    None
+    let boxes: Vec<_> = round
+        .iter()
+        .map(|&i| {
+            let (at, r) = (beads[i].initial_position.xyz(), beads[i].radius);
+            (at - r, at + r)
+        })
+        .collect();
+    overlapping(&boxes).into_iter().find_map(|(k, l)| {
+        let (i, j) = (round[k], round[l]);
+        let (a, b) = (beads[i], beads[j]);
+        let d = b.initial_position - a.initial_position;
+        let reach = a.radius + b.radius;
+        let by = reach - d.dot(d).sqrt();
+        (by > TOUCHING * reach).then_some((i, j, by))
+    })
 }
 
 /// The constraints, then the springs, with the beads they name as indices

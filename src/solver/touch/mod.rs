@@ -34,6 +34,7 @@
 use bevy::math::DVec3;
 use thiserror::Error;
 
+use super::coupled::islands;
 use super::impact::{ImpactError, Strike};
 use super::solve::SolveError;
 use super::state::BeadState;
@@ -270,39 +271,20 @@ pub fn overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
     pairs
 }
 
-/// The bodies the pairs join, grouped (union–find), in the order of
-/// their first pair.
+/// The bodies the pairs join, grouped ([`islands`]'s grouping, the pairs
+/// as links), each group that a pair names, in the order of its first
+/// body.
 fn groups(beads: &[TouchBead], bodies: usize, pairs: &[(usize, usize)]) -> Vec<Vec<usize>> {
-    let mut parent: Vec<usize> = (0..bodies).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
+    let links: Vec<[usize; 2]> = pairs
+        .iter()
+        .map(|&(i, j)| [beads[i].body, beads[j].body])
+        .collect();
+    let mut named = vec![false; bodies];
+    for &body in links.iter().flatten() {
+        named[body] = true;
     }
-    for &(i, j) in pairs {
-        let (a, b) = (
-            root(&mut parent, beads[i].body),
-            root(&mut parent, beads[j].body),
-        );
-        parent[a.max(b)] = a.min(b);
-    }
-    let mut found: Vec<(usize, Vec<usize>)> = Vec::new();
-    for &(i, j) in pairs {
-        let r = root(&mut parent, beads[i].body);
-        let at = match found.iter().position(|g| g.0 == r) {
-            Some(at) => at,
-            None => {
-                found.push((r, Vec::new()));
-                found.len() - 1
-            }
-        };
-        for body in [beads[i].body, beads[j].body] {
-            if !found[at].1.contains(&body) {
-                found[at].1.push(body);
-            }
-        }
-    }
-    found.into_iter().map(|(_, b)| b).collect()
+    islands(bodies, links.iter().map(|l| l.as_slice()))
+        .into_iter()
+        .filter(|group| named[group[0]])
+        .collect()
 }
