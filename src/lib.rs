@@ -106,7 +106,8 @@ pub use geometry::{
     Friction, ImplicitCurve, Oscillate, Side, Spin, Surface, WireKind, WireMotion, WireShape,
 };
 pub use plugin::{
-    IslandReport, Islands, ParallelStep, Restart, SimClock, WireBeadPlugin, WireBeadSystems,
+    IslandReport, Islands, ParallelStep, PressedPair, Restart, SimClock, WireBeadPlugin,
+    WireBeadSystems,
 };
 pub use preset::{
     ActivePreset, LoadPreset, SceneFile, SceneLink, ScenePreset, ScenePresetPlugin, SpaceScene,

@@ -34,7 +34,7 @@ use bevy::prelude::*;
 
 pub use clock::{ClockPlugin, SimClock};
 pub use forces::SpringAnchorPlugin;
-pub use islands::{IslandPlugin, IslandReport, Islands};
+pub use islands::{IslandPlugin, IslandReport, Islands, PressedPair};
 pub use parallel::{ParallelStep, StepSplit, compute_on_all_cores, use_single_threaded_executors};
 pub use params::ParamsPlugin;
 pub use restart::{Restart, RestartPlugin};

@@ -44,8 +44,8 @@ mod wire_normal;
 
 pub use contact::{Contact, ContactEvent, SurfaceStep, free_step, step_surface};
 pub use coupled::{
-    Constraint, Island, IslandError, IslandMark, IslandRow, IslandWork, RowKind, RowReport,
-    SpringLink, islands,
+    Constraint, Island, IslandError, IslandMark, IslandRow, IslandWork, OPENING, RowKind,
+    RowReport, SpringLink, islands,
 };
 pub use euler::{explicit_euler, semi_implicit_euler};
 pub use impact::{
@@ -63,7 +63,7 @@ pub use state::{Advance, BeadState, LinearForce};
 pub use step::{StepOutput, constraint_state, constraint_state_on, step, step_on};
 pub use touch::{
     MAX_IMPACTS_PER_STEP, SHORT_PART, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody,
-    TouchError, overlapping, settle_touches,
+    TouchError, may_touch, overlapping, settle_touches,
 };
 
 /// What the solver's unit tests share.

@@ -6,10 +6,10 @@ use std::collections::HashMap;
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
-use super::{CachedIsland, InIsland, IslandReport, Islands, LinkRows, WireRow};
+use super::{CachedIsland, ContactRow, InIsland, IslandReport, Islands, LinkRows, WireRow, touch};
 use crate::dynamics::{
-    Bead, BeadMotion, BeadRadius, Dimension, DivergenceReason, Joint, OnWire, Pin, Rod, SpaceBead,
-    Spring, WirePose, WireRows,
+    Bead, BeadMotion, BeadRadius, Dimension, DivergenceReason, Joint, OnWire, Pin, Rod, SimParams,
+    SpaceBead, Spring, WirePose, WireRows,
 };
 use crate::plugin::clock::SimClock;
 use crate::plugin::report::Divergences;
@@ -34,7 +34,7 @@ type BuildBead<V> = (
     BeadMotion<V>,
     Option<&'static OnWire>,
     Has<InIsland>,
-    Has<BeadRadius>,
+    Option<&'static BeadRadius>,
 );
 
 /// A link while the islands are built: its rows and the beads it names.
@@ -43,6 +43,8 @@ struct Pending<V: Dimension> {
     rows: Vec<IslandRow<V>>,
     pin: bool,
     anchored: bool,
+    /// A contact between two beads near each other (see `touch`).
+    contact: bool,
 }
 
 /// The rows that hold a bead at `at`, one along each axis.
@@ -70,6 +72,7 @@ pub(super) fn prepare_islands<V: Dimension>(
     mut commands: Commands,
     mut divergences: Divergences,
     clock: Res<SimClock>,
+    params: Res<SimParams>,
 ) {
     islands.dirty = false;
     islands.cached.clear();
@@ -111,6 +114,7 @@ pub(super) fn prepare_islands<V: Dimension>(
                     }],
                     pin: false,
                     anchored: false,
+                    contact: false,
                 },
                 beads.to_vec(),
             )),
@@ -137,6 +141,7 @@ pub(super) fn prepare_islands<V: Dimension>(
                 rows: pin_rows(at),
                 pin: true,
                 anchored: pin.anchor().is_some(),
+                contact: false,
             },
             vec![pin.bead()],
         ));
@@ -156,6 +161,7 @@ pub(super) fn prepare_islands<V: Dimension>(
                     }],
                     pin: false,
                     anchored: false,
+                    contact: false,
                 },
                 joint.beads().to_vec(),
             )),
@@ -169,6 +175,30 @@ pub(super) fn prepare_islands<V: Dimension>(
             Some(&b) => missing("spring", entity, b),
             None => springs.push((entity, *spring)),
         }
+    }
+    // Beads with radii that may meet soon, joined by contact rows.
+    let with_radius: Vec<(Entity, BeadState<V>, f64)> = beads
+        .iter()
+        .filter_map(|(entity, bead, _, _, radius)| {
+            let r = radius?.get();
+            (r > 0.0).then(|| (entity, bead.state(), r))
+        })
+        .collect();
+    for (i, j) in touch::near(&with_radius, params.timestep) {
+        let ((a, _, ra), (b, _, rb)) = (with_radius[i], with_radius[j]);
+        named.push((
+            Pending {
+                entity: a,
+                rows: vec![IslandRow {
+                    kind: RowKind::Rod { length: ra + rb },
+                    beads: vec![0, 1],
+                }],
+                pin: false,
+                anchored: false,
+                contact: true,
+            },
+            vec![a, b],
+        ));
     }
     // The beads in islands: every bead a link names, every bead on no
     // wire, every bead on a wire without a step of its own (a curve in
@@ -192,9 +222,9 @@ pub(super) fn prepare_islands<V: Dimension>(
             join(b, &mut members);
         }
     }
-    for (entity, _, on_wire, _, touches) in &beads {
+    for (entity, _, on_wire, _, radius) in &beads {
         let lone = on_wire.is_some_and(|on| wires.get(on.0).map_or(true, |(w, _)| w.lone()));
-        if !lone || touches {
+        if !lone || radius.is_some() {
             join(entity, &mut members);
         }
     }
@@ -276,16 +306,26 @@ pub(super) fn prepare_islands<V: Dimension>(
         }
         let mut link_rows = Vec::new();
         let mut anchored = Vec::new();
+        let mut contacts = Vec::new();
         for (pending, local) in links {
             let start = rows.len();
             if pending.anchored {
                 anchored.push((start, pending.entity));
             }
-            link_rows.push(if pending.pin {
-                LinkRows::Pin(pending.entity, start)
+            if let (true, Some(RowKind::Rod { length })) =
+                (pending.contact, pending.rows.first().map(|r| &r.kind))
+            {
+                contacts.push(ContactRow {
+                    row: start,
+                    a: local[0].min(local[1]),
+                    b: local[0].max(local[1]),
+                    reach: *length,
+                });
+            } else if pending.pin {
+                link_rows.push(LinkRows::Pin(pending.entity, start));
             } else {
-                LinkRows::One(pending.entity, start)
-            });
+                link_rows.push(LinkRows::One(pending.entity, start));
+            }
             for mut row in pending.rows {
                 row.beads = row.beads.iter().map(|&i| local[i]).collect();
                 rows.push(row);
@@ -315,7 +355,11 @@ pub(super) fn prepare_islands<V: Dimension>(
             None => Island::new(&masses, rows, springs)
                 .map_err(|e| DivergenceReason::InvalidConstraint(e.to_string())),
         };
+        contacts.sort_unstable_by_key(|c| (c.a, c.b));
         let built = built.map(|mut island| {
+            for contact in &contacts {
+                island.set_contact(contact.row);
+            }
             for (row, _, surface, partner) in sides {
                 island.set_side(row, surface.side, surface.restitution);
                 if surface.resists() {
@@ -352,6 +396,7 @@ pub(super) fn prepare_islands<V: Dimension>(
                     links: link_rows,
                     wire_rows,
                     anchored,
+                    contacts,
                     outcome: None,
                     touching: Vec::new(),
                     start: Vec::new(),

@@ -106,6 +106,32 @@ pub struct IslandReport {
     /// How many substeps the last step took (more than one where a Newton
     /// solve had no root at the full step).
     pub substeps: u32,
+    /// The pairs of its beads pressed together at the end of the last
+    /// step, each with the force they press with.
+    pub pressed: Vec<PressedPair>,
+}
+
+/// Two beads that touch, pressed together at the end of a step: the
+/// force of their contact row, `λ` (newtons, along the line between their
+/// centres; zero or more).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PressedPair {
+    /// One bead.
+    pub a: Entity,
+    /// The other.
+    pub b: Entity,
+    /// The force each presses on the other with.
+    pub force: f64,
+}
+
+/// A contact row of an island: the row, its two beads (`a < b`, their
+/// indices in the island) and the sum of their radii.
+#[derive(Clone, Copy, Debug)]
+struct ContactRow {
+    row: usize,
+    a: usize,
+    b: usize,
+    reach: f64,
 }
 
 /// Which link a range of rows belongs to, for its diagnostics.
@@ -142,6 +168,8 @@ struct CachedIsland<V: Dimension> {
     wire_rows: Vec<WireRow>,
     /// The first row of each pin fixed to another entity, and the pin.
     anchored: Vec<(usize, Entity)>,
+    /// The contact rows between its beads that may touch, by `(a, b)`.
+    contacts: Vec<ContactRow>,
     /// What this step did: not stepped (a bead of it has stopped), or the
     /// step's result.
     outcome: Option<Result<(), SolveError>>,

@@ -4,7 +4,7 @@
 
 use bevy::prelude::*;
 
-use super::{CachedIsland, InIsland, Islands, LinkRows, touch};
+use super::{CachedIsland, InIsland, Islands, LinkRows, PressedPair, touch};
 use crate::dynamics::{
     BeadDiagnostics, BeadForce, BeadMotion, BeadPosition, BeadRadius, BeadVelocity, BeadsStruck,
     ConstraintDiagnostics, Contacts, Dimension, Diverged, DivergenceReason, Pin, Restitution,
@@ -147,6 +147,9 @@ pub(super) fn step_islands<V: Dimension>(
         &mut struck,
         &mut divergences,
     );
+    if touch::regroup(&islands.cached, settings.dt) {
+        islands.mark_dirty();
+    }
     for cached in &mut islands.cached {
         match cached.outcome {
             None => continue,
@@ -208,6 +211,16 @@ pub(super) fn step_islands<V: Dimension>(
                 *d = report;
             }
         }
+        cached.report.pressed.clear();
+        for contact in &cached.contacts {
+            if cached.work.holds(contact.row) {
+                cached.report.pressed.push(PressedPair {
+                    a: cached.report.beads[contact.a],
+                    b: cached.report.beads[contact.b],
+                    force: rows[contact.row].lambda,
+                });
+            }
+        }
         cached.report.energy = cached.island.energy(&cached.states, gravity);
         cached.report.redundant = cached.work.redundant();
         cached.report.substeps = cached.work.substeps();
@@ -234,6 +247,7 @@ fn step_island<V: Dimension>(cached: &mut CachedIsland<V>, time: f64, settings: 
         return;
     }
     if !cached.touching.is_empty() {
+        cached.island.begin(time, &cached.states, &mut cached.work);
         cached.start.clone_from(&cached.states);
         cached.mark = cached.work.mark();
     }

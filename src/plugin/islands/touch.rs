@@ -87,6 +87,82 @@ impl<V: Dimension> TouchBody<V> for IslandBody<'_, V> {
         self.cached.states.clear();
         self.cached.states.extend_from_slice(states);
     }
+
+    fn contact(&self, a: usize, b: usize) -> Option<bool> {
+        let row = self.cached.contact_row(a, b)?;
+        Some(self.cached.mark.holds(row))
+    }
+
+    fn hold(&mut self, a: usize, b: usize, held: bool) {
+        if let Some(row) = self.cached.contact_row(a, b) {
+            self.cached.mark.hold(row, held);
+        }
+    }
+}
+
+impl<V: Dimension> CachedIsland<V> {
+    /// The contact row between beads `a` and `b` of the island, if it has
+    /// one.
+    fn contact_row(&self, a: usize, b: usize) -> Option<usize> {
+        let key = (a.min(b), a.max(b));
+        self.contacts
+            .binary_search_by_key(&key, |c| (c.a, c.b))
+            .ok()
+            .map(|k| self.contacts[k].row)
+    }
+}
+
+/// How many steps ahead the islands are built for: beads with radii that
+/// may meet within this many steps are joined by contact rows.
+const NEAR_STEPS: f64 = 4.0;
+
+/// How much of its radius more each bead's box is grown by when the
+/// islands are built, so that a pair joined stays joined a while.
+const NEAR_MARGIN: f64 = 0.25;
+
+/// The pairs of beads `(entity, state, radius)` that may meet within
+/// [`NEAR_STEPS`] steps of `dt`, with [`NEAR_MARGIN`] to spare: the island
+/// builder joins them by contact rows.
+pub(super) fn near<V: Dimension>(
+    beads: &[(Entity, BeadState<V>, f64)],
+    dt: f64,
+) -> Vec<(usize, usize)> {
+    let states: Vec<(BeadState<V>, f64)> = beads.iter().map(|&(_, s, r)| (s, r)).collect();
+    solver::may_touch(&states, NEAR_STEPS * dt, NEAR_MARGIN)
+}
+
+/// Whether the islands should be built again before the next step: two
+/// beads that may meet within it are not joined by a contact row (in
+/// different islands, or not yet near at the last build), or two joined
+/// by one have gone far apart (their islands may part).
+pub(super) fn regroup<V: Dimension>(cached: &[CachedIsland<V>], dt: f64) -> bool {
+    let mut beads = Vec::new();
+    let mut place = Vec::new();
+    for (k, island) in cached.iter().enumerate() {
+        if island.outcome != Some(Ok(())) {
+            continue;
+        }
+        for &(bead, radius, _) in &island.touching {
+            beads.push((island.states[bead], radius));
+            place.push((k, bead));
+        }
+        for contact in &island.contacts {
+            let (a, b) = (island.states.get(contact.a), island.states.get(contact.b));
+            let (Some(a), Some(b)) = (a, b) else { continue };
+            let reach = contact.reach;
+            let d = a.position - b.position;
+            let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
+            if d.dot(d).sqrt() - reach > 4.0 * reach + 4.0 * NEAR_STEPS * dt * speeds {
+                return true;
+            }
+        }
+    }
+    solver::may_touch(&beads, dt, 0.0)
+        .into_iter()
+        .any(|(i, j)| {
+            let ((ki, a), (kj, b)) = (place[i], place[j]);
+            ki != kj || cached[ki].contact_row(a, b).is_none()
+        })
 }
 
 /// Settles the touches of the step that started at `time` (see

@@ -22,4 +22,4 @@ mod tests;
 
 pub use constraint::{Constraint, RowKind, SpringLink};
 pub use group::islands;
-pub use island::{Island, IslandError, IslandMark, IslandRow, IslandWork, RowReport};
+pub use island::{Island, IslandError, IslandMark, IslandRow, IslandWork, OPENING, RowReport};

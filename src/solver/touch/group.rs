@@ -10,6 +10,7 @@ use super::{
 };
 use crate::geometry::Coordinates;
 use crate::solver::contact::locate;
+use crate::solver::coupled::OPENING;
 use crate::solver::impact::{Response, Touch, resolve_impacts};
 use crate::solver::solve::SolveError;
 use crate::solver::state::BeadState;
@@ -36,6 +37,8 @@ pub(super) struct Group<'a, V: Coordinates> {
     tried: Vec<bool>,
     /// Whether the group was cut at all.
     cut: bool,
+    /// The pairs in touch pressed into each other, held this step.
+    pressed: Vec<(usize, usize)>,
 }
 
 impl<'a, V: Coordinates> Group<'a, V> {
@@ -62,6 +65,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
             end,
             tried,
             cut: false,
+            pressed: Vec::new(),
         };
         group.pairs = group.find_pairs(&[]).0;
         group
@@ -201,13 +205,19 @@ impl<'a, V: Coordinates> Group<'a, V> {
     }
 
     /// The first instant (from now) a pair that is apart meets, and the
-    /// pair; none if no pair meets before the step's end.
+    /// pair; none if no pair meets before the step's end. Every pair that
+    /// may meet is followed at once: regula falsi on the least of their
+    /// gaps, each trial stepping their bodies once, so that the cost of a
+    /// cut does not grow with the number of pairs.
     fn first_meeting<B: TouchBody<V>>(
         &mut self,
         bodies: &mut [B],
     ) -> Result<Option<(f64, (usize, usize))>, TouchError> {
         let h = self.left();
-        let mut first: Option<(f64, (usize, usize))> = None;
+        let mut pressed = Vec::new();
+        // The pairs that may meet, each with its gap now and the part of
+        // the step by which it may have met.
+        let mut candidates = Vec::new();
         for k in 0..self.pairs.len() {
             let pair = self.pairs[k];
             let (a0, b0) = (self.state(pair.0, false), self.state(pair.1, false));
@@ -220,86 +230,133 @@ impl<'a, V: Coordinates> Group<'a, V> {
                 let u = n.dot(b0.velocity - a0.velocity) / n.dot(n).sqrt();
                 let speeds =
                     a0.velocity.dot(a0.velocity).sqrt() + b0.velocity.dot(b0.velocity).sqrt();
-                if -u > CLOSING * speeds {
+                // Closing by rounding, or too slowly to close by what
+                // counts as touching within the step, is not closing.
+                if -u > CLOSING * speeds && -u * self.span.dt > TOUCHING * r {
                     return Ok(Some((0.0, pair)));
+                }
+                if self.gap(pair, a1.position, b1.position) < -TOUCHING * r {
+                    pressed.push(pair);
                 }
                 continue;
             }
             if h <= 0.0 {
                 continue;
             }
-            let within = first.map_or(h, |(tau, _)| tau);
-            let Some(bracket) = self.bracket(bodies, pair, [a0, b0, a1, b1], h)? else {
-                continue;
-            };
-            if bracket > within {
-                // Meets, but after a pair already found: still look for
-                // the instant if it may come first.
-                let trial = self.trial_gap(bodies, pair, within)?;
-                if trial > 0.0 {
-                    continue;
-                }
-            }
-            let hi = bracket.min(within);
-            let tau = locate(hi, g0, |tau| self.trial_gap(bodies, pair, tau))?;
-            if first.is_none_or(|(t, _)| tau < t) {
-                first = Some((tau, pair));
+            if let Some(by) = self.may_meet(pair, [a0, b0, a1, b1], h) {
+                candidates.push((pair, g0, by));
             }
         }
-        Ok(first)
+        let first = self.locate_first(bodies, &mut candidates, h)?;
+        // Pairs in touch that the rest of the step presses into each
+        // other: held from now where a contact row can, and the step taken
+        // again. Each pair once a step, so that the cuts end.
+        let mut held = None;
+        for pair in pressed {
+            let slot = self.slot(pair.0);
+            let (ba, bb) = (self.beads[pair.0].bead, self.beads[pair.1].bead);
+            let body = &mut bodies[self.bodies[slot]];
+            if slot == self.slot(pair.1)
+                && body.contact(ba, bb) == Some(false)
+                && !self.pressed.contains(&pair)
+            {
+                body.hold(ba, bb, true);
+                self.pressed.push(pair);
+                held = held.or(Some((0.0, pair)));
+            }
+        }
+        Ok(held.or(first))
     }
 
-    /// A part `τ ≤ h` at whose end the pair's gap is closed, if it meets:
-    /// `h` where it ends closed, else the instant its straight paths come
-    /// closest, where they come closer than the radii and the bodies'
-    /// own paths close the gap there too.
-    fn bracket<B: TouchBody<V>>(
-        &mut self,
-        bodies: &mut [B],
+    /// The part `τ ≤ h` by which a pair apart now may have met: `h` where
+    /// its gap ends closed, else where its straight paths come closest,
+    /// if they come closer than the radii within the step (a pair too
+    /// fast for a step); none if it does not meet.
+    fn may_meet(
+        &self,
         pair: (usize, usize),
         [a0, b0, a1, b1]: [BeadState<V>; 4],
         h: f64,
-    ) -> Result<Option<f64>, TouchError> {
+    ) -> Option<f64> {
         if self.gap(pair, a1.position, b1.position) <= 0.0 {
-            return Ok(Some(h));
+            return Some(h);
         }
         let d0 = b0.position - a0.position;
         let change = (b1.position - a1.position) - d0;
         let length = change.dot(change);
         if length.is_nan() || length <= 0.0 {
-            return Ok(None);
+            return None;
         }
         let s = (-d0.dot(change) / length).clamp(0.0, 1.0);
         let closest = d0 + change * s;
         let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
-        if s <= 0.0 || s >= 1.0 || closest.dot(closest).sqrt() >= r {
-            return Ok(None);
-        }
-        let tau = s * h;
-        Ok((self.trial_gap(bodies, pair, tau)? <= 0.0).then_some(tau))
+        (s > 0.0 && s < 1.0 && closest.dot(closest).sqrt() < r).then_some(s * h)
     }
 
-    /// The pair's gap after stepping its bodies from now by `tau`.
-    fn trial_gap<B: TouchBody<V>>(
+    /// Where the first of `candidates` (pair, gap now, part by which it
+    /// may have met) meets: the earliest part at whose end one has met
+    /// brackets it, and regula falsi on the least gap locates it.
+    fn locate_first<B: TouchBody<V>>(
         &mut self,
         bodies: &mut [B],
-        pair: (usize, usize),
-        tau: f64,
-    ) -> Result<f64, SolveError> {
-        let (sa, sb) = (self.slot(pair.0), self.slot(pair.1));
-        let mut xa = self.now[sa].clone();
-        bodies[self.bodies[sa]].advance(self.time, tau, &mut xa)?;
-        self.tried[sa] = true;
-        let pa = xa[self.beads[pair.0].bead].position;
-        let pb = if sb == sa {
-            xa[self.beads[pair.1].bead].position
-        } else {
-            let mut xb = self.now[sb].clone();
-            bodies[self.bodies[sb]].advance(self.time, tau, &mut xb)?;
-            self.tried[sb] = true;
-            xb[self.beads[pair.1].bead].position
+        candidates: &mut [((usize, usize), f64, f64)],
+        h: f64,
+    ) -> Result<Option<(f64, (usize, usize))>, TouchError> {
+        candidates.sort_by(|x, y| x.2.total_cmp(&y.2));
+        let mut bracket = None;
+        let mut tried = f64::NAN;
+        for k in 0..candidates.len() {
+            let by = candidates[k].2;
+            if by == tried {
+                continue;
+            }
+            tried = by;
+            if self.least_gap(bodies, candidates, by)?.0 <= 0.0 {
+                bracket = Some(by);
+                break;
+            }
+            if by >= h {
+                break;
+            }
+        }
+        let Some(hi) = bracket else {
+            return Ok(None);
         };
-        Ok(self.gap(pair, pa, pb))
+        let g0 = candidates.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+        let tau = locate(hi, g0, |tau| Ok(self.least_gap(bodies, candidates, tau)?.0))?;
+        let (_, pair) = self.least_gap(bodies, candidates, tau)?;
+        Ok(Some((tau, pair)))
+    }
+
+    /// The least gap of `candidates` after stepping their bodies from now
+    /// by `tau` (each once), and its pair.
+    fn least_gap<B: TouchBody<V>>(
+        &mut self,
+        bodies: &mut [B],
+        candidates: &[((usize, usize), f64, f64)],
+        tau: f64,
+    ) -> Result<(f64, (usize, usize)), SolveError> {
+        let mut stepped: Vec<Option<Vec<BeadState<V>>>> = vec![None; self.bodies.len()];
+        let mut least = (f64::INFINITY, (0, 0));
+        for &(pair, ..) in candidates {
+            let mut position = |i: usize| -> Result<V, SolveError> {
+                let slot = self.slot(i);
+                if stepped[slot].is_none() {
+                    let mut states = self.now[slot].clone();
+                    bodies[self.bodies[slot]].advance(self.time, tau, &mut states)?;
+                    self.tried[slot] = true;
+                    stepped[slot] = Some(states);
+                }
+                let states = stepped[slot].as_deref().unwrap_or_default();
+                Ok(states[self.beads[i].bead].position)
+            };
+            let (pa, pb) = (position(pair.0)?, position(pair.1)?);
+            let gap = self.gap(pair, pa, pb);
+            if gap < least.0 {
+                least = (gap, pair);
+            }
+        }
+        Ok(least)
     }
 
     /// Steps every body of the group from now by `h`: to a new now (kept
@@ -384,6 +441,31 @@ impl<'a, V: Coordinates> Group<'a, V> {
         }
         let mut strikes = Vec::new();
         resolve_impacts(&touches, &responses, &mut velocities, &mut strikes)?;
+        // A pair a strike left in touch is held where a row joins it; a
+        // bounce, or a pair that parts, is set aside.
+        for (k, &pair) in named.iter().enumerate() {
+            let (sa, sb) = (self.slot(pair.0), self.slot(pair.1));
+            if sa != sb {
+                continue;
+            }
+            let (ba, bb) = (self.beads[pair.0].bead, self.beads[pair.1].bead);
+            let body = &mut bodies[self.bodies[sa]];
+            if body.contact(ba, bb).is_none() {
+                continue;
+            }
+            let (va, vb) = (
+                velocities[flat(self, pair.0)],
+                velocities[flat(self, pair.1)],
+            );
+            let n = touches[k].normal();
+            let reach = self.beads[pair.0].radius + self.beads[pair.1].radius;
+            let speeds = va.dot(va).sqrt() + vb.dot(vb).sqrt();
+            if n.dot(vb - va) > OPENING * (reach + speeds) {
+                body.hold(ba, bb, false);
+            } else if let Some(last) = strikes.iter().rev().find(|s| s.touch == k) {
+                body.hold(ba, bb, !last.bounced);
+            }
+        }
         for strike in strikes {
             let (a, b) = named[strike.touch];
             struck.push(StruckPair {

@@ -24,7 +24,12 @@
 //!
 //! A pair already touching that does not close (beads hanging side by
 //! side, or moving on together after a strike at `e = 0`) is left in
-//! touch.
+//! touch. Where a body joins the pair by a contact row (an island's
+//! [`set_contact`](crate::solver::Island::set_contact)), a strike that
+//! leaves the pair in touch holds the row, so that the pair pressed
+//! together for the rest of the step stays apart; a bounce sets it aside.
+//! A pair left in touch that the rest of the step presses into each
+//! other is held there too, at the instant it touches.
 //!
 //! | file | what it holds |
 //! |---|---|
@@ -93,6 +98,21 @@ pub trait TouchBody<V: Coordinates> {
     fn push(&self, bead: usize) -> V;
     /// Takes `states` as where the step ends.
     fn finish(&mut self, states: &[BeadState<V>]);
+    /// Whether a contact row of the body joins its beads `a` and `b`
+    /// (see [`Island::set_contact`](crate::solver::Island::set_contact)),
+    /// and if so whether it holds them in the steps from the last
+    /// [`TouchBody::keep`]; none where no row joins them (the body cannot
+    /// hold them in touch, and they strike only).
+    fn contact(&self, a: usize, b: usize) -> Option<bool> {
+        let _ = (a, b);
+        None
+    }
+    /// Holds the contact between beads `a` and `b` in the steps from the
+    /// last [`TouchBody::keep`] (a strike left them in touch), or sets it
+    /// aside (they bounced or part). A body without the row ignores it.
+    fn hold(&mut self, a: usize, b: usize, held: bool) {
+        let _ = (a, b, held);
+    }
 }
 
 /// A bead that may touch others: its body, its index there, its radius
@@ -247,6 +267,28 @@ impl Pool {
         }
         bodies
     }
+}
+
+/// The pairs of beads, each `(state, radius)`, that may come to touch
+/// within `within` seconds: those whose boxes overlap, each grown by its
+/// radius, a `margin` fraction more, and along each axis twice the way its
+/// velocity takes it in `within` ([`overlapping`]). An island builder joins such pairs
+/// by contact rows before they meet (see
+/// [`Island::set_contact`](crate::solver::Island::set_contact)).
+pub fn may_touch<V: Coordinates>(
+    beads: &[(BeadState<V>, f64)],
+    within: f64,
+    margin: f64,
+) -> Vec<(usize, usize)> {
+    let boxes: Vec<(DVec3, DVec3)> = beads
+        .iter()
+        .map(|(state, radius)| {
+            let p = state.position.xyz();
+            let grown = radius * (1.0 + margin) + 2.0 * within * state.velocity.xyz().abs();
+            (p - grown, p + grown)
+        })
+        .collect();
+    overlapping(&boxes)
 }
 
 /// The pairs of boxes `(lowest, highest corner)` that overlap, by sweep

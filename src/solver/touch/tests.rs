@@ -216,3 +216,26 @@ proptest::proptest! {
         proptest::prop_assert_eq!(overlapping(&boxes), every);
     }
 }
+
+/// Two beads of radius 0.1 m, 1 m apart: at rest they may not touch
+/// within a second; closing at 0.5 m/s each they may (1 m of boxes grown
+/// by twice the way), and moving along lines 0.3 m apart they may not
+/// (each box grows along its motion only).
+#[test]
+fn beads_may_touch_only_where_their_motion_can_bring_them_together() {
+    let bead = |x: f64, y: f64, vx: f64| {
+        (
+            BeadState {
+                position: DVec2::new(x, y),
+                velocity: DVec2::new(vx, 0.0),
+            },
+            0.1,
+        )
+    };
+    assert!(may_touch(&[bead(0.0, 0.0, 0.0), bead(1.0, 0.0, 0.0)], 1.0, 0.0).is_empty());
+    assert_eq!(
+        may_touch(&[bead(0.0, 0.0, 0.5), bead(1.0, 0.0, -0.5)], 1.0, 0.0),
+        vec![(0, 1)]
+    );
+    assert!(may_touch(&[bead(0.0, 0.0, 5.0), bead(0.5, 0.3, -5.0)], 1.0, 0.0).is_empty());
+}

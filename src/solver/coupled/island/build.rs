@@ -178,6 +178,7 @@ impl<V: WireSpace> Island<V> {
         let paths = vec![None; kinds.len()];
         let sides = vec![(0.0, 0.0); kinds.len()];
         let rough = vec![None; kinds.len()];
+        let contacts = vec![false; kinds.len()];
         Ok(Self {
             inverse_mass,
             rows: kinds,
@@ -188,6 +189,7 @@ impl<V: WireSpace> Island<V> {
             paths,
             moving: 0,
             sides,
+            contacts,
             rough,
             rough_rows: 0,
         })

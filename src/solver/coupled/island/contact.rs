@@ -184,7 +184,8 @@ impl<V: WireSpace> Island<V> {
         self.accelerate(forces, Gains::NONE, work, Stage::Start)?;
         for r in 0..self.rows() {
             let (side, _) = self.sides[r];
-            if side != 0.0 && !work.inactive[r] && side * work.lambda[r] < 0.0 {
+            let parts = || self.parting(r, states) == Some(true);
+            if side != 0.0 && !work.inactive[r] && (side * work.lambda[r] < 0.0 || parts()) {
                 work.inactive[r] = true;
                 let bead = self.entry_bead[self.row_start[r]];
                 let position = states[bead].position;
@@ -210,7 +211,8 @@ impl<V: WireSpace> Island<V> {
         work.time = time;
         for r in 0..self.rows() {
             let (side, restitution) = self.sides[r];
-            if side == 0.0 || !work.inactive[r] {
+            if side == 0.0 || !work.inactive[r] || self.contacts[r] {
+                // Where beads meet is the touch settlement's to find.
                 continue;
             }
             let bead = self.entry_bead[self.row_start[r]];

@@ -42,6 +42,11 @@ pub const MAX_HALVINGS: u32 = 6;
 /// After this many steps in a row that needed no more halvings than they
 /// started with, a step tries one halving fewer.
 pub const CALM_STEPS: u32 = 8;
+/// A contact row's beads part where their gap opens faster than this
+/// fraction of their reach (the two radii) plus their speeds, per second:
+/// slower is rounding, and the row holds on (see [`Island::set_contact`]).
+pub const OPENING: f64 = 1e-9;
+
 /// The most exact Newton steps RATTLE's position solve takes before it
 /// takes the step as having no root near (and halves it).
 pub const EXACT_STEPS: u32 = 8;
@@ -78,6 +83,9 @@ pub struct Island<V: WireSpace = DVec2> {
     /// Each row's side (+1, −1, or 0 for a two-sided row) and restitution
     /// (see [`Island::set_side`]).
     sides: Vec<(f64, f64)>,
+    /// Whether each row is a contact between two beads that touch (see
+    /// [`Island::set_contact`]).
+    contacts: Vec<bool>,
     /// Each wire row's friction, if it has any (see [`Island::set_rough`]).
     rough: Vec<Option<RoughRow>>,
     /// How many rows have friction: with none, the matrices may be factored
@@ -157,6 +165,23 @@ pub struct IslandMark<V: WireSpace = DVec2> {
     sticks: Vec<Option<(V, f64)>>,
     level: u32,
     calm: u32,
+}
+
+impl<V: WireSpace> IslandMark<V> {
+    /// Holds contact row `row` from here (its beads press), or sets it
+    /// aside (they part), for the steps taken from this mark (see
+    /// [`Island::set_contact`]). Whether the row is held, before.
+    pub fn hold(&mut self, row: usize, held: bool) -> Option<bool> {
+        let inactive = self.inactive.get_mut(row)?;
+        let was = !*inactive;
+        *inactive = !held;
+        Some(was)
+    }
+
+    /// Whether row `row` is held in the steps taken from this mark.
+    pub fn holds(&self, row: usize) -> bool {
+        !self.inactive.get(row).copied().unwrap_or(false)
+    }
 }
 
 impl<V: WireSpace> IslandWork<V> {
@@ -281,6 +306,32 @@ impl<V: WireSpace> Island<V> {
         {
             *slot = (side.sign(), restitution.clamp(0.0, 1.0));
         }
+    }
+
+    /// Makes rod row `row` a contact between two beads that touch: one
+    /// side (`|x_a − x_b| ≥ length`, the two radii), held only while its
+    /// beads press. A contact row starts set aside, is set aside at a
+    /// step's start where its λ would pull or its beads part
+    /// ([`OPENING`]), and is never landed on by the island's own step: where its beads meet within a step is the touch
+    /// settlement's to find ([`settle_touches`](crate::solver::settle_touches)),
+    /// which holds it ([`IslandMark::hold`]) where a strike leaves the
+    /// pair in touch or the step presses a touching pair together. A strike's answer ([`Island::respond`]) leaves
+    /// contact rows out: each pair strikes in turn. Rows of other kinds
+    /// are left as they are.
+    pub fn set_contact(&mut self, row: usize) {
+        if let (Some(RowKind::Rod { .. }), Some(slot), Some(contact)) = (
+            self.rows.get(row),
+            self.sides.get_mut(row),
+            self.contacts.get_mut(row),
+        ) {
+            *slot = (1.0, 0.0);
+            *contact = true;
+        }
+    }
+
+    /// Whether row `row` is a contact (see [`Island::set_contact`]).
+    pub fn is_contact(&self, row: usize) -> bool {
+        self.contacts.get(row).copied().unwrap_or(false)
     }
 
     /// Gives the wire of row `row` Coulomb friction and viscous damping

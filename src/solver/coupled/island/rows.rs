@@ -4,7 +4,7 @@
 
 use bevy::math::DVec2;
 
-use super::{Island, IslandWork};
+use super::{Island, IslandWork, OPENING};
 use crate::geometry::{Placement, Twist, WireSpace, placed_geometry};
 use crate::solver::coupled::constraint::RowKind;
 use crate::solver::state::{BeadState, LinearForce};
@@ -28,6 +28,24 @@ impl<V: WireSpace> Island<V> {
             normal: g.normal,
             wire: twist.velocity_at(state.position),
         }
+    }
+
+    /// Whether the beads of contact row `r` part where they are in
+    /// `states` (see [`OPENING`]); none for a row of another kind.
+    pub(super) fn parting(&self, r: usize, states: &[BeadState<V>]) -> Option<bool> {
+        let RowKind::Rod { length } = self.rows[r] else {
+            return None;
+        };
+        if !self.contacts[r] {
+            return None;
+        }
+        let entries = &self.entry_bead[self.row_start[r]..self.row_start[r + 1]];
+        let (a, b) = (states.get(entries[0])?, states.get(entries[1])?);
+        let d = a.position - b.position;
+        let distance = d.dot(d).sqrt();
+        let rate = d.dot(a.velocity - b.velocity) / distance;
+        let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
+        Some(rate > OPENING * (length + speeds))
     }
 
     /// The shape of wire row `r` and where its wire is at `time`, with its

@@ -192,8 +192,19 @@ impl<V: WireSpace> Island<V> {
         Ok(())
     }
 
+    /// Sets the rows a fresh `work` starts with at `states` (as its first
+    /// step would), so that what it carries can be kept
+    /// ([`IslandWork::mark`]) before that step. A work that has stepped is
+    /// left as it is.
+    pub fn begin(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
+        if work.inactive.len() != self.rows() {
+            self.start_rows(time, states, work);
+        }
+    }
+
     /// Which rows a fresh island starts with: a bead that starts off a
-    /// one-sided wire, on the side it pushes toward, starts in flight;
+    /// one-sided wire, on the side it pushes toward, starts in flight; a
+    /// contact starts set aside;
     /// stick rows start set aside (a bead slides until friction stops it),
     /// but a bead at rest on a rough wire starts held by static friction.
     pub(super) fn start_rows(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
@@ -207,10 +218,14 @@ impl<V: WireSpace> Island<V> {
         }
         for r in 0..self.rows() {
             let (side, _) = self.sides[r];
-            if side != 0.0
-                && whole
-                && side * self.wire_row(r, states, time).c > OFF_THE_WIRE * self.rows[r].scale()
-            {
+            if side == 0.0 || !whole {
+                continue;
+            }
+            // A contact is held only once its beads press (see
+            // `Island::set_contact`).
+            let apart = self.contacts[r]
+                || side * self.wire_row(r, states, time).c > OFF_THE_WIRE * self.rows[r].scale();
+            if apart {
                 work.inactive[r] = true;
             }
         }

@@ -330,3 +330,43 @@ fn an_island_lands_within_the_step_where_a_lone_bead_does() {
         }
     }
 }
+
+/// A contact row between a pinned bead and a 2 kg bead resting on it:
+/// set aside at the start; held (from a mark), the pair presses with the
+/// weight, `λ = m g` to 1e-12 of it, and the bead stays put; pushed up
+/// instead, the row is let go at the step's start and the bead leaves.
+#[test]
+fn a_contact_row_holds_a_pressing_pair_and_lets_a_pulling_one_go() {
+    let (r, m, g) = (0.1, 2.0, 9.81);
+    let [px, py] = pin(0, DVec2::ZERO);
+    let mut island = Island::new(&[1.0, m], vec![px, py, rod(0, 1, 2.0 * r)], vec![]).unwrap();
+    island.set_contact(2);
+    assert!(island.is_contact(2) && !island.is_contact(0));
+    let start = at_rest(&[DVec2::ZERO, DVec2::new(0.0, 2.0 * r)]);
+    let s = settings(Method::Rattle, 1.0 / 240.0);
+    for (weight, held) in [(-g, true), (g, false)] {
+        let forces = vec![
+            LinearForce::constant(DVec2::ZERO),
+            LinearForce::constant(DVec2::new(0.0, m * weight)),
+        ];
+        let mut states = start.clone();
+        let mut work = IslandWork::default();
+        island.begin(0.0, &states, &mut work);
+        assert!(!work.holds(2), "a contact starts set aside");
+        let mut mark = work.mark();
+        assert_eq!(mark.hold(2, true), Some(false));
+        work.rewind(&mark);
+        island
+            .step_at(0.0, &mut states, &forces, &s, &mut work)
+            .unwrap();
+        assert_eq!(work.holds(2), held);
+        let rise = states[1].position.y - 2.0 * r;
+        if held {
+            let lambda = work.rows()[2].lambda;
+            assert!((lambda - m * g).abs() <= 1e-12 * m * g, "λ = {lambda}");
+            assert!(rise.abs() <= 1e-15 && states[1].velocity.length() <= 1e-12);
+        } else {
+            assert!(rise > 0.0 && states[1].velocity.y > 0.0, "rise {rise}");
+        }
+    }
+}
