@@ -201,9 +201,14 @@ pub fn draw_forces(
     style: Res<DebugRenderStyle>,
     mut gizmos: Gizmos,
 ) {
-    let g = params.gravity.length().max(1e-3) as f32;
+    let largest = beads
+        .iter()
+        .filter_map(|(_, _, d, _, on_wire)| d.filter(|_| on_wire))
+        .map(|d| d.constraint_force.length())
+        .fold(0.0, f64::max);
     for (bead, mass, diagnostics, drag, on_wire) in &beads {
-        let per_newton = style.force_scale / (mass.get() as f32 * g);
+        let per_newton =
+            style.force_scale * force_unit(params.gravity.length(), mass.get(), largest);
         let at = bead.as_vec2();
         let force = diagnostics
             .filter(|_| on_wire)
@@ -220,6 +225,22 @@ pub fn draw_forces(
                 style.drag,
             );
         }
+    }
+}
+
+/// How long an arrow for one newton is, as a share of an arrow for the
+/// bead's weight (`mass` under `gravity`); with no gravity to weigh by, of
+/// an arrow for the `largest` constraint force in the scene.
+pub fn force_unit(gravity: f64, mass: f64, largest: f64) -> f32 {
+    let unit = if gravity > 1e-9 {
+        mass * gravity
+    } else {
+        largest
+    };
+    if unit > 0.0 && unit.is_finite() {
+        unit.recip() as f32
+    } else {
+        0.0
     }
 }
 

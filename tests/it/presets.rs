@@ -31,6 +31,8 @@ pub(crate) const SHIPPED: &[&str] = &[
     "newtons_cradle.scene.ron",
     "air_track.scene.ron",
     "air_track_sticky.scene.ron",
+    "abacus.scene.ron",
+    "train.scene.ron",
 ];
 
 /// The shipped presets that join beads.
@@ -41,6 +43,7 @@ const COUPLED: &[&str] = &[
     "ring.scene.ron",
     "spring_pair.scene.ron",
     "newtons_cradle.scene.ron",
+    "abacus.scene.ron",
 ];
 
 /// The shipped presets, found at run time: a test binary reused from another

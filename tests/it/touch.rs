@@ -288,6 +288,8 @@ fn no_preset_lets_beads_overlap() {
         "newtons_cradle.scene.ron",
         "air_track.scene.ron",
         "air_track_sticky.scene.ron",
+        "abacus.scene.ron",
+        "train.scene.ron",
     ] {
         let (mut app, _, preset) = shipped(name);
         let steps = (10.0 / preset.params.timestep).round() as u32;

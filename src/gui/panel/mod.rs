@@ -55,6 +55,8 @@ impl Default for PresetCatalog {
                 ("Newton's cradle", "scenes/newtons_cradle.scene.ron"),
                 ("Air track, elastic", "scenes/air_track.scene.ron"),
                 ("Air track, sticky", "scenes/air_track_sticky.scene.ron"),
+                ("Abacus", "scenes/abacus.scene.ron"),
+                ("Train on a closed track", "scenes/train.scene.ron"),
                 (
                     "In space: bead on a rotating hoop",
                     "scenes/rotating_hoop.scene.ron",

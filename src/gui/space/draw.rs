@@ -12,6 +12,7 @@ use bevy::render::render_resource::Face;
 
 use super::shapes::{curve_points, fitted_surface_mesh};
 use super::{Orbit, SPACE_LAYER, SpaceGizmos};
+use crate::debug_render::force_unit;
 use crate::geometry::{Side, SpaceShape};
 use crate::gui::render::{BeadSizes, SceneStyle, Trail};
 use crate::{
@@ -316,14 +317,19 @@ pub fn draw_links(
             gizmos.line(a, b, style.spring);
         }
     }
-    let g = params.gravity_in_space().length().max(1e-3) as f32;
+    let g = params.gravity_in_space().length();
     let scale = 2.0 * style.force_scale * orbit.size;
+    let largest = beads
+        .iter()
+        .filter_map(|(_, _, d, _, on_wire)| d.filter(|_| on_wire))
+        .map(|d| d.constraint_force.length())
+        .fold(0.0, f64::max);
     for (bead, mass, diagnostics, drag, on_wire) in &beads {
         let p = bead.0.as_vec3();
         let force = diagnostics
             .filter(|_| on_wire)
             .map_or(Vec3::ZERO, |d| d.constraint_force.as_vec3())
-            * (scale / (mass.get() as f32 * g));
+            * (scale * force_unit(g, mass.get(), largest));
         if force.is_finite() && force.length() > 1e-3 * scale {
             gizmos.arrow(p, p + force, style.constraint_force);
         }

@@ -114,7 +114,7 @@ impl<V: Dimension> CachedIsland<V> {
 
 /// How many steps ahead the islands are built for: beads with radii that
 /// may meet within this many steps are joined by contact rows.
-const NEAR_STEPS: f64 = 4.0;
+const NEAR_STEPS: f64 = 2.0;
 
 /// How much of its radius more each bead's box is grown by when the
 /// islands are built, so that a pair joined stays joined a while.

@@ -187,6 +187,9 @@ impl<V: WireSpace> Island<V> {
             let parts = || self.parting(r, states) == Some(true);
             if side != 0.0 && !work.inactive[r] && (side * work.lambda[r] < 0.0 || parts()) {
                 work.inactive[r] = true;
+                if self.contacts[r] {
+                    continue; // a pair parting is no bead leaving its wire
+                }
                 let bead = self.entry_bead[self.row_start[r]];
                 let position = states[bead].position;
                 work.events
