@@ -43,8 +43,9 @@ struct Pending<V: Dimension> {
     rows: Vec<IslandRow<V>>,
     pin: bool,
     anchored: bool,
-    /// A contact between two beads near each other (see `touch`).
-    contact: bool,
+    /// A contact between two beads near each other (see `touch`): the
+    /// sum of their radii.
+    contact: Option<f64>,
 }
 
 /// The rows that hold a bead at `at`, one along each axis.
@@ -114,7 +115,7 @@ pub(super) fn prepare_islands<V: Dimension>(
                     }],
                     pin: false,
                     anchored: false,
-                    contact: false,
+                    contact: None,
                 },
                 beads.to_vec(),
             )),
@@ -141,7 +142,7 @@ pub(super) fn prepare_islands<V: Dimension>(
                 rows: pin_rows(at),
                 pin: true,
                 anchored: pin.anchor().is_some(),
-                contact: false,
+                contact: None,
             },
             vec![pin.bead()],
         ));
@@ -161,7 +162,7 @@ pub(super) fn prepare_islands<V: Dimension>(
                     }],
                     pin: false,
                     anchored: false,
-                    contact: false,
+                    contact: None,
                 },
                 joint.beads().to_vec(),
             )),
@@ -195,7 +196,7 @@ pub(super) fn prepare_islands<V: Dimension>(
                 }],
                 pin: false,
                 anchored: false,
-                contact: true,
+                contact: Some(ra + rb),
             },
             vec![a, b],
         ));
@@ -312,14 +313,12 @@ pub(super) fn prepare_islands<V: Dimension>(
             if pending.anchored {
                 anchored.push((start, pending.entity));
             }
-            if let (true, Some(RowKind::Rod { length })) =
-                (pending.contact, pending.rows.first().map(|r| &r.kind))
-            {
+            if let Some(reach) = pending.contact {
                 contacts.push(ContactRow {
                     row: start,
                     a: local[0].min(local[1]),
                     b: local[0].max(local[1]),
-                    reach: *length,
+                    reach,
                 });
             } else if pending.pin {
                 link_rows.push(LinkRows::Pin(pending.entity, start));

@@ -22,4 +22,5 @@ mod tests;
 
 pub use constraint::{Constraint, RowKind, SpringLink};
 pub use group::islands;
+pub(crate) use island::parts;
 pub use island::{Island, IslandError, IslandMark, IslandRow, IslandWork, OPENING, RowReport};

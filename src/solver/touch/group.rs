@@ -10,7 +10,7 @@ use super::{
 };
 use crate::geometry::Coordinates;
 use crate::solver::contact::locate;
-use crate::solver::coupled::OPENING;
+use crate::solver::coupled::parts;
 use crate::solver::impact::{Response, Touch, resolve_impacts};
 use crate::solver::solve::SolveError;
 use crate::solver::state::BeadState;
@@ -460,7 +460,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
             let n = touches[k].normal();
             let reach = self.beads[pair.0].radius + self.beads[pair.1].radius;
             let speeds = va.dot(va).sqrt() + vb.dot(vb).sqrt();
-            if n.dot(vb - va) > OPENING * (reach + speeds) {
+            if parts(n.dot(vb - va), reach, speeds) {
                 body.hold(ba, bb, false);
             } else if let Some(last) = strikes.iter().rev().find(|s| s.touch == k) {
                 body.hold(ba, bb, !last.bounced);

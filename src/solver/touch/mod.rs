@@ -272,8 +272,8 @@ impl Pool {
 /// The pairs of beads, each `(state, radius)`, that may come to touch
 /// within `within` seconds: those whose boxes overlap, each grown by its
 /// radius, a `margin` fraction more, and along each axis twice the way its
-/// velocity takes it in `within` ([`overlapping`]). An island builder joins such pairs
-/// by contact rows before they meet (see
+/// velocity takes it in `within` ([`overlapping`]). An island builder
+/// joins such pairs by contact rows before they meet (see
 /// [`Island::set_contact`](crate::solver::Island::set_contact)).
 pub fn may_touch<V: Coordinates>(
     beads: &[(BeadState<V>, f64)],

@@ -47,6 +47,13 @@ pub const CALM_STEPS: u32 = 8;
 /// slower is rounding, and the row holds on (see [`Island::set_contact`]).
 pub const OPENING: f64 = 1e-9;
 
+/// Whether a pair in touch whose gap opens at `rate`, of `reach` (the two
+/// radii) and `speeds` (the sum of its beads' speeds), parts (see
+/// [`OPENING`]).
+pub(crate) fn parts(rate: f64, reach: f64, speeds: f64) -> bool {
+    rate > OPENING * (reach + speeds)
+}
+
 /// The most exact Newton steps RATTLE's position solve takes before it
 /// takes the step as having no root near (and halves it).
 pub const EXACT_STEPS: u32 = 8;
@@ -312,12 +319,13 @@ impl<V: WireSpace> Island<V> {
     /// side (`|x_a − x_b| ≥ length`, the two radii), held only while its
     /// beads press. A contact row starts set aside, is set aside at a
     /// step's start where its λ would pull or its beads part
-    /// ([`OPENING`]), and is never landed on by the island's own step: where its beads meet within a step is the touch
-    /// settlement's to find ([`settle_touches`](crate::solver::settle_touches)),
-    /// which holds it ([`IslandMark::hold`]) where a strike leaves the
-    /// pair in touch or the step presses a touching pair together. A strike's answer ([`Island::respond`]) leaves
-    /// contact rows out: each pair strikes in turn. Rows of other kinds
-    /// are left as they are.
+    /// ([`OPENING`]), and is never landed on by the island's own step:
+    /// where its beads meet within a step is the touch settlement's to
+    /// find ([`settle_touches`](crate::solver::settle_touches)), which
+    /// holds it ([`IslandMark::hold`]) where a strike leaves the pair in
+    /// touch or the step presses a touching pair together. A strike's
+    /// answer ([`Island::respond`]) leaves contact rows out: each pair
+    /// strikes in turn. Rows of other kinds are left as they are.
     pub fn set_contact(&mut self, row: usize) {
         if let (Some(RowKind::Rod { .. }), Some(slot), Some(contact)) = (
             self.rows.get(row),

@@ -94,9 +94,7 @@ impl<V: WireSpace> Island<V> {
                 forces: usize::from(bead < self.beads()),
             });
         }
-        if work.inactive.len() != self.rows() {
-            self.start_rows(time, states, work);
-        }
+        self.begin(time, states, work);
         // Each pair strikes in turn: the contacts are left out.
         let held = self.contacts.contains(&true).then(|| work.inactive.clone());
         if held.is_some() {

@@ -4,7 +4,7 @@
 
 use bevy::math::DVec2;
 
-use super::{Island, IslandWork, OPENING};
+use super::{Island, IslandWork, parts};
 use crate::geometry::{Placement, Twist, WireSpace, placed_geometry};
 use crate::solver::coupled::constraint::RowKind;
 use crate::solver::state::{BeadState, LinearForce};
@@ -31,7 +31,8 @@ impl<V: WireSpace> Island<V> {
     }
 
     /// Whether the beads of contact row `r` part where they are in
-    /// `states` (see [`OPENING`]); none for a row of another kind.
+    /// `states` (see [`OPENING`](super::OPENING)); none for a row of
+    /// another kind.
     pub(super) fn parting(&self, r: usize, states: &[BeadState<V>]) -> Option<bool> {
         let RowKind::Rod { length } = self.rows[r] else {
             return None;
@@ -45,7 +46,7 @@ impl<V: WireSpace> Island<V> {
         let distance = d.dot(d).sqrt();
         let rate = d.dot(a.velocity - b.velocity) / distance;
         let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
-        Some(rate > OPENING * (length + speeds))
+        Some(parts(rate, length, speeds))
     }
 
     /// The shape of wire row `r` and where its wire is at `time`, with its

@@ -65,9 +65,7 @@ impl<V: WireSpace> Island<V> {
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         work.events.clear();
-        if work.inactive.len() != self.rows() {
-            self.start_rows(time, states, work);
-        }
+        self.begin(time, states, work);
         let one_sided = self.one_sided();
         let rough = self.is_rough();
         if one_sided || rough {
