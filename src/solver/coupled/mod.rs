@@ -23,4 +23,6 @@ mod tests;
 pub use constraint::{Constraint, RowKind, SpringLink};
 pub use group::islands;
 pub(crate) use island::parts;
-pub use island::{Island, IslandError, IslandMark, IslandRow, IslandWork, OPENING, RowReport};
+pub use island::{
+    Island, IslandError, IslandMark, IslandRow, IslandWork, OPENING, RowReport, TOUCHING,
+};

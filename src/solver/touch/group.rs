@@ -225,6 +225,9 @@ impl<'a, V: Coordinates> Group<'a, V> {
             let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
             let g0 = self.gap(pair, a0.position, b0.position);
             if g0 <= TOUCHING * r {
+                if self.held(bodies, pair) {
+                    continue; // its contact row keeps it from closing
+                }
                 // In touch: struck now if it closes, else left resting.
                 let n = b0.position - a0.position;
                 let u = n.dot(b0.velocity - a0.velocity) / n.dot(n).sqrt();
@@ -408,7 +411,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
             let (a, b) = (self.state(pair.0, false), self.state(pair.1, false));
             let (ta, tb) = (self.beads[pair.0], self.beads[pair.1]);
             let r = ta.radius + tb.radius;
-            if self.gap(pair, a.position, b.position) > TOUCHING * r {
+            if self.gap(pair, a.position, b.position) > TOUCHING * r || self.held(bodies, pair) {
                 continue;
             }
             let (fa, fb) = (flat(self, pair.0), flat(self, pair.1));
@@ -481,6 +484,14 @@ impl<'a, V: Coordinates> Group<'a, V> {
             }
         }
         Ok(())
+    }
+
+    /// Whether a contact row holds pair `(i, j)` now: pressed together,
+    /// the two answer a strike as one and do not strike each other.
+    fn held<B: TouchBody<V>>(&self, bodies: &[B], (i, j): (usize, usize)) -> bool {
+        let slot = self.slot(i);
+        let (a, b) = (self.beads[i].bead, self.beads[j].bead);
+        slot == self.slot(j) && bodies[self.bodies[slot]].contact(a, b) == Some(true)
     }
 
     /// Hands each body its new end, if the group was cut; a body whose

@@ -29,7 +29,9 @@
 //! leaves the pair in touch holds the row, so that the pair pressed
 //! together for the rest of the step stays apart; a bounce sets it aside.
 //! A pair left in touch that the rest of the step presses into each
-//! other is held there too, at the instant it touches.
+//! other is held there too, at the instant it touches. A held pair does
+//! not strike: its body answers a strike on either bead with the row
+//! held, so beads pressed together take a blow as one.
 //!
 //! | file | what it holds |
 //! |---|---|
@@ -51,8 +53,7 @@ mod tests;
 
 use group::Group;
 
-/// Two beads whose gap is at most this fraction of their radii touch.
-pub const TOUCHING: f64 = 1e-10;
+pub use super::coupled::TOUCHING;
 
 /// A pair in touch closes (and strikes at once) where it closes faster
 /// than this fraction of its two beads' speeds: slower is rounding.

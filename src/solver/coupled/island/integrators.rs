@@ -6,7 +6,7 @@
 //! velocity solve.
 
 use super::newton::Direction;
-use super::{Island, IslandWork, RowReport};
+use super::{CONTACT_PASSES, Island, IslandWork, RowReport, TOUCHING};
 use crate::geometry::WireSpace;
 
 use crate::solver::rattle::{rattle_drift, rattle_half_kick};
@@ -138,6 +138,14 @@ impl<V: WireSpace> Island<V> {
 
     /// Eq. (8) for an island: SHAKE's position solve (Newton on all of the
     /// island's `C` along `W J₀ᵀ`), then the linear velocity solve.
+    ///
+    /// Contacts between beads in touch at the step's start are one-sided
+    /// in both solves: a contact row set aside that the position solve
+    /// would leave overlapping by more than [`TOUCHING`] of its reach is
+    /// held and the solve taken again (at most [`CONTACT_PASSES`] solves;
+    /// a row held is not let go within the step, so the passes end), and a
+    /// held one the velocity solve would pull together is let go and the
+    /// velocities projected again.
     pub(super) fn rattle(
         &self,
         forces: &[LinearForce<V>],
@@ -145,21 +153,14 @@ impl<V: WireSpace> Island<V> {
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         let n = self.beads();
-        self.evaluate_at_start(work, work.time);
-        if self.rows() > 0 {
-            self.factor(work, true)?;
+        let start = work.time;
+        for _ in 0..CONTACT_PASSES {
+            work.time = start;
+            self.rattle_positions(forces, h, work)?;
+            if !self.take_contacts(work) {
+                break;
+            }
         }
-        self.applied(forces, &work.x0, &work.v0, &mut work.force);
-        work.x.clear();
-        work.v.clear();
-        for i in 0..n {
-            let start = (work.x0[i], work.v0[i]);
-            let m = self.inverse_mass[i].recip();
-            work.x.push(rattle_drift(start, work.force[i], m, h));
-            work.v.push(work.v0[i]);
-        }
-        work.time += h;
-        self.newton(work, Direction::First)?;
         let to_lambda = 2.0 / (h * h);
         work.reports.clear();
         work.reports.extend(work.lambda.iter().map(|&mu| RowReport {
@@ -176,12 +177,97 @@ impl<V: WireSpace> Island<V> {
             work.v[i] = rattle_half_kick(work.v[i], work.force[i], m, h);
         }
         self.evaluate_at_new(work);
-        self.project_velocity(work)?;
+        self.project_velocity_pushing(work)?;
         let to_mu = 2.0 / h;
         for (report, nu) in work.reports.iter_mut().zip(&work.rhs) {
             report.lambda += 0.5 * to_mu * nu;
         }
         Ok(())
+    }
+
+    /// RATTLE's drift and position solve from `work.x0, work.v0` at
+    /// `work.time`: `work.x` on the held rows, `work.lambda` their μ.
+    fn rattle_positions(
+        &self,
+        forces: &[LinearForce<V>],
+        h: f64,
+        work: &mut IslandWork<V>,
+    ) -> Result<(), SolveError> {
+        self.evaluate_at_start(work, work.time);
+        if self.rows() > 0 {
+            self.factor(work, true)?;
+        }
+        self.applied(forces, &work.x0, &work.v0, &mut work.force);
+        work.x.clear();
+        work.v.clear();
+        for i in 0..self.beads() {
+            let start = (work.x0[i], work.v0[i]);
+            let m = self.inverse_mass[i].recip();
+            work.x.push(rattle_drift(start, work.force[i], m, h));
+            work.v.push(work.v0[i]);
+        }
+        work.time += h;
+        self.newton(work, Direction::First)
+    }
+
+    /// After a position solve: holds each contact row in touch at the
+    /// step's start that the solve leaves overlapping. Whether any was.
+    fn take_contacts(&self, work: &mut IslandWork<V>) -> bool {
+        let mut changed = false;
+        for r in 0..self.rows() {
+            if !work.inactive[r] || work.touching.get(r) != Some(&true) {
+                continue;
+            }
+            if let Some((gap, reach)) = self.contact_gap(r, &work.x)
+                && gap < -TOUCHING * reach
+            {
+                work.inactive[r] = false;
+                changed = true;
+            }
+        }
+        changed
+    }
+
+    /// Lets go of each held contact row whose multiplier pulls. Whether
+    /// any was.
+    fn let_go(&self, multipliers: &[f64], inactive: &mut [bool]) -> bool {
+        let mut changed = false;
+        for (r, &multiplier) in multipliers.iter().enumerate() {
+            if self.contacts[r] && !inactive[r] && self.sides[r].0 * multiplier < 0.0 {
+                inactive[r] = true;
+                changed = true;
+            }
+        }
+        changed
+    }
+
+    /// [`Island::project_velocity`] with every held contact row pushing:
+    /// one whose multiplier pulls is let go and the velocities projected
+    /// again from where they were.
+    pub(super) fn project_velocity_pushing(
+        &self,
+        work: &mut IslandWork<V>,
+    ) -> Result<(), SolveError> {
+        if !self.contacts.contains(&true) {
+            return self.project_velocity(work);
+        }
+        let unprojected = work.v.clone();
+        let mut passes = 0;
+        loop {
+            self.project_velocity(work)?;
+            passes += 1;
+            let pulled = self.let_go(&work.rhs, &mut work.inactive);
+            if !pulled || passes == CONTACT_PASSES {
+                return Ok(());
+            }
+            work.v.clone_from(&unprojected);
+            for r in 0..self.rows() {
+                if work.inactive[r] {
+                    work.gradient[self.row_start[r]..self.row_start[r + 1]].fill(V::ZERO);
+                    work.bias[r] = 0.0;
+                }
+            }
+        }
     }
 }
 

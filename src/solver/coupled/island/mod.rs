@@ -42,6 +42,9 @@ pub const MAX_HALVINGS: u32 = 6;
 /// After this many steps in a row that needed no more halvings than they
 /// started with, a step tries one halving fewer.
 pub const CALM_STEPS: u32 = 8;
+/// Two beads whose gap is at most this fraction of their radii touch.
+pub const TOUCHING: f64 = 1e-10;
+
 /// A contact row's beads part where their gap opens faster than this
 /// fraction of their reach (the two radii) plus their speeds, per second:
 /// slower is rounding, and the row holds on (see [`Island::set_contact`]).
@@ -53,6 +56,10 @@ pub const OPENING: f64 = 1e-9;
 pub(crate) fn parts(rate: f64, reach: f64, speeds: f64) -> bool {
     rate > OPENING * (reach + speeds)
 }
+
+/// How many times RATTLE's position solve, or a velocity projection, is
+/// taken for contacts that overlap or pull (see [`Island::set_contact`]).
+const CONTACT_PASSES: usize = 16;
 
 /// The most exact Newton steps RATTLE's position solve takes before it
 /// takes the step as having no root near (and halves it).
@@ -136,6 +143,10 @@ pub struct IslandWork<V: WireSpace = DVec2> {
     time: f64,
     /// The rows set aside: one-sided wires their beads have left.
     inactive: Vec<bool>,
+    /// The contact rows whose beads touched where the step began: RATTLE's
+    /// position solve holds them where they would overlap (see
+    /// [`Island::set_contact`]).
+    touching: Vec<bool>,
     /// Each wire row's curve parameter where its bead was after the last
     /// step (NaN: unknown), so a self-crossing track keeps it on its branch.
     hints: Vec<f64>,
@@ -319,13 +330,18 @@ impl<V: WireSpace> Island<V> {
     /// side (`|x_a − x_b| ≥ length`, the two radii), held only while its
     /// beads press. A contact row starts set aside, is set aside at a
     /// step's start where its λ would pull or its beads part
-    /// ([`OPENING`]), and is never landed on by the island's own step:
-    /// where its beads meet within a step is the touch settlement's to
-    /// find ([`settle_touches`](crate::solver::settle_touches)), which
-    /// holds it ([`IslandMark::hold`]) where a strike leaves the pair in
-    /// touch or the step presses a touching pair together. A strike's
-    /// answer ([`Island::respond`]) leaves contact rows out: each pair
-    /// strikes in turn. Rows of other kinds are left as they are.
+    /// ([`OPENING`]), and within RATTLE's step where its velocity
+    /// multiplier would pull. Where beads apart meet within a step is the
+    /// touch settlement's to find
+    /// ([`settle_touches`](crate::solver::settle_touches)), which holds
+    /// the row ([`IslandMark::hold`]) where a strike leaves the pair in
+    /// touch or the step presses a touching pair together; RATTLE's own
+    /// step holds a row whose beads touched at its start where its
+    /// position solve would leave them overlapping, so a pile of beads
+    /// pressing on each other settles within one step. A held pair does
+    /// not strike: a strike's answer ([`Island::respond`]) keeps the held
+    /// rows, so that beads pressed together answer as one, while pairs
+    /// apart strike in turn. Rows of other kinds are left as they are.
     pub fn set_contact(&mut self, row: usize) {
         if let (Some(RowKind::Rod { .. }), Some(slot), Some(contact)) = (
             self.rows.get(row),

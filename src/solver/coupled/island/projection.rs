@@ -74,9 +74,10 @@ impl<V: WireSpace> Island<V> {
     /// How the beads' velocities answer an `impulse` on bead `bead` at
     /// `states` and `time`: `Δv = P W f`, the impulse's kick projected in
     /// the kinetic-energy norm onto the rows that hold now (rods, pins,
-    /// joints, friction holding a bead still, and the wires the beads are
-    /// on, not a one-sided wire a bead has left, nor a contact between
-    /// beads: each pair strikes in turn). A moving wire's own
+    /// joints, friction holding a bead still, the wires the beads are
+    /// on, not a one-sided wire a bead has left, and the contacts held
+    /// between beads pressed together, but not one the impulse would pull
+    /// apart: it is let go and the kick projected again). A moving wire's own
     /// velocity does not enter: the answer is linear in the impulse, one
     /// velocity change per bead (eq. 18 for a bead joined to others).
     pub fn respond<'w>(
@@ -95,23 +96,15 @@ impl<V: WireSpace> Island<V> {
             });
         }
         self.begin(time, states, work);
-        // Each pair strikes in turn: the contacts are left out.
-        let held = self.contacts.contains(&true).then(|| work.inactive.clone());
-        if held.is_some() {
-            for (inactive, &contact) in work.inactive.iter_mut().zip(&self.contacts) {
-                *inactive |= contact;
-            }
-        }
+        let held = work.inactive.clone();
         work.time = time;
         work.load(states);
         self.evaluate_at_new(work);
         work.bias.fill(0.0);
         work.v.fill(V::ZERO);
         work.v[bead] = impulse * self.inverse_mass[bead];
-        let projected = self.project_velocity(work);
-        if let Some(held) = held {
-            work.inactive = held;
-        }
+        let projected = self.project_velocity_pushing(work);
+        work.inactive = held;
         projected?;
         Ok(&work.v)
     }

@@ -30,6 +30,21 @@ impl<V: WireSpace> Island<V> {
         }
     }
 
+    /// The gap `|x_a − x_b| − (r_a + r_b)` of contact row `r`'s beads at
+    /// positions `x`, and its reach `r_a + r_b`; none for a row of another
+    /// kind.
+    pub(super) fn contact_gap(&self, r: usize, x: &[V]) -> Option<(f64, f64)> {
+        let RowKind::Rod { length } = self.rows[r] else {
+            return None;
+        };
+        if !self.contacts[r] {
+            return None;
+        }
+        let entries = &self.entry_bead[self.row_start[r]..self.row_start[r + 1]];
+        let d = *x.get(entries[0])? - *x.get(entries[1])?;
+        Some((d.dot(d).sqrt() - length, length))
+    }
+
     /// Whether the beads of contact row `r` part where they are in
     /// `states` (see [`OPENING`](super::OPENING)); none for a row of
     /// another kind.

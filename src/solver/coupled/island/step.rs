@@ -6,7 +6,7 @@ use crate::geometry::WireSpace;
 
 use super::integrators::Stage;
 use super::projection::Restore;
-use super::{CALM_STEPS, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow};
+use super::{CALM_STEPS, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow, TOUCHING};
 use crate::solver::contact::locate;
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use crate::solver::method::Method;
@@ -71,6 +71,7 @@ impl<V: WireSpace> Island<V> {
         if one_sided || rough {
             self.leave(time, states, forces, work)?;
         }
+        self.touching(states, work);
         let mut resisted = Vec::new();
         let slides = if rough && states.len() == self.beads() && forces.len() == self.beads() {
             resisted.extend_from_slice(forces);
@@ -110,6 +111,22 @@ impl<V: WireSpace> Island<V> {
         }
         self.follow(time + settings.dt, states, work);
         Ok(())
+    }
+
+    /// Marks the contact rows whose beads touch at `states` (the step's
+    /// start): those RATTLE's position solve may hold.
+    fn touching(&self, states: &[BeadState<V>], work: &mut IslandWork<V>) {
+        work.touching.clear();
+        if !self.contacts.contains(&true) || states.len() != self.beads() {
+            return;
+        }
+        work.x.clear();
+        work.x.extend(states.iter().map(|s| s.position));
+        for r in 0..self.rows() {
+            let gap = self.contact_gap(r, &work.x);
+            work.touching
+                .push(gap.is_some_and(|(gap, reach)| gap <= TOUCHING * reach));
+        }
     }
 
     /// The one-sided rows set aside whose beads are off their wires on the

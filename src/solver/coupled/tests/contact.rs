@@ -370,3 +370,61 @@ fn a_contact_row_holds_a_pressing_pair_and_lets_a_pulling_one_go() {
         }
     }
 }
+
+/// A 2 kg bead resting on a pinned one, its contact row set aside: RATTLE's
+/// own step finds the pair touching at its start and pressed into each
+/// other at its end, holds the row and takes the step again, so the bead
+/// stays put (to rounding) pressing with its weight to 1e-12 of it.
+#[test]
+fn rattle_holds_a_touching_pair_its_step_would_press_together() {
+    let (r, m, g) = (0.1, 2.0, 9.81);
+    let [px, py] = pin(0, DVec2::ZERO);
+    let mut island = Island::new(&[1.0, m], vec![px, py, rod(0, 1, 2.0 * r)], vec![]).unwrap();
+    island.set_contact(2);
+    let mut states = at_rest(&[DVec2::ZERO, DVec2::new(0.0, 2.0 * r)]);
+    let forces = vec![
+        LinearForce::constant(DVec2::ZERO),
+        LinearForce::constant(DVec2::new(0.0, -m * g)),
+    ];
+    let s = settings(Method::Rattle, 1.0 / 240.0);
+    let mut work = IslandWork::default();
+    island.begin(0.0, &states, &mut work);
+    assert!(!work.holds(2), "a contact starts set aside");
+    for k in 0..240 {
+        island
+            .step_at(k as f64 / 240.0, &mut states, &forces, &s, &mut work)
+            .unwrap();
+        assert!(work.holds(2), "step {k}: the pressed pair is held");
+        let sink = 2.0 * r - states[1].position.y;
+        assert!(sink.abs() <= 1e-14 * r, "step {k}: sunk by {sink:e}");
+        let lambda = work.rows()[2].lambda;
+        assert!((lambda - m * g).abs() <= 1e-12 * m * g, "λ = {lambda}");
+    }
+}
+
+/// Two free 1 kg beads pressed together (their contact row held) answer a
+/// unit impulse on one along the line between them as one 2 kg body: each
+/// moves at ½ m/s to 1e-15; set aside, the struck bead alone takes 1 m/s.
+#[test]
+fn a_strike_on_a_held_pair_moves_it_as_one() {
+    let mut island = Island::new(&[1.0, 1.0], vec![rod(0, 1, 0.2)], vec![]).unwrap();
+    island.set_contact(0);
+    let states = at_rest(&[DVec2::ZERO, DVec2::new(0.2, 0.0)]);
+    for (held, expect) in [(true, [0.5, 0.5]), (false, [1.0, 0.0])] {
+        let mut work = IslandWork::default();
+        island.begin(0.0, &states, &mut work);
+        let mut mark = work.mark();
+        mark.hold(0, held);
+        work.rewind(&mark);
+        let answer = island
+            .respond(0.0, &states, 0, DVec2::new(1.0, 0.0), &mut work)
+            .unwrap();
+        for (k, v) in answer.iter().enumerate() {
+            assert!(
+                (v.x - expect[k]).abs() <= 1e-15 && v.y.abs() <= 1e-15,
+                "held {held}: bead {k} at {v}"
+            );
+        }
+        assert_eq!(work.holds(0), held, "the answer leaves the row as it was");
+    }
+}
