@@ -638,60 +638,78 @@ fn the_train_couples_runs_on_pressed_together_and_parts_where_the_track_pulls() 
     assert_eq!(world.query::<&Diverged>().iter(world).count(), 0);
 }
 
-/// A row of sixteen beads (radius 2 cm, 1 kg, `e = 0`) poured into a
-/// one-sided bowl of radius 1 m with RATTLE at 240 Hz: they land, slide
-/// in and strike each other, and within a second lie pressed together
-/// along the bowl (all fifteen neighbouring pairs held), never
-/// overlapping by more than 1e-9 of a radius (measured 2e-14); from then
-/// the pressed row rocks in the frictionless bowl keeping its energy to
-/// 1e-9 of it (measured 1e-12).
+/// Beads of 2 cm and 1 kg at `e = 0` poured into a one-sided bowl of
+/// radius 1 m with RATTLE at 240 Hz, in rows of 23 (a debug build pours
+/// one row of sixteen; a release build two rows of 23, which `.ci/run`
+/// runs): they land, slide in, strike each other and come to lie pressed
+/// together, every bead pressed by a neighbour, never overlapping by more
+/// than 1e-9 of a radius (measured 2e-14 for one row, 2e-12 for two);
+/// in the last second nothing strikes and the pile, rocking in the
+/// frictionless bowl, keeps its energy to 1e-9 of it (measured 2e-12 and
+/// 1e-11).
 #[test]
-fn a_row_poured_into_a_bowl_lies_pressed_together_without_overlap() {
-    let (n, r) = (16usize, 0.02);
+fn a_pile_poured_into_a_bowl_lies_pressed_together_without_overlap() {
+    let (n, cols, steps) = if cfg!(debug_assertions) {
+        (16, 16, 480)
+    } else {
+        (46, 23, 720)
+    };
+    let r = 0.02;
     let beads: String = (0..n)
         .map(|k| {
-            let x = -0.5 + (k as f64 + 0.5) / n as f64 + 0.003 * ((k * 7 % 13) as f64 / 13.0 - 0.5);
-            format!("(name: \"b{k}\", mass: 1.0, radius: {r}, initial_position: ({x}, -0.8)),")
+            let (i, j) = (k % cols, k / cols);
+            let jitter = 0.003 * ((k * 7919 % 13) as f64 / 13.0 - 0.5);
+            let x = -0.5 + (i as f64 + 0.5) / cols as f64 + jitter;
+            let y = -0.8 + 2.3 * r * j as f64;
+            format!("(name: \"b{k}\", mass: 1.0, radius: {r}, initial_position: ({x}, {y})),")
         })
         .collect();
     let text = format!(
-        "(name: \"row\", params: (timestep: {}, integrator: Rattle), contacts: (restitution: 0.0), \
+        "(name: \"pile\", params: (timestep: {}, integrator: Rattle), contacts: (restitution: 0.0), \
          wires: [(shape: Circle((radius: 1.0)), side: Negative, beads: [{beads}])])",
         1.0 / 240.0
     );
     let preset = ScenePreset::from_ron(&text).unwrap_or_else(|e| panic!("{e}"));
     let plugin = WireBeadPlugin::new(preset.params.clone()).expect("valid params");
     let mut app = Headless::new(plugin).single_threaded().build();
-    preset.spawn(&mut app.world_mut().commands());
+    let spawned = preset.spawn(&mut app.world_mut().commands());
     app.world_mut().flush();
-    let islands = |app: &App| -> (f64, usize) {
+    let energy = |app: &App| -> f64 {
         let islands = app.world().resource::<Islands>();
-        (
-            islands.iter().map(|i| i.energy).sum(),
-            islands.iter().map(|i| i.pressed.len()).sum(),
-        )
+        islands.iter().map(|i| i.energy).sum()
     };
     let mut worst = f64::MIN;
-    let mut rested = None;
+    let mut last_second = None;
     let mut worst_change = 0.0f64;
-    for step in 1..=720 {
+    for step in 1..=steps {
         run_steps(&mut app, 1);
         worst = worst.max(worst_overlap(&mut app));
-        let (energy, pressed) = islands(&app);
-        if step == 240 {
-            assert_eq!(pressed, n - 1, "every neighbouring pair presses");
-            rested = Some(energy);
+        if step == steps - 240 {
+            last_second = Some(energy(&app));
         }
-        if let Some(e0) = rested {
-            worst_change = worst_change.max((energy - e0).abs() / e0.abs());
-            assert_eq!(pressed, n - 1, "step {step}: the row stays pressed");
+        if let Some(e0) = last_second {
+            worst_change = worst_change.max((energy(&app) - e0).abs() / e0.abs());
+            let messages = app.world().resource::<Messages<BeadsStruck>>();
+            assert_eq!(
+                messages.iter_current_update_messages().count(),
+                0,
+                "step {step}: still striking"
+            );
         }
     }
+    let islands = app.world().resource::<Islands>();
+    let pressed: Vec<Entity> = islands
+        .iter()
+        .flat_map(|i| i.pressed.iter().flat_map(|p| [p.a, p.b]))
+        .collect();
+    let loose = spawned.iter().filter(|b| !pressed.contains(b)).count();
+    assert_eq!(loose, 0, "beads not pressed by a neighbour");
     let world = app.world_mut();
     assert_eq!(world.query::<&Diverged>().iter(world).count(), 0);
     assert!(worst <= 1e-9, "beads overlap by {worst:e} of a radius");
     assert!(
         worst_change <= 1e-9,
-        "the pressed row's energy changed by {worst_change:e} of it"
+        "the resting pile's energy changed by {worst_change:e} of it"
     );
+    eprintln!("{n} beads: overlap {worst:e}, energy change {worst_change:e}");
 }

@@ -10,8 +10,8 @@ use super::CachedIsland;
 use crate::dynamics::{BeadsStruck, Dimension, DivergenceReason};
 use crate::plugin::report::Divergences;
 use crate::solver::{
-    self, BeadState, Integrator, Method, SolveError, Stabilization, StepSettings, StepSpan,
-    StruckPair, TouchBead, TouchBody, TouchError,
+    self, BeadState, Integrator, Method, Pressed, SolveError, Stabilization, StepSettings,
+    StepSpan, StruckPair, TouchBead, TouchBody, TouchError,
 };
 
 /// What an island keeps of its beads that touch: each one's index in the
@@ -68,6 +68,7 @@ impl<V: Dimension> TouchBody<V> for IslandBody<'_, V> {
         impulse: V,
     ) -> Result<Vec<V>, SolveError> {
         let cached = &mut *self.cached;
+        cached.work.rewind(&cached.mark);
         let answer = cached
             .island
             .respond(time, states, bead, impulse, &mut cached.work)?
@@ -76,6 +77,28 @@ impl<V: Dimension> TouchBody<V> for IslandBody<'_, V> {
         // carries on from.
         cached.work.rewind(&cached.mark);
         Ok(answer)
+    }
+
+    fn press(
+        &mut self,
+        time: f64,
+        states: &[BeadState<V>],
+    ) -> Result<Option<Pressed<V>>, SolveError> {
+        let cached = &mut *self.cached;
+        if cached.contacts.is_empty() {
+            return Ok(None);
+        }
+        cached.work.rewind(&cached.mark);
+        let (velocities, impulses) = cached.island.press(time, states, &mut cached.work)?;
+        let velocities = velocities.to_vec();
+        let impulses = cached
+            .contacts
+            .iter()
+            .filter(|c| impulses[c.row] != 0.0)
+            .map(|c| (c.a, c.b, impulses[c.row]))
+            .collect();
+        cached.work.rewind(&cached.mark);
+        Ok(Some((velocities, impulses)))
     }
 
     fn push(&self, bead: usize) -> V {
@@ -213,11 +236,9 @@ pub(super) fn settle<V: Dimension>(
     }
     if let Err(e) = settled {
         let why = match e {
-            TouchError::TooManyImpacts { a, b } => format!(
-                "beads {} and {} were still striking after {} instants of impact within one step",
-                entities[a],
-                entities[b],
-                solver::MAX_IMPACTS_PER_STEP
+            TouchError::TooManyImpacts { a, b, instants } => format!(
+                "beads {} and {} were still striking after {instants} instants of impact within one step",
+                entities[a], entities[b],
             ),
             e => e.to_string(),
         };

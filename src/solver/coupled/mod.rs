@@ -22,7 +22,7 @@ mod tests;
 
 pub use constraint::{Constraint, RowKind, SpringLink};
 pub use group::islands;
-pub(crate) use island::parts;
 pub use island::{
     Island, IslandError, IslandMark, IslandRow, IslandWork, OPENING, RowReport, TOUCHING,
 };
+pub(crate) use island::{closes, parts};

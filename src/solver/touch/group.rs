@@ -5,13 +5,13 @@
 use bevy::math::DVec3;
 
 use super::{
-    CLOSING, MAX_IMPACTS_PER_STEP, Pool, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody,
-    TouchError, overlapping, swept,
+    MAX_IMPACTS_PER_STEP, Pool, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody, TouchError,
+    overlapping, swept,
 };
 use crate::geometry::Coordinates;
 use crate::solver::contact::locate;
-use crate::solver::coupled::parts;
-use crate::solver::impact::{Response, Touch, resolve_impacts};
+use crate::solver::coupled::{closes, parts};
+use crate::solver::impact::{Response, Strike, Touch, resolve_impacts};
 use crate::solver::solve::SolveError;
 use crate::solver::state::BeadState;
 
@@ -187,7 +187,9 @@ impl<'a, V: Coordinates> Group<'a, V> {
         struck: &mut Vec<StruckPair>,
     ) -> Result<(), TouchError> {
         let mut last = (0, 0);
-        for _ in 0..MAX_IMPACTS_PER_STEP {
+        let mut instants = 0;
+        while instants < MAX_IMPACTS_PER_STEP * self.pairs.len().max(1) {
+            instants += 1;
             let Some((tau, pair)) = self.first_meeting(bodies)? else {
                 return self.finish(bodies);
             };
@@ -201,6 +203,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
         Err(TouchError::TooManyImpacts {
             a: last.0,
             b: last.1,
+            instants,
         })
     }
 
@@ -229,13 +232,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
                     continue; // its contact row keeps it from closing
                 }
                 // In touch: struck now if it closes, else left resting.
-                let n = b0.position - a0.position;
-                let u = n.dot(b0.velocity - a0.velocity) / n.dot(n).sqrt();
-                let speeds =
-                    a0.velocity.dot(a0.velocity).sqrt() + b0.velocity.dot(b0.velocity).sqrt();
-                // Closing by rounding, or too slowly to close by what
-                // counts as touching within the step, is not closing.
-                if -u > CLOSING * speeds && -u * self.span.dt > TOUCHING * r {
+                if self.closing(pair).is_some() {
                     return Ok(Some((0.0, pair)));
                 }
                 if self.gap(pair, a1.position, b1.position) < -TOUCHING * r {
@@ -269,6 +266,18 @@ impl<'a, V: Coordinates> Group<'a, V> {
             }
         }
         Ok(held.or(first))
+    }
+
+    /// How fast pair `(i, j)`, in touch now, closes (m/s, positive); none
+    /// where it does not. Closing by rounding, or too slowly to close by
+    /// what counts as touching within the step, is not closing.
+    fn closing(&self, pair: (usize, usize)) -> Option<f64> {
+        let (a, b) = (self.state(pair.0, false), self.state(pair.1, false));
+        let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
+        let n = b.position - a.position;
+        let u = n.dot(b.velocity - a.velocity) / n.dot(n).sqrt();
+        let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
+        closes(u, r, speeds, self.span.dt).then_some(-u)
     }
 
     /// The part `τ ≤ h` by which a pair apart now may have met: `h` where
@@ -390,12 +399,15 @@ impl<'a, V: Coordinates> Group<'a, V> {
         Ok(())
     }
 
-    /// Strikes every pair touching now (eq. 18, pair by pair).
+    /// Strikes every pair touching now: at `e = 0` those a contact row
+    /// joins all at once ([`Group::press`]), the rest pair by pair
+    /// (eq. 18).
     fn strike<B: TouchBody<V>>(
         &mut self,
         bodies: &mut [B],
         struck: &mut Vec<StruckPair>,
     ) -> Result<(), TouchError> {
+        self.press(bodies, struck)?;
         // The group's velocities side by side, each body's from its offset.
         let mut offsets = Vec::with_capacity(self.bodies.len());
         let mut velocities = Vec::new();
@@ -411,7 +423,10 @@ impl<'a, V: Coordinates> Group<'a, V> {
             let (a, b) = (self.state(pair.0, false), self.state(pair.1, false));
             let (ta, tb) = (self.beads[pair.0], self.beads[pair.1]);
             let r = ta.radius + tb.radius;
-            if self.gap(pair, a.position, b.position) > TOUCHING * r || self.held(bodies, pair) {
+            if self.gap(pair, a.position, b.position) > TOUCHING * r
+                || self.held(bodies, pair)
+                || self.pressable(bodies, pair)
+            {
                 continue;
             }
             let (fa, fb) = (flat(self, pair.0), flat(self, pair.1));
@@ -484,6 +499,104 @@ impl<'a, V: Coordinates> Group<'a, V> {
             }
         }
         Ok(())
+    }
+
+    /// Holds every pair in touch now that closes at `e = 0` where a
+    /// contact row joins it, and projects each such body's velocities
+    /// onto its held rows: an inelastic strike of all of them at once
+    /// (Moreau's), which striking pair by pair reaches only in the limit
+    /// of infinitely many strikes where the pairs form a pile. Pairs the
+    /// projection makes close are held too and the velocities projected
+    /// again from where they were; a pair the projection would pull is
+    /// let go again, unstruck.
+    fn press<B: TouchBody<V>>(
+        &mut self,
+        bodies: &mut [B],
+        struck: &mut Vec<StruckPair>,
+    ) -> Result<(), TouchError> {
+        let mut pressed = Vec::new();
+        let mut impulses = vec![Vec::new(); self.bodies.len()];
+        let before = self.now.clone();
+        // Each pass holds one pair more at least, so the passes end.
+        for _ in 0..=self.pairs.len() {
+            let more = self.closing_at_zero(bodies);
+            if more.is_empty() {
+                break;
+            }
+            let mut slots = Vec::new();
+            for &(slot, pair, _) in &more {
+                let (ba, bb) = (self.beads[pair.0].bead, self.beads[pair.1].bead);
+                bodies[self.bodies[slot]].hold(ba, bb, true);
+                slots.push(slot);
+            }
+            slots.sort_unstable();
+            slots.dedup();
+            for slot in slots {
+                let body = &mut bodies[self.bodies[slot]];
+                let Some((velocities, pushes)) = body.press(self.time, &before[slot])? else {
+                    continue;
+                };
+                for (state, v) in self.now[slot].iter_mut().zip(velocities) {
+                    state.velocity = v;
+                }
+                impulses[slot] = pushes;
+            }
+            pressed.extend(more);
+        }
+        for (k, &(slot, pair, closing_speed)) in pressed.iter().enumerate() {
+            let (ba, bb) = (self.beads[pair.0].bead, self.beads[pair.1].bead);
+            let impulse = impulses[slot]
+                .iter()
+                .find(|&&(a, b, _)| (a, b) == (ba.min(bb), ba.max(bb)))
+                .map_or(0.0, |p| p.2);
+            if impulse <= 0.0 {
+                bodies[self.bodies[slot]].hold(ba, bb, false);
+                continue;
+            }
+            struck.push(StruckPair {
+                a: pair.0,
+                b: pair.1,
+                time: self.time,
+                strike: Strike {
+                    touch: k,
+                    impulse,
+                    closing_speed,
+                    bounced: false,
+                },
+            });
+        }
+        Ok(())
+    }
+
+    /// The pairs in touch now, set aside by a contact row of one body,
+    /// that close at `e = 0`: `(slot, pair, closing speed)`.
+    fn closing_at_zero<B: TouchBody<V>>(&self, bodies: &[B]) -> Vec<(usize, (usize, usize), f64)> {
+        let mut closing = Vec::new();
+        for &pair in &self.pairs {
+            let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
+            let (a, b) = (self.state(pair.0, false), self.state(pair.1, false));
+            if !self.pressable(bodies, pair)
+                || self.held(bodies, pair)
+                || self.gap(pair, a.position, b.position) > TOUCHING * r
+            {
+                continue;
+            }
+            if let Some(speed) = self.closing(pair) {
+                closing.push((self.slot(pair.0), pair, speed));
+            }
+        }
+        closing
+    }
+
+    /// Whether pair `(i, j)` strikes at `e = 0` and a contact row of one
+    /// body joins it: its strikes are that body's to press
+    /// ([`Group::press`]), not pair by pair.
+    fn pressable<B: TouchBody<V>>(&self, bodies: &[B], (i, j): (usize, usize)) -> bool {
+        let (a, b) = (self.beads[i], self.beads[j]);
+        let slot = self.slot(i);
+        a.restitution.min(b.restitution) == 0.0
+            && slot == self.slot(j)
+            && bodies[self.bodies[slot]].contact(a.bead, b.bead).is_some()
     }
 
     /// Whether a contact row holds pair `(i, j)` now: pressed together,

@@ -31,7 +31,10 @@
 //! A pair left in touch that the rest of the step presses into each
 //! other is held there too, at the instant it touches. A held pair does
 //! not strike: its body answers a strike on either bead with the row
-//! held, so beads pressed together take a blow as one.
+//! held, so beads pressed together take a blow as one. Pairs at `e = 0`
+//! that a contact row joins are struck all at once (their rows held and
+//! the body's velocities projected onto them, [`TouchBody::press`]), so
+//! that a pile does not trade ever smaller strikes pair by pair.
 //!
 //! | file | what it holds |
 //! |---|---|
@@ -55,10 +58,6 @@ use group::Group;
 
 pub use super::coupled::TOUCHING;
 
-/// A pair in touch closes (and strikes at once) where it closes faster
-/// than this fraction of its two beads' speeds: slower is rounding.
-const CLOSING: f64 = 1e-9;
-
 /// A part of a step shorter than this fraction of the step is best taken
 /// by a method whose velocity does not come from a position difference
 /// over the part (RK4 with projection): RATTLE's loses the digits the
@@ -66,7 +65,8 @@ const CLOSING: f64 = 1e-9;
 pub const SHORT_PART: f64 = 1e-3;
 
 /// How many instants of impact one group of bodies may be cut at within
-/// one step before the step is reported as not settling.
+/// one step, per pair of beads it follows (a pile meets many), before
+/// the step is reported as not settling.
 pub const MAX_IMPACTS_PER_STEP: usize = 64;
 
 /// Something that steps a few beads together (an island): what settling
@@ -108,6 +108,20 @@ pub trait TouchBody<V: Coordinates> {
         let _ = (a, b);
         None
     }
+    /// Its beads' velocities at `states` and `time` projected onto what
+    /// holds them in the steps from the last [`TouchBody::keep`], its held
+    /// contacts included (see [`Island::press`](crate::solver::Island::press)):
+    /// an inelastic strike of every held pair at once, with each held
+    /// pair's impulse `(a, b, p)` (N s, pushing positive). None where the
+    /// body has no contact rows.
+    fn press(
+        &mut self,
+        time: f64,
+        states: &[BeadState<V>],
+    ) -> Result<Option<Pressed<V>>, SolveError> {
+        let _ = (time, states);
+        Ok(None)
+    }
     /// Holds the contact between beads `a` and `b` in the steps from the
     /// last [`TouchBody::keep`] (a strike left them in touch), or sets it
     /// aside (they bounced or part). A body without the row ignores it.
@@ -115,6 +129,11 @@ pub trait TouchBody<V: Coordinates> {
         let _ = (a, b, held);
     }
 }
+
+/// What a body's beads do when its held contacts are pressed at once
+/// ([`TouchBody::press`]): their velocities, and each held pair's impulse
+/// `(a, b, p)`.
+pub type Pressed<V> = (Vec<V>, Vec<(usize, usize, f64)>);
 
 /// A bead that may touch others: its body, its index there, its radius
 /// and its restitution.
@@ -156,13 +175,15 @@ pub enum TouchError {
     Impact(#[from] ImpactError),
     /// A group met more instants of impact within one step than allowed.
     #[error(
-        "beads {a} and {b} were still striking after {MAX_IMPACTS_PER_STEP} instants of impact within one step"
+        "beads {a} and {b} were still striking after {instants} instants of impact within one step"
     )]
     TooManyImpacts {
         /// The first bead of the last pair.
         a: usize,
         /// The second bead of the last pair.
         b: usize,
+        /// How many instants the group was cut at.
+        instants: usize,
     },
     /// A bead names a body or a bead of a body that is not there.
     #[error("touching bead {bead} names a body or a bead that is not there")]

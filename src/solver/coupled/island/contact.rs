@@ -5,7 +5,6 @@
 use crate::geometry::WireSpace;
 
 use super::integrators::Stage;
-use super::newton::Direction;
 use super::rows::RowAt;
 use super::{Island, IslandWork, RoughRow};
 use crate::solver::contact::{ContactEvent, bounces};
@@ -165,12 +164,17 @@ impl<V: WireSpace> Island<V> {
 
     /// Sets aside every one-sided row whose λ (eq. 12 with no
     /// stabilization) at the step's start has the sign its wire cannot
-    /// push with.
+    /// push with, and every contact row whose beads part. A contact row
+    /// whose λ would pull is left to the step's velocity solve where it
+    /// lets such rows go (`pushing`: RATTLE, and a step that projects):
+    /// that solve weighs every contact at once, where λ at the start lets
+    /// go of every row that pulls while the others hold.
     pub(super) fn leave(
         &self,
         time: f64,
         states: &[BeadState<V>],
         forces: &[LinearForce<V>],
+        pushing: bool,
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         if states.len() != self.beads() || forces.len() != self.beads() {
@@ -185,7 +189,8 @@ impl<V: WireSpace> Island<V> {
         for r in 0..self.rows() {
             let (side, _) = self.sides[r];
             let parts = || self.parting(r, states) == Some(true);
-            if side != 0.0 && !work.inactive[r] && (side * work.lambda[r] < 0.0 || parts()) {
+            let pulls = side * work.lambda[r] < 0.0 && !(pushing && self.contacts[r]);
+            if side != 0.0 && !work.inactive[r] && (pulls || parts()) {
                 work.inactive[r] = true;
                 if self.contacts[r] {
                     continue; // a pair parting is no bead leaving its wire
@@ -227,7 +232,7 @@ impl<V: WireSpace> Island<V> {
             let BeadState { position, velocity } = states[bead];
             work.inactive[r] = false;
             work.load(states);
-            self.newton(work, Direction::Current)?;
+            self.newton_holding(work)?;
             self.evaluate_at_new(work);
             let nn = normal.dot(normal).max(f64::MIN_POSITIVE);
             let across = normal.dot(velocity - wire);

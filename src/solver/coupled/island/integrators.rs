@@ -6,7 +6,7 @@
 //! velocity solve.
 
 use super::newton::Direction;
-use super::{CONTACT_PASSES, Island, IslandWork, RowReport, TOUCHING};
+use super::{CONTACT_PASSES, Island, IslandWork, RowReport};
 use crate::geometry::WireSpace;
 
 use crate::solver::rattle::{rattle_drift, rattle_half_kick};
@@ -139,13 +139,11 @@ impl<V: WireSpace> Island<V> {
     /// Eq. (8) for an island: SHAKE's position solve (Newton on all of the
     /// island's `C` along `W J₀ᵀ`), then the linear velocity solve.
     ///
-    /// Contacts between beads in touch at the step's start are one-sided
-    /// in both solves: a contact row set aside that the position solve
-    /// would leave overlapping by more than [`TOUCHING`] of its reach is
-    /// held and the solve taken again (at most [`CONTACT_PASSES`] solves;
-    /// a row held is not let go within the step, so the passes end), and a
-    /// held one the velocity solve would pull together is let go and the
-    /// velocities projected again.
+    /// A contact row set aside whose beads touched at the step's start
+    /// and that the position solve leaves overlapping is held and the
+    /// solve taken again (see [`Island::step_at`]); a held contact row
+    /// the velocity solve would pull on is let go
+    /// ([`Island::project_velocity_pushing`]).
     pub(super) fn rattle(
         &self,
         forces: &[LinearForce<V>],
@@ -154,10 +152,25 @@ impl<V: WireSpace> Island<V> {
     ) -> Result<(), SolveError> {
         let n = self.beads();
         let start = work.time;
-        for _ in 0..CONTACT_PASSES {
+        // Each pass holds one contact row more at least.
+        for _ in 0..self.rows() + CONTACT_PASSES {
             work.time = start;
-            self.rattle_positions(forces, h, work)?;
-            if !self.take_contacts(work) {
+            self.evaluate_at_start(work, work.time);
+            if self.rows() > 0 {
+                self.factor(work, true)?;
+            }
+            self.applied(forces, &work.x0, &work.v0, &mut work.force);
+            work.x.clear();
+            work.v.clear();
+            for i in 0..n {
+                let start = (work.x0[i], work.v0[i]);
+                let m = self.inverse_mass[i].recip();
+                work.x.push(rattle_drift(start, work.force[i], m, h));
+                work.v.push(work.v0[i]);
+            }
+            work.time += h;
+            self.newton(work, Direction::First)?;
+            if !self.hold_overlapping(work) {
                 break;
             }
         }
@@ -185,65 +198,14 @@ impl<V: WireSpace> Island<V> {
         Ok(())
     }
 
-    /// RATTLE's drift and position solve from `work.x0, work.v0` at
-    /// `work.time`: `work.x` on the held rows, `work.lambda` their μ.
-    fn rattle_positions(
-        &self,
-        forces: &[LinearForce<V>],
-        h: f64,
-        work: &mut IslandWork<V>,
-    ) -> Result<(), SolveError> {
-        self.evaluate_at_start(work, work.time);
-        if self.rows() > 0 {
-            self.factor(work, true)?;
-        }
-        self.applied(forces, &work.x0, &work.v0, &mut work.force);
-        work.x.clear();
-        work.v.clear();
-        for i in 0..self.beads() {
-            let start = (work.x0[i], work.v0[i]);
-            let m = self.inverse_mass[i].recip();
-            work.x.push(rattle_drift(start, work.force[i], m, h));
-            work.v.push(work.v0[i]);
-        }
-        work.time += h;
-        self.newton(work, Direction::First)
-    }
-
-    /// After a position solve: holds each contact row in touch at the
-    /// step's start that the solve leaves overlapping. Whether any was.
-    fn take_contacts(&self, work: &mut IslandWork<V>) -> bool {
-        let mut changed = false;
-        for r in 0..self.rows() {
-            if !work.inactive[r] || work.touching.get(r) != Some(&true) {
-                continue;
-            }
-            if let Some((gap, reach)) = self.contact_gap(r, &work.x)
-                && gap < -TOUCHING * reach
-            {
-                work.inactive[r] = false;
-                changed = true;
-            }
-        }
-        changed
-    }
-
-    /// Lets go of each held contact row whose multiplier pulls. Whether
-    /// any was.
-    fn let_go(&self, multipliers: &[f64], inactive: &mut [bool]) -> bool {
-        let mut changed = false;
-        for (r, &multiplier) in multipliers.iter().enumerate() {
-            if self.contacts[r] && !inactive[r] && self.sides[r].0 * multiplier < 0.0 {
-                inactive[r] = true;
-                changed = true;
-            }
-        }
-        changed
-    }
-
-    /// [`Island::project_velocity`] with every held contact row pushing:
-    /// one whose multiplier pulls is let go and the velocities projected
-    /// again from where they were.
+    /// [`Island::project_velocity`] with every held contact row pushing
+    /// and none closing: the velocities projected from where they were
+    /// onto the held rows, a contact row whose multiplier pulls let go,
+    /// and one let go whose beads then close held again, one row at a
+    /// time by the least-index rule (Murty's principal pivoting, which
+    /// ends where `J W Jᵀ` is positive definite) until none is left; at
+    /// most [`CONTACT_PASSES`] projections more than twice the contact
+    /// rows.
     pub(super) fn project_velocity_pushing(
         &self,
         work: &mut IslandWork<V>,
@@ -252,24 +214,47 @@ impl<V: WireSpace> Island<V> {
             return self.project_velocity(work);
         }
         let unprojected = work.v.clone();
-        let mut passes = 0;
-        loop {
+        let (gradient, bias) = (work.gradient.clone(), work.bias.clone());
+        let set_aside = work.inactive.clone();
+        let fastest = unprojected
+            .iter()
+            .map(|v| v.dot(*v).sqrt())
+            .fold(0.0, f64::max);
+        let contacts = self.contacts.iter().filter(|&&c| c).count();
+        for _ in 0..2 * contacts + CONTACT_PASSES {
             self.project_velocity(work)?;
-            passes += 1;
-            let pulled = self.let_go(&work.rhs, &mut work.inactive);
-            if !pulled || passes == CONTACT_PASSES {
+            // The first contact row out of place: held and pulling, or let
+            // go here and closing.
+            let flip = (0..self.rows()).find(|&r| {
+                self.contacts[r]
+                    && !set_aside[r]
+                    && if work.inactive[r] {
+                        -self.rate(r, &gradient, &work.v, &bias) > PUSHING_SLACK * fastest
+                    } else {
+                        work.rhs[r] < 0.0
+                    }
+            });
+            let Some(r) = flip else {
                 return Ok(());
-            }
+            };
+            work.inactive[r] = !work.inactive[r];
             work.v.clone_from(&unprojected);
-            for r in 0..self.rows() {
-                if work.inactive[r] {
-                    work.gradient[self.row_start[r]..self.row_start[r + 1]].fill(V::ZERO);
-                    work.bias[r] = 0.0;
-                }
+            let entries = self.row_start[r]..self.row_start[r + 1];
+            if work.inactive[r] {
+                work.gradient[entries].fill(V::ZERO);
+                work.bias[r] = 0.0;
+            } else {
+                work.gradient[entries.clone()].copy_from_slice(&gradient[entries]);
+                work.bias[r] = bias[r];
             }
         }
+        Ok(())
     }
 }
+
+/// A contact row let go whose beads close slower than this fraction of
+/// the fastest bead's speed is not closing: rounding.
+const PUSHING_SLACK: f64 = 1e-12;
 
 /// Which state a solve of eq. (12) is at.
 #[derive(Clone, Copy, PartialEq, Eq)]

@@ -57,8 +57,22 @@ pub(crate) fn parts(rate: f64, reach: f64, speeds: f64) -> bool {
     rate > OPENING * (reach + speeds)
 }
 
-/// How many times RATTLE's position solve, or a velocity projection, is
-/// taken for contacts that overlap or pull (see [`Island::set_contact`]).
+/// A pair in touch closes (and strikes at once) where it closes faster
+/// than this fraction of its two beads' speeds: slower is rounding.
+const CLOSING: f64 = 1e-9;
+
+/// Whether a pair in touch whose gap opens at `rate`, of `reach` and
+/// `speeds` as in [`parts`], closes: faster than [`CLOSING`] of its
+/// speeds, and by more than what counts as touching ([`TOUCHING`] of its
+/// reach) within a step of `dt`. A pair that closes is the touch
+/// settlement's to strike; one that does not and presses is held.
+pub(crate) fn closes(rate: f64, reach: f64, speeds: f64, dt: f64) -> bool {
+    -rate > CLOSING * speeds && -rate * dt > TOUCHING * reach
+}
+
+/// How many more times than the island has rows a step, a position
+/// solve or a velocity projection is taken again for contacts that
+/// overlap, pull or close (see [`Island::set_contact`]).
 const CONTACT_PASSES: usize = 16;
 
 /// The most exact Newton steps RATTLE's position solve takes before it
@@ -328,20 +342,23 @@ impl<V: WireSpace> Island<V> {
 
     /// Makes rod row `row` a contact between two beads that touch: one
     /// side (`|x_a − x_b| ≥ length`, the two radii), held only while its
-    /// beads press. A contact row starts set aside, is set aside at a
-    /// step's start where its λ would pull or its beads part
-    /// ([`OPENING`]), and within RATTLE's step where its velocity
-    /// multiplier would pull. Where beads apart meet within a step is the
-    /// touch settlement's to find
+    /// beads press. A contact row starts set aside and is set aside at a
+    /// step's start where its beads part ([`OPENING`]); where it pulls is
+    /// judged by the step's velocity solve with every contact at once
+    /// (RATTLE, or a step that projects: the row is let go there), or by
+    /// its λ at the step's start (a step with neither). Where beads apart
+    /// meet within a step is the touch settlement's to find
     /// ([`settle_touches`](crate::solver::settle_touches)), which holds
     /// the row ([`IslandMark::hold`]) where a strike leaves the pair in
-    /// touch or the step presses a touching pair together; RATTLE's own
-    /// step holds a row whose beads touched at its start where its
-    /// position solve would leave them overlapping, so a pile of beads
-    /// pressing on each other settles within one step. A held pair does
-    /// not strike: a strike's answer ([`Island::respond`]) keeps the held
-    /// rows, so that beads pressed together answer as one, while pairs
-    /// apart strike in turn. Rows of other kinds are left as they are.
+    /// touch or the step presses a touching pair together; the island's
+    /// own step holds a row whose beads touched at its start where the
+    /// step would leave them overlapping, and takes it again
+    /// ([`Island::step_at`]), so a pile of beads pressing on each other
+    /// settles within one step. A held pair does not strike: a strike's
+    /// answer ([`Island::respond`]) keeps the held rows, so that beads
+    /// pressed together answer as one, while pairs apart strike in turn;
+    /// pairs at `e = 0` are struck all at once by [`Island::press`]. Rows
+    /// of other kinds are left as they are.
     pub fn set_contact(&mut self, row: usize) {
         if let (Some(RowKind::Rod { .. }), Some(slot), Some(contact)) = (
             self.rows.get(row),

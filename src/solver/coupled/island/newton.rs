@@ -5,7 +5,7 @@
 //! by the lone bead's test, each row within its tolerance or the worst
 //! row accepted.
 
-use super::{EXACT_STEPS, Island, IslandWork};
+use super::{CONTACT_PASSES, EXACT_STEPS, Island, IslandWork};
 use crate::geometry::WireSpace;
 
 use crate::solver::newton::{NEWTON_MAX_ITERATIONS, newton_accepted, newton_within};
@@ -119,6 +119,23 @@ impl<V: WireSpace> Island<V> {
             self.push(along, &work.rhs, &mut work.x);
             i += 1;
         }
+    }
+
+    /// Newton along the current gradients, each contact row set aside
+    /// whose beads touched where the step began and that the projection
+    /// leaves overlapping held and the projection taken again from where
+    /// it started (see [`Island::step_at`]).
+    pub(super) fn newton_holding(&self, work: &mut IslandWork<V>) -> Result<(), SolveError> {
+        let start = work.x.clone();
+        // Each pass holds one contact row more at least.
+        for _ in 0..self.rows() + CONTACT_PASSES {
+            self.newton(work, Direction::Current)?;
+            if !self.hold_overlapping(work) {
+                break;
+            }
+            work.x.clone_from(&start);
+        }
+        Ok(())
     }
 
     /// The largest coordinate of row `r`'s beads at `x`: how far rounding

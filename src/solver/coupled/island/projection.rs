@@ -6,7 +6,6 @@
 
 use crate::geometry::WireSpace;
 
-use super::newton::Direction;
 use super::{Island, IslandWork};
 use crate::solver::restore::{energy_scale, kinetic_scale};
 use crate::solver::solve::SolveError;
@@ -109,6 +108,44 @@ impl<V: WireSpace> Island<V> {
         Ok(&work.v)
     }
 
+    /// The beads' velocities at `states` and `time` projected onto the
+    /// rows that hold now, the contacts held between beads included (one
+    /// that would pull is let go, as in [`Island::respond`]): the
+    /// velocities nearest the given ones in the kinetic-energy norm that
+    /// meet `Ċ = 0` on those rows (a moving wire's own velocity kept).
+    /// Where held contacts close, this is an inelastic strike of all of
+    /// them at once (Moreau's), each row's impulse (N s, pushing positive)
+    /// the second slice; a row not held has none. The rows held are left
+    /// as they were.
+    pub fn press<'w>(
+        &self,
+        time: f64,
+        states: &[BeadState<V>],
+        work: &'w mut IslandWork<V>,
+    ) -> Result<(&'w [V], &'w [f64]), SolveError> {
+        if states.len() != self.beads() {
+            return Err(SolveError::WrongLength {
+                beads: self.beads(),
+                states: states.len(),
+                forces: self.beads(),
+            });
+        }
+        self.begin(time, states, work);
+        let held = work.inactive.clone();
+        work.time = time;
+        work.load(states);
+        self.evaluate_at_new(work);
+        let projected = self.project_velocity_pushing(work);
+        for (impulse, &inactive) in work.rhs.iter_mut().zip(&work.inactive) {
+            if inactive {
+                *impulse = 0.0;
+            }
+        }
+        work.inactive = held;
+        projected?;
+        Ok((&work.v, &work.rhs))
+    }
+
     /// Removes the velocity's component off the constraints:
     /// `v ← v − W Jᵀ (J W Jᵀ)⁻¹ J v` at `work.x` (rows evaluated there).
     /// Returns with the multipliers (of `−J v`) in `work.rhs`.
@@ -142,9 +179,9 @@ impl<V: WireSpace> Island<V> {
         restore: Restore,
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
-        self.newton(work, Direction::Current)?;
+        self.newton_holding(work)?;
         self.evaluate_at_new(work);
-        self.project_velocity(work)?;
+        self.project_velocity_pushing(work)?;
         let kinetic = |v: &[V]| self.kinetic(v.iter().copied());
         let now = kinetic(&work.v);
         let h = match restore {

@@ -49,6 +49,14 @@ impl<V: WireSpace> Island<V> {
     /// `states` (see [`OPENING`](super::OPENING)); none for a row of
     /// another kind.
     pub(super) fn parting(&self, r: usize, states: &[BeadState<V>]) -> Option<bool> {
+        let (rate, reach, speeds) = self.opening(r, states)?;
+        Some(parts(rate, reach, speeds))
+    }
+
+    /// How fast the gap of contact row `r`'s beads opens where they are in
+    /// `states` (negative: closes), their reach (the two radii) and the
+    /// sum of their speeds; none for a row of another kind.
+    pub(super) fn opening(&self, r: usize, states: &[BeadState<V>]) -> Option<(f64, f64, f64)> {
         let RowKind::Rod { length } = self.rows[r] else {
             return None;
         };
@@ -61,7 +69,7 @@ impl<V: WireSpace> Island<V> {
         let distance = d.dot(d).sqrt();
         let rate = d.dot(a.velocity - b.velocity) / distance;
         let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
-        Some(parts(rate, length, speeds))
+        Some((rate, length, speeds))
     }
 
     /// The shape of wire row `r` and where its wire is at `time`, with its

@@ -4,12 +4,15 @@
 
 use crate::geometry::WireSpace;
 
+use super::closes;
 use super::integrators::Stage;
 use super::projection::Restore;
-use super::{CALM_STEPS, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow, TOUCHING};
+use super::{
+    CALM_STEPS, CONTACT_PASSES, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow, TOUCHING,
+};
 use crate::solver::contact::locate;
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
-use crate::solver::method::Method;
+use crate::solver::method::{Integrator, Method};
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
@@ -56,6 +59,15 @@ impl<V: WireSpace> Island<V> {
 
     /// [`Island::step`] for a step that starts at time `time`: the time
     /// at which wires on a path (see [`Island::move_wire`]) are placed.
+    ///
+    /// A contact row set aside whose beads touched at the step's start
+    /// and that the step leaves overlapping by more than [`TOUCHING`] of
+    /// their reach is held and the step taken again from its start, so a
+    /// pile pressing on itself settles within the step (RATTLE does the
+    /// same within its position solve first, and a post-stabilizing step
+    /// within its projection, where a pass costs less). A row held is not
+    /// let go by the step taken again, so the passes end: at most 16 more
+    /// than the island has rows.
     pub fn step_at(
         &self,
         time: f64,
@@ -64,14 +76,77 @@ impl<V: WireSpace> Island<V> {
         settings: &StepSettings,
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
+        if !self.contacts.contains(&true) {
+            return self.step_holding(time, states, forces, settings, &[], work);
+        }
+        let start = states.to_vec();
+        let mark = work.mark();
+        let mut hold = Vec::new();
+        let passes = self.rows() + CONTACT_PASSES;
+        for pass in 1..=passes {
+            self.step_holding(time, states, forces, settings, &hold, work)?;
+            work.x.clear();
+            work.x.extend(states.iter().map(|s| s.position));
+            let more = self.overlapping(work);
+            if more.is_empty() || pass == passes {
+                break;
+            }
+            hold.extend(more);
+            states.copy_from_slice(&start);
+            work.rewind(&mark);
+        }
+        Ok(())
+    }
+
+    /// The contact rows set aside whose beads touched where the step
+    /// began and overlap at `work.x` by more than [`TOUCHING`] of their
+    /// reach: those the step holds and is taken again with.
+    pub(super) fn overlapping(&self, work: &IslandWork<V>) -> Vec<usize> {
+        (0..self.rows())
+            .filter(|&r| {
+                work.inactive[r]
+                    && work.touching.get(r) == Some(&true)
+                    && self
+                        .contact_gap(r, &work.x)
+                        .is_some_and(|(gap, reach)| gap < -TOUCHING * reach)
+            })
+            .collect()
+    }
+
+    /// Holds the rows [`Island::overlapping`] finds. Whether there were
+    /// any.
+    pub(super) fn hold_overlapping(&self, work: &mut IslandWork<V>) -> bool {
+        let more = self.overlapping(work);
+        for &r in &more {
+            work.inactive[r] = false;
+        }
+        !more.is_empty()
+    }
+
+    /// One pass of [`Island::step_at`], the contact rows `hold` held from
+    /// its start.
+    fn step_holding(
+        &self,
+        time: f64,
+        states: &mut [BeadState<V>],
+        forces: &[LinearForce<V>],
+        settings: &StepSettings,
+        hold: &[usize],
+        work: &mut IslandWork<V>,
+    ) -> Result<(), SolveError> {
         work.events.clear();
         self.begin(time, states, work);
         let one_sided = self.one_sided();
         let rough = self.is_rough();
         if one_sided || rough {
-            self.leave(time, states, forces, work)?;
+            let method = settings.method;
+            let pushing = method.integrator() == Integrator::Rattle || method.projects();
+            self.leave(time, states, forces, pushing, work)?;
         }
-        self.touching(states, work);
+        self.touching(states, settings.dt, work);
+        for &r in hold {
+            work.inactive[r] = false;
+        }
         let mut resisted = Vec::new();
         let slides = if rough && states.len() == self.beads() && forces.len() == self.beads() {
             resisted.extend_from_slice(forces);
@@ -114,8 +189,10 @@ impl<V: WireSpace> Island<V> {
     }
 
     /// Marks the contact rows whose beads touch at `states` (the step's
-    /// start): those RATTLE's position solve may hold.
-    fn touching(&self, states: &[BeadState<V>], work: &mut IslandWork<V>) {
+    /// start) and do not close within a step of `dt` ([`closes`]): those
+    /// the step may hold where it would press them together. A pair that
+    /// closes is the touch settlement's to strike.
+    fn touching(&self, states: &[BeadState<V>], dt: f64, work: &mut IslandWork<V>) {
         work.touching.clear();
         if !self.contacts.contains(&true) || states.len() != self.beads() {
             return;
@@ -123,9 +200,13 @@ impl<V: WireSpace> Island<V> {
         work.x.clear();
         work.x.extend(states.iter().map(|s| s.position));
         for r in 0..self.rows() {
-            let gap = self.contact_gap(r, &work.x);
-            work.touching
-                .push(gap.is_some_and(|(gap, reach)| gap <= TOUCHING * reach));
+            let touches = self
+                .contact_gap(r, &work.x)
+                .is_some_and(|(gap, reach)| gap <= TOUCHING * reach);
+            let closing = self
+                .opening(r, states)
+                .is_some_and(|(rate, reach, speeds)| closes(rate, reach, speeds, dt));
+            work.touching.push(touches && !closing);
         }
     }
 

@@ -334,7 +334,9 @@ fn an_island_lands_within_the_step_where_a_lone_bead_does() {
 /// A contact row between a pinned bead and a 2 kg bead resting on it:
 /// set aside at the start; held (from a mark), the pair presses with the
 /// weight, `λ = m g` to 1e-12 of it, and the bead stays put; pushed up
-/// instead, the row is let go at the step's start and the bead leaves.
+/// instead, RATTLE's velocity solve lets the row go (its multiplier
+/// would pull) and the bead leaves: moving up after the step, risen after
+/// the next.
 #[test]
 fn a_contact_row_holds_a_pressing_pair_and_lets_a_pulling_one_go() {
     let (r, m, g) = (0.1, 2.0, 9.81);
@@ -366,7 +368,12 @@ fn a_contact_row_holds_a_pressing_pair_and_lets_a_pulling_one_go() {
             assert!((lambda - m * g).abs() <= 1e-12 * m * g, "λ = {lambda}");
             assert!(rise.abs() <= 1e-15 && states[1].velocity.length() <= 1e-12);
         } else {
-            assert!(rise > 0.0 && states[1].velocity.y > 0.0, "rise {rise}");
+            assert!(states[1].velocity.y > 0.0, "v = {}", states[1].velocity);
+            island
+                .step_at(s.dt, &mut states, &forces, &s, &mut work)
+                .unwrap();
+            let rise = states[1].position.y - 2.0 * r;
+            assert!(rise > 0.0 && !work.holds(2), "rise {rise}");
         }
     }
 }
@@ -426,5 +433,37 @@ fn a_strike_on_a_held_pair_moves_it_as_one() {
             );
         }
         assert_eq!(work.holds(0), held, "the answer leaves the row as it was");
+    }
+}
+
+/// Two free 1 kg beads in touch, the first closing on the second at
+/// 1 m/s, their contact row held: pressed, they move on together at
+/// ½ m/s to 1e-15, the row pushing with ½ N s, having lost ¼ J (`½ μ u²`,
+/// μ = ½ kg); pulling apart instead, the row is let go and nothing moves.
+#[test]
+fn pressing_a_closing_held_pair_strikes_it_inelastically() {
+    let mut island = Island::new(&[1.0, 1.0], vec![rod(0, 1, 0.2)], vec![]).unwrap();
+    island.set_contact(0);
+    for (u, expect, push) in [(1.0, [0.5, 0.5], 0.5), (-1.0, [-1.0, 0.0], 0.0)] {
+        let mut states = at_rest(&[DVec2::ZERO, DVec2::new(0.2, 0.0)]);
+        states[0].velocity = DVec2::new(u, 0.0);
+        let mut work = IslandWork::default();
+        island.begin(0.0, &states, &mut work);
+        let mut mark = work.mark();
+        mark.hold(0, true);
+        work.rewind(&mark);
+        let (velocities, impulses) = island.press(0.0, &states, &mut work).unwrap();
+        for (k, v) in velocities.iter().enumerate() {
+            assert!(
+                (v.x - expect[k]).abs() <= 1e-15 && v.y.abs() <= 1e-15,
+                "u = {u}: bead {k} at {v}"
+            );
+        }
+        assert!(
+            (impulses[0] - push).abs() <= 1e-15,
+            "impulse {}",
+            impulses[0]
+        );
+        assert!(work.holds(0), "the press leaves the row held");
     }
 }
