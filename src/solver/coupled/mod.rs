@@ -25,4 +25,4 @@ pub use group::islands;
 pub use island::{
     Island, IslandError, IslandMark, IslandRow, IslandWork, OPENING, RowReport, TOUCHING,
 };
-pub(crate) use island::{closes, parts};
+pub(crate) use island::{closes, opening_rate, parts};

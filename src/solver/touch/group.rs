@@ -10,7 +10,7 @@ use super::{
 };
 use crate::geometry::Coordinates;
 use crate::solver::contact::locate;
-use crate::solver::coupled::{closes, parts};
+use crate::solver::coupled::{closes, opening_rate, parts};
 use crate::solver::impact::{Response, Strike, Touch, resolve_impacts};
 use crate::solver::solve::SolveError;
 use crate::solver::state::BeadState;
@@ -274,9 +274,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
     fn closing(&self, pair: (usize, usize)) -> Option<f64> {
         let (a, b) = (self.state(pair.0, false), self.state(pair.1, false));
         let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
-        let n = b.position - a.position;
-        let u = n.dot(b.velocity - a.velocity) / n.dot(n).sqrt();
-        let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
+        let (u, speeds) = opening_rate(&a, &b);
         closes(u, r, speeds, self.span.dt).then_some(-u)
     }
 
@@ -514,12 +512,15 @@ impl<'a, V: Coordinates> Group<'a, V> {
         bodies: &mut [B],
         struck: &mut Vec<StruckPair>,
     ) -> Result<(), TouchError> {
+        let mut more = self.closing_at_zero(bodies);
+        if more.is_empty() {
+            return Ok(());
+        }
         let mut pressed = Vec::new();
         let mut impulses = vec![Vec::new(); self.bodies.len()];
         let before = self.now.clone();
         // Each pass holds one pair more at least, so the passes end.
         for _ in 0..=self.pairs.len() {
-            let more = self.closing_at_zero(bodies);
             if more.is_empty() {
                 break;
             }
@@ -541,7 +542,8 @@ impl<'a, V: Coordinates> Group<'a, V> {
                 }
                 impulses[slot] = pushes;
             }
-            pressed.extend(more);
+            pressed.append(&mut more);
+            more = self.closing_at_zero(bodies);
         }
         for (k, &(slot, pair, closing_speed)) in pressed.iter().enumerate() {
             let (ba, bb) = (self.beads[pair.0].bead, self.beads[pair.1].bead);

@@ -57,6 +57,18 @@ pub(crate) fn parts(rate: f64, reach: f64, speeds: f64) -> bool {
     rate > OPENING * (reach + speeds)
 }
 
+/// How fast the gap between beads `a` and `b` opens (negative: closes),
+/// along the line between their centres, and the sum of their speeds.
+pub(crate) fn opening_rate<V: crate::geometry::Coordinates>(
+    a: &BeadState<V>,
+    b: &BeadState<V>,
+) -> (f64, f64) {
+    let d = b.position - a.position;
+    let rate = d.dot(b.velocity - a.velocity) / d.dot(d).sqrt();
+    let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
+    (rate, speeds)
+}
+
 /// A pair in touch closes (and strikes at once) where it closes faster
 /// than this fraction of its two beads' speeds: slower is rounding.
 const CLOSING: f64 = 1e-9;
@@ -157,9 +169,9 @@ pub struct IslandWork<V: WireSpace = DVec2> {
     time: f64,
     /// The rows set aside: one-sided wires their beads have left.
     inactive: Vec<bool>,
-    /// The contact rows whose beads touched where the step began: RATTLE's
-    /// position solve holds them where they would overlap (see
-    /// [`Island::set_contact`]).
+    /// The contact rows whose beads touched where the step began without
+    /// closing: the step holds them where it would leave them overlapping
+    /// (see [`Island::step_at`]).
     touching: Vec<bool>,
     /// Each wire row's curve parameter where its bead was after the last
     /// step (NaN: unknown), so a self-crossing track keeps it on its branch.

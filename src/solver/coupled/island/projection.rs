@@ -94,17 +94,11 @@ impl<V: WireSpace> Island<V> {
                 forces: usize::from(bead < self.beads()),
             });
         }
-        self.begin(time, states, work);
-        let held = work.inactive.clone();
-        work.time = time;
-        work.load(states);
-        self.evaluate_at_new(work);
-        work.bias.fill(0.0);
-        work.v.fill(V::ZERO);
-        work.v[bead] = impulse * self.inverse_mass[bead];
-        let projected = self.project_velocity_pushing(work);
-        work.inactive = held;
-        projected?;
+        self.project_held(time, states, work, |island, work| {
+            work.bias.fill(0.0);
+            work.v.fill(V::ZERO);
+            work.v[bead] = impulse * island.inverse_mass[bead];
+        })?;
         Ok(&work.v)
     }
 
@@ -130,20 +124,36 @@ impl<V: WireSpace> Island<V> {
                 forces: self.beads(),
             });
         }
+        self.project_held(time, states, work, |_, _| {})?;
+        Ok((&work.v, &work.rhs))
+    }
+
+    /// The rows evaluated at `states` and `time`, `set` given the work to
+    /// put the velocities to project (and their bias) in place, and the
+    /// velocities projected onto the rows held, a contact that would pull
+    /// let go ([`Island::project_velocity_pushing`]); a row let go there
+    /// has no multiplier, and the rows held are left as they were.
+    fn project_held(
+        &self,
+        time: f64,
+        states: &[BeadState<V>],
+        work: &mut IslandWork<V>,
+        set: impl FnOnce(&Self, &mut IslandWork<V>),
+    ) -> Result<(), SolveError> {
         self.begin(time, states, work);
         let held = work.inactive.clone();
         work.time = time;
         work.load(states);
         self.evaluate_at_new(work);
+        set(self, work);
         let projected = self.project_velocity_pushing(work);
-        for (impulse, &inactive) in work.rhs.iter_mut().zip(&work.inactive) {
+        for (multiplier, &inactive) in work.rhs.iter_mut().zip(&work.inactive) {
             if inactive {
-                *impulse = 0.0;
+                *multiplier = 0.0;
             }
         }
         work.inactive = held;
-        projected?;
-        Ok((&work.v, &work.rhs))
+        projected
     }
 
     /// Removes the velocity's component off the constraints:

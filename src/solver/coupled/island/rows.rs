@@ -4,7 +4,7 @@
 
 use bevy::math::DVec2;
 
-use super::{Island, IslandWork, parts};
+use super::{Island, IslandWork, opening_rate, parts};
 use crate::geometry::{Placement, Twist, WireSpace, placed_geometry};
 use crate::solver::coupled::constraint::RowKind;
 use crate::solver::state::{BeadState, LinearForce};
@@ -30,19 +30,23 @@ impl<V: WireSpace> Island<V> {
         }
     }
 
+    /// Contact row `r`'s two beads and its reach `r_a + r_b`; none for a
+    /// row of another kind.
+    fn contact_pair(&self, r: usize) -> Option<(usize, usize, f64)> {
+        let RowKind::Rod { length } = self.rows[r] else {
+            return None;
+        };
+        let entries = &self.entry_bead[self.row_start[r]..self.row_start[r + 1]];
+        self.contacts[r].then(|| (entries[0], entries[1], length))
+    }
+
     /// The gap `|x_a − x_b| − (r_a + r_b)` of contact row `r`'s beads at
     /// positions `x`, and its reach `r_a + r_b`; none for a row of another
     /// kind.
     pub(super) fn contact_gap(&self, r: usize, x: &[V]) -> Option<(f64, f64)> {
-        let RowKind::Rod { length } = self.rows[r] else {
-            return None;
-        };
-        if !self.contacts[r] {
-            return None;
-        }
-        let entries = &self.entry_bead[self.row_start[r]..self.row_start[r + 1]];
-        let d = *x.get(entries[0])? - *x.get(entries[1])?;
-        Some((d.dot(d).sqrt() - length, length))
+        let (a, b, reach) = self.contact_pair(r)?;
+        let d = *x.get(a)? - *x.get(b)?;
+        Some((d.dot(d).sqrt() - reach, reach))
     }
 
     /// Whether the beads of contact row `r` part where they are in
@@ -57,19 +61,9 @@ impl<V: WireSpace> Island<V> {
     /// `states` (negative: closes), their reach (the two radii) and the
     /// sum of their speeds; none for a row of another kind.
     pub(super) fn opening(&self, r: usize, states: &[BeadState<V>]) -> Option<(f64, f64, f64)> {
-        let RowKind::Rod { length } = self.rows[r] else {
-            return None;
-        };
-        if !self.contacts[r] {
-            return None;
-        }
-        let entries = &self.entry_bead[self.row_start[r]..self.row_start[r + 1]];
-        let (a, b) = (states.get(entries[0])?, states.get(entries[1])?);
-        let d = a.position - b.position;
-        let distance = d.dot(d).sqrt();
-        let rate = d.dot(a.velocity - b.velocity) / distance;
-        let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
-        Some((rate, length, speeds))
+        let (a, b, reach) = self.contact_pair(r)?;
+        let (rate, speeds) = opening_rate(states.get(a)?, states.get(b)?);
+        Some((rate, reach, speeds))
     }
 
     /// The shape of wire row `r` and where its wire is at `time`, with its

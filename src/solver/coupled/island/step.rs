@@ -76,7 +76,9 @@ impl<V: WireSpace> Island<V> {
         settings: &StepSettings,
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
-        if !self.contacts.contains(&true) {
+        self.touching(states, settings.dt, work);
+        if !work.touching.contains(&true) {
+            // Nothing in touch: no row the step could press to hold.
             return self.step_holding(time, states, forces, settings, &[], work);
         }
         let start = states.to_vec();
@@ -143,7 +145,6 @@ impl<V: WireSpace> Island<V> {
             let pushing = method.integrator() == Integrator::Rattle || method.projects();
             self.leave(time, states, forces, pushing, work)?;
         }
-        self.touching(states, settings.dt, work);
         for &r in hold {
             work.inactive[r] = false;
         }
