@@ -57,13 +57,13 @@ pub use method::{Integrator, Method, Stabilization};
 pub use projection::project;
 pub use rattle::rattle;
 pub use rk4::rk4;
-pub use settings::{Gains, StepSettings};
+pub use settings::{Gains, SHORT_PART, StepSettings};
 pub use solve::{SolveError, Solved, lambda, solve};
 pub use state::{Advance, BeadState, LinearForce};
 pub use step::{StepOutput, constraint_state, constraint_state_on, step, step_on};
 pub use touch::{
-    MAX_IMPACTS_PER_STEP, Pressed, SHORT_PART, StepSpan, StruckPair, TOUCHING, TouchBead,
-    TouchBody, TouchError, may_touch, overlapping, settle_touches,
+    MAX_IMPACTS_PER_STEP, Pressed, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody,
+    TouchError, may_touch, overlapping, settle_touches,
 };
 
 /// What the solver's unit tests share.

@@ -1,7 +1,7 @@
 //! [`StepSettings`]: what is the same for every bead in a step. Nothing
 //! that belongs to one bead (its mass, its state, its force) lives here.
 
-use super::method::{Method, Stabilization};
+use super::method::{Integrator, Method, Stabilization};
 
 /// The settings of one step, shared by every bead.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,7 +20,29 @@ pub struct StepSettings {
     pub drift_bound: f64,
 }
 
+/// A part of a step shorter than this fraction of the step is best taken
+/// by a method whose velocity does not come from a position difference
+/// over the part (RK4 with projection): RATTLE's loses the digits the
+/// part is short by.
+pub const SHORT_PART: f64 = 1e-3;
+
 impl StepSettings {
+    /// The settings for a part `h` of this step: RK4 with projection where
+    /// the part is shorter than [`SHORT_PART`] of the step, the step's own
+    /// method otherwise.
+    pub fn part(&self, h: f64) -> Self {
+        let method = if h < SHORT_PART * self.dt {
+            Method::new(Integrator::Rk4, Some(Stabilization::Projection)).unwrap_or_default()
+        } else {
+            self.method
+        };
+        Self {
+            dt: h,
+            method,
+            ..*self
+        }
+    }
+
     /// The gains that enter eq. (3): the configured α and β under
     /// Baumgarte, zero otherwise.
     pub fn gains(&self) -> Gains {

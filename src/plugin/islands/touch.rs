@@ -10,8 +10,8 @@ use super::CachedIsland;
 use crate::dynamics::{BeadsStruck, Dimension, DivergenceReason};
 use crate::plugin::report::Divergences;
 use crate::solver::{
-    self, BeadState, Integrator, Method, Pressed, SolveError, Stabilization, StepSettings,
-    StepSpan, StruckPair, TouchBead, TouchBody, TouchError,
+    self, BeadState, Pressed, SolveError, StepSettings, StepSpan, StruckPair, TouchBead, TouchBody,
+    TouchError,
 };
 
 /// What an island keeps of its beads that touch: each one's index in the
@@ -41,16 +41,7 @@ impl<V: Dimension> TouchBody<V> for IslandBody<'_, V> {
     ) -> Result<(), SolveError> {
         let cached = &mut *self.cached;
         cached.work.rewind(&cached.mark);
-        let method = if h < solver::SHORT_PART * self.settings.dt {
-            Method::new(Integrator::Rk4, Some(Stabilization::Projection)).unwrap_or_default()
-        } else {
-            self.settings.method
-        };
-        let settings = StepSettings {
-            dt: h,
-            method,
-            ..self.settings
-        };
+        let settings = self.settings.part(h);
         cached
             .island
             .step_at(time, states, &cached.forces, &settings, &mut cached.work)

@@ -35,11 +35,22 @@ pub(crate) fn locate(
     g0: f64,
     mut g: impl FnMut(f64) -> Result<f64, SolveError>,
 ) -> Result<f64, SolveError> {
-    let (mut a, mut b) = (0.0, h);
-    let (mut ga, mut gb) = (g0, g(h)?);
-    if ga.is_nan() || ga <= 0.0 {
+    if g0.is_nan() || g0 <= 0.0 {
         return Ok(0.0);
     }
+    let gh = g(h)?;
+    locate_between((0.0, g0), (h, gh), h, g)
+}
+
+/// [`locate`] within the bracket from `a` (where `g` is positive) to `b`
+/// (where it is not), each with its value of `g`, to a width of 1e-13 of
+/// `h`: the end `b` of the last bracket.
+pub(crate) fn locate_between(
+    (mut a, mut ga): (f64, f64),
+    (mut b, mut gb): (f64, f64),
+    h: f64,
+    mut g: impl FnMut(f64) -> Result<f64, SolveError>,
+) -> Result<f64, SolveError> {
     let mut last = 0;
     for _ in 0..100 {
         if b - a <= 1e-13 * h || gb == 0.0 {

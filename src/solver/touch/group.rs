@@ -9,7 +9,7 @@ use super::{
     overlapping, swept,
 };
 use crate::geometry::Coordinates;
-use crate::solver::contact::locate;
+use crate::solver::contact::locate_between;
 use crate::solver::coupled::{closes, opening_rate, parts};
 use crate::solver::impact::{Response, Strike, Touch, resolve_impacts};
 use crate::solver::solve::SolveError;
@@ -304,52 +304,120 @@ impl<'a, V: Coordinates> Group<'a, V> {
     }
 
     /// Where the first of `candidates` (pair, gap now, part by which it
-    /// may have met) meets: the earliest part at whose end one has met
-    /// brackets it, and regula falsi on the least gap locates it.
+    /// may have met) meets. Newton's method on the least gap from the
+    /// earliest meeting their smooth paths predict ([`Group::predict`]),
+    /// each trial stepping the bodies and taking the gap's rate from the
+    /// closest pair, ends where the least gap is within
+    /// [`ARRIVED`] of the touching tolerance of nothing; where it does not
+    /// within [`NEWTON_TRIALS`], the earliest part at whose end one has
+    /// met brackets the meeting, and regula falsi on the least gap
+    /// locates it within what Newton's trials bracketed.
     fn locate_first<B: TouchBody<V>>(
         &mut self,
         bodies: &mut [B],
         candidates: &mut [((usize, usize), f64, f64)],
         h: f64,
     ) -> Result<Option<(f64, (usize, usize))>, TouchError> {
-        candidates.sort_by(|x, y| x.2.total_cmp(&y.2));
-        let mut bracket = None;
-        let mut tried = f64::NAN;
-        for k in 0..candidates.len() {
-            let by = candidates[k].2;
-            if by == tried {
-                continue;
-            }
-            tried = by;
-            if self.least_gap(bodies, candidates, by)?.0 <= 0.0 {
-                bracket = Some(by);
+        let g0 = candidates.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+        let mut low = (0.0, g0);
+        let mut high = None;
+        let predicted = candidates
+            .iter()
+            .filter_map(|c| self.predict(c.0, c.2))
+            .fold(f64::INFINITY, f64::min);
+        let mut tau = predicted;
+        for _ in 0..NEWTON_TRIALS {
+            if !(tau > low.0 && tau <= high.map_or(h, |(b, _)| b)) {
                 break;
             }
-            if by >= h {
-                break;
+            let (gap, pair, rate) = self.least_gap(bodies, candidates, tau)?;
+            let reach = self.beads[pair.0].radius + self.beads[pair.1].radius;
+            if gap.abs() <= ARRIVED * TOUCHING * reach {
+                return Ok(Some((tau, pair)));
+            }
+            if gap > 0.0 {
+                low = (tau, gap);
+            } else {
+                high = Some((tau, gap));
+            }
+            tau -= gap / rate;
+        }
+        if high.is_none() {
+            candidates.sort_by(|x, y| x.2.total_cmp(&y.2));
+            let mut tried = f64::NAN;
+            for k in 0..candidates.len() {
+                let by = candidates[k].2;
+                if by == tried || by <= low.0 {
+                    continue;
+                }
+                tried = by;
+                let (gap, ..) = self.least_gap(bodies, candidates, by)?;
+                if gap <= 0.0 {
+                    high = Some((by, gap));
+                    break;
+                }
+                low = (by, gap);
+                if by >= h {
+                    break;
+                }
             }
         }
-        let Some(hi) = bracket else {
+        let Some(high) = high else {
             return Ok(None);
         };
-        let g0 = candidates.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
-        let tau = locate(hi, g0, |tau| Ok(self.least_gap(bodies, candidates, tau)?.0))?;
-        let (_, pair) = self.least_gap(bodies, candidates, tau)?;
+        let tau = locate_between(low, high, h, |tau| {
+            Ok(self.least_gap(bodies, candidates, tau)?.0)
+        })?;
+        let (_, pair, _) = self.least_gap(bodies, candidates, tau)?;
         Ok(Some((tau, pair)))
     }
 
+    /// The earliest part of the step left by which pair `(i, j)` meets
+    /// on the cubic paths through its beads' states now and at the
+    /// step's end (Hermite's: exact where a bead's acceleration is
+    /// constant), looked for up to `by`; none if it does not meet there.
+    fn predict(&self, pair: (usize, usize), by: f64) -> Option<f64> {
+        let h = self.left();
+        let ends = |i: usize| (self.state(i, false), self.state(i, true));
+        let ((a0, a1), (b0, b1)) = (ends(pair.0), ends(pair.1));
+        let gap = |tau: f64| {
+            let at = |s0: BeadState<V>, s1: BeadState<V>| hermite(s0, s1, h, tau);
+            self.gap(pair, at(a0, a1), at(b0, b1))
+        };
+        let samples = 32;
+        let mut before = 0.0;
+        for k in 1..=samples {
+            let tau = by * k as f64 / samples as f64;
+            if gap(tau) <= 0.0 {
+                let (mut lo, mut hi) = (before, tau);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    if gap(mid) > 0.0 {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                return Some(hi);
+            }
+            before = tau;
+        }
+        None
+    }
+
     /// The least gap of `candidates` after stepping their bodies from now
-    /// by `tau` (each once), and its pair.
+    /// by `tau` (each once), its pair, and how fast that pair's gap opens
+    /// there.
     fn least_gap<B: TouchBody<V>>(
         &mut self,
         bodies: &mut [B],
         candidates: &[((usize, usize), f64, f64)],
         tau: f64,
-    ) -> Result<(f64, (usize, usize)), SolveError> {
+    ) -> Result<(f64, (usize, usize), f64), SolveError> {
         let mut stepped: Vec<Option<Vec<BeadState<V>>>> = vec![None; self.bodies.len()];
-        let mut least = (f64::INFINITY, (0, 0));
+        let mut least = (f64::INFINITY, (0, 0), 0.0);
         for &(pair, ..) in candidates {
-            let mut position = |i: usize| -> Result<V, SolveError> {
+            let mut state = |i: usize| -> Result<BeadState<V>, SolveError> {
                 let slot = self.slot(i);
                 if stepped[slot].is_none() {
                     let mut states = self.now[slot].clone();
@@ -358,12 +426,12 @@ impl<'a, V: Coordinates> Group<'a, V> {
                     stepped[slot] = Some(states);
                 }
                 let states = stepped[slot].as_deref().unwrap_or_default();
-                Ok(states[self.beads[i].bead].position)
+                Ok(states[self.beads[i].bead])
             };
-            let (pa, pb) = (position(pair.0)?, position(pair.1)?);
-            let gap = self.gap(pair, pa, pb);
+            let (a, b) = (state(pair.0)?, state(pair.1)?);
+            let gap = self.gap(pair, a.position, b.position);
             if gap < least.0 {
-                least = (gap, pair);
+                least = (gap, pair, opening_rate(&a, &b).0);
             }
         }
         Ok(least)
@@ -624,4 +692,24 @@ impl<'a, V: Coordinates> Group<'a, V> {
         }
         Ok(())
     }
+}
+
+/// How close to touching, as a fraction of [`TOUCHING`] of a pair's
+/// reach, Newton's trials must bring the least gap to end the search for
+/// an instant of impact.
+const ARRIVED: f64 = 0.01;
+
+/// How many of Newton's trials an instant of impact is looked for with
+/// before regula falsi takes over.
+const NEWTON_TRIALS: usize = 4;
+
+/// Where the cubic through `s0` and `s1`, `h` apart, with their positions
+/// and velocities (Hermite's), is `tau` after `s0`.
+pub(super) fn hermite<V: Coordinates>(s0: BeadState<V>, s1: BeadState<V>, h: f64, tau: f64) -> V {
+    let s = tau / h;
+    let (s2, s3) = (s * s, s * s * s);
+    s0.position * (2.0 * s3 - 3.0 * s2 + 1.0)
+        + s0.velocity * ((s3 - 2.0 * s2 + s) * h)
+        + s1.position * (-2.0 * s3 + 3.0 * s2)
+        + s1.velocity * ((s3 - s2) * h)
 }

@@ -58,12 +58,6 @@ use group::Group;
 
 pub use super::coupled::TOUCHING;
 
-/// A part of a step shorter than this fraction of the step is best taken
-/// by a method whose velocity does not come from a position difference
-/// over the part (RK4 with projection): RATTLE's loses the digits the
-/// part is short by.
-pub const SHORT_PART: f64 = 1e-3;
-
 /// How many instants of impact one group of bodies may be cut at within
 /// one step, per pair of beads it follows (a pile meets many), before
 /// the step is reported as not settling.
@@ -78,7 +72,7 @@ pub trait TouchBody<V: Coordinates> {
     fn end(&self) -> &[BeadState<V>];
     /// Steps `states`, at `time`, on by `h`, from what the body kept at
     /// the last [`TouchBody::keep`] (or before the step). A part shorter
-    /// than [`SHORT_PART`] of the step wants a method whose velocity does
+    /// than [`SHORT_PART`](crate::solver::SHORT_PART) of the step wants a method whose velocity does
     /// not come from a position difference.
     fn advance(&mut self, time: f64, h: f64, states: &mut [BeadState<V>])
     -> Result<(), SolveError>;

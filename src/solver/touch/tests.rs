@@ -115,6 +115,32 @@ fn a_pair_that_would_pass_through_in_one_step_meets_and_exchanges() {
         b.position.x
     );
     assert!((a.velocity.x + 6.0).abs() <= 1e-12 && (b.velocity.x - 6.0).abs() <= 1e-12);
+    // Their paths are straight, so the predicted instant is the one: a
+    // trial there, the step to it and the step on from it.
+    for body in &bodies {
+        assert_eq!(body.steps, 3, "advances of one body");
+    }
+}
+
+/// The cubic through two states is exact for a bead under a constant
+/// acceleration: where it predicts a pile's beads meet within a step.
+#[test]
+fn the_cubic_through_two_states_is_exact_under_constant_acceleration() {
+    let (h, g) = (0.25, DVec2::new(0.3, -9.81));
+    let start = BeadState {
+        position: DVec2::new(1.0, 2.0),
+        velocity: DVec2::new(-0.5, 4.0),
+    };
+    let at = |t: f64| start.position + start.velocity * t + g * (0.5 * t * t);
+    let end = BeadState {
+        position: at(h),
+        velocity: start.velocity + g * h,
+    };
+    for k in 0..=8 {
+        let t = h * k as f64 / 8.0;
+        let error = (group::hermite(start, end, h, t) - at(t)).length();
+        assert!(error <= 1e-14, "at {t}: {error:e}");
+    }
 }
 
 /// Five equal balls, four touching at rest and one coming in: exactly

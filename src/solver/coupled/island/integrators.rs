@@ -200,12 +200,14 @@ impl<V: WireSpace> Island<V> {
 
     /// [`Island::project_velocity`] with every held contact row pushing
     /// and none closing: the velocities projected from where they were
-    /// onto the held rows, a contact row whose multiplier pulls let go,
-    /// and one let go whose beads then close held again, one row at a
-    /// time by the least-index rule (Murty's principal pivoting, which
-    /// ends where `J W Jᵀ` is positive definite) until none is left; at
-    /// most [`CONTACT_PASSES`] projections more than twice the contact
-    /// rows.
+    /// onto the held rows, every contact row whose multiplier pulls let
+    /// go and every one let go whose beads then close held again, all at
+    /// once while that leaves fewer rows out of place (block principal
+    /// pivoting, Júdice and Pires), and one row at a time by the
+    /// least-index rule (Murty's principal pivoting, which ends where
+    /// `J W Jᵀ` is positive definite) for a pass when it has not for
+    /// [`BLOCK_CHANCES`] passes; at most [`CONTACT_PASSES`] projections
+    /// more than twice the contact rows.
     pub(super) fn project_velocity_pushing(
         &self,
         work: &mut IslandWork<V>,
@@ -221,36 +223,55 @@ impl<V: WireSpace> Island<V> {
             .map(|v| v.dot(*v).sqrt())
             .fold(0.0, f64::max);
         let contacts = self.contacts.iter().filter(|&&c| c).count();
+        let (mut fewest, mut chances) = (usize::MAX, BLOCK_CHANCES);
         for _ in 0..2 * contacts + CONTACT_PASSES {
             self.project_velocity(work)?;
-            // The first contact row out of place: held and pulling, or let
-            // go here and closing.
-            let flip = (0..self.rows()).find(|&r| {
-                self.contacts[r]
-                    && !set_aside[r]
-                    && if work.inactive[r] {
-                        -self.rate(r, &gradient, &work.v, &bias) > PUSHING_SLACK * fastest
-                    } else {
-                        work.rhs[r] < 0.0
-                    }
-            });
-            let Some(r) = flip else {
+            // The contact rows out of place: held and pulling, or let go
+            // here and closing.
+            let out: Vec<usize> = (0..self.rows())
+                .filter(|&r| {
+                    self.contacts[r]
+                        && !set_aside[r]
+                        && if work.inactive[r] {
+                            -self.rate(r, &gradient, &work.v, &bias) > PUSHING_SLACK * fastest
+                        } else {
+                            work.rhs[r] < 0.0
+                        }
+                })
+                .collect();
+            if out.is_empty() {
                 return Ok(());
-            };
-            work.inactive[r] = !work.inactive[r];
-            work.v.clone_from(&unprojected);
-            let entries = self.row_start[r]..self.row_start[r + 1];
-            if work.inactive[r] {
-                work.gradient[entries].fill(V::ZERO);
-                work.bias[r] = 0.0;
-            } else {
-                work.gradient[entries.clone()].copy_from_slice(&gradient[entries]);
-                work.bias[r] = bias[r];
             }
+            let flips = if out.len() < fewest {
+                (fewest, chances) = (out.len(), BLOCK_CHANCES);
+                &out[..]
+            } else if chances > 0 {
+                chances -= 1;
+                &out[..]
+            } else {
+                &out[..1]
+            };
+            for &r in flips {
+                work.inactive[r] = !work.inactive[r];
+                let entries = self.row_start[r]..self.row_start[r + 1];
+                if work.inactive[r] {
+                    work.gradient[entries].fill(V::ZERO);
+                    work.bias[r] = 0.0;
+                } else {
+                    work.gradient[entries.clone()].copy_from_slice(&gradient[entries]);
+                    work.bias[r] = bias[r];
+                }
+            }
+            work.v.clone_from(&unprojected);
         }
         Ok(())
     }
 }
+
+/// How many passes of [`Island::project_velocity_pushing`] may flip every
+/// row out of place without leaving fewer out of place than ever before,
+/// before one pass flips only the first.
+const BLOCK_CHANCES: usize = 3;
 
 /// A contact row let go whose beads close slower than this fraction of
 /// the fastest bead's speed is not closing: rounding.

@@ -256,11 +256,7 @@ impl<V: WireSpace> Island<V> {
         let trial = |tau: f64, states: &mut [BeadState<V>], work: &mut IslandWork<V>| {
             states.copy_from_slice(start);
             (work.level, work.calm) = (flight.level, flight.calm);
-            let part = StepSettings {
-                dt: tau,
-                ..*settings
-            };
-            self.substeps(time, states, forces, &part, work)
+            self.substeps(time, states, forces, &settings.part(tau), work)
         };
         let mut probe = start.to_vec();
         let g0 = self.crossing(time, start, flight.rows);
@@ -273,11 +269,7 @@ impl<V: WireSpace> Island<V> {
             self.land(time + tau, states, forces, settings.dt, work)?;
             let rest = settings.dt - tau;
             if rest > 1e-13 * settings.dt {
-                let part = StepSettings {
-                    dt: rest,
-                    ..*settings
-                };
-                self.substeps(time + tau, states, forces, &part, work)?;
+                self.substeps(time + tau, states, forces, &settings.part(rest), work)?;
             }
             Ok(())
         });
