@@ -39,7 +39,15 @@ pub(super) struct Group<'a, V: Coordinates> {
     cut: bool,
     /// The pairs in touch pressed into each other, held this step.
     pressed: Vec<(usize, usize)>,
+    /// The part the last trial stepped the bodies by from now, and the
+    /// states it took each body it stepped to; cleared by anything else
+    /// that steps or holds a body.
+    last_trial: Option<(f64, Trial<V>)>,
 }
+
+/// Each body's states after a trial, by its place in the group; none for
+/// a body the trial did not step.
+type Trial<V> = Vec<Option<Vec<BeadState<V>>>>;
 
 impl<'a, V: Coordinates> Group<'a, V> {
     pub(super) fn new<B: TouchBody<V>>(
@@ -66,6 +74,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
             tried,
             cut: false,
             pressed: Vec::new(),
+            last_trial: None,
         };
         group.pairs = group.find_pairs(&[]).0;
         group
@@ -262,6 +271,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
             {
                 body.hold(ba, bb, true);
                 self.pressed.push(pair);
+                self.last_trial = None;
                 held = held.or(Some((0.0, pair)));
             }
         }
@@ -414,7 +424,8 @@ impl<'a, V: Coordinates> Group<'a, V> {
         candidates: &[((usize, usize), f64, f64)],
         tau: f64,
     ) -> Result<(f64, (usize, usize), f64), SolveError> {
-        let mut stepped: Vec<Option<Vec<BeadState<V>>>> = vec![None; self.bodies.len()];
+        self.last_trial = None;
+        let mut stepped: Trial<V> = vec![None; self.bodies.len()];
         let mut least = (f64::INFINITY, (0, 0), 0.0);
         for &(pair, ..) in candidates {
             let mut state = |i: usize| -> Result<BeadState<V>, SolveError> {
@@ -434,6 +445,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
                 least = (gap, pair, opening_rate(&a, &b).0);
             }
         }
+        self.last_trial = Some((tau, stepped));
         Ok(least)
     }
 
@@ -445,12 +457,24 @@ impl<'a, V: Coordinates> Group<'a, V> {
         h: f64,
         to_now: bool,
     ) -> Result<(), TouchError> {
+        // A body the last trial stepped by just `h` (and nothing since)
+        // is where this step would take it.
+        let mut trial = match self.last_trial.take() {
+            Some((tau, stepped)) if tau == h => stepped,
+            _ => Vec::new(),
+        };
         for slot in 0..self.bodies.len() {
             let body = &mut bodies[self.bodies[slot]];
-            let mut states = self.now[slot].clone();
-            if h > 0.0 {
-                body.advance(self.time, h, &mut states)?;
-            }
+            let states = match trial.get_mut(slot).and_then(Option::take) {
+                Some(states) => states,
+                None => {
+                    let mut states = self.now[slot].clone();
+                    if h > 0.0 {
+                        body.advance(self.time, h, &mut states)?;
+                    }
+                    states
+                }
+            };
             self.tried[slot] = false;
             if to_now {
                 body.keep();
