@@ -394,6 +394,10 @@ impl<'a, V: Coordinates> Group<'a, V> {
             let at = |s0: BeadState<V>, s1: BeadState<V>| hermite(s0, s1, h, tau);
             self.gap(pair, at(a0, a1), at(b0, b1))
         };
+        // The first of 32 samples at which the gap has closed brackets
+        // the meeting; bisection on the cubic, which costs no step, finds
+        // it to the last bit (regula falsi's 1e-13 of the step would be
+        // looser than what Newton's first trial is to meet).
         let samples = 32;
         let mut before = 0.0;
         for k in 1..=samples {
