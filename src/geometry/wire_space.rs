@@ -45,6 +45,14 @@ pub trait WireSpace: Coordinates {
     fn shape_geometry(shape: &Self::Shape, p: Self, hint: Option<f64>) -> Geometry<Self>;
     /// `shape`'s characteristic length.
     fn shape_scale(shape: &Self::Shape) -> f64;
+    /// Whether `shape` ends (an open curve in the plane; see
+    /// [`ImplicitCurve::has_ends`](super::ImplicitCurve::has_ends)).
+    fn shape_has_ends(shape: &Self::Shape) -> bool;
+    /// How far past an end of `shape` the point nearest the local point
+    /// `p` lies, looked for near the parameter `hint` (see
+    /// [`ImplicitCurve::past_end`](super::ImplicitCurve::past_end)):
+    /// zero or less on the curve, −∞ for a shape with no end.
+    fn shape_past_end(shape: &Self::Shape, p: Self, hint: f64) -> f64;
     /// `shape`'s own parameter at the local point `p`, near `hint` (NaN
     /// where it has none).
     fn shape_parameter(shape: &Self::Shape, p: Self, hint: f64) -> f64;
@@ -184,6 +192,12 @@ impl WireSpace for DVec2 {
     fn shape_scale(shape: &WireShape) -> f64 {
         shape.curve().scale()
     }
+    fn shape_has_ends(shape: &WireShape) -> bool {
+        shape.curve().has_ends()
+    }
+    fn shape_past_end(shape: &WireShape, p: Self, hint: f64) -> f64 {
+        shape.curve().past_end_near(p, hint)
+    }
     fn shape_parameter(shape: &WireShape, p: Self, hint: f64) -> f64 {
         shape.curve().parameter(p, hint)
     }
@@ -233,6 +247,12 @@ impl WireSpace for DVec3 {
             SpaceRow::Surface(surface) => surface.scale(),
             SpaceRow::Curve { curve, .. } => curve.scale(),
         }
+    }
+    fn shape_has_ends(_shape: &SpaceRow) -> bool {
+        false
+    }
+    fn shape_past_end(_shape: &SpaceRow, _p: Self, _hint: f64) -> f64 {
+        f64::NEG_INFINITY
     }
     fn shape_parameter(shape: &SpaceRow, p: Self, hint: f64) -> f64 {
         match shape {

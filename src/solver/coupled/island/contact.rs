@@ -162,7 +162,8 @@ impl<V: WireSpace> Island<V> {
         work.sticks[s] = Some((axis, offset));
     }
 
-    /// Sets aside every one-sided row whose λ (eq. 12 with no
+    /// Sets aside every wire row whose bead is past its wire's end, every
+    /// one-sided row whose λ (eq. 12 with no
     /// stabilization) at the step's start has the sign its wire cannot
     /// push with, and every contact row whose beads part. A contact row
     /// whose λ would pull is left to the step's velocity solve where it
@@ -187,10 +188,14 @@ impl<V: WireSpace> Island<V> {
         work.time = time;
         self.accelerate(forces, Gains::NONE, work, Stage::Start)?;
         for r in 0..self.rows() {
+            if work.inactive[r] {
+                continue;
+            }
             let (side, _) = self.sides[r];
             let parts = || self.parting(r, states) == Some(true);
             let pulls = side * work.lambda[r] < 0.0 && !(pushing && self.contacts[r]);
-            if side != 0.0 && !work.inactive[r] && (pulls || parts()) {
+            let off_end = || self.ends(r) && self.past_end(r, states, time, &work.hints) > 0.0;
+            if (side != 0.0 && (pulls || parts())) || off_end() {
                 work.inactive[r] = true;
                 if self.contacts[r] {
                     continue; // a pair parting is no bead leaving its wire
@@ -204,9 +209,9 @@ impl<V: WireSpace> Island<V> {
         Ok(())
     }
 
-    /// Lands every bead whose set-aside one-sided row it crossed during the
-    /// step: the island projected onto its rows with that one back, the
-    /// bead's velocity across the wire reversed and scaled by the
+    /// Lands every bead whose set-aside one-sided row of `rows` it crossed
+    /// during the step: the island projected onto its rows with that one
+    /// back, the bead's velocity across the wire reversed and scaled by the
     /// restitution.
     pub(super) fn land(
         &self,
@@ -214,13 +219,18 @@ impl<V: WireSpace> Island<V> {
         states: &mut [BeadState<V>],
         forces: &[LinearForce<V>],
         h: f64,
+        rows: &[usize],
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         work.time = time;
-        for r in 0..self.rows() {
+        for &r in rows {
             let (side, restitution) = self.sides[r];
             if side == 0.0 || !work.inactive[r] || self.contacts[r] {
                 // Where beads meet is the touch settlement's to find.
+                continue;
+            }
+            if self.past_end(r, states, time, &work.hints) > 0.0 {
+                // Past an end the wire goes on only as far as `C` does.
                 continue;
             }
             let bead = self.entry_bead[self.row_start[r]];

@@ -30,6 +30,38 @@ impl<V: WireSpace> Island<V> {
         }
     }
 
+    /// Whether row `r` is a wire's that ends (an open curve): its bead
+    /// leaves it past an end.
+    pub(super) fn ends(&self, r: usize) -> bool {
+        matches!(&self.rows[r], RowKind::Wire { shape, .. } if V::shape_has_ends(shape))
+    }
+
+    /// Whether any row is a wire's that ends.
+    pub(super) fn has_ends(&self) -> bool {
+        (0..self.rows()).any(|r| self.ends(r))
+    }
+
+    /// How far past an end of its wire wire row `r`'s bead is in `states`
+    /// at `time`, the nearest point looked for near the row's kept
+    /// parameter in `hints`: zero or less on the wire, −∞ for a wire with
+    /// no end or a row of another kind.
+    pub(super) fn past_end(
+        &self,
+        r: usize,
+        states: &[BeadState<V>],
+        time: f64,
+        hints: &[f64],
+    ) -> f64 {
+        let (Some((shape, pose, _)), Some(state)) = (
+            self.wire_at(r, time),
+            states.get(self.entry_bead[self.row_start[r]]),
+        ) else {
+            return f64::NEG_INFINITY;
+        };
+        let local = Placement::to_local(&pose, state.position);
+        V::shape_past_end(shape, local, hints.get(r).copied().unwrap_or(f64::NAN))
+    }
+
     /// Contact row `r`'s two beads and its reach `r_a + r_b`; none for a
     /// row of another kind.
     fn contact_pair(&self, r: usize) -> Option<(usize, usize, f64)> {

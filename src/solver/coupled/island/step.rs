@@ -10,7 +10,7 @@ use super::projection::Restore;
 use super::{
     CALM_STEPS, CONTACT_PASSES, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow, TOUCHING,
 };
-use crate::solver::contact::locate;
+use crate::solver::contact::{ContactEvent, locate};
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use crate::solver::method::{Integrator, Method};
 use crate::solver::settings::StepSettings;
@@ -18,9 +18,9 @@ use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
 use crate::solver::step::drift_check;
 
-/// A step's flight, as [`Island::land_within`] takes it again: where and
-/// when it started, its forces and settings, the substep level it started
-/// at, and the rows it may land on.
+/// A step as [`Island::cut_within`] takes it again: where and when it
+/// started, its forces and settings, the substep level it started at, and
+/// the rows the event may happen on.
 struct Flight<'a, V> {
     time: f64,
     start: &'a [BeadState<V>],
@@ -29,6 +29,15 @@ struct Flight<'a, V> {
     level: u32,
     calm: u32,
     rows: &'a [usize],
+}
+
+/// What [`Island::cut_within`] cuts a step at.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Cut {
+    /// A bead in flight crosses its one-sided wire: it lands.
+    Landing,
+    /// A bead passes an end of its wire: it leaves it.
+    End,
 }
 
 impl<V: WireSpace> Island<V> {
@@ -140,7 +149,8 @@ impl<V: WireSpace> Island<V> {
         self.begin(time, states, work);
         let one_sided = self.one_sided();
         let rough = self.is_rough();
-        if one_sided || rough {
+        let ends = self.has_ends();
+        if one_sided || rough || ends {
             let method = settings.method;
             let pushing = method.integrator() == Integrator::Rattle || method.projects();
             self.leave(time, states, forces, pushing, work)?;
@@ -156,31 +166,56 @@ impl<V: WireSpace> Island<V> {
             Vec::new()
         };
         let forces = if rough { &resisted[..] } else { forces };
-        let flying = if one_sided {
-            self.flying(time, states, work)
+        let above = if one_sided {
+            self.above(time, states, work)
         } else {
             Vec::new()
         };
-        let start = (!flying.is_empty()).then(|| (states.to_vec(), work.level, work.calm));
+        let flying: Vec<usize> = above
+            .iter()
+            .copied()
+            .filter(|&r| self.sides[r].0 * self.wire_row(r, states, time).c > 0.0)
+            .collect();
+        let ending = if ends {
+            (0..self.rows())
+                .filter(|&r| self.ends(r) && !work.inactive[r])
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let start = (!flying.is_empty() || !ending.is_empty())
+            .then(|| (states.to_vec(), work.level, work.calm));
         self.substeps(time, states, forces, settings, work)?;
-        if let Some((start, level, calm)) = start
-            && self.crossing(time + settings.dt, states, &flying) <= 0.0
-        {
-            let flight = Flight {
+        if let Some((start, level, calm)) = &start {
+            let flight = |rows| Flight {
                 time,
-                start: &start,
+                start,
                 forces,
                 settings,
-                level,
-                calm,
-                rows: &flying,
+                level: *level,
+                calm: *calm,
+                rows,
             };
-            self.land_within(&flight, states, work)?;
+            let end = time + settings.dt;
+            if !ending.is_empty() && self.on_the_wire(end, states, &ending, work) < 0.0 {
+                // Past an end within the step: the bead leaves there (a
+                // landing the same step makes is taken at its end).
+                self.cut_within(&flight(&ending), Cut::End, states, work)?;
+            } else if !flying.is_empty() && self.crossing(end, states, &flying, work) <= 0.0 {
+                self.cut_within(&flight(&flying), Cut::Landing, states, work)?;
+            }
         }
         if one_sided {
             // A landing the located one left (another row, or a bounce
             // that came back), at the step's end.
-            self.land(time + settings.dt, states, forces, settings.dt, work)?;
+            self.land(
+                time + settings.dt,
+                states,
+                forces,
+                settings.dt,
+                &above,
+                work,
+            )?;
         }
         if rough {
             self.stop(time + settings.dt, states, &slides, work)?;
@@ -211,36 +246,86 @@ impl<V: WireSpace> Island<V> {
         }
     }
 
-    /// The one-sided rows set aside whose beads are off their wires on the
-    /// side they push toward: the rows a flight may land on within the
-    /// step.
-    fn flying(&self, time: f64, states: &[BeadState<V>], work: &IslandWork<V>) -> Vec<usize> {
+    /// The one-sided rows set aside whose beads are not behind their wires
+    /// (off them, on the side they push toward, or on them) where no end
+    /// is passed: the rows a bead may land on within the step. A bead that
+    /// passed an end and came round behind the wire does not land on it.
+    fn above(&self, time: f64, states: &[BeadState<V>], work: &IslandWork<V>) -> Vec<usize> {
         if states.len() != self.beads() {
             return Vec::new();
         }
         (0..self.rows())
-            .filter(|&r| self.sides[r].0 != 0.0 && work.inactive[r])
-            .filter(|&r| self.sides[r].0 * self.wire_row(r, states, time).c > 0.0)
+            .filter(|&r| self.sides[r].0 != 0.0 && work.inactive[r] && !self.contacts[r])
+            .filter(|&r| {
+                let c = self.sides[r].0 * self.wire_row(r, states, time).c;
+                c >= -OFF_THE_WIRE * self.rows[r].scale()
+                    && self.past_end(r, states, time, &work.hints) <= 0.0
+            })
             .collect()
     }
 
     /// How far the nearest of `rows` is from crossing its wire at `time`:
-    /// the least `side · C` (not positive once one has crossed).
-    fn crossing(&self, time: f64, states: &[BeadState<V>], rows: &[usize]) -> f64 {
+    /// the least `side · C` (not positive once one has crossed) of the
+    /// rows whose beads have not passed an end.
+    fn crossing(
+        &self,
+        time: f64,
+        states: &[BeadState<V>],
+        rows: &[usize],
+        work: &IslandWork<V>,
+    ) -> f64 {
         rows.iter()
+            .filter(|&&r| self.past_end(r, states, time, &work.hints) <= 0.0)
             .map(|&r| self.sides[r].0 * self.wire_row(r, states, time).c)
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// A flight that crossed a wire within the step lands where it does,
-    /// as a lone bead's does ([`locate`]): the step is taken again to the
-    /// crossing, the bead lands there ([`Island::land`]), and the rest of
-    /// the step follows from the landing. Each trial step starts from the
-    /// same substep level. If a trial step fails, the step is kept as it
-    /// was taken whole, to land at its end.
-    fn land_within(
+    /// How far the bead of the nearest of `rows` is from an end of its
+    /// wire at `time`: the least `−past end` (negative once one has passed).
+    fn on_the_wire(
+        &self,
+        time: f64,
+        states: &[BeadState<V>],
+        rows: &[usize],
+        work: &IslandWork<V>,
+    ) -> f64 {
+        rows.iter()
+            .map(|&r| -self.past_end(r, states, time, &work.hints))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Sets aside each of `rows` whose bead is at or past an end of its
+    /// wire at `time`: the bead leaves the wire there.
+    fn leave_at_ends(
+        &self,
+        time: f64,
+        states: &[BeadState<V>],
+        rows: &[usize],
+        work: &mut IslandWork<V>,
+    ) {
+        for &r in rows {
+            if self.past_end(r, states, time, &work.hints) >= 0.0 {
+                work.inactive[r] = true;
+                let bead = self.entry_bead[self.row_start[r]];
+                let position = states[bead].position;
+                work.events
+                    .push((r, bead, ContactEvent::Left { time, position }));
+            }
+        }
+    }
+
+    /// An event within the step located where it happens, as a lone
+    /// bead's is ([`locate`]): a flight that crossed a wire lands there
+    /// ([`Island::land`]); a bead that passed an end of its wire leaves it
+    /// there. The step is taken again to the instant, the event happens,
+    /// and the rest of the step follows from there. Each trial step starts
+    /// from the same substep level. If a trial step fails, the step is
+    /// kept as it was taken whole (to land at its end; a bead past an end
+    /// leaves at the next step's start).
+    fn cut_within(
         &self,
         flight: &Flight<V>,
+        cut: Cut,
         states: &mut [BeadState<V>],
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
@@ -249,34 +334,44 @@ impl<V: WireSpace> Island<V> {
             start,
             forces,
             settings,
+            rows,
             ..
         } = *flight;
         let whole = states.to_vec();
         let (level, calm, events) = (work.level, work.calm, work.events.len());
+        let inactive = work.inactive.clone();
         let trial = |tau: f64, states: &mut [BeadState<V>], work: &mut IslandWork<V>| {
             states.copy_from_slice(start);
             (work.level, work.calm) = (flight.level, flight.calm);
             self.substeps(time, states, forces, &settings.part(tau), work)
         };
+        let measure = |time: f64, states: &[BeadState<V>], work: &IslandWork<V>| match cut {
+            Cut::Landing => self.crossing(time, states, rows, work),
+            Cut::End => self.on_the_wire(time, states, rows, work),
+        };
         let mut probe = start.to_vec();
-        let g0 = self.crossing(time, start, flight.rows);
+        let g0 = measure(time, start, work);
         let located = locate(settings.dt, g0, |tau| {
             trial(tau, &mut probe, work)?;
-            Ok(self.crossing(time + tau, &probe, flight.rows))
+            Ok(measure(time + tau, &probe, work))
         });
-        let landed = located.and_then(|tau| {
+        let cut_there = located.and_then(|tau| {
             trial(tau, states, work)?;
-            self.land(time + tau, states, forces, settings.dt, work)?;
+            match cut {
+                Cut::Landing => self.land(time + tau, states, forces, settings.dt, rows, work)?,
+                Cut::End => self.leave_at_ends(time + tau, states, rows, work),
+            }
             let rest = settings.dt - tau;
             if rest > 1e-13 * settings.dt {
                 self.substeps(time + tau, states, forces, &settings.part(rest), work)?;
             }
             Ok(())
         });
-        if landed.is_err() {
+        if cut_there.is_err() {
             states.copy_from_slice(&whole);
             (work.level, work.calm) = (level, calm);
             work.events.truncate(events);
+            work.inactive = inactive;
         }
         Ok(())
     }
@@ -292,7 +387,8 @@ impl<V: WireSpace> Island<V> {
     }
 
     /// Which rows a fresh island starts with: a bead that starts off a
-    /// one-sided wire, on the side it pushes toward, starts in flight; a
+    /// one-sided wire, on the side it pushes toward, or past an end of its
+    /// wire, starts in flight; a
     /// contact starts set aside;
     /// stick rows start set aside (a bead slides until friction stops it),
     /// but a bead at rest on a rough wire starts held by static friction.
@@ -307,14 +403,16 @@ impl<V: WireSpace> Island<V> {
         }
         for r in 0..self.rows() {
             let (side, _) = self.sides[r];
-            if side == 0.0 || !whole {
+            if !whole {
                 continue;
             }
             // A contact is held only once its beads press (see
             // `Island::set_contact`).
-            let apart = self.contacts[r]
-                || side * self.wire_row(r, states, time).c > OFF_THE_WIRE * self.rows[r].scale();
-            if apart {
+            let apart = side != 0.0
+                && (self.contacts[r]
+                    || side * self.wire_row(r, states, time).c
+                        > OFF_THE_WIRE * self.rows[r].scale());
+            if apart || (self.ends(r) && self.past_end(r, states, time, &work.hints) > 0.0) {
                 work.inactive[r] = true;
             }
         }
