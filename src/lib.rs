@@ -96,7 +96,7 @@ mod validate;
 pub use controls::KeyboardControlsPlugin;
 pub use dynamics::{
     Bead, BeadBundle, BeadDiagnostics, BeadDiverged, BeadForce, BeadForces, BeadForcesItem,
-    BeadMass, BeadParams, BeadPosition, BeadRadius, BeadVelocity, BeadsStruck,
+    BeadMass, BeadParams, BeadPosition, BeadRadius, BeadVelocity, BeadsStruck, CatchesBeads,
     ConstraintDiagnostics, ContactChanged, Contacts, Dimension, Diverged, DivergenceReason, Joint,
     MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams, NextParams, NextWireShape, OnWire, Pin,
     PrescribedMotion, RailOrientation, Restitution, Rod, SimParams, SpaceBead, SpaceBeadBundle,

@@ -1,5 +1,6 @@
 //! Beads that touch: a bead's [`BeadRadius`] and [`Restitution`], the
-//! scene-wide [`Contacts`], and the [`BeadsStruck`] message.
+//! scene-wide [`Contacts`], the [`BeadsStruck`] message, and the wires
+//! that catch beads with radii ([`CatchesBeads`]).
 
 use bevy::prelude::*;
 
@@ -26,6 +27,22 @@ impl BeadRadius {
         self.0
     }
 }
+
+/// Makes a one-sided wire (see [`Surface`](crate::Surface)) catch every
+/// bead with a [`BeadRadius`] that flies onto it, not only the beads on it:
+/// a marble run's tracks, each marble free or on a track of its own,
+/// falling from one track onto the next. Such a bead lands on the wire
+/// from the side it pushes toward (never from behind), by the wire's
+/// restitution, runs along it with its centre on it, and leaves it where
+/// the wire would have to pull or past an end, as the wire's own beads
+/// do. A bead starts on it only where it starts on it.
+///
+/// Every bead with a radius gets a row on every wire that catches, in its
+/// island: the cost of a step grows with their product. A two-sided wire
+/// catches nothing.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
+#[reflect(Component)]
+pub struct CatchesBeads;
 
 /// A bead's own restitution, for the pairs it strikes in: the pair takes
 /// the smaller of its two beads' (a bead without one takes

@@ -191,9 +191,19 @@ pub struct WirePreset {
     /// Viscous damping along it, N·s/m; none by default.
     #[serde(default)]
     pub damping: f64,
+    /// Whether it catches every bead with a radius that flies onto it, not
+    /// only its own (a marble run's track; see [`CatchesBeads`](crate::CatchesBeads)): `false`
+    /// by default, and only on a one-sided wire.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub catches: bool,
     /// The beads on it.
     #[serde(default)]
     pub beads: Vec<BeadPreset>,
+}
+
+/// Whether a flag is off (and goes unwritten).
+fn is_false(flag: &bool) -> bool {
+    !flag
 }
 
 impl WirePreset {
@@ -270,6 +280,12 @@ impl ScenePreset {
                 .and_then(|_| wire.motion.validate())
                 .and_then(|_| wire.surface().validate())
                 .map_err(|source| PresetError::Wire { index, source })?;
+            if wire.catches && wire.side == Side::Both {
+                let source = ParamError::Incompatible(
+                    "a wire that catches beads must be one-sided (side: Positive or Negative)",
+                );
+                return Err(PresetError::Wire { index, source });
+            }
         }
         let wires: Vec<&[BeadPreset]> = self.wires.iter().map(|w| w.beads.as_slice()).collect();
         check_beads_and_links(&wires, &self.beads, &self.constraints, &self.springs).map(drop)

@@ -5,7 +5,8 @@ use bevy::prelude::*;
 
 use super::format::{BeadPreset, SceneLink, ScenePreset};
 use crate::dynamics::{
-    BeadRadius, BeadVelocity, Dimension, OnWire, Pin, PrescribedMotion, Rod, Spring, Wire,
+    BeadRadius, BeadVelocity, CatchesBeads, Dimension, OnWire, Pin, PrescribedMotion, Rod, Spring,
+    Wire,
 };
 use crate::geometry::{Pose, Twist};
 
@@ -31,6 +32,9 @@ impl ScenePreset {
                     && wire.motion.moves()
                 {
                     entity.insert(motion);
+                }
+                if wire.catches {
+                    entity.insert(CatchesBeads);
                 }
                 entity.id()
             });

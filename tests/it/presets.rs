@@ -33,6 +33,7 @@ pub(crate) const SHIPPED: &[&str] = &[
     "air_track_sticky.scene.ron",
     "abacus.scene.ron",
     "train.scene.ron",
+    "marble_run.scene.ron",
 ];
 
 /// The shipped presets that join beads.

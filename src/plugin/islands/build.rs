@@ -8,9 +8,10 @@ use bevy::prelude::*;
 
 use super::{CachedIsland, ContactRow, InIsland, IslandReport, Islands, LinkRows, WireRow, touch};
 use crate::dynamics::{
-    Bead, BeadMotion, BeadRadius, Dimension, DivergenceReason, Joint, OnWire, Pin, Rod, SimParams,
-    SpaceBead, Spring, WirePose, WireRows,
+    Bead, BeadMotion, BeadRadius, CatchesBeads, Dimension, DivergenceReason, Joint, OnWire, Pin,
+    Rod, SimParams, SpaceBead, Spring, WirePose, WireRows,
 };
+use crate::geometry::{Side, Surface};
 use crate::plugin::clock::SimClock;
 use crate::plugin::report::Divergences;
 use crate::solver::{self, BeadState, Island, IslandRow, IslandWork, RowKind, SpringLink};
@@ -37,6 +38,10 @@ type BuildBead<V> = (
     Option<&'static BeadRadius>,
 );
 
+/// Whether each wire row held its bead (by bead, wire and the wire's
+/// row), and where the bead was, when the last islands were stepped.
+type Carried<V> = HashMap<(Entity, Entity, usize), (bool, BeadState<V>)>;
+
 /// A link while the islands are built: its rows and the beads it names.
 struct Pending<V: Dimension> {
     entity: Entity,
@@ -46,6 +51,67 @@ struct Pending<V: Dimension> {
     /// A contact between two beads near each other (see `touch`): the
     /// sum of their radii.
     contact: Option<f64>,
+}
+
+/// An island's wire rows while it is built: which wire each is of, each
+/// wire's surface by its first row, and the rows of wires that catch.
+#[derive(Default)]
+struct WiredRows {
+    wire_rows: Vec<WireRow>,
+    /// Each wire's first row, bead, surface, and on a curve in space its
+    /// second row.
+    sides: Vec<(usize, usize, Surface, Option<usize>)>,
+    /// The rows of wires that catch the bead rather than hold it.
+    catching: Vec<usize>,
+}
+
+impl WiredRows {
+    /// Appends to `rows` the rows that put bead `local` on `wire` (`own`:
+    /// the wire it is on; otherwise one that catches it, and nothing for a
+    /// two-sided one), placed where the wire is at `time`. An error in
+    /// words for a wire that is not one or not placed.
+    fn add<V: Dimension>(
+        &mut self,
+        rows: &mut Vec<IslandRow<V>>,
+        wire: Entity,
+        local: usize,
+        own: bool,
+        wires: &Query<(&V::Wire, &WirePose<V>)>,
+        time: f64,
+    ) -> Result<(), String> {
+        let (shape, path) = match wires.get(wire).map(|(w, p)| (w, p.get())) {
+            Ok((shape, Ok(path))) => (shape, path),
+            Ok((_, Err(e))) => return Err(e.to_string()),
+            Err(_) => return Err(format!("entity {wire} has no Wire")),
+        };
+        let surface = *shape.surface();
+        if !own && surface.side == Side::Both {
+            return Ok(());
+        }
+        let pose = V::path_at(&path, time).0;
+        let shapes = shape.rows();
+        // A curve in space: its two rows rub as one (see
+        // `Island::pair_rows`).
+        let partner = (shapes.len() == 2).then_some(rows.len() + 1);
+        self.sides.push((rows.len(), local, surface, partner));
+        for (part, shape) in shapes.into_iter().enumerate() {
+            if !own {
+                self.catching.push(rows.len());
+            }
+            self.wire_rows.push(WireRow {
+                bead: local,
+                row: rows.len(),
+                wire,
+                part,
+                own,
+            });
+            rows.push(IslandRow {
+                kind: RowKind::Wire { shape, pose },
+                beads: vec![local],
+            });
+        }
+        Ok(())
+    }
 }
 
 /// The rows that hold a bead at `at`, one along each axis.
@@ -69,6 +135,7 @@ pub(super) fn prepare_islands<V: Dimension>(
     links: Links<V>,
     mut beads: Query<BuildBead<V>>,
     wires: Query<(&V::Wire, &WirePose<V>)>,
+    catching: Query<Entity, (With<CatchesBeads>, With<V::Wire>)>,
     transforms: Query<&Transform>,
     mut commands: Commands,
     mut divergences: Divergences,
@@ -76,7 +143,24 @@ pub(super) fn prepare_islands<V: Dimension>(
     params: Res<SimParams>,
 ) {
     islands.dirty = false;
+    // Whether each bead's wire rows held it, where the islands being
+    // rebuilt left it: a rebuild starts them so where the bead still is.
+    let mut was_held: Carried<V> = HashMap::new();
+    for cached in &islands.cached {
+        for row in &cached.wire_rows {
+            let (Some(&bead), Some(&state)) = (
+                cached.report.beads.get(row.bead),
+                cached.states.get(row.bead),
+            ) else {
+                continue;
+            };
+            let held = cached.work.holds(row.row);
+            was_held.insert((bead, row.wire, row.part), (held, state));
+        }
+    }
     islands.cached.clear();
+    let mut catchers: Vec<Entity> = catching.iter().collect();
+    catchers.sort_unstable();
     let is_bead = |e: Entity| beads.contains(e);
     // A link naming a bead of the other dimension is the other
     // dimension's to build (or to refuse, if it mixes them).
@@ -270,41 +354,34 @@ pub(super) fn prepare_islands<V: Dimension>(
         let entities: Vec<Entity> = group.iter().map(|&m| members[m]).collect();
         let mut masses = Vec::with_capacity(group.len());
         let mut rows = Vec::new();
-        let mut wire_rows = Vec::new();
+        let mut wired = WiredRows::default();
         let mut invalid = None;
-        let mut sides = Vec::new();
         for (local, &entity) in entities.iter().enumerate() {
-            let Ok((_, bead, on_wire, ..)) = beads.get(entity) else {
+            let Ok((_, bead, on_wire, _, radius)) = beads.get(entity) else {
                 invalid = Some(format!("entity {entity} is no longer a bead"));
                 break;
             };
             masses.push(bead.mass());
-            let Some(on_wire) = on_wire else { continue };
-            match wires.get(on_wire.0).map(|(w, p)| (w, p.get())) {
-                Ok((wire, Ok(path))) => {
-                    let pose = V::path_at(&path, clock.time).0;
-                    let shapes = wire.rows();
-                    // A curve in space: its two rows rub as one (see
-                    // `Island::pair_rows`).
-                    let partner = (shapes.len() == 2).then_some(rows.len() + 1);
-                    sides.push((rows.len(), local, *wire.surface(), partner));
-                    for (part, shape) in shapes.into_iter().enumerate() {
-                        wire_rows.push(WireRow {
-                            bead: local,
-                            row: rows.len(),
-                            wire: on_wire.0,
-                            part,
-                        });
-                        rows.push(IslandRow {
-                            kind: RowKind::Wire { shape, pose },
-                            beads: vec![local],
-                        });
+            let own = on_wire.map(|on| on.0);
+            if let Some(wire) = own
+                && let Err(why) = wired.add(&mut rows, wire, local, true, &wires, clock.time)
+            {
+                invalid = Some(why);
+            }
+            // A bead with a radius may land on every wire that catches.
+            if radius.is_some_and(|r| r.get() > 0.0) {
+                for &wire in catchers.iter().filter(|&&w| Some(w) != own) {
+                    if let Err(why) = wired.add(&mut rows, wire, local, false, &wires, clock.time) {
+                        invalid = Some(why);
                     }
                 }
-                Ok((_, Err(e))) => invalid = Some(e.to_string()),
-                Err(_) => invalid = Some(format!("entity {} has no Wire", on_wire.0)),
             }
         }
+        let WiredRows {
+            wire_rows,
+            sides,
+            catching,
+        } = wired;
         let mut link_rows = Vec::new();
         let mut anchored = Vec::new();
         let mut contacts = Vec::new();
@@ -359,6 +436,9 @@ pub(super) fn prepare_islands<V: Dimension>(
             for contact in &contacts {
                 island.set_contact(contact.row);
             }
+            for &row in &catching {
+                island.set_catching(row);
+            }
             for (row, _, surface, partner) in sides {
                 island.set_side(row, surface.side, surface.restitution);
                 if surface.resists() {
@@ -377,6 +457,7 @@ pub(super) fn prepare_islands<V: Dimension>(
                     &mut island,
                     &entities,
                     &wire_rows,
+                    &was_held,
                     &wires,
                     &mut beads,
                     &clock,
@@ -430,18 +511,26 @@ fn start_island<V: Dimension>(
     island: &mut Island<V>,
     entities: &[Entity],
     wire_rows: &[WireRow],
+    was_held: &Carried<V>,
     wires: &Query<(&V::Wire, &WirePose<V>)>,
     beads: &mut Query<BuildBead<V>>,
     clock: &SimClock,
 ) -> IslandWork<V> {
+    let mut work = IslandWork::default();
     for wire_row in wire_rows {
         if let Ok((_, pose)) = wires.get(wire_row.wire)
             && let Ok(path) = pose.get()
         {
             island.move_wire(wire_row.row, None, path);
         }
+        let bead = entities[wire_row.bead];
+        let key = (bead, wire_row.wire, wire_row.part);
+        if let (Some(&(held, then)), Ok((_, now, ..))) = (was_held.get(&key), beads.get(bead))
+            && then == now.state()
+        {
+            work.carry(wire_row.row, held);
+        }
     }
-    let mut work = IslandWork::default();
     let mut states: Vec<BeadState<V>> = Vec::with_capacity(entities.len());
     for &entity in entities {
         match beads.get(entity) {

@@ -22,7 +22,7 @@ use super::clock::advance_clock;
 use super::schedule::WireBeadSystems;
 use super::wires::place_wires;
 use crate::dynamics::{
-    BeadRadius, ConstraintDiagnostics, Dimension, Joint, OnWire, Pin, Rod, Spring,
+    BeadRadius, CatchesBeads, ConstraintDiagnostics, Dimension, Joint, OnWire, Pin, Rod, Spring,
 };
 use crate::solver::{BeadState, Island, IslandMark, IslandWork, LinearForce, SolveError};
 
@@ -39,6 +39,7 @@ impl Plugin for IslandPlugin {
             .register_type::<Pin>()
             .register_type::<Pin<DVec3>>()
             .register_type::<Spring>()
+            .register_type::<CatchesBeads>()
             .register_type::<ConstraintDiagnostics>();
         add_islands::<DVec2>(app);
         add_islands::<DVec3>(app);
@@ -65,6 +66,8 @@ fn add_islands<V: Dimension>(app: &mut App) {
         .add_observer(topology_changed::<Remove, Joint<V>, V>)
         .add_observer(topology_changed::<Insert, BeadRadius, V>)
         .add_observer(topology_changed::<Remove, BeadRadius, V>)
+        .add_observer(topology_changed::<Insert, CatchesBeads, V>)
+        .add_observer(topology_changed::<Remove, CatchesBeads, V>)
         .add_systems(
             PreUpdate,
             build::prepare_islands::<V>
@@ -143,14 +146,17 @@ enum LinkRows {
     Pin(Entity, usize),
 }
 
-/// A wire row of an island: the bead it holds, the row, the wire, and
-/// which of the wire's rows it is (a curve in space has two).
+/// A wire row of an island: the bead it holds, the row, the wire,
+/// which of the wire's rows it is (a curve in space has two), and whether
+/// the wire is the bead's own (or one that catches it, see
+/// [`CatchesBeads`](crate::CatchesBeads)).
 #[derive(Clone, Copy, Debug)]
 struct WireRow {
     bead: usize,
     row: usize,
     wire: Entity,
     part: usize,
+    own: bool,
 }
 
 /// One island as the step keeps it.

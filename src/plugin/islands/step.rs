@@ -179,7 +179,11 @@ pub(super) fn step_islands<V: Dimension>(
             if let Some(mut transform) = transform {
                 V::place(&mut transform, state.position);
             }
-            let wire_row = cached.wire_rows.iter().find(|w| w.bead == i).map(|w| w.row);
+            let wire_row = cached
+                .wire_rows
+                .iter()
+                .find(|w| w.bead == i && w.own)
+                .map(|w| w.row);
             if let (Some(mut contact), Some(row)) = (contact, wire_row) {
                 let held = if cached.work.holds(row) {
                     Contact::OnWire

@@ -179,6 +179,7 @@ impl<V: WireSpace> Island<V> {
         let sides = vec![(0.0, 0.0); kinds.len()];
         let rough = vec![None; kinds.len()];
         let contacts = vec![false; kinds.len()];
+        let catching = vec![false; kinds.len()];
         Ok(Self {
             inverse_mass,
             rows: kinds,
@@ -190,6 +191,7 @@ impl<V: WireSpace> Island<V> {
             moving: 0,
             sides,
             contacts,
+            catching,
             rough,
             rough_rows: 0,
         })

@@ -126,6 +126,9 @@ pub struct Island<V: WireSpace = DVec2> {
     /// Whether each row is a contact between two beads that touch (see
     /// [`Island::set_contact`]).
     contacts: Vec<bool>,
+    /// Whether each wire row catches its bead rather than holds it from
+    /// the start (see [`Island::set_catching`]).
+    catching: Vec<bool>,
     /// Each wire row's friction, if it has any (see [`Island::set_rough`]).
     rough: Vec<Option<RoughRow>>,
     /// How many rows have friction: with none, the matrices may be factored
@@ -169,6 +172,9 @@ pub struct IslandWork<V: WireSpace = DVec2> {
     time: f64,
     /// The rows set aside: one-sided wires their beads have left.
     inactive: Vec<bool>,
+    /// Whether each row starts held, where a fresh work is told (see
+    /// [`IslandWork::carry`]).
+    carried: Vec<Option<bool>>,
     /// The contact rows whose beads touched where the step began without
     /// closing: the step holds them where it would leave them overlapping
     /// (see [`Island::step_at`]).
@@ -286,6 +292,19 @@ impl<V: WireSpace> IslandWork<V> {
         !self.inactive.get(row).copied().unwrap_or(false)
     }
 
+    /// Starts wire row `row` of a fresh work held (or set aside) whatever
+    /// the rule of the island's first step would say: what an island
+    /// rebuilt around beads where the last one left them carries over, so
+    /// a bead that had left its one-sided wire and is now behind it (on
+    /// another wire that caught it) stays off it. A work that has stepped
+    /// is not changed.
+    pub fn carry(&mut self, row: usize, held: bool) {
+        if self.carried.len() <= row {
+            self.carried.resize(row + 1, None);
+        }
+        self.carried[row] = Some(held);
+    }
+
     /// The beads that left or landed on a one-sided row in the last step:
     /// `(row, bead, event)`.
     pub fn events(&self) -> &[(usize, usize, ContactEvent<V>)] {
@@ -343,12 +362,30 @@ impl<V: WireSpace> Island<V> {
     /// it crosses, located as a lone bead's landing is (the island
     /// projected onto it, the bead's normal velocity reversed and scaled
     /// by the restitution, the row kept aside if it bounced), and the step
-    /// goes on from there. A leaving falls on a step's start.
+    /// goes on from there. A leaving falls on a step's start. (Past an
+    /// end of an open wire, one-sided or not, the bead leaves at the
+    /// instant it passes the end, found within the step, and does not land
+    /// on the wire's continuation past the end.)
     pub fn set_side(&mut self, row: usize, side: Side, restitution: f64) {
         if let (Some(RowKind::Wire { .. }), Some(slot)) =
             (self.rows.get(row), self.sides.get_mut(row))
         {
             *slot = (side.sign(), restitution.clamp(0.0, 1.0));
+        }
+    }
+
+    /// Makes the one-sided wire of row `row` (see [`Island::set_side`])
+    /// one that catches its bead rather than one the bead is on: the row
+    /// starts held only where the bead starts on the wire (within
+    /// 1e-9 of its scale, not past an end), and set aside
+    /// wherever else it starts, on either side; the bead lands on it from
+    /// the side it pushes toward, never from behind. A track of a marble
+    /// run, which every marble may fall onto.
+    pub fn set_catching(&mut self, row: usize) {
+        if let (Some(RowKind::Wire { .. }), Some(slot)) =
+            (self.rows.get(row), self.catching.get_mut(row))
+        {
+            *slot = true;
         }
     }
 

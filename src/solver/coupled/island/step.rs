@@ -387,8 +387,10 @@ impl<V: WireSpace> Island<V> {
     }
 
     /// Which rows a fresh island starts with: a bead that starts off a
-    /// one-sided wire, on the side it pushes toward, or past an end of its
-    /// wire, starts in flight; a
+    /// one-sided wire, on the side it pushes toward (or on either side of
+    /// a wire that catches it, see [`Island::set_catching`]), or past an
+    /// end of its wire, starts in flight (a row told otherwise by
+    /// [`IslandWork::carry`] starts as it was told); a
     /// contact starts set aside;
     /// stick rows start set aside (a bead slides until friction stops it),
     /// but a bead at rest on a rough wire starts held by static friction.
@@ -408,12 +410,18 @@ impl<V: WireSpace> Island<V> {
             }
             // A contact is held only once its beads press (see
             // `Island::set_contact`).
+            let c = || self.wire_row(r, states, time).c;
+            let off = OFF_THE_WIRE * self.rows[r].scale();
             let apart = side != 0.0
-                && (self.contacts[r]
-                    || side * self.wire_row(r, states, time).c
-                        > OFF_THE_WIRE * self.rows[r].scale());
+                && (self.contacts[r] || side * c() > off || (self.catching[r] && c().abs() > off));
             if apart || (self.ends(r) && self.past_end(r, states, time, &work.hints) > 0.0) {
                 work.inactive[r] = true;
+            }
+        }
+        // What a rebuilt island carries over (see `IslandWork::carry`).
+        for (r, carried) in work.carried.iter().enumerate().take(self.rows()) {
+            if let (Some(held), false) = (carried, self.contacts[r]) {
+                work.inactive[r] = !held;
             }
         }
         // A bead at rest on a rough wire starts held by static friction.
