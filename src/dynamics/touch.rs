@@ -65,29 +65,53 @@ impl Restitution {
     }
 }
 
-/// How beads that touch strike, scene-wide.
+/// How beads that touch strike, scene-wide: their restitution and
+/// Coulomb friction.
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Reflect)]
 #[reflect(Resource)]
 pub struct Contacts {
     restitution: f64,
+    friction: f64,
 }
 
 impl Default for Contacts {
-    /// Elastic: `e = 1`.
+    /// Elastic (`e = 1`) and frictionless.
     fn default() -> Self {
-        Self { restitution: 1.0 }
+        Self {
+            restitution: 1.0,
+            friction: 0.0,
+        }
     }
 }
 
 impl Contacts {
-    /// Strikes with restitution `e` (between 0 and 1).
+    /// Strikes with restitution `e` (between 0 and 1), frictionless.
     pub fn new(restitution: f64) -> Result<Self, ParamError> {
-        self::restitution(restitution).map(|restitution| Self { restitution })
+        self::restitution(restitution).map(|restitution| Self {
+            restitution,
+            friction: 0.0,
+        })
+    }
+
+    /// With Coulomb friction `μ` (zero or more and finite) between beads
+    /// that strike: each strike of impulse `p` opposes the pair's slip
+    /// across the line between their centres with an impulse of at most
+    /// `μ p`, as much as stops it where that is less (see
+    /// [`rub`](crate::solver::rub)), pairs struck together at `e = 0` as
+    /// well as pairs struck one by one. Pressed pairs do not rub between
+    /// strikes.
+    pub fn with_friction(self, friction: f64) -> Result<Self, ParamError> {
+        non_negative("friction", friction).map(|friction| Self { friction, ..self })
     }
 
     /// The restitution of a pair whose beads have none of their own.
     pub fn restitution(&self) -> f64 {
         self.restitution
+    }
+
+    /// The Coulomb friction between beads.
+    pub fn friction(&self) -> f64 {
+        self.friction
     }
 }
 
@@ -107,6 +131,9 @@ pub struct BeadsStruck {
     /// Whether they bounced apart, or stayed in touch (`e = 0`, or too
     /// slow to bounce).
     pub bounced: bool,
+    /// The friction impulse against their slip (N s; zero without
+    /// [`Contacts::with_friction`]).
+    pub friction_impulse: f64,
 }
 
 #[cfg(test)]
@@ -128,5 +155,17 @@ mod tests {
         assert!(Restitution::new(f64::NAN).is_err());
         assert!(Contacts::new(-0.1).is_err());
         assert_eq!(Restitution::new(0.0).map(|e| e.get()), Ok(0.0));
+        assert_eq!(
+            Contacts::default()
+                .with_friction(-0.2)
+                .unwrap_err()
+                .to_string(),
+            "friction must be zero or more and finite, got -0.2"
+        );
+        assert!(Contacts::default().with_friction(f64::INFINITY).is_err());
+        assert_eq!(
+            Contacts::default().with_friction(0.4).map(|c| c.friction()),
+            Ok(0.4)
+        );
     }
 }

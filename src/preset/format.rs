@@ -71,19 +71,23 @@ impl<V: Coordinates> BeadPreset<V> {
 }
 
 /// How a scene's beads strike when they touch: `contacts: (restitution:
-/// e)`, elastic (`e = 1`) by default.
+/// e, friction: μ)`, elastic (`e = 1`) and frictionless by default.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct ContactsPreset {
     /// The restitution of a strike, from 0 (the pair stays together) to 1.
     pub restitution: f64,
+    /// Coulomb friction between beads that strike, zero or more.
+    pub friction: f64,
 }
 
 impl Default for ContactsPreset {
     fn default() -> Self {
+        let contacts = Contacts::default();
         Self {
-            restitution: Contacts::default().restitution(),
+            restitution: contacts.restitution(),
+            friction: contacts.friction(),
         }
     }
 }
@@ -91,7 +95,9 @@ impl Default for ContactsPreset {
 impl ContactsPreset {
     /// As the resource, if valid.
     pub fn contacts(&self) -> Result<Contacts, PresetError> {
-        Contacts::new(self.restitution).map_err(PresetError::Contacts)
+        Contacts::new(self.restitution)
+            .and_then(|c| c.with_friction(self.friction))
+            .map_err(PresetError::Contacts)
     }
 
     /// Whether it is the default (and goes unwritten).

@@ -36,6 +36,14 @@
 //! first pair exchanges, the middle ball carries `v` into the third, and
 //! the first ball takes the middle one's rebound.
 //!
+//! **Friction** (Coulomb, coefficient `μ`): after each strike of impulse
+//! `p`, the pair's slip (the part of `v_b − v_a` across the normal) is
+//! opposed by an impulse along it of at most `μ p`: `min(μ p, |s| / w_t)`,
+//! where `w_t` is the pair's weight along the slip (as `w` along the
+//! normal, from its response to an impulse along each tangent), so a
+//! strike stops the slip where friction can and never reverses it. Such an
+//! impulse never adds energy.
+//!
 //! A pair whose bounce `e u` would be slower than the speed one step's
 //! forces give it along the normal (its rest speed, [`Touch::resting_below`])
 //! strikes with `e = 0`: it stays in touch, as a bead landing slowly on a
@@ -171,6 +179,7 @@ pub struct Touch<V = DVec2> {
     gap: f64,
     restitution: f64,
     rest_speed: f64,
+    friction: f64,
 }
 
 impl<V: Coordinates> Touch<V> {
@@ -192,7 +201,47 @@ impl<V: Coordinates> Touch<V> {
             gap: distance - (ra + rb),
             restitution,
             rest_speed: 0.0,
+            friction: 0.0,
         })
+    }
+
+    /// The pair rubs with Coulomb friction `μ` (zero or more; none by
+    /// default) at each strike: see the module's documentation. A
+    /// negative or NaN `μ` rubs with none.
+    pub fn with_friction(self, friction: f64) -> Self {
+        Self {
+            friction: if friction > 0.0 { friction } else { 0.0 },
+            ..self
+        }
+    }
+
+    /// Its Coulomb friction `μ`.
+    pub fn friction(&self) -> f64 {
+        self.friction
+    }
+
+    /// Unit vectors across the normal, each at right angles to the others:
+    /// one in the plane, two in space. A pair's slip is along them.
+    pub fn tangents(&self) -> Vec<V> {
+        let dimension = V::ZERO.components().len();
+        let mut basis: Vec<V> = Vec::with_capacity(dimension - 1);
+        for k in 0..dimension {
+            if basis.len() + 1 == dimension {
+                break;
+            }
+            let mut axis = V::ZERO;
+            *axis.components_mut()[k] = 1.0;
+            let mut t = axis - self.normal * self.normal.dot(axis);
+            for &b in &basis {
+                t = t - b * b.dot(t);
+            }
+            let length = t.dot(t).sqrt();
+            // An axis nearly along the normal or the others: the next one.
+            if length > 0.5 {
+                basis.push(t * length.recip());
+            }
+        }
+        basis
     }
 
     /// The pair stays in touch (strikes with `e = 0`) where its bounce
@@ -245,6 +294,9 @@ impl<V: Coordinates> Touch<V> {
 pub struct Response<V = DVec2> {
     changes: Vec<(usize, V)>,
     weight: f64,
+    /// The same per unit impulse along each of [`Touch::tangents`] (none
+    /// for a pair without friction).
+    tangents: Vec<Vec<(usize, V)>>,
 }
 
 impl<V: Coordinates> Response<V> {
@@ -259,7 +311,18 @@ impl<V: Coordinates> Response<V> {
                 .fold(V::ZERO, |sum, (_, dv)| sum + *dv)
         };
         let weight = touch.normal.dot(of(touch.b) - of(touch.a));
-        Self { changes, weight }
+        Self {
+            changes,
+            weight,
+            tangents: Vec::new(),
+        }
+    }
+
+    /// With the answers to a unit impulse along each of the pair's
+    /// [`Touch::tangents`] (`−t̂` on `a`, `+t̂` on `b`), as `changes` are
+    /// to one along the normal: what friction needs.
+    pub fn with_tangents(self, tangents: Vec<Vec<(usize, V)>>) -> Self {
+        Self { tangents, ..self }
     }
 
     /// The answer of two beads each held by its own rows alone (free, or
@@ -272,14 +335,18 @@ impl<V: Coordinates> Response<V> {
             })
         };
         let (a, b) = (bead(touch.a)?, bead(touch.b)?);
-        let n = touch.normal;
-        Ok(Self::new(
-            touch,
+        let along = |d: V| {
             vec![
-                (touch.a, -a.freedom.project(n) * a.inverse_mass),
-                (touch.b, b.freedom.project(n) * b.inverse_mass),
-            ],
-        ))
+                (touch.a, -a.freedom.project(d) * a.inverse_mass),
+                (touch.b, b.freedom.project(d) * b.inverse_mass),
+            ]
+        };
+        let tangents = if touch.friction > 0.0 {
+            touch.tangents().into_iter().map(along).collect()
+        } else {
+            Vec::new()
+        };
+        Ok(Self::new(touch, along(touch.normal)).with_tangents(tangents))
     }
 
     /// `w = n̂·(Δv_b − Δv_a)` per unit impulse: zero where neither bead
@@ -301,6 +368,9 @@ pub struct Strike {
     /// Whether it bounced (struck with its restitution) or stayed in
     /// touch (closed slower than the rest speed, struck with `e = 0`).
     pub bounced: bool,
+    /// The friction impulse (N s) against the pair's slip, at most `μ`
+    /// times [`Strike::impulse`]; zero without friction.
+    pub friction_impulse: f64,
 }
 
 /// Strikes `touch` with restitution `e`: the impulse of eq. (18),
@@ -325,12 +395,61 @@ pub fn strike<V: Coordinates>(
     p
 }
 
+/// Opposes the slip of `touch` (the part of `v_b − v_a` across its
+/// normal) with an impulse along it of at most `limit` (`μ` times the
+/// strike's impulse), through the answers to impulses along the pair's
+/// tangents in `response`: as much as stops the slip, where that is less.
+/// Returns the impulse, zero where the pair does not slip, has no
+/// tangents' answers, or cannot be moved along its slip.
+pub fn rub<V: Coordinates>(
+    touch: &Touch<V>,
+    limit: f64,
+    response: &Response<V>,
+    velocities: &mut [V],
+) -> f64 {
+    let tangents = touch.tangents();
+    if limit.is_nan() || limit <= 0.0 || response.tangents.len() != tangents.len() {
+        return 0.0;
+    }
+    let relative = velocities[touch.b] - velocities[touch.a];
+    let along: Vec<f64> = tangents.iter().map(|t| t.dot(relative)).collect();
+    let slip = along.iter().map(|s| s * s).sum::<f64>().sqrt();
+    if slip.is_nan() || slip <= 0.0 {
+        return 0.0;
+    }
+    // The answer to a unit impulse along the slip, from the tangents'.
+    let mut changes = Vec::new();
+    for (k, answers) in response.tangents.iter().enumerate() {
+        let share = along[k] / slip;
+        changes.extend(answers.iter().map(|&(i, dv)| (i, dv * share)));
+    }
+    let direction = tangents
+        .iter()
+        .zip(&along)
+        .fold(V::ZERO, |sum, (&t, &s)| sum + t * (s / slip));
+    let of = |bead: usize| {
+        changes
+            .iter()
+            .filter(|(i, _)| *i == bead)
+            .fold(V::ZERO, |sum, (_, dv)| sum + *dv)
+    };
+    let weight = direction.dot(of(touch.b) - of(touch.a));
+    if weight.is_nan() || weight <= 0.0 {
+        return 0.0;
+    }
+    let impulse = limit.min(slip / weight);
+    for &(i, dv) in &changes {
+        velocities[i] -= dv * impulse;
+    }
+    impulse
+}
+
 /// Resolves the strikes among touching beads by sequential pairwise
 /// impacts (see the module's documentation): while a pair in `touches`
 /// closes, the fastest closing one strikes through its response (the
 /// same index in `responses`), with its restitution where its bounce
-/// outruns its rest speed, with `e = 0` otherwise. Each strike is
-/// appended to `strikes`.
+/// outruns its rest speed, with `e = 0` otherwise, and rubs with its
+/// friction ([`rub`]). Each strike is appended to `strikes`.
 ///
 /// Stops with [`ImpactError::DidNotSettle`] after
 /// [`MAX_STRIKES_PER_TOUCH`] strikes per pair, the velocities as the last
@@ -382,11 +501,13 @@ pub fn resolve_impacts<V: Coordinates>(
             // closes them there is not theirs to stop.
             return Ok(());
         }
+        let friction_impulse = rub(touch, touch.friction * impulse, &responses[i], velocities);
         strikes.push(Strike {
             touch: i,
             impulse,
             closing_speed,
             bounced: e > 0.0,
+            friction_impulse,
         });
     }
     match closing(velocities) {
@@ -665,6 +786,47 @@ mod tests {
         );
     }
 
+    /// Ball `a` (1 kg) at 1 m/s along x strikes ball `b` (1 kg, at rest)
+    /// whose centre is 60° off its path, at `e = 1`: the normal impulse
+    /// `cos 60°` and a slip of `sin 60°` across the normal. With `μ = 0.2`
+    /// the pair slides (friction `μ p = 0.1` N s, less than the `0.433`
+    /// that would stop the slip) and loses `f s − f² w_t / 2` of energy;
+    /// with `μ = 1` the slip stops. Both to 1e-15.
+    #[test]
+    fn friction_opposes_the_slip_by_mu_p_or_stops_it() {
+        let theta = 60f64.to_radians();
+        let n = DVec2::new(theta.cos(), theta.sin());
+        let t = DVec2::new(-n.y, n.x);
+        let beads = [ImpactBead {
+            inverse_mass: 1.0,
+            freedom: Freedom::free(),
+        }; 2];
+        for (mu, slides) in [(0.2, true), (1.0, false)] {
+            let touch = Touch::between((0, DVec2::ZERO, 0.5), (1, n, 0.5), 1.0)
+                .expect("apart")
+                .with_friction(mu);
+            assert_eq!(touch.tangents().len(), 1);
+            let response = Response::through(&touch, &beads).expect("two beads");
+            let mut v = [DVec2::X, DVec2::ZERO];
+            let mut strikes = Vec::new();
+            resolve_impacts(&[touch], &[response], &mut v, &mut strikes).expect("settles");
+            let (p, slip) = (theta.cos(), theta.sin());
+            let f = if slides { mu * p } else { slip / 2.0 };
+            assert!((strikes[0].impulse - p).abs() <= 1e-15);
+            assert!((strikes[0].friction_impulse - f).abs() <= 1e-15);
+            let sign = t.dot(-DVec2::X).signum();
+            let expected_a = DVec2::X - n * p + t * (f * sign);
+            let expected_b = n * p - t * (f * sign);
+            assert!((v[0] - expected_a).length() <= 1e-15, "{:?}", v[0]);
+            assert!((v[1] - expected_b).length() <= 1e-15, "{:?}", v[1]);
+            let lost = 0.5 - energy(&beads, &v);
+            assert!((lost - (f * slip - f * f)).abs() <= 1e-15, "lost {lost}");
+            if !slides {
+                assert!(t.dot(v[1] - v[0]).abs() <= 1e-15);
+            }
+        }
+    }
+
     fn vector() -> impl proptest::strategy::Strategy<Value = DVec3> {
         use proptest::prelude::*;
         (-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z))
@@ -714,6 +876,38 @@ mod tests {
             strike(&touch, 1.0, &response, &mut elastic);
             let kept = energy(&beads, &elastic);
             proptest::prop_assert!((kept - before).abs() <= 1e-12 * before.max(1e-300));
+        }
+
+        /// Any two closing beads, free or held, struck at any restitution
+        /// with any friction: the friction impulse is at most `μ p`, no bead
+        /// leaves its freedom, and the energy never grows.
+        #[test]
+        fn friction_never_adds_energy_or_exceeds_mu_p(
+            (ma, mb) in (0.05..20.0f64, 0.05..20.0f64),
+            (fa, fb) in (freedom(), freedom()),
+            (xb, va, vb) in (vector(), vector(), vector()),
+            (e, mu) in (0.0..=1.0f64, 0.0..3.0f64),
+        ) {
+            let beads = [
+                ImpactBead { inverse_mass: 1.0 / ma, freedom: fa },
+                ImpactBead { inverse_mass: 1.0 / mb, freedom: fb },
+            ];
+            proptest::prop_assume!(xb.length() > 1e-3);
+            let touch = Touch::between((0, DVec3::ZERO, 0.0), (1, xb, xb.length()), e)
+                .expect("apart")
+                .with_friction(mu);
+            let mut v = [fa.project(va), fb.project(vb)];
+            // A pair strikes only while it closes.
+            proptest::prop_assume!(touch.normal_speed(&v) < 0.0);
+            let before = energy(&beads, &v);
+            let response = Response::through(&touch, &beads).expect("two beads");
+            let p = strike(&touch, e, &response, &mut v);
+            let f = rub(&touch, mu * p, &response, &mut v);
+            let scale = 1e-12 * (1.0 + va.length() + vb.length());
+            proptest::prop_assert!(f >= 0.0 && f <= mu * p * (1.0 + 1e-15));
+            proptest::prop_assert!((fa.project(v[0]) - v[0]).length() <= scale);
+            proptest::prop_assert!((fb.project(v[1]) - v[1]).length() <= scale);
+            proptest::prop_assert!(energy(&beads, &v) <= before * (1.0 + 1e-12) + 1e-300);
         }
     }
 }

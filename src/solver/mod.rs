@@ -50,7 +50,7 @@ pub use coupled::{
 pub use euler::{explicit_euler, semi_implicit_euler};
 pub use impact::{
     Freedom, ImpactBead, ImpactError, MAX_STRIKES_PER_TOUCH, Response, Strike, Touch,
-    resolve_impacts, strike,
+    resolve_impacts, rub, strike,
 };
 pub(crate) use lanes::{LANES, RoundLanes, RoundSteps, step_on_round_batches};
 pub use method::{Integrator, Method, Stabilization};

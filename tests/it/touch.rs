@@ -334,10 +334,10 @@ fn the_air_track_presets_end_as_their_files_say() {
     }
 }
 
-/// A scene's bad radius, restitution, starting overlap or wire that
-/// catches beads but pushes both ways: refused in one line naming it.
+/// A scene's bad radius, restitution, friction, starting overlap or wire
+/// that catches beads but pushes both ways: refused in one line naming it.
 #[test]
-fn bad_radii_restitutions_overlaps_and_catching_wires_are_refused_in_one_line() {
+fn bad_radii_restitutions_frictions_overlaps_and_catching_wires_are_refused_in_one_line() {
     let scene = |bead_a: &str, contacts: &str| {
         format!(
             "(name: \"t\", {contacts} wires: [(shape: Line(()), beads: [{bead_a}, (name: \"b\", radius: 0.1, initial_position: (1.0, 0.0))])])"
@@ -385,6 +385,13 @@ fn bad_radii_restitutions_overlaps_and_catching_wires_are_refused_in_one_line() 
         "",
     );
     assert!(ScenePreset::from_ron(&touching).is_ok());
+    assert_eq!(
+        refused(scene(
+            "(name: \"a\", radius: 0.1, initial_position: (0.0, 0.0))",
+            "contacts: (friction: -0.2),"
+        )),
+        "contacts: friction must be zero or more and finite, got -0.2"
+    );
     // A wire that catches beads pushes one way only.
     assert_eq!(
         refused("(name: \"t\", wires: [(shape: Line(()), catches: true)])".to_string()),
@@ -826,4 +833,57 @@ fn the_marble_run_takes_every_marble_from_track_to_track_into_the_cup() {
     }
     assert!(worst <= 1e-9, "marbles overlap by {worst:e} of a radius");
     eprintln!("marble run: overlap {worst:e}, landings {landed:?}, leavings {left:?}");
+}
+
+/// Two free balls of 1 kg and radius 0.1 m with no gravity, `contacts:
+/// (restitution: 1.0, friction: 0.2)`: one at 2 m/s along x strikes the
+/// other, at rest 0.1 m off its path, so they meet with their line of
+/// centres 30° off it. The strike's normal impulse is `2 cos 30°` N s and
+/// the slip across it 1 m/s: friction gives `μ p = 0.346` N s against it
+/// (less than the 0.5 N s that would stop it), and both balls leave with
+/// the velocities of that impulse to 1e-12, the message saying so.
+#[test]
+fn balls_struck_off_centre_with_friction_leave_with_the_coulomb_impulse() {
+    let text = format!(
+        "(name: \"rub\", params: (timestep: {}, integrator: Rattle, gravity: (0.0, 0.0)), \
+         contacts: (restitution: 1.0, friction: 0.2), \
+         beads: [(name: \"a\", mass: 1.0, radius: 0.1, initial_position: (-1.0, 0.0), initial_velocity: (2.0, 0.0)), \
+                 (name: \"b\", mass: 1.0, radius: 0.1, initial_position: (0.0, 0.1))])",
+        1.0 / 60.0
+    );
+    let preset = ScenePreset::from_ron(&text).unwrap_or_else(|e| panic!("{e}"));
+    let plugin = WireBeadPlugin::new(preset.params.clone()).expect("valid params");
+    let mut app = Headless::new(plugin).single_threaded().build();
+    let beads = preset.spawn(&mut app.world_mut().commands());
+    app.world_mut().flush();
+    let mut rubbed = Vec::new();
+    for _ in 0..60 {
+        run_steps(&mut app, 1);
+        let messages = app.world().resource::<Messages<BeadsStruck>>();
+        rubbed.extend(
+            messages
+                .iter_current_update_messages()
+                .map(|m| m.friction_impulse),
+        );
+    }
+    let n = DVec2::new(3f64.sqrt() / 2.0, 0.5);
+    let t = DVec2::new(-n.y, n.x);
+    let (p, f) = (3f64.sqrt(), 0.2 * 3f64.sqrt());
+    let a = DVec2::new(2.0, 0.0) - n * p + t * f;
+    let b = n * p - t * f;
+    let va = bead_state(app.world(), beads[0]).expect("a").velocity;
+    let vb = bead_state(app.world(), beads[1]).expect("b").velocity;
+    assert!((va - a).length() <= 1e-12, "a leaves at {va:?}, not {a:?}");
+    assert!((vb - b).length() <= 1e-12, "b leaves at {vb:?}, not {b:?}");
+    assert_eq!(rubbed.len(), 1, "one strike: {rubbed:?}");
+    assert!(
+        (rubbed[0] - f).abs() <= 1e-12,
+        "friction impulse {}",
+        rubbed[0]
+    );
+    eprintln!(
+        "off-centre strike with friction: {:e} and {:e} m/s off",
+        (va - a).length(),
+        (vb - b).length()
+    );
 }

@@ -84,7 +84,9 @@ pub(super) fn step_islands<V: Dimension>(
             };
             if let Some(radius) = radius.filter(|r| r.get() > 0.0) {
                 let e = restitution.map_or(contacts.restitution(), Restitution::get);
-                cached.touching.push((cached.states.len(), radius.get(), e));
+                cached
+                    .touching
+                    .push((cached.states.len(), radius.get(), e, contacts.friction()));
             }
             let mass = cached.masses[cached.states.len()];
             cached.states.push(state);

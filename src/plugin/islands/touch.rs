@@ -15,8 +15,8 @@ use crate::solver::{
 };
 
 /// What an island keeps of its beads that touch: each one's index in the
-/// island, radius and restitution.
-pub(super) type Touching = Vec<(usize, f64, f64)>;
+/// island, radius, restitution and friction.
+pub(super) type Touching = Vec<(usize, f64, f64, f64)>;
 
 /// One island as the touch settlement steps it.
 struct IslandBody<'a, V: Dimension> {
@@ -156,7 +156,7 @@ pub(super) fn regroup<V: Dimension>(cached: &[CachedIsland<V>], dt: f64) -> bool
         if island.outcome != Some(Ok(())) {
             continue;
         }
-        for &(bead, radius, _) in &island.touching {
+        for &(bead, radius, ..) in &island.touching {
             beads.push((island.states[bead], radius));
             place.push((k, bead));
         }
@@ -196,12 +196,13 @@ pub(super) fn settle<V: Dimension>(
         if island.outcome != Some(Ok(())) {
             continue;
         }
-        for &(bead, radius, restitution) in &island.touching {
+        for &(bead, radius, restitution, friction) in &island.touching {
             beads.push(TouchBead {
                 body,
                 bead,
                 radius,
                 restitution,
+                friction,
             });
             entities.push(island.report.beads[bead]);
         }
@@ -249,9 +250,14 @@ pub(super) fn settle<V: Dimension>(
 fn report(pair: &StruckPair, entities: &[Entity], struck: &mut MessageWriter<BeadsStruck>) {
     let (a, b) = (entities[pair.a], entities[pair.b]);
     let s = pair.strike;
+    let rubbed = if s.friction_impulse > 0.0 {
+        format!(" and {:.4} N s of friction", s.friction_impulse)
+    } else {
+        String::new()
+    };
     if s.bounced {
         info!(
-            "wirebead: beads {a} and {b} struck at t = {:.4} s, closing at {:.3} m/s, and bounced apart with an impulse of {:.4} N s",
+            "wirebead: beads {a} and {b} struck at t = {:.4} s, closing at {:.3} m/s, and bounced apart with an impulse of {:.4} N s{rubbed}",
             pair.time, s.closing_speed, s.impulse
         );
     } else {
@@ -267,5 +273,6 @@ fn report(pair: &StruckPair, entities: &[Entity], struck: &mut MessageWriter<Bea
         impulse: s.impulse,
         closing_speed: s.closing_speed,
         bounced: s.bounced,
+        friction_impulse: s.friction_impulse,
     });
 }

@@ -11,7 +11,7 @@ use super::{
 use crate::geometry::Coordinates;
 use crate::solver::contact::locate_between;
 use crate::solver::coupled::{closes, opening_rate, parts};
-use crate::solver::impact::{Response, Strike, Touch, resolve_impacts};
+use crate::solver::impact::{Response, Strike, Touch, resolve_impacts, rub};
 use crate::solver::solve::SolveError;
 use crate::solver::state::BeadState;
 
@@ -526,28 +526,23 @@ impl<'a, V: Coordinates> Group<'a, V> {
             let (fa, fb) = (flat(self, pair.0), flat(self, pair.1));
             let e = ta.restitution.min(tb.restitution);
             let touch =
-                Touch::between((fa, a.position, ta.radius), (fb, b.position, tb.radius), e)?;
+                Touch::between((fa, a.position, ta.radius), (fb, b.position, tb.radius), e)?
+                    .with_friction(ta.friction.min(tb.friction));
             let n = touch.normal();
             let (sa, sb) = (self.slot(pair.0), self.slot(pair.1));
             let push =
                 bodies[self.bodies[sb]].push(tb.bead) - bodies[self.bodies[sa]].push(ta.bead);
             let touch = touch.resting_below(n.dot(push).abs() * self.span.dt);
-            let mut changes = Vec::new();
-            for (slot, bead, sign) in [(sa, ta.bead, -1.0), (sb, tb.bead, 1.0)] {
-                let answer = bodies[self.bodies[slot]].respond(
-                    self.time,
-                    &self.now[slot],
-                    bead,
-                    n * sign,
-                )?;
-                changes.extend(
-                    answer
-                        .into_iter()
-                        .enumerate()
-                        .map(|(k, dv)| (offsets[slot] + k, dv)),
-                );
-            }
-            responses.push(Response::new(&touch, changes));
+            let ends = [(sa, ta.bead), (sb, tb.bead)];
+            let mut answer = |d: V| self.answer(bodies, ends, d, &offsets);
+            let response = Response::new(&touch, answer(n)?);
+            let response = if touch.friction() > 0.0 {
+                let tangents = touch.tangents().into_iter().map(&mut answer);
+                response.with_tangents(tangents.collect::<Result<_, _>>()?)
+            } else {
+                response
+            };
+            responses.push(response);
             touches.push(touch);
             named.push(pair);
         }
@@ -593,6 +588,30 @@ impl<'a, V: Coordinates> Group<'a, V> {
             }
         }
         Ok(())
+    }
+
+    /// The answer of the group's velocities (side by side, each body's
+    /// from its offset) to a unit impulse `−d` on the first of `ends` and
+    /// `+d` on the second (each a body's slot and its bead there).
+    fn answer<B: TouchBody<V>>(
+        &self,
+        bodies: &mut [B],
+        ends: [(usize, usize); 2],
+        d: V,
+        offsets: &[usize],
+    ) -> Result<Vec<(usize, V)>, SolveError> {
+        let mut changes = Vec::new();
+        for ((slot, bead), sign) in ends.into_iter().zip([-1.0, 1.0]) {
+            let answer =
+                bodies[self.bodies[slot]].respond(self.time, &self.now[slot], bead, d * sign)?;
+            changes.extend(
+                answer
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, dv)| (offsets[slot] + k, dv)),
+            );
+        }
+        Ok(changes)
     }
 
     /// Holds every pair in touch now that closes at `e = 0` where a
@@ -651,6 +670,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
                 bodies[self.bodies[slot]].hold(ba, bb, false);
                 continue;
             }
+            let friction_impulse = self.rub_pressed(bodies, slot, pair, impulse)?;
             struck.push(StruckPair {
                 a: pair.0,
                 b: pair.1,
@@ -660,10 +680,47 @@ impl<'a, V: Coordinates> Group<'a, V> {
                     impulse,
                     closing_speed,
                     bounced: false,
+                    friction_impulse,
                 },
             });
         }
         Ok(())
+    }
+
+    /// Rubs a pair the press struck with `impulse` (both beads in the body
+    /// in `slot`, their contact held): its slip opposed by at most its
+    /// friction times the impulse, answered by the body with the held
+    /// rows ([`rub`]). The friction impulse.
+    fn rub_pressed<B: TouchBody<V>>(
+        &mut self,
+        bodies: &mut [B],
+        slot: usize,
+        pair: (usize, usize),
+        impulse: f64,
+    ) -> Result<f64, TouchError> {
+        let (ta, tb) = (self.beads[pair.0], self.beads[pair.1]);
+        let friction = ta.friction.min(tb.friction);
+        if friction <= 0.0 {
+            return Ok(0.0);
+        }
+        let states = &self.now[slot];
+        let (xa, xb) = (states[ta.bead].position, states[tb.bead].position);
+        let touch = Touch::between((ta.bead, xa, ta.radius), (tb.bead, xb, tb.radius), 0.0)?
+            .with_friction(friction);
+        let ends = [(slot, ta.bead), (slot, tb.bead)];
+        let offsets = vec![0; self.bodies.len()];
+        let tangents = touch
+            .tangents()
+            .into_iter()
+            .map(|t| self.answer(bodies, ends, t, &offsets))
+            .collect::<Result<_, _>>()?;
+        let response = Response::new(&touch, Vec::new()).with_tangents(tangents);
+        let mut velocities: Vec<V> = self.now[slot].iter().map(|s| s.velocity).collect();
+        let rubbed = rub(&touch, friction * impulse, &response, &mut velocities);
+        for (state, v) in self.now[slot].iter_mut().zip(velocities) {
+            state.velocity = v;
+        }
+        Ok(rubbed)
     }
 
     /// The pairs in touch now, set aside by a contact row of one body,

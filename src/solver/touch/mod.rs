@@ -142,6 +142,9 @@ pub struct TouchBead {
     pub radius: f64,
     /// Its restitution: a pair strikes with the smaller of its two.
     pub restitution: f64,
+    /// Its Coulomb friction `μ` against another bead: a pair rubs with
+    /// the smaller of its two (see [`rub`](crate::solver::rub)).
+    pub friction: f64,
 }
 
 /// One strike within a step: the two beads (indices into the list of

@@ -75,6 +75,7 @@ fn beads(bodies: usize, radius: f64) -> Vec<TouchBead> {
             bead: 0,
             radius,
             restitution: 1.0,
+            friction: 0.0,
         })
         .collect()
 }
