@@ -29,6 +29,8 @@ struct Flight<'a, V> {
     level: u32,
     calm: u32,
     rows: &'a [usize],
+    /// The one-sided rows a bead may land on ([`Island::above`]).
+    above: &'a [usize],
 }
 
 /// What [`Island::cut_within`] cuts a step at.
@@ -195,6 +197,7 @@ impl<V: WireSpace> Island<V> {
                 level: *level,
                 calm: *calm,
                 rows,
+                above: &above,
             };
             let end = time + settings.dt;
             if !ending.is_empty() && self.on_the_wire(end, states, &ending, work) < 0.0 {
@@ -246,10 +249,12 @@ impl<V: WireSpace> Island<V> {
         }
     }
 
-    /// The one-sided rows set aside whose beads are not behind their wires
-    /// (off them, on the side they push toward, or on them) where no end
-    /// is passed: the rows a bead may land on within the step. A bead that
-    /// passed an end and came round behind the wire does not land on it.
+    /// The one-sided rows set aside that a bead may land on within the
+    /// step: those whose bead has not passed an end of the wire, and, on
+    /// a wire with ends or one that catches, is not behind it (off it on
+    /// the side it pushes toward, or on it). A bead behind a wire with no
+    /// end crossed it (it could not go round) and lands; one that went
+    /// round an end, or a marble under another track, does not.
     fn above(&self, time: f64, states: &[BeadState<V>], work: &IslandWork<V>) -> Vec<usize> {
         if states.len() != self.beads() {
             return Vec::new();
@@ -257,9 +262,12 @@ impl<V: WireSpace> Island<V> {
         (0..self.rows())
             .filter(|&r| self.sides[r].0 != 0.0 && work.inactive[r] && !self.contacts[r])
             .filter(|&r| {
-                let c = self.sides[r].0 * self.wire_row(r, states, time).c;
-                c >= -OFF_THE_WIRE * self.rows[r].scale()
-                    && self.past_end(r, states, time, &work.hints) <= 0.0
+                let behind = || {
+                    self.sides[r].0 * self.wire_row(r, states, time).c
+                        < -OFF_THE_WIRE * self.rows[r].scale()
+                };
+                let strict = self.catching[r] || self.ends(r);
+                !(strict && behind()) && self.past_end(r, states, time, &work.hints) <= 0.0
             })
             .collect()
     }
@@ -358,7 +366,9 @@ impl<V: WireSpace> Island<V> {
         let cut_there = located.and_then(|tau| {
             trial(tau, states, work)?;
             match cut {
-                Cut::Landing => self.land(time + tau, states, forces, settings.dt, rows, work)?,
+                Cut::Landing => {
+                    self.land(time + tau, states, forces, settings.dt, flight.above, work)?;
+                }
                 Cut::End => self.leave_at_ends(time + tau, states, rows, work),
             }
             let rest = settings.dt - tau;
