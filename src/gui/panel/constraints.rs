@@ -7,23 +7,28 @@ use super::view::PanelView;
 use crate::ConstraintDiagnostics;
 
 /// The last strikes: which beads, when, how fast they closed, the impulse
-/// and whether they bounced apart or stayed in touch.
+/// (and the friction impulse, where a strike rubbed) and whether they
+/// bounced apart or stayed in touch.
 pub(super) fn strikes_section(ui: &mut egui::Ui, view: &PanelView) {
     if view.strikes.0.is_empty() {
         return;
     }
+    let rubbed = view.strikes.0.iter().any(|s| s.friction_impulse > 0.0);
     ui.separator();
     egui::CollapsingHeader::new("Strikes")
         .default_open(true)
         .show(ui, |ui| {
             egui::Grid::new("strikes")
-                .num_columns(4)
+                .num_columns(if rubbed { 5 } else { 4 })
                 .striped(true)
                 .show(ui, |ui| {
                     ui.strong("");
                     ui.strong("t (s)");
                     ui.strong("closing (m/s)");
                     ui.strong("impulse (N s)");
+                    if rubbed {
+                        ui.strong("friction (N s)");
+                    }
                     ui.end_row();
                     for s in &view.strikes.0 {
                         let how = if s.bounced { "bounced" } else { "stayed" };
@@ -31,6 +36,9 @@ pub(super) fn strikes_section(ui: &mut egui::Ui, view: &PanelView) {
                         ui.monospace(format!("{:.4}", s.time));
                         ui.monospace(format!("{:.4}", s.closing_speed));
                         ui.monospace(format!("{:.4}", s.impulse));
+                        if rubbed {
+                            ui.monospace(format!("{:.4}", s.friction_impulse));
+                        }
                         ui.end_row();
                     }
                 });

@@ -148,8 +148,13 @@ const STRIKES_SHOWN: usize = 6;
 #[derive(Resource, Default)]
 pub struct RecentStrikes(pub(super) VecDeque<BeadsStruck>);
 
-/// Keeps the last six strikes; forgets them when the run
-/// starts again (the clock went back).
+/// A strike that leaves its pair in touch closing slower than this (m/s)
+/// is a resting pair's, not listed: a pile trades such strikes every step.
+const RESTING_CLOSING: f64 = 1e-3;
+
+/// Keeps the last six strikes (leaving out resting pairs' below
+/// [`RESTING_CLOSING`]); forgets them when the run starts again (the clock
+/// went back).
 pub fn record_strikes(
     mut struck: MessageReader<BeadsStruck>,
     clock: Res<SimClock>,
@@ -159,7 +164,9 @@ pub fn record_strikes(
         recent.0.clear();
     }
     for strike in struck.read() {
-        recent.0.push_front(*strike);
+        if strike.bounced || strike.closing_speed >= RESTING_CLOSING {
+            recent.0.push_front(*strike);
+        }
     }
     recent.0.truncate(STRIKES_SHOWN);
 }

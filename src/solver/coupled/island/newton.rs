@@ -50,7 +50,8 @@ impl<V: WireSpace> Island<V> {
             for r in 0..rows {
                 let scale = self.rows[r].scale().max(f64::MIN_POSITIVE);
                 let residual = work.c[r].abs();
-                worst = worst.max(residual / scale);
+                let slack = if self.contacts[r] { CONTACT_SLACK } else { 1.0 };
+                worst = worst.max(residual / (slack * scale));
                 // The reach only while every row so far is within.
                 within = within && newton_within(residual, scale, self.reach(r, &work.x));
             }
@@ -177,6 +178,14 @@ impl<V: WireSpace> Island<V> {
         Ok(())
     }
 }
+
+/// How many times a wire's residual a held contact row's may be where a
+/// Newton solve stalls and takes it: 4e-10 of the two radii instead of
+/// [`NEWTON_ACCEPT`](crate::solver::newton::NEWTON_ACCEPT)'s 1e-10. Beads
+/// jammed among others can hold more contact rows than they can meet
+/// exactly at once, and there exact Newton steps stall a little above
+/// 1e-10 of the radii however short the step.
+const CONTACT_SLACK: f64 = 4.0;
 
 /// The gradients a Newton iteration moves along.
 #[derive(Clone, Copy, PartialEq, Eq)]
