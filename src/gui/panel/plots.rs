@@ -152,9 +152,9 @@ pub struct RecentStrikes(pub(super) VecDeque<BeadsStruck>);
 /// is a resting pair's, not listed: a pile trades such strikes every step.
 const RESTING_CLOSING: f64 = 1e-3;
 
-/// Keeps the last six strikes (leaving out resting pairs' below
-/// [`RESTING_CLOSING`]); forgets them when the run starts again (the clock
-/// went back).
+/// Keeps the last six strikes (leaving out resting pairs' closing slower
+/// than 1 mm/s); forgets them when the run starts again (the clock went
+/// back).
 pub fn record_strikes(
     mut struck: MessageReader<BeadsStruck>,
     clock: Res<SimClock>,
