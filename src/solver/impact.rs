@@ -407,8 +407,11 @@ pub fn rub<V: Coordinates>(
     response: &Response<V>,
     velocities: &mut [V],
 ) -> f64 {
+    if limit.is_nan() || limit <= 0.0 || response.tangents.is_empty() {
+        return 0.0;
+    }
     let tangents = touch.tangents();
-    if limit.is_nan() || limit <= 0.0 || response.tangents.len() != tangents.len() {
+    if response.tangents.len() != tangents.len() {
         return 0.0;
     }
     let relative = velocities[touch.b] - velocities[touch.a];

@@ -180,7 +180,7 @@ impl<V: WireSpace> Island<V> {
         let rough = vec![None; kinds.len()];
         let contacts = vec![false; kinds.len()];
         let catching = vec![false; kinds.len()];
-        Ok(Self {
+        let mut island = Self {
             inverse_mass,
             rows: kinds,
             row_start,
@@ -192,8 +192,11 @@ impl<V: WireSpace> Island<V> {
             sides,
             contacts,
             catching,
+            ended: 0,
             rough,
             rough_rows: 0,
-        })
+        };
+        island.count_ends();
+        Ok(island)
     }
 }

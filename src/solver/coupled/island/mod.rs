@@ -129,6 +129,9 @@ pub struct Island<V: WireSpace = DVec2> {
     /// Whether each wire row catches its bead rather than holds it from
     /// the start (see [`Island::set_catching`]).
     catching: Vec<bool>,
+    /// How many rows are of wires that end: with none, a step looks for
+    /// no end.
+    ended: usize,
     /// Each wire row's friction, if it has any (see [`Island::set_rough`]).
     rough: Vec<Option<RoughRow>>,
     /// How many rows have friction: with none, the matrices may be factored
@@ -328,6 +331,7 @@ impl<V: WireSpace> Island<V> {
             }
             if let Some(shape) = shape {
                 *placed_shape = shape;
+                self.count_ends();
             }
         }
     }
@@ -350,8 +354,14 @@ impl<V: WireSpace> Island<V> {
             }
             if let Some(shape) = shape {
                 *placed_shape = shape;
+                self.count_ends();
             }
         }
+    }
+
+    /// Counts the rows of wires that end again (a wire's shape changed).
+    fn count_ends(&mut self) {
+        self.ended = (0..self.rows()).filter(|&r| self.ends(r)).count();
     }
 
     /// Makes the wire of row `row` one-sided (see

@@ -38,7 +38,7 @@ impl<V: WireSpace> Island<V> {
 
     /// Whether any row is a wire's that ends.
     pub(super) fn has_ends(&self) -> bool {
-        (0..self.rows()).any(|r| self.ends(r))
+        self.ended > 0
     }
 
     /// How far past an end of its wire wire row `r`'s bead is in `states`

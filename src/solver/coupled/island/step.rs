@@ -413,9 +413,10 @@ impl<V: WireSpace> Island<V> {
                 work.inactive[s] = true;
             }
         }
+        let ends = self.has_ends();
         for r in 0..self.rows() {
             let (side, _) = self.sides[r];
-            if !whole {
+            if !whole || (side == 0.0 && !ends) {
                 continue;
             }
             // A contact is held only once its beads press (see
@@ -424,7 +425,8 @@ impl<V: WireSpace> Island<V> {
             let off = OFF_THE_WIRE * self.rows[r].scale();
             let apart = side != 0.0
                 && (self.contacts[r] || side * c() > off || (self.catching[r] && c().abs() > off));
-            if apart || (self.ends(r) && self.past_end(r, states, time, &work.hints) > 0.0) {
+            if apart || (ends && self.ends(r) && self.past_end(r, states, time, &work.hints) > 0.0)
+            {
                 work.inactive[r] = true;
             }
         }
