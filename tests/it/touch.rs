@@ -256,7 +256,13 @@ fn the_cradle_sends_out_as_many_balls_as_came_in() {
 /// contacts.
 fn shipped(name: &str) -> (App, Vec<Entity>, ScenePreset) {
     let text = std::fs::read_to_string(crate::presets::shipped_dir().join(name)).expect(name);
-    let preset = ScenePreset::from_ron(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+    spawned(&text)
+}
+
+/// A scene's text, spawned into a headless app with its parameters and
+/// contacts: the app, the beads in the file's order and the scene.
+fn spawned(text: &str) -> (App, Vec<Entity>, ScenePreset) {
+    let preset = ScenePreset::from_ron(text).unwrap_or_else(|e| panic!("{e}"));
     let plugin = WireBeadPlugin::new(preset.params.clone()).expect("valid params");
     let mut app = Headless::new(plugin).single_threaded().build();
     let beads = preset.spawn(&mut app.world_mut().commands());
@@ -684,11 +690,7 @@ fn a_pile_poured_into_a_bowl_lies_pressed_together_without_overlap() {
          wires: [(shape: Circle((radius: 1.0)), side: Negative, beads: [{beads}])])",
         1.0 / 240.0
     );
-    let preset = ScenePreset::from_ron(&text).unwrap_or_else(|e| panic!("{e}"));
-    let plugin = WireBeadPlugin::new(preset.params.clone()).expect("valid params");
-    let mut app = Headless::new(plugin).single_threaded().build();
-    let spawned = preset.spawn(&mut app.world_mut().commands());
-    app.world_mut().flush();
+    let (mut app, spawned, _) = spawned(&text);
     let energy = |app: &App| -> f64 {
         let islands = app.world().resource::<Islands>();
         islands.iter().map(|i| i.energy).sum()
@@ -748,11 +750,7 @@ fn off_the_ramp(radius: Option<f64>) -> (BeadState, bool) {
          side: Positive, beads: [{bead}])])",
         1.0 / 240.0
     );
-    let preset = ScenePreset::from_ron(&text).unwrap_or_else(|e| panic!("{e}"));
-    let plugin = WireBeadPlugin::new(preset.params.clone()).expect("valid params");
-    let mut app = Headless::new(plugin).single_threaded().build();
-    let spawned = preset.spawn(&mut app.world_mut().commands());
-    app.world_mut().flush();
+    let (mut app, spawned, _) = spawned(&text);
     run_steps(&mut app, 240);
     let world = app.world_mut();
     assert_eq!(world.query::<&Diverged>().iter(world).count(), 0);
@@ -851,11 +849,7 @@ fn balls_struck_off_centre_with_friction_leave_with_the_coulomb_impulse() {
                  (name: \"b\", mass: 1.0, radius: 0.1, initial_position: (0.0, 0.1))])",
         1.0 / 60.0
     );
-    let preset = ScenePreset::from_ron(&text).unwrap_or_else(|e| panic!("{e}"));
-    let plugin = WireBeadPlugin::new(preset.params.clone()).expect("valid params");
-    let mut app = Headless::new(plugin).single_threaded().build();
-    let beads = preset.spawn(&mut app.world_mut().commands());
-    app.world_mut().flush();
+    let (mut app, beads, _) = spawned(&text);
     let mut rubbed = Vec::new();
     for _ in 0..60 {
         run_steps(&mut app, 1);
