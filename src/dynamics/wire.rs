@@ -329,8 +329,9 @@ impl WireContact {
     }
 }
 
-/// Sent when a bead leaves its one-sided wire or lands on it (also
-/// logged, one line).
+/// Sent when a bead leaves a wire (a one-sided one that would have to
+/// pull, or any past its end) or lands on a one-sided one, its own or one
+/// that catches it (also logged, one line).
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
 pub struct ContactChanged<V: Coordinates = DVec2> {
     /// The bead.

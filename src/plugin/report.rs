@@ -73,7 +73,7 @@ impl<V: Dimension> ContactReports<'_, V> {
 fn describe_event<V: Dimension>(event: &ContactEvent<V>) -> String {
     match *event {
         ContactEvent::Left { time, position } => format!(
-            "left its wire at t = {time:.4} s at {}, where the wire would have had to pull",
+            "left a wire at t = {time:.4} s at {}, where it would have had to pull or past its end",
             point(position)
         ),
         ContactEvent::Landed {
@@ -82,7 +82,7 @@ fn describe_event<V: Dimension>(event: &ContactEvent<V>) -> String {
             normal_speed,
             bounced,
         } => format!(
-            "landed on its wire at t = {time:.4} s at {} at {normal_speed:.3} m/s across it and {}",
+            "landed on a wire at t = {time:.4} s at {} at {normal_speed:.3} m/s across it and {}",
             point(position),
             if bounced { "bounced off" } else { "stayed on" }
         ),

@@ -400,7 +400,8 @@ pub fn strike<V: Coordinates>(
 /// strike's impulse), through the answers to impulses along the pair's
 /// tangents in `response`: as much as stops the slip, where that is less.
 /// Returns the impulse, zero where the pair does not slip, has no
-/// tangents' answers, or cannot be moved along its slip.
+/// tangents' answers, cannot be moved along its slip, or names a bead
+/// that `velocities` does not have.
 pub fn rub<V: Coordinates>(
     touch: &Touch<V>,
     limit: f64,
@@ -408,6 +409,11 @@ pub fn rub<V: Coordinates>(
     velocities: &mut [V],
 ) -> f64 {
     if limit.is_nan() || limit <= 0.0 || response.tangents.is_empty() {
+        return 0.0;
+    }
+    let count = velocities.len();
+    let named = response.tangents.iter().flatten().map(|(i, _)| *i);
+    if touch.a >= count || touch.b >= count || named.into_iter().any(|i| i >= count) {
         return 0.0;
     }
     let tangents = touch.tangents();
@@ -465,11 +471,15 @@ pub fn resolve_impacts<V: Coordinates>(
 ) -> Result<(), ImpactError> {
     let count = velocities.len();
     let named = || {
-        touches.iter().flat_map(|t| [t.a, t.b]).chain(
-            responses
-                .iter()
-                .flat_map(|r| r.changes.iter().map(|(i, _)| *i)),
-        )
+        touches
+            .iter()
+            .flat_map(|t| [t.a, t.b])
+            .chain(responses.iter().flat_map(|r| {
+                r.changes
+                    .iter()
+                    .chain(r.tangents.iter().flatten())
+                    .map(|(i, _)| *i)
+            }))
     };
     if let Some(bead) = named().find(|&i| i >= count) {
         return Err(ImpactError::MissingBead { bead, beads: count });

@@ -148,13 +148,18 @@ pub(super) fn prepare_islands<V: Dimension>(
     let mut was_held: Carried<V> = HashMap::new();
     for cached in &islands.cached {
         for row in &cached.wire_rows {
-            let (Some(&bead), Some(&state)) = (
-                cached.report.beads.get(row.bead),
-                cached.states.get(row.bead),
-            ) else {
+            let Some(&bead) = cached.report.beads.get(row.bead) else {
                 continue;
             };
-            let held = cached.work.holds(row.row);
+            let (held, state) = match cached.states.get(row.bead) {
+                Some(&state) => (cached.work.holds(row.row), state),
+                // Built and not stepped since: what it was told to carry,
+                // where the bead is now.
+                None => match (cached.work.carried(row.row), beads.get(bead)) {
+                    (Some(held), Ok((_, now, ..))) => (held, now.state()),
+                    _ => continue,
+                },
+            };
             was_held.insert((bead, row.wire, row.part), (held, state));
         }
     }

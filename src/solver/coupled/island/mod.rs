@@ -308,6 +308,11 @@ impl<V: WireSpace> IslandWork<V> {
         self.carried[row] = Some(held);
     }
 
+    /// What [`IslandWork::carry`] told row `row` to start as, if anything.
+    pub fn carried(&self, row: usize) -> Option<bool> {
+        self.carried.get(row).copied().flatten()
+    }
+
     /// The beads that left or landed on a one-sided row in the last step:
     /// `(row, bead, event)`.
     pub fn events(&self) -> &[(usize, usize, ContactEvent<V>)] {

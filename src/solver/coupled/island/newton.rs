@@ -37,6 +37,7 @@ impl<V: WireSpace> Island<V> {
         work.lambda.resize(rows, 0.0);
         let mut exact = direction == Direction::First && rows == 1;
         let mut previous = f64::INFINITY;
+        let mut previous_taken = f64::INFINITY;
         let mut rising = 0;
         let mut exacts = 0;
         let mut i = 0;
@@ -47,15 +48,19 @@ impl<V: WireSpace> Island<V> {
             // its wire; or the worst row, relative to its scale, accepted.
             let mut within = true;
             let mut worst = 0.0f64;
+            // The worst row for the acceptance, a held contact's with its
+            // slack.
+            let mut taken = 0.0f64;
             for r in 0..rows {
                 let scale = self.rows[r].scale().max(f64::MIN_POSITIVE);
                 let residual = work.c[r].abs();
+                worst = worst.max(residual / scale);
                 let slack = if self.contacts[r] { CONTACT_SLACK } else { 1.0 };
-                worst = worst.max(residual / (slack * scale));
+                taken = taken.max(residual / (slack * scale));
                 // The reach only while every row so far is within.
                 within = within && newton_within(residual, scale, self.reach(r, &work.x));
             }
-            if within || newton_accepted(worst, previous, 1.0, last) {
+            if within || newton_accepted(taken, previous_taken, 1.0, last) {
                 return self.same_branch(work, direction, worst);
             }
             if last || !worst.is_finite() {
@@ -89,7 +94,7 @@ impl<V: WireSpace> Island<V> {
                     });
                 }
             }
-            previous = worst;
+            (previous, previous_taken) = (worst, taken);
             work.rhs.clear();
             work.rhs.extend(work.c.iter().map(|c| -c));
             let along = match direction {
