@@ -304,13 +304,7 @@ impl<V: Coordinates> Response<V> {
     /// bead may be listed more than once, its changes add) to a unit
     /// impulse on `touch`.
     pub fn new(touch: &Touch<V>, changes: Vec<(usize, V)>) -> Self {
-        let of = |bead: usize| {
-            changes
-                .iter()
-                .filter(|(i, _)| *i == bead)
-                .fold(V::ZERO, |sum, (_, dv)| sum + *dv)
-        };
-        let weight = touch.normal.dot(of(touch.b) - of(touch.a));
+        let weight = weight_along(touch, touch.normal, &changes);
         Self {
             changes,
             weight,
@@ -354,6 +348,20 @@ impl<V: Coordinates> Response<V> {
     pub fn weight(&self) -> f64 {
         self.weight
     }
+}
+
+/// A pair's weight along `d`: `d·(Δv_b − Δv_a)` for the velocity
+/// changes `changes` (bead, change; a bead listed more than once takes
+/// their sum) that a unit impulse along `d` makes, the inverse of the
+/// pair's effective mass along it.
+fn weight_along<V: Coordinates>(touch: &Touch<V>, d: V, changes: &[(usize, V)]) -> f64 {
+    let of = |bead: usize| {
+        changes
+            .iter()
+            .filter(|(i, _)| *i == bead)
+            .fold(V::ZERO, |sum, (_, dv)| sum + *dv)
+    };
+    d.dot(of(touch.b) - of(touch.a))
 }
 
 /// One strike that [`resolve_impacts`] made.
@@ -436,13 +444,7 @@ pub fn rub<V: Coordinates>(
         .iter()
         .zip(&along)
         .fold(V::ZERO, |sum, (&t, &s)| sum + t * (s / slip));
-    let of = |bead: usize| {
-        changes
-            .iter()
-            .filter(|(i, _)| *i == bead)
-            .fold(V::ZERO, |sum, (_, dv)| sum + *dv)
-    };
-    let weight = direction.dot(of(touch.b) - of(touch.a));
+    let weight = weight_along(touch, direction, &changes);
     if weight.is_nan() || weight <= 0.0 {
         return 0.0;
     }

@@ -200,13 +200,25 @@ impl<V: WireSpace> Island<V> {
                 if self.contacts[r] {
                     continue; // a pair parting is no bead leaving its wire
                 }
-                let bead = self.entry_bead[self.row_start[r]];
-                let position = states[bead].position;
-                work.events
-                    .push((r, bead, ContactEvent::Left { time, position }));
+                self.report_left(r, time, states, work);
             }
         }
         Ok(())
+    }
+
+    /// Records that wire row `r`'s bead left its wire at `time`, where it
+    /// is in `states`.
+    pub(super) fn report_left(
+        &self,
+        r: usize,
+        time: f64,
+        states: &[BeadState<V>],
+        work: &mut IslandWork<V>,
+    ) {
+        let bead = self.entry_bead[self.row_start[r]];
+        let position = states[bead].position;
+        work.events
+            .push((r, bead, ContactEvent::Left { time, position }));
     }
 
     /// Lands every bead whose set-aside one-sided row of `rows` it crossed

@@ -14,10 +14,7 @@ impl<V: WireSpace> Island<V> {
     /// Wire row `r` where its bead is in `states` at `time`, whether the
     /// row is held or not (zero for a row of another kind).
     pub(super) fn wire_row(&self, r: usize, states: &[BeadState<V>], time: f64) -> RowAt<V> {
-        let (Some((shape, pose, twist)), Some(state)) = (
-            self.wire_at(r, time),
-            states.get(self.entry_bead[self.row_start[r]]),
-        ) else {
+        let Some((shape, pose, twist, state)) = self.wire_and_bead(r, states, time) else {
             return RowAt::default();
         };
         let g = placed_geometry(&pose, state.position, |local| {
@@ -52,10 +49,7 @@ impl<V: WireSpace> Island<V> {
         time: f64,
         hints: &[f64],
     ) -> f64 {
-        let (Some((shape, pose, _)), Some(state)) = (
-            self.wire_at(r, time),
-            states.get(self.entry_bead[self.row_start[r]]),
-        ) else {
+        let Some((shape, pose, _, state)) = self.wire_and_bead(r, states, time) else {
             return f64::NEG_INFINITY;
         };
         let local = Placement::to_local(&pose, state.position);
@@ -98,6 +92,19 @@ impl<V: WireSpace> Island<V> {
         Some((rate, reach, speeds))
     }
 
+    /// Wire row `r`'s wire at `time` (as [`Island::wire_at`]) and its
+    /// bead's state in `states`; none for a row of another kind.
+    fn wire_and_bead<'a>(
+        &'a self,
+        r: usize,
+        states: &'a [BeadState<V>],
+        time: f64,
+    ) -> Option<(&'a V::Shape, V::Pose, Twist<V>, &'a BeadState<V>)> {
+        let (shape, pose, twist) = self.wire_at(r, time)?;
+        let state = states.get(self.entry_bead[self.row_start[r]])?;
+        Some((shape, pose, twist, state))
+    }
+
     /// The shape of wire row `r` and where its wire is at `time`, with its
     /// twist; none for a row of another kind.
     fn wire_at(&self, r: usize, time: f64) -> Option<(&V::Shape, V::Pose, Twist<V>)> {
@@ -116,10 +123,7 @@ impl<V: WireSpace> Island<V> {
     pub(super) fn follow(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
         work.hints.resize(self.rows(), f64::NAN);
         for r in 0..self.rows() {
-            let (Some((shape, pose, _)), Some(state)) = (
-                self.wire_at(r, time),
-                states.get(self.entry_bead[self.row_start[r]]),
-            ) else {
+            let Some((shape, pose, _, state)) = self.wire_and_bead(r, states, time) else {
                 continue;
             };
             let local = Placement::to_local(&pose, state.position);

@@ -10,7 +10,7 @@ use super::projection::Restore;
 use super::{
     CALM_STEPS, CONTACT_PASSES, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow, TOUCHING,
 };
-use crate::solver::contact::{ContactEvent, locate};
+use crate::solver::contact::locate;
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use crate::solver::method::{Integrator, Method};
 use crate::solver::settings::StepSettings;
@@ -314,10 +314,7 @@ impl<V: WireSpace> Island<V> {
         for &r in rows {
             if self.past_end(r, states, time, &work.hints) >= 0.0 {
                 work.inactive[r] = true;
-                let bead = self.entry_bead[self.row_start[r]];
-                let position = states[bead].position;
-                work.events
-                    .push((r, bead, ContactEvent::Left { time, position }));
+                self.report_left(r, time, states, work);
             }
         }
     }
