@@ -369,12 +369,15 @@ pub fn simulate_scene<S: Scene>(
         record_scene::<S::V>.after(WireBeadSystems::Writeback),
     );
     app.world_mut().run_system_cached(record_scene::<S::V>).ok();
+    let bar = crate::run::progress(u64::from(steps), "steps");
     let mut done = 0;
     while done < steps && !app.world().resource::<Recorder<S::V>>().stopped {
-        let batch = (steps - done).min(500);
+        let batch = (steps - done).min(10);
         run_steps(&mut app, batch);
         done += batch;
+        bar.inc(u64::from(batch));
     }
+    bar.finish_and_clear();
     let diverged = beads.iter().find_map(|&b| {
         app.world()
             .get::<Diverged>(b)

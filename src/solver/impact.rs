@@ -47,7 +47,9 @@
 //! A pair whose bounce `e u` would be slower than the speed one step's
 //! forces give it along the normal (its rest speed, [`Touch::resting_below`])
 //! strikes with `e = 0`: it stays in touch, as a bead landing slowly on a
-//! one-sided wire stays on it (eq. 16).
+//! one-sided wire stays on it (eq. 16). A pair at `e = 0` that meets
+//! slower than its step's forces move it is not struck at all: its
+//! island's step holds it (see [`settle_touches`](crate::solver::settle_touches)).
 
 use bevy::math::DVec2;
 use thiserror::Error;

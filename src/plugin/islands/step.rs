@@ -112,6 +112,21 @@ pub(super) fn step_islands<V: Dimension>(
                 }
             }
         }
+        // Each contact row's restitution, the least of its two beads'.
+        for contact in &cached.contacts {
+            let e = |bead: usize| {
+                let k = cached.touching.partition_point(|t| t.0 < bead);
+                cached
+                    .touching
+                    .get(k)
+                    .filter(|t| t.0 == bead)
+                    .map_or(1.0, |t| t.2)
+            };
+            let restitution = e(contact.a).min(e(contact.b));
+            cached
+                .island
+                .set_contact_restitution(contact.row, restitution);
+        }
         cached.outcome = Some(Ok(()));
         stepped_beads += cached.states.len();
     }

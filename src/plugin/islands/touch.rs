@@ -42,9 +42,14 @@ impl<V: Dimension> TouchBody<V> for IslandBody<'_, V> {
         let cached = &mut *self.cached;
         cached.work.rewind(&cached.mark);
         let settings = self.settings.part(h);
-        cached
-            .island
-            .step_at(time, states, &cached.forces, &settings, &mut cached.work)
+        cached.island.step_part(
+            time,
+            states,
+            &cached.forces,
+            &settings,
+            self.settings.dt,
+            &mut cached.work,
+        )
     }
 
     fn keep(&mut self) {

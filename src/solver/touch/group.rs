@@ -10,7 +10,7 @@ use super::{
 };
 use crate::geometry::Coordinates;
 use crate::solver::contact::locate_between;
-use crate::solver::coupled::{closes, opening_rate, parts};
+use crate::solver::coupled::{closes, ends_in_touch, meets_slowly, opening_rate, parts};
 use crate::solver::impact::{Response, Strike, Touch, resolve_impacts, rub};
 use crate::solver::solve::SolveError;
 use crate::solver::state::BeadState;
@@ -240,9 +240,15 @@ impl<'a, V: Coordinates> Group<'a, V> {
                 if self.held(bodies, pair) {
                     continue; // its contact row keeps it from closing
                 }
-                // In touch: struck now if it closes, else left resting.
+                // In touch: struck now if it closes, else left resting;
+                // one that meets slowly and that its body's step ends in
+                // touch (its row held) has met within the step.
                 if self.closing(pair).is_some() {
-                    return Ok(Some((0.0, pair)));
+                    let end = self.gap(pair, a1.position, b1.position);
+                    if !(self.meets_slowly(bodies, pair, (a0, b0)) && ends_in_touch(end, r)) {
+                        return Ok(Some((0.0, pair)));
+                    }
+                    continue;
                 }
                 if self.gap(pair, a1.position, b1.position) < -TOUCHING * r {
                     pressed.push(pair);
@@ -252,7 +258,8 @@ impl<'a, V: Coordinates> Group<'a, V> {
             if h <= 0.0 {
                 continue;
             }
-            if let Some(by) = self.may_meet(pair, [a0, b0, a1, b1], h) {
+            let slow = self.meets_slowly(bodies, pair, (a0, b0));
+            if let Some(by) = self.may_meet(pair, [a0, b0, a1, b1], h, slow) {
                 candidates.push((pair, g0, by));
             }
         }
@@ -289,7 +296,12 @@ impl<'a, V: Coordinates> Group<'a, V> {
     }
 
     /// The part `τ ≤ h` by which a pair apart now may have met: `h` where
-    /// its gap ends closed, else where its straight paths come closest,
+    /// its gap ends closed by more than what counts as touching (a pair
+    /// the step ends in touch, as one whose row the step held, is in
+    /// touch where the next step starts), else, unless it is `slow` (it
+    /// [meets slowly](Group::meets_slowly): its step holds it where it
+    /// ends overlapping, and it does not where it ends apart), where its
+    /// straight paths come closest,
     /// if they come closer than the radii within the step (a pair too
     /// fast for a step); none if it does not meet.
     fn may_meet(
@@ -297,8 +309,14 @@ impl<'a, V: Coordinates> Group<'a, V> {
         pair: (usize, usize),
         [a0, b0, a1, b1]: [BeadState<V>; 4],
         h: f64,
+        slow: bool,
     ) -> Option<f64> {
-        if self.gap(pair, a1.position, b1.position) <= 0.0 {
+        let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
+        let end = self.gap(pair, a1.position, b1.position);
+        if ends_in_touch(end, r) || (slow && end > 0.0) {
+            return None;
+        }
+        if end < 0.0 {
             return Some(h);
         }
         let d0 = b0.position - a0.position;
@@ -309,7 +327,6 @@ impl<'a, V: Coordinates> Group<'a, V> {
         }
         let s = (-d0.dot(change) / length).clamp(0.0, 1.0);
         let closest = d0 + change * s;
-        let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
         (s > 0.0 && s < 1.0 && closest.dot(closest).sqrt() < r).then_some(s * h)
     }
 
@@ -752,6 +769,26 @@ impl<'a, V: Coordinates> Group<'a, V> {
         a.restitution.min(b.restitution) == 0.0
             && slot == self.slot(j)
             && bodies[self.bodies[slot]].contact(a.bead, b.bead).is_some()
+    }
+
+    /// Whether pair `(i, j)`, its beads at `(a, b)`, meets slowly
+    /// ([`meets_slowly`]) where a contact row of one body joins it: that
+    /// body's step holds it, where the step would leave it overlapping,
+    /// rather than the pair being struck where it meets.
+    fn meets_slowly<B: TouchBody<V>>(
+        &self,
+        bodies: &[B],
+        (i, j): (usize, usize),
+        (a, b): (BeadState<V>, BeadState<V>),
+    ) -> bool {
+        if !self.pressable(bodies, (i, j)) {
+            return false;
+        }
+        let moved = |k: usize| {
+            let push = bodies[self.bodies[self.slot(k)]].push(self.beads[k].bead);
+            push.dot(push).sqrt() * self.span.dt
+        };
+        meets_slowly(0.0, -opening_rate(&a, &b).0, moved(i) + moved(j))
     }
 
     /// Whether a contact row holds pair `(i, j)` now: pressed together,

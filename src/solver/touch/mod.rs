@@ -36,6 +36,18 @@
 //! the body's velocities projected onto them, [`TouchBody::press`]), so
 //! that a pile does not trade ever smaller strikes pair by pair.
 //!
+//! A pair at `e = 0` joined by a contact row that meets no faster than
+//! one whole step's forces move its two beads (`|f| / m` times the step,
+//! each) is not struck at its instant: its body's step holds the row
+//! where the pair would end overlapping, so that it ends the step in
+//! touch, with no strike to report (a plastic impact within the step,
+//! as a time-stepping scheme takes every contact). Momentum is kept and
+//! `½ μ v²` lost as by the strike; where the pair ends is at most its
+//! closing speed times the step from where the strike at its instant
+//! would leave it. A pile settling in a bowl meets countless times at
+//! such speeds (inelastic collapse), where cutting the step at each
+//! meeting would not end.
+//!
 //! | file | what it holds |
 //! |---|---|
 //! | `mod` | [`TouchBody`], [`TouchBead`], [`settle_touches`], the broad phase ([`overlapping`]) and the groups it finds |

@@ -82,6 +82,32 @@ pub(crate) fn closes(rate: f64, reach: f64, speeds: f64, dt: f64) -> bool {
     -rate > CLOSING * speeds && -rate * dt > TOUCHING * reach
 }
 
+/// How many times a wire's residual a held contact row's may be where a
+/// Newton solve stalls and takes it: 4e-10 of the two radii instead of
+/// [`NEWTON_ACCEPT`](crate::solver::newton::NEWTON_ACCEPT)'s 1e-10. Beads
+/// jammed among others can hold more contact rows than they can meet
+/// exactly at once, and there exact Newton steps stall a little above
+/// 1e-10 of the radii however short the step.
+pub(crate) const CONTACT_SLACK: f64 = 4.0;
+
+/// Whether a contact row's beads `gap` apart, of `reach` (the two radii),
+/// end a step in touch: within what a Newton solve takes of a held
+/// contact row ([`CONTACT_SLACK`] times
+/// [`NEWTON_ACCEPT`](crate::solver::newton::NEWTON_ACCEPT) of the reach).
+pub(crate) fn ends_in_touch(gap: f64, reach: f64) -> bool {
+    gap.abs() <= CONTACT_SLACK * crate::solver::newton::NEWTON_ACCEPT * reach
+}
+
+/// Whether a pair of restitution `restitution` whose gap closes at
+/// `closing` (m/s) meets slowly: at `e = 0`, no faster than `moved`, the
+/// speed one whole step's forces give its two beads (each `|f| / m`
+/// times the step, summed). Such a meeting is the island's step to hold,
+/// not the touch settlement's to strike at its instant (see
+/// [`Island::step_at`]).
+pub(crate) fn meets_slowly(restitution: f64, closing: f64, moved: f64) -> bool {
+    restitution == 0.0 && closing <= moved
+}
+
 /// How many more times than the island has rows a step, a position
 /// solve or a velocity projection is taken again for contacts that
 /// overlap, pull or close (see [`Island::set_contact`]).
@@ -429,8 +455,20 @@ impl<V: WireSpace> Island<V> {
             self.sides.get_mut(row),
             self.contacts.get_mut(row),
         ) {
-            *slot = (1.0, 0.0);
+            *slot = (1.0, 1.0);
             *contact = true;
+        }
+    }
+
+    /// Gives contact row `row` its pair's restitution (the two beads'
+    /// least; 1 until told). A pair at `e = 0` whose beads meet slowly is
+    /// held by the step rather than struck where it meets (see
+    /// [`Island::step_at`]). Rows of other kinds are left as they are.
+    pub fn set_contact_restitution(&mut self, row: usize, restitution: f64) {
+        if self.is_contact(row)
+            && let Some(slot) = self.sides.get_mut(row)
+        {
+            slot.1 = restitution;
         }
     }
 

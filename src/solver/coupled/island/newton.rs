@@ -5,7 +5,7 @@
 //! by the lone bead's test, each row within its tolerance or the worst
 //! row accepted.
 
-use super::{CONTACT_PASSES, EXACT_STEPS, Island, IslandWork};
+use super::{CONTACT_PASSES, CONTACT_SLACK, EXACT_STEPS, Island, IslandWork};
 use crate::geometry::WireSpace;
 
 use crate::solver::newton::{NEWTON_MAX_ITERATIONS, newton_accepted, newton_within};
@@ -183,14 +183,6 @@ impl<V: WireSpace> Island<V> {
         Ok(())
     }
 }
-
-/// How many times a wire's residual a held contact row's may be where a
-/// Newton solve stalls and takes it: 4e-10 of the two radii instead of
-/// [`NEWTON_ACCEPT`](crate::solver::newton::NEWTON_ACCEPT)'s 1e-10. Beads
-/// jammed among others can hold more contact rows than they can meet
-/// exactly at once, and there exact Newton steps stall a little above
-/// 1e-10 of the radii however short the step.
-const CONTACT_SLACK: f64 = 4.0;
 
 /// The gradients a Newton iteration moves along.
 #[derive(Clone, Copy, PartialEq, Eq)]

@@ -58,7 +58,7 @@ impl<V: WireSpace> Island<V> {
 
     /// Contact row `r`'s two beads and its reach `r_a + r_b`; none for a
     /// row of another kind.
-    fn contact_pair(&self, r: usize) -> Option<(usize, usize, f64)> {
+    pub(super) fn contact_pair(&self, r: usize) -> Option<(usize, usize, f64)> {
         let RowKind::Rod { length } = self.rows[r] else {
             return None;
         };

@@ -4,12 +4,12 @@
 
 use crate::geometry::WireSpace;
 
-use super::closes;
 use super::integrators::Stage;
 use super::projection::Restore;
 use super::{
     CALM_STEPS, CONTACT_PASSES, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow, TOUCHING,
 };
+use super::{closes, meets_slowly};
 use crate::solver::contact::locate;
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use crate::solver::method::{Integrator, Method};
@@ -78,7 +78,10 @@ impl<V: WireSpace> Island<V> {
     /// same within its position solve first, and a post-stabilizing step
     /// within its projection, where a pass costs less). A row held is not
     /// let go by the step taken again, so the passes end: at most 16 more
-    /// than the island has rows.
+    /// than the island has rows. A step that keeps its rows on their
+    /// constraints (RATTLE, or one that projects) holds in the same way
+    /// a row whose beads are apart and meet slowly at `e = 0`
+    /// ([`Island::set_contact_restitution`]): they end the step in touch.
     pub fn step_at(
         &self,
         time: f64,
@@ -87,7 +90,24 @@ impl<V: WireSpace> Island<V> {
         settings: &StepSettings,
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
-        self.touching(states, settings.dt, work);
+        self.step_part(time, states, forces, settings, settings.dt, work)
+    }
+
+    /// [`Island::step_at`] for a part of a step of `whole` seconds
+    /// (`settings` being the part's, [`StepSettings::part`]), as the touch
+    /// settlement takes the rest of a step it cut: which pairs meet slowly
+    /// (see [`Island::step_at`]) is judged by what the whole step's
+    /// forces give them.
+    pub fn step_part(
+        &self,
+        time: f64,
+        states: &mut [BeadState<V>],
+        forces: &[LinearForce<V>],
+        settings: &StepSettings,
+        whole: f64,
+        work: &mut IslandWork<V>,
+    ) -> Result<(), SolveError> {
+        self.touching(states, forces, settings, whole, work);
         if !work.touching.contains(&true) {
             // Nothing in touch: no row the step could press to hold.
             return self.step_holding(time, states, forces, settings, &[], work);
@@ -227,26 +247,76 @@ impl<V: WireSpace> Island<V> {
         Ok(())
     }
 
-    /// Marks the contact rows whose beads touch at `states` (the step's
-    /// start) and do not close within a step of `dt` ([`closes`]): those
-    /// the step may hold where it would press them together. A pair that
-    /// closes is the touch settlement's to strike.
-    fn touching(&self, states: &[BeadState<V>], dt: f64, work: &mut IslandWork<V>) {
+    /// Marks the contact rows the step may hold where it would leave their
+    /// beads overlapping: those whose beads touch at `states` (the step's
+    /// start) and do not close within the step ([`closes`]), and, for a
+    /// step that keeps its rows on their constraints (RATTLE, or one that
+    /// projects), those whose beads are apart and meet slowly at `e = 0`
+    /// ([`Island::slow_meeting`]). A pair in touch that closes, or one
+    /// apart that meets faster, is the touch settlement's to strike.
+    fn touching(
+        &self,
+        states: &[BeadState<V>],
+        forces: &[LinearForce<V>],
+        settings: &StepSettings,
+        whole: f64,
+        work: &mut IslandWork<V>,
+    ) {
         work.touching.clear();
         if !self.contacts.contains(&true) || states.len() != self.beads() {
             return;
         }
+        let method = settings.method;
+        let exact = method.integrator() == Integrator::Rattle || method.projects();
+        let dt = settings.dt;
         work.x.clear();
         work.x.extend(states.iter().map(|s| s.position));
         for r in 0..self.rows() {
-            let touches = self
-                .contact_gap(r, &work.x)
-                .is_some_and(|(gap, reach)| gap <= TOUCHING * reach);
-            let closing = self
-                .opening(r, states)
-                .is_some_and(|(rate, reach, speeds)| closes(rate, reach, speeds, dt));
-            work.touching.push(touches && !closing);
+            let (Some((gap, reach)), Some((rate, _, speeds))) =
+                (self.contact_gap(r, &work.x), self.opening(r, states))
+            else {
+                work.touching.push(false);
+                continue;
+            };
+            let holds = (gap <= TOUCHING * reach && !closes(rate, reach, speeds, dt))
+                || (exact && self.slow_meeting(r, (gap, rate), states, forces, (dt, whole)));
+            work.touching.push(holds);
         }
+    }
+
+    /// Whether contact row `r`'s beads, `gap` apart and opening at `rate`
+    /// where they are in `states`, meet within a step of `dt` (a part of
+    /// one of `whole`) no faster than a whole step's forces move them
+    /// (each bead's `|f| / m` times `whole`, summed), where the pair's
+    /// restitution is 0 (see [`Island::set_contact_restitution`] and
+    /// [`meets_slowly`]). Such a pair is not struck at
+    /// the instant it meets: the step holds its row, as it does a pair
+    /// pressed together, so that it ends the step in touch (the pair
+    /// meets within the step, a plastic impact spread over it). A pile
+    /// settling at `e = 0` so takes its countless slow meetings within
+    /// its steps, where cutting the step at each would not end
+    /// (inelastic collapse); a strike faster than its forces is still
+    /// located at its instant.
+    fn slow_meeting(
+        &self,
+        r: usize,
+        (gap, rate): (f64, f64),
+        states: &[BeadState<V>],
+        forces: &[LinearForce<V>],
+        (dt, whole): (f64, f64),
+    ) -> bool {
+        let Some((a, b, _)) = self.contact_pair(r) else {
+            return false;
+        };
+        let moved = |i: usize| {
+            let (Some(force), Some(state)) = (forces.get(i), states.get(i)) else {
+                return 0.0;
+            };
+            let f = force.at(state.position);
+            f.dot(f).sqrt() * self.inverse_mass[i] * whole
+        };
+        let slow = moved(a) + moved(b);
+        meets_slowly(self.sides[r].1, -rate, slow) && gap <= 2.0 * slow * dt
     }
 
     /// The one-sided rows set aside that a bead may land on within the
