@@ -198,6 +198,12 @@ impl Method {
     pub fn projects(self) -> bool {
         self.stabilization() == Some(Stabilization::Projection)
     }
+
+    /// Whether the step ends with every held row on its constraint:
+    /// RATTLE, or a step that projects.
+    pub fn ends_on_constraints(self) -> bool {
+        self.integrator() == Integrator::Rattle || self.projects()
+    }
 }
 
 impl fmt::Display for Method {

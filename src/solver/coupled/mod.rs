@@ -25,4 +25,4 @@ pub use group::islands;
 pub use island::{
     Island, IslandError, IslandMark, IslandRow, IslandWork, OPENING, RowReport, TOUCHING,
 };
-pub(crate) use island::{closes, ends_in_touch, meets_slowly, opening_rate, parts};
+pub(crate) use island::{closes, ends_in_touch, meets_slowly, opening_rate, parts, step_speed};

@@ -10,7 +10,9 @@ use super::{
 };
 use crate::geometry::Coordinates;
 use crate::solver::contact::locate_between;
-use crate::solver::coupled::{closes, ends_in_touch, meets_slowly, opening_rate, parts};
+use crate::solver::coupled::{
+    closes, ends_in_touch, meets_slowly, opening_rate, parts, step_speed,
+};
 use crate::solver::impact::{Response, Strike, Touch, resolve_impacts, rub};
 use crate::solver::solve::SolveError;
 use crate::solver::state::BeadState;
@@ -236,6 +238,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
             let (a1, b1) = (self.state(pair.0, true), self.state(pair.1, true));
             let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
             let g0 = self.gap(pair, a0.position, b0.position);
+            let end = self.gap(pair, a1.position, b1.position);
             if g0 <= TOUCHING * r {
                 if self.held(bodies, pair) {
                     continue; // its contact row keeps it from closing
@@ -244,22 +247,27 @@ impl<'a, V: Coordinates> Group<'a, V> {
                 // one that meets slowly and that its body's step ends in
                 // touch (its row held) has met within the step.
                 if self.closing(pair).is_some() {
-                    let end = self.gap(pair, a1.position, b1.position);
                     if !(self.meets_slowly(bodies, pair, (a0, b0)) && ends_in_touch(end, r)) {
                         return Ok(Some((0.0, pair)));
                     }
                     continue;
                 }
-                if self.gap(pair, a1.position, b1.position) < -TOUCHING * r {
+                if end < -TOUCHING * r {
                     pressed.push(pair);
                 }
                 continue;
             }
-            if h <= 0.0 {
+            // Apart: a pair the step ends in touch (as one whose row the
+            // step held) is in touch where the next step starts; one that
+            // meets slowly is its body's step to hold where it ends
+            // overlapping, and left alone where it ends apart.
+            if h <= 0.0
+                || ends_in_touch(end, r)
+                || (end > 0.0 && self.meets_slowly(bodies, pair, (a0, b0)))
+            {
                 continue;
             }
-            let slow = self.meets_slowly(bodies, pair, (a0, b0));
-            if let Some(by) = self.may_meet(pair, [a0, b0, a1, b1], h, slow) {
+            if let Some(by) = self.may_meet(pair, [a0, b0, a1, b1], end, h) {
                 candidates.push((pair, g0, by));
             }
         }
@@ -295,28 +303,19 @@ impl<'a, V: Coordinates> Group<'a, V> {
         closes(u, r, speeds, self.span.dt).then_some(-u)
     }
 
-    /// The part `τ ≤ h` by which a pair apart now may have met: `h` where
-    /// its gap ends closed by more than what counts as touching (a pair
-    /// the step ends in touch, as one whose row the step held, is in
-    /// touch where the next step starts), else, unless it is `slow` (it
-    /// [meets slowly](Group::meets_slowly): its step holds it where it
-    /// ends overlapping, and it does not where it ends apart), where its
-    /// straight paths come closest,
-    /// if they come closer than the radii within the step (a pair too
-    /// fast for a step); none if it does not meet.
+    /// The part `τ ≤ h` by which a pair apart now, its gap `end` at the
+    /// step's end, may have met: `h` where its gap ends closed, else where
+    /// its straight paths come closest, if they come closer than the radii
+    /// within the step (a pair too fast for a step); none if it does not
+    /// meet.
     fn may_meet(
         &self,
         pair: (usize, usize),
         [a0, b0, a1, b1]: [BeadState<V>; 4],
+        end: f64,
         h: f64,
-        slow: bool,
     ) -> Option<f64> {
-        let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
-        let end = self.gap(pair, a1.position, b1.position);
-        if ends_in_touch(end, r) || (slow && end > 0.0) {
-            return None;
-        }
-        if end < 0.0 {
+        if end <= 0.0 {
             return Some(h);
         }
         let d0 = b0.position - a0.position;
@@ -327,6 +326,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
         }
         let s = (-d0.dot(change) / length).clamp(0.0, 1.0);
         let closest = d0 + change * s;
+        let r = self.beads[pair.0].radius + self.beads[pair.1].radius;
         (s > 0.0 && s < 1.0 && closest.dot(closest).sqrt() < r).then_some(s * h)
     }
 
@@ -784,11 +784,9 @@ impl<'a, V: Coordinates> Group<'a, V> {
         if !self.pressable(bodies, (i, j)) {
             return false;
         }
-        let moved = |k: usize| {
-            let push = bodies[self.bodies[self.slot(k)]].push(self.beads[k].bead);
-            push.dot(push).sqrt() * self.span.dt
-        };
-        meets_slowly(0.0, -opening_rate(&a, &b).0, moved(i) + moved(j))
+        let push = |k: usize| bodies[self.bodies[self.slot(k)]].push(self.beads[k].bead);
+        let moved = step_speed([push(i), push(j)], self.span.dt);
+        meets_slowly(0.0, -opening_rate(&a, &b).0, moved)
     }
 
     /// Whether a contact row holds pair `(i, j)` now: pressed together,

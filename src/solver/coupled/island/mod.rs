@@ -108,6 +108,13 @@ pub(crate) fn meets_slowly(restitution: f64, closing: f64, moved: f64) -> bool {
     restitution == 0.0 && closing <= moved
 }
 
+/// The speed a step of `dt` gives two beads under `pushes` (each bead's
+/// acceleration from its forces, `f / m`): `(|p_a| + |p_b|) dt`, the
+/// `moved` of [`meets_slowly`].
+pub(crate) fn step_speed<V: crate::geometry::Coordinates>(pushes: [V; 2], dt: f64) -> f64 {
+    pushes.iter().map(|p| p.dot(*p).sqrt()).sum::<f64>() * dt
+}
+
 /// How many more times than the island has rows a step, a position
 /// solve or a velocity projection is taken again for contacts that
 /// overlap, pull or close (see [`Island::set_contact`]).

@@ -9,10 +9,10 @@ use super::projection::Restore;
 use super::{
     CALM_STEPS, CONTACT_PASSES, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow, TOUCHING,
 };
-use super::{closes, meets_slowly};
+use super::{closes, meets_slowly, step_speed};
 use crate::solver::contact::locate;
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
-use crate::solver::method::{Integrator, Method};
+use crate::solver::method::Method;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
@@ -173,8 +173,7 @@ impl<V: WireSpace> Island<V> {
         let rough = self.is_rough();
         let ends = self.has_ends();
         if one_sided || rough || ends {
-            let method = settings.method;
-            let pushing = method.integrator() == Integrator::Rattle || method.projects();
+            let pushing = settings.method.ends_on_constraints();
             self.leave(time, states, forces, pushing, work)?;
         }
         for &r in hold {
@@ -266,8 +265,7 @@ impl<V: WireSpace> Island<V> {
         if !self.contacts.contains(&true) || states.len() != self.beads() {
             return;
         }
-        let method = settings.method;
-        let exact = method.integrator() == Integrator::Rattle || method.projects();
+        let exact = settings.method.ends_on_constraints();
         let dt = settings.dt;
         work.x.clear();
         work.x.extend(states.iter().map(|s| s.position));
@@ -308,14 +306,11 @@ impl<V: WireSpace> Island<V> {
         let Some((a, b, _)) = self.contact_pair(r) else {
             return false;
         };
-        let moved = |i: usize| {
-            let (Some(force), Some(state)) = (forces.get(i), states.get(i)) else {
-                return 0.0;
-            };
-            let f = force.at(state.position);
-            f.dot(f).sqrt() * self.inverse_mass[i] * whole
+        let push = |i: usize| match (forces.get(i), states.get(i)) {
+            (Some(force), Some(state)) => force.at(state.position) * self.inverse_mass[i],
+            _ => V::ZERO,
         };
-        let slow = moved(a) + moved(b);
+        let slow = step_speed([push(a), push(b)], whole);
         meets_slowly(self.sides[r].1, -rate, slow) && gap <= 2.0 * slow * dt
     }
 
