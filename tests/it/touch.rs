@@ -725,10 +725,10 @@ fn the_train_couples_runs_on_pressed_together_and_parts_where_the_track_pulls() 
 /// one row of sixteen; a release build two rows of 23, which `.ci/run`
 /// runs): they land, slide in, strike each other and come to lie pressed
 /// together, every bead pressed by a neighbour, never overlapping by more
-/// than 1e-9 of a radius (measured 8e-14 for two rows);
+/// than 1e-9 of a radius (measured 9e-14 for two rows);
 /// in the last second nothing strikes and the pile, rocking in the
-/// frictionless bowl, keeps its energy to 1e-9 of it (measured 2e-12 and
-/// 1e-11).
+/// frictionless bowl, keeps its energy to 1e-9 of it (measured 1.4e-12
+/// for two rows).
 #[test]
 fn a_pile_poured_into_a_bowl_lies_pressed_together_without_overlap() {
     let (n, cols, steps) = if cfg!(debug_assertions) {

@@ -141,8 +141,11 @@ impl<V: WireSpace> Island<V> {
     ///
     /// A contact row set aside whose beads touched at the step's start
     /// and that the position solve leaves overlapping is held and the
-    /// solve taken again (see [`Island::step_at`]); a held contact row
-    /// the velocity solve would pull on is let go
+    /// solve taken again (see [`Island::step_at`]). Where the position
+    /// solve finds no root with the contacts held (a jammed pile holds
+    /// more of them than its beads can meet at once), those whose
+    /// multipliers pull are let go and the solve taken again. A held
+    /// contact row the velocity solve would pull on is let go
     /// ([`Island::project_velocity_pushing`]).
     pub(super) fn rattle(
         &self,
@@ -152,7 +155,8 @@ impl<V: WireSpace> Island<V> {
     ) -> Result<(), SolveError> {
         let n = self.beads();
         let start = work.time;
-        // Each pass holds one contact row more at least.
+        // Each pass holds one contact row more at least, or lets go one.
+        let mut unsolved = None;
         for _ in 0..self.rows() + CONTACT_PASSES {
             work.time = start;
             self.evaluate_at_start(work, work.time);
@@ -169,10 +173,20 @@ impl<V: WireSpace> Island<V> {
                 work.v.push(work.v0[i]);
             }
             work.time += h;
-            self.newton(work, Direction::First)?;
+            match self.newton(work, Direction::First) {
+                Err(failed @ SolveError::NoConvergence { .. }) if self.let_go_pulling(work) => {
+                    unsolved = Some(failed);
+                    continue;
+                }
+                solved => solved?,
+            }
+            unsolved = None;
             if !self.hold_overlapping(work) {
                 break;
             }
+        }
+        if let Some(failed) = unsolved {
+            return Err(failed);
         }
         let to_lambda = 2.0 / (h * h);
         work.reports.clear();
@@ -196,6 +210,23 @@ impl<V: WireSpace> Island<V> {
             report.lambda += 0.5 * to_mu * nu;
         }
         Ok(())
+    }
+
+    /// Lets go of every held contact row whose multiplier in `work.lambda`
+    /// pulls its beads together: where Newton's method found no root with
+    /// a pile's contacts all held (more of them than its beads can meet
+    /// at once), those that would have to pull are not pressed. Whether
+    /// there were any.
+    fn let_go_pulling(&self, work: &mut IslandWork<V>) -> bool {
+        let mut any = false;
+        for r in 0..self.rows() {
+            if self.contacts[r] && !work.inactive[r] && work.lambda.get(r).is_some_and(|&l| l < 0.0)
+            {
+                work.inactive[r] = true;
+                any = true;
+            }
+        }
+        any
     }
 
     /// [`Island::project_velocity`] with every held contact row pushing

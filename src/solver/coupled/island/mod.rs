@@ -215,6 +215,10 @@ pub struct IslandWork<V: WireSpace = DVec2> {
     /// closing: the step holds them where it would leave them overlapping
     /// (see [`Island::step_at`]).
     touching: Vec<bool>,
+    /// The one-sided wire rows whose beads, in flight where the step
+    /// began, reach their wires slowly: the step lands them at its end
+    /// instead of at the instant (see [`Island::lands_slowly`]).
+    landing_slowly: Vec<bool>,
     /// Each wire row's curve parameter where its bead was after the last
     /// step (NaN: unknown), so a self-crossing track keeps it on its branch.
     hints: Vec<f64>,

@@ -109,6 +109,7 @@ impl<V: WireSpace> Island<V> {
                     &self.inverse_mass,
                     &work.gradient,
                     along,
+                    &work.inactive,
                     &mut work.lu,
                     &mut work.rhs,
                     self.natural_order(),

@@ -300,6 +300,10 @@ impl<V: WireSpace> Island<V> {
     /// Adds `W Jᵀ μ` (with `gradient`) to `out`.
     pub(super) fn push(&self, gradient: &[V], mu: &[f64], out: &mut [V]) {
         for (r, &m) in mu.iter().enumerate() {
+            if m == 0.0 {
+                // A row set aside, or one that moves nothing.
+                continue;
+            }
             let entries = self.row_start[r]..self.row_start[r + 1];
             for (&bead, g) in self.entry_bead[entries.clone()]
                 .iter()

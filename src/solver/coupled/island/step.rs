@@ -82,6 +82,9 @@ impl<V: WireSpace> Island<V> {
     /// constraints (RATTLE, or one that projects) holds in the same way
     /// a row whose beads are apart and meet slowly at `e = 0`
     /// ([`Island::set_contact_restitution`]): they end the step in touch.
+    /// A bead in flight that reaches a one-sided wire of restitution 0 no
+    /// faster than the step's forces move it lands at the step's end, not
+    /// at its instant.
     pub fn step_at(
         &self,
         time: f64,
@@ -108,6 +111,7 @@ impl<V: WireSpace> Island<V> {
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
         self.touching(states, forces, settings, whole, work);
+        self.landing_slowly(time, states, forces, (settings.dt, whole), work);
         if !work.touching.contains(&true) {
             // Nothing in touch: no row the step could press to hold.
             return self.step_holding(time, states, forces, settings, &[], work);
@@ -196,6 +200,7 @@ impl<V: WireSpace> Island<V> {
             .iter()
             .copied()
             .filter(|&r| self.sides[r].0 * self.wire_row(r, states, time).c > 0.0)
+            .filter(|&r| work.landing_slowly.get(r) != Some(&true))
             .collect();
         let ending = if ends {
             (0..self.rows())
@@ -312,6 +317,63 @@ impl<V: WireSpace> Island<V> {
         };
         let slow = step_speed([push(a), push(b)], whole);
         meets_slowly(self.sides[r].1, -rate, slow) && gap <= 2.0 * slow * dt
+    }
+
+    /// Marks the one-sided wire rows whose beads are off their wires at
+    /// `states` (at `time`) and would land slowly
+    /// ([`Island::lands_slowly`]) in a step of `dt`, a part of one of
+    /// `whole`; whether a bead is in flight is the step's to say.
+    fn landing_slowly(
+        &self,
+        time: f64,
+        states: &[BeadState<V>],
+        forces: &[LinearForce<V>],
+        (dt, whole): (f64, f64),
+        work: &mut IslandWork<V>,
+    ) {
+        work.landing_slowly.clear();
+        work.landing_slowly.extend((0..self.rows()).map(|r| {
+            self.sides[r].0 != 0.0
+                && !self.contacts[r]
+                && self.lands_slowly(r, time, states, forces, (dt, whole))
+        }));
+    }
+
+    /// Whether one-sided wire row `r`'s bead, in flight in `states` at
+    /// `time`, reaches its wire within a step of `dt` (a part of one of
+    /// `whole`) no faster than a whole step's forces move it (`|f| / m`
+    /// times `whole`), where the wire's restitution is 0: within twice
+    /// that speed times the step of it and closing no faster ([`meets_slowly`],
+    /// as for a pair of beads). Such a landing is not located at its
+    /// instant: the bead lands at the step's end ([`Island::land`]), moved
+    /// back onto its wire by no more than its forces move it in the step.
+    /// The beads of a pile settling at `e = 0` in a one-sided bowl leave
+    /// it and land again countless times at such speeds, where cutting the
+    /// step at each would not end; a landing faster than its forces is
+    /// still located at its instant.
+    fn lands_slowly(
+        &self,
+        r: usize,
+        time: f64,
+        states: &[BeadState<V>],
+        forces: &[LinearForce<V>],
+        (dt, whole): (f64, f64),
+    ) -> bool {
+        let (side, restitution) = self.sides[r];
+        let bead = self.entry_bead[self.row_start[r]];
+        let (Some(state), Some(force)) = (states.get(bead), forces.get(bead)) else {
+            return false;
+        };
+        let row = self.wire_row(r, states, time);
+        let length = row.normal.dot(row.normal).sqrt();
+        if length.is_nan() || length <= 0.0 {
+            return false;
+        }
+        let gap = side * row.c / length;
+        let closing = -side * row.normal.dot(state.velocity - row.wire) / length;
+        let push = force.at(state.position) * self.inverse_mass[bead];
+        let slow = step_speed([push, V::ZERO], whole);
+        gap > 0.0 && meets_slowly(restitution, closing, slow) && gap <= 2.0 * slow * dt
     }
 
     /// The one-sided rows set aside that a bead may land on within the

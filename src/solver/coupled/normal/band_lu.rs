@@ -17,6 +17,7 @@ impl NormalMatrix {
         inverse_mass: &[f64],
         now: &[V],
         first: &[V],
+        inactive: &[bool],
         m: &mut Vec<f64>,
         order: &mut Vec<f64>,
         rhs: &mut [f64],
@@ -28,11 +29,11 @@ impl NormalMatrix {
         let mut largest = 0.0f64;
         for (col, k, row) in self.upper_entries() {
             let (i, c) = (band.at(row), band.at(col));
-            let upper = self.unsymmetric_value(k, false, inverse_mass, now, first);
+            let upper = self.unsymmetric_value((k, false), inverse_mass, (now, first), inactive);
             m[i * w + c + p - i] = upper;
             largest = largest.max(upper.abs());
             if row != col {
-                let lower = self.unsymmetric_value(k, true, inverse_mass, now, first);
+                let lower = self.unsymmetric_value((k, true), inverse_mass, (now, first), inactive);
                 m[c * w + i + p - c] = lower;
                 largest = largest.max(lower.abs());
             }

@@ -26,6 +26,16 @@
 //! the load, so consistent redundant constraints hold with no NaN and no
 //! panic, and [`NormalMatrix::factor`] counts them.
 //!
+//! A row set aside (a contact whose beads are apart or let go) has no
+//! gradient and its λ is its right-hand side. Where rows are set aside and
+//! `A` is factored sparse, only the held rows are factored: `A` on them,
+//! in `A`'s own minimum-degree order restricted to them, its symbolic
+//! factorization made again only when the rows set aside change. A pile's
+//! island joins every pair of beads near each other by a contact row, most
+//! of them set aside, so its cost is that of the rows held. The exact
+//! Newton matrix gives a row set aside a unit diagonal, so its LU stays
+//! regular and the row's step is its right-hand side.
+//!
 //! | file | what it holds |
 //! |---|---|
 //! | `mod` | what the matrix and its factorizations hold; filling, scaling and factoring `A`, and which solver takes each solve |
@@ -33,7 +43,7 @@
 //! | `order` | the band ordering: the rows' own, or reverse Cuthill–McKee |
 //! | `band_ldlt` | `LDLᵀ` of `A` as a band matrix, and its solve |
 //! | `band_lu` | the Newton matrix `J₁ W J₀ᵀ` as a band matrix, solved by Gaussian elimination |
-//! | `sparse_ldlt` | `LDLᵀ` of `A` by faer's sparse Cholesky, and its solve |
+//! | `sparse_ldlt` | `LDLᵀ` of `A` by faer's sparse Cholesky, of all rows or of the held rows alone, and its solves |
 //! | `sparse_lu` | the Newton matrix solved by faer's sparse LU |
 
 use std::sync::OnceLock;
@@ -76,6 +86,9 @@ enum Layout {
     Sparse,
     /// A band matrix: row `i`'s `D` and the `L` entries left of it.
     Band,
+    /// faer's sparse factorization of the held rows alone
+    /// ([`HeldRows`]); a row set aside has λ = its right-hand side.
+    Held,
 }
 
 /// One product `w_bead · g_i · g_j` that makes up an entry of `A`.
@@ -141,6 +154,31 @@ pub(crate) struct LuWork {
     scratch: Scratch,
 }
 
+/// `A` on the rows held (those not set aside) alone, in the order of
+/// `A`'s own elimination restricted to them, and the symbolic
+/// factorization of that pattern, made again only when the rows held
+/// change. A pile's island joins every pair of beads near each other by a
+/// contact row, most of them set aside; their rows meet no other, and
+/// leaving them out of the factorization leaves the held rows' solve as
+/// it is and its cost that of the rows held.
+#[derive(Default)]
+struct HeldRows {
+    /// The matrix ([`NormalMatrix::id`]) and the rows set aside the
+    /// pattern was made for.
+    made_for: Option<(u64, Vec<bool>)>,
+    /// The rows held, by their index in `A`.
+    rows: Vec<usize>,
+    /// Each held value's index among `A`'s values, and its row and
+    /// column in `A`.
+    source: Vec<(usize, usize, usize)>,
+    /// The pattern of the held rows' upper triangle and its symbolic
+    /// factorization (`None` for no held row or one).
+    symbolic: Option<(SymbolicSparseColMat<usize>, SymbolicCholesky<usize>)>,
+    values: Vec<f64>,
+    rhs: Vec<f64>,
+    memory: Option<MemBuffer>,
+}
+
 /// A factored `A`, kept between solves within a step.
 #[derive(Default)]
 pub(crate) struct Factored {
@@ -154,6 +192,8 @@ pub(crate) struct Factored {
     layout: Layout,
     /// The right-hand side in a band's order of the rows.
     order: Vec<f64>,
+    /// The held rows' factorization, where rows are set aside.
+    held: HeldRows,
 }
 
 impl NormalMatrix {
@@ -169,14 +209,18 @@ impl NormalMatrix {
         natural: bool,
         f: &mut Factored,
     ) -> Result<(), usize> {
+        f.redundant = 0;
+        if inactive.contains(&true)
+            && let Some(symbolic) = &self.symbolic
+            && !(natural && self.band.is_some())
+        {
+            f.layout = Layout::Held;
+            return self.factor_held(symbolic, inverse_mass, gradient, inactive, f);
+        }
         let nnz = self.term_start.len() - 1;
         f.values.clear();
-        f.values.extend((0..nnz).map(|k| {
-            self.terms[self.term_start[k]..self.term_start[k + 1]]
-                .iter()
-                .map(|t| inverse_mass[t.bead] * gradient[t.left].dot(gradient[t.right]))
-                .sum::<f64>()
-        }));
+        f.values
+            .extend((0..nnz).map(|k| self.value(k, inverse_mass, gradient)));
         f.scale.clear();
         for (r, &k) in self.diagonal.iter().enumerate() {
             if inactive.get(r) == Some(&true) {
@@ -187,13 +231,8 @@ impl NormalMatrix {
                 f.scale.push(1.0);
                 continue;
             }
-            let d = f.values[k];
-            if !(d.is_finite() && d > 1e-300) {
-                return Err(r);
-            }
-            f.scale.push(d.sqrt().recip());
+            f.scale.push(self.diagonal_scale(r, f.values[k])?);
         }
-        f.redundant = 0;
         f.layout = Layout::Sparse;
         let Some(symbolic) = &self.symbolic else {
             // A single row: solved in closed form.
@@ -210,10 +249,32 @@ impl NormalMatrix {
         self.factor_sparse(symbolic, f)
     }
 
+    /// `A`'s value `k` (upper triangle): the sum of its terms
+    /// `w_bead · g_i · g_j`.
+    fn value<V: Coordinates>(&self, k: usize, inverse_mass: &[f64], gradient: &[V]) -> f64 {
+        self.terms[self.term_start[k]..self.term_start[k + 1]]
+            .iter()
+            .map(|t| inverse_mass[t.bead] * gradient[t.left].dot(gradient[t.right]))
+            .sum()
+    }
+
+    /// Row `r`'s scale `1/√A_rr` from its diagonal `d`; a vanishing
+    /// diagonal (a singular point) is the error, naming the row.
+    fn diagonal_scale(&self, r: usize, d: f64) -> Result<f64, usize> {
+        if d.is_finite() && d > 1e-300 {
+            Ok(d.sqrt().recip())
+        } else {
+            Err(r)
+        }
+    }
+
     /// Solves `A λ = rhs` in place with the last factorization.
     pub(crate) fn solve(&self, f: &mut Factored, rhs: &mut [f64]) {
         if let (Layout::Band, Some(band)) = (f.layout, &self.band) {
             return self.solve_band(band, f, rhs);
+        }
+        if f.layout == Layout::Held {
+            return self.solve_held(f, rhs);
         }
         let Some(symbolic) = &self.symbolic else {
             if let (Some(b), Some(&k)) = (rhs.first_mut(), self.diagonal.first()) {
@@ -226,21 +287,33 @@ impl NormalMatrix {
 
     /// Solves `J_now W J_firstᵀ x = rhs` in place (the exact Newton matrix
     /// of RATTLE's position solve): in the rows' order where `natural` and
-    /// the matrix is a band, else by faer's sparse LU. Returns
+    /// the matrix is a band, else by faer's sparse LU. A row set aside
+    /// (`inactive`, no gradient) steps by its right-hand side. Returns
     /// `false` where the matrix is singular or faer could not factor it.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn solve_unsymmetric<V: Coordinates>(
         &self,
         inverse_mass: &[f64],
         now: &[V],
         first: &[V],
+        inactive: &[bool],
         lu: &mut LuWork,
         rhs: &mut [f64],
         natural: bool,
     ) -> bool {
         if let (true, Some(band)) = (natural, &self.band) {
             let LuWork { values, order, .. } = lu;
-            return self.solve_unsymmetric_band(band, inverse_mass, now, first, values, order, rhs);
+            return self.solve_unsymmetric_band(
+                band,
+                inverse_mass,
+                now,
+                first,
+                inactive,
+                values,
+                order,
+                rhs,
+            );
         }
-        self.solve_unsymmetric_sparse(inverse_mass, now, first, lu, rhs)
+        self.solve_unsymmetric_sparse(inverse_mass, now, first, inactive, lu, rhs)
     }
 }

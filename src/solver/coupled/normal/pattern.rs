@@ -149,15 +149,20 @@ impl NormalMatrix {
     }
 
     /// The value of `J_now W J_firstᵀ` at the upper entry `k`, or at its
-    /// mirror below the diagonal.
+    /// mirror below the diagonal; a row set aside (`inactive`, no
+    /// gradient) has a unit diagonal, so its step is its right-hand side
+    /// (zero, its `C`).
     pub(super) fn unsymmetric_value<V: Coordinates>(
         &self,
-        k: usize,
-        mirror: bool,
+        (k, mirror): (usize, bool),
         inverse_mass: &[f64],
-        now: &[V],
-        first: &[V],
+        (now, first): (&[V], &[V]),
+        inactive: &[bool],
     ) -> f64 {
+        let col = self.column[k];
+        if self.diagonal[col] == k && inactive.get(col) == Some(&true) {
+            return 1.0;
+        }
         self.terms[self.term_start[k]..self.term_start[k + 1]]
             .iter()
             .map(|t| {

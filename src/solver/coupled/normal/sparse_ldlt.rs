@@ -1,13 +1,52 @@
-//! `LDLᵀ` of the scaled `A` by faer's sparse Cholesky, its solve, and the
-//! scratch memory they need.
+//! `LDLᵀ` of the scaled `A` by faer's sparse Cholesky, of all its rows or
+//! of the rows held alone, their solves, and the scratch memory they need.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-use faer::sparse::SparseColMatRef;
-use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky};
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::{
+    LdltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
-use super::{DROPPED_PIVOT, Factored, NormalMatrix, REDUNDANT_PIVOT, Scratch};
+use crate::geometry::Coordinates;
+
+use super::{DROPPED_PIVOT, Factored, HeldRows, NormalMatrix, REDUNDANT_PIVOT, Scratch};
+
+/// How faer's `LDLᵀ` treats a pivot: at or below [`REDUNDANT_PIVOT`] it
+/// becomes [`DROPPED_PIVOT`].
+fn dropping() -> LdltRegularization<'static, f64> {
+    LdltRegularization {
+        dynamic_regularization_signs: None,
+        dynamic_regularization_delta: DROPPED_PIVOT,
+        dynamic_regularization_epsilon: REDUNDANT_PIVOT,
+    }
+}
+
+/// `LDLᵀ` of `a` under `symbolic` into `l_values`, each redundant pivot
+/// dropped ([`dropping`]): how many were.
+fn factor_dropping(
+    symbolic: &SymbolicCholesky<usize>,
+    a: SparseColMatRef<'_, usize, f64>,
+    memory: &mut MemBuffer,
+    l_values: &mut Vec<f64>,
+) -> Result<usize, usize> {
+    l_values.clear();
+    l_values.resize(symbolic.len_val(), 0.0);
+    symbolic
+        .factorize_numeric_ldlt(
+            l_values,
+            a,
+            Side::Upper,
+            dropping(),
+            Par::Seq,
+            MemStack::new(memory),
+            Default::default(),
+        )
+        .map_err(|_| 0usize)?;
+    Ok(l_values.iter().filter(|&&v| v == DROPPED_PIVOT).count())
+}
 
 impl NormalMatrix {
     /// `LDLᵀ` of the scaled `A` (filled into `f.values`) by faer's sparse
@@ -18,27 +57,177 @@ impl NormalMatrix {
         symbolic: &SymbolicCholesky<usize>,
         f: &mut Factored,
     ) -> Result<(), usize> {
-        f.l_values.clear();
-        f.l_values.resize(symbolic.len_val(), 0.0);
         let memory = self.scratch(symbolic, &mut f.scratch);
         let a = SparseColMatRef::new(self.pattern.as_ref(), &f.values);
-        symbolic
-            .factorize_numeric_ldlt(
-                &mut f.l_values,
-                a,
-                Side::Upper,
-                LdltRegularization {
-                    dynamic_regularization_signs: None,
-                    dynamic_regularization_delta: DROPPED_PIVOT,
-                    dynamic_regularization_epsilon: REDUNDANT_PIVOT,
-                },
-                Par::Seq,
-                MemStack::new(memory),
-                Default::default(),
-            )
-            .map_err(|_| 0usize)?;
-        f.redundant = f.l_values.iter().filter(|&&v| v == DROPPED_PIVOT).count();
+        f.redundant = factor_dropping(symbolic, a, memory, &mut f.l_values)?;
         Ok(())
+    }
+
+    /// Fills, scales and factors `A` as [`NormalMatrix::factor_sparse`]
+    /// does, for the held rows alone (those not `inactive`), in the order
+    /// `symbolic` eliminates `A`'s rows restricted to them: a row set aside
+    /// meets no other, so its elimination changes nothing in the others',
+    /// and it keeps a unit scale. The pattern and its symbolic
+    /// factorization are made again only where the rows set aside
+    /// changed.
+    pub(super) fn factor_held<V: Coordinates>(
+        &self,
+        symbolic: &SymbolicCholesky<usize>,
+        inverse_mass: &[f64],
+        gradient: &[V],
+        inactive: &[bool],
+        f: &mut Factored,
+    ) -> Result<(), usize> {
+        let set_aside = &inactive[..self.n.min(inactive.len())];
+        let made = f
+            .held
+            .made_for
+            .as_ref()
+            .is_some_and(|(id, made)| *id == self.id && made[..] == *set_aside);
+        if !made {
+            self.held_pattern(symbolic, set_aside, &mut f.held)?;
+        }
+        let HeldRows {
+            rows,
+            source,
+            symbolic,
+            values,
+            memory,
+            ..
+        } = &mut f.held;
+        f.scale.clear();
+        f.scale.resize(self.n, 1.0);
+        for &r in rows.iter() {
+            let k = self.diagonal[r];
+            f.scale[r] = self.diagonal_scale(r, self.value(k, inverse_mass, gradient))?;
+        }
+        values.clear();
+        values.extend(source.iter().map(|&(k, row, col)| {
+            self.value(k, inverse_mass, gradient) * (f.scale[row] * f.scale[col])
+        }));
+        let (Some((pattern, symbolic)), Some(memory)) = (symbolic, memory) else {
+            // No row held, or one: solved in closed form.
+            return Ok(());
+        };
+        let a = SparseColMatRef::new(pattern.as_ref(), values);
+        f.redundant = factor_dropping(symbolic, a, memory, &mut f.l_values)?;
+        Ok(())
+    }
+
+    /// Makes `held`'s pattern for the rows not in `set_aside`: `A`'s upper
+    /// entries between two held rows, and its symbolic factorization in
+    /// `symbolic`'s order of `A`'s rows restricted to the held ones.
+    fn held_pattern(
+        &self,
+        symbolic: &SymbolicCholesky<usize>,
+        set_aside: &[bool],
+        held: &mut HeldRows,
+    ) -> Result<(), usize> {
+        let mut position = vec![usize::MAX; self.n];
+        held.rows.clear();
+        for (r, slot) in position.iter_mut().enumerate() {
+            if set_aside.get(r) != Some(&true) {
+                *slot = held.rows.len();
+                held.rows.push(r);
+            }
+        }
+        let m = held.rows.len();
+        // `A`'s entries come by column, each column's by row; the held
+        // rows keep their order, so the held entries do too. Only the
+        // held columns are read.
+        let (a_col_ptr, a_row_idx) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        let mut col_ptr = Vec::with_capacity(m + 1);
+        col_ptr.push(0);
+        let mut row_idx = Vec::new();
+        held.source.clear();
+        for &col in &held.rows {
+            for (k, &row) in a_row_idx
+                .iter()
+                .enumerate()
+                .take(a_col_ptr[col + 1])
+                .skip(a_col_ptr[col])
+            {
+                let r = position[row];
+                if r != usize::MAX {
+                    row_idx.push(r);
+                    held.source.push((k, row, col));
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        held.made_for = Some((self.id, set_aside.to_vec()));
+        held.symbolic = None;
+        held.memory = None;
+        if m < 2 {
+            return Ok(());
+        }
+        let forward: Vec<usize> = match symbolic.perm() {
+            Some(order) => order
+                .arrays()
+                .0
+                .iter()
+                .map(|&r| position[r])
+                .filter(|&p| p != usize::MAX)
+                .collect(),
+            None => (0..m).collect(),
+        };
+        let mut inverse = vec![0; m];
+        for (i, &p) in forward.iter().enumerate() {
+            inverse[p] = i;
+        }
+        let pattern = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
+        let order = SymmetricOrdering::Custom(PermRef::new_checked(&forward, &inverse, m));
+        let first = held.rows[0];
+        let symbolic =
+            factorize_symbolic_cholesky(pattern.as_ref(), Side::Upper, order, Default::default())
+                .map_err(|_| first)?;
+        held.memory = Some(MemBuffer::new(
+            symbolic
+                .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
+                .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
+        ));
+        held.symbolic = Some((pattern, symbolic));
+        Ok(())
+    }
+
+    /// [`NormalMatrix::solve`] with the held rows' `LDLᵀ` of
+    /// [`NormalMatrix::factor_held`]; a row set aside (a unit diagonal)
+    /// keeps its right-hand side.
+    pub(super) fn solve_held(&self, f: &mut Factored, rhs: &mut [f64]) {
+        for (b, s) in rhs.iter_mut().zip(&f.scale) {
+            *b *= s;
+        }
+        let HeldRows {
+            rows,
+            symbolic,
+            values,
+            rhs: part,
+            memory,
+            ..
+        } = &mut f.held;
+        part.clear();
+        part.extend(rows.iter().map(|&r| rhs[r]));
+        match (symbolic, memory) {
+            (Some((_, symbolic)), Some(memory)) => {
+                LdltRef::new(symbolic, &f.l_values).solve_in_place_with_conj(
+                    Conj::No,
+                    MatMut::from_column_major_slice_mut(part, rows.len(), 1),
+                    Par::Seq,
+                    MemStack::new(memory),
+                );
+            }
+            _ => {
+                if let (Some(b), Some(d)) = (part.first_mut(), values.first()) {
+                    *b /= d;
+                }
+            }
+        }
+        for (&r, b) in rows.iter().zip(part.iter()) {
+            rhs[r] = *b;
+        }
+        for (b, s) in rhs.iter_mut().zip(&f.scale) {
+            *b *= s;
+        }
     }
 
     /// [`NormalMatrix::solve`] with faer's sparse `LDLᵀ` of

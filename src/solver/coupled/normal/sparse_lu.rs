@@ -17,6 +17,7 @@ impl NormalMatrix {
         inverse_mass: &[f64],
         now: &[V],
         first: &[V],
+        inactive: &[bool],
         lu: &mut LuWork,
         rhs: &mut [f64],
     ) -> bool {
@@ -25,9 +26,9 @@ impl NormalMatrix {
         };
         lu.values.clear();
         lu.values.extend(
-            u.source
-                .iter()
-                .map(|&(k, mirror)| self.unsymmetric_value(k, mirror, inverse_mass, now, first)),
+            u.source.iter().map(|&source| {
+                self.unsymmetric_value(source, inverse_mass, (now, first), inactive)
+            }),
         );
         if lu.scratch.owner != self.id {
             lu.scratch.memory = None;

@@ -91,7 +91,7 @@ fn natural_matches_sparse_for(rows: &Rows, what: &str) -> (Layout, bool) {
     let mut unsymmetric = [rhs.clone(), rhs.clone()];
     for (natural, x) in [true, false].into_iter().zip(&mut unsymmetric) {
         let mut lu = LuWork::default();
-        assert!(matrix.solve_unsymmetric(inverse_mass, now, first, &mut lu, x, natural));
+        assert!(matrix.solve_unsymmetric(inverse_mass, now, first, &inactive, &mut lu, x, natural));
     }
     for [a, b] in [solved, unsymmetric] {
         for (a, b) in a.iter().zip(&b) {
@@ -209,6 +209,7 @@ fn a_band_matrix_drops_a_redundant_row_and_refuses_a_singular_newton_matrix() {
         &inverse_mass,
         &gradient,
         &gradient,
+        &vec![false; rows],
         &mut lu,
         &mut rhs,
         true
@@ -239,5 +240,107 @@ fn a_small_matrix_drops_a_redundant_row_and_refuses_a_singular_newton_matrix() {
     assert_eq!(rhs[3], 0.0, "the redundant row carries {}", rhs[3]);
     let mut lu = LuWork::default();
     let mut rhs = vec![0.0, 0.0, 0.3, 0.3];
-    assert!(!matrix.solve_unsymmetric(&[1.0, 1.0], &gradient, &gradient, &mut lu, &mut rhs, true));
+    assert!(!matrix.solve_unsymmetric(
+        &[1.0, 1.0],
+        &gradient,
+        &gradient,
+        &[false; 4],
+        &mut lu,
+        &mut rhs,
+        true,
+    ));
+}
+
+/// `J W Jᵀ λ − b` on row `r` of `rows` (gradients `gradient`), the
+/// largest over the rows not `set_aside`.
+fn worst_residual(
+    rows: &Rows,
+    gradient: &[DVec2],
+    lambda: &[f64],
+    b: &[f64],
+    set_aside: &[bool],
+) -> f64 {
+    let (row_start, entry_bead, _, _, inverse_mass) = rows;
+    let mut pushed = vec![DVec2::ZERO; inverse_mass.len()];
+    for r in 0..row_start.len() - 1 {
+        for e in row_start[r]..row_start[r + 1] {
+            pushed[entry_bead[e]] += lambda[r] * inverse_mass[entry_bead[e]] * gradient[e];
+        }
+    }
+    (0..row_start.len() - 1)
+        .filter(|&r| !set_aside[r])
+        .map(|r| {
+            let met: f64 = (row_start[r]..row_start[r + 1])
+                .map(|e| gradient[e].dot(pushed[entry_bead[e]]))
+                .sum();
+            (met - b[r]).abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn rows_set_aside_are_left_out_of_the_sparse_factorization() {
+    let rows = ring(24);
+    let (row_start, entry_bead, first, _, inverse_mass) = &rows;
+    let matrix = NormalMatrix::new(row_start, entry_bead, inverse_mass.len()).unwrap();
+    let n = row_start.len() - 1;
+    let b: Vec<f64> = (0..n).map(|r| (r as f64 * 0.7).sin() - 0.2).collect();
+    let solve = |set_aside: &[usize], f: &mut Factored| {
+        let inactive: Vec<bool> = (0..n).map(|r| set_aside.contains(&r)).collect();
+        // A row set aside has no gradient.
+        let mut gradient = first.clone();
+        for &r in set_aside {
+            gradient[row_start[r]..row_start[r + 1]].fill(DVec2::ZERO);
+        }
+        matrix
+            .factor(inverse_mass, &gradient, &inactive, false, f)
+            .unwrap();
+        let mut lambda = b.clone();
+        matrix.solve(f, &mut lambda);
+        let residual = worst_residual(&rows, &gradient, &lambda, &b, &inactive);
+        // The Newton matrix with the same gradients at both ends is `A`.
+        let mut stepped = b.clone();
+        let mut lu = LuWork::default();
+        for natural in [false, true] {
+            let solved = matrix.solve_unsymmetric(
+                inverse_mass,
+                &gradient,
+                &gradient,
+                &inactive,
+                &mut lu,
+                &mut stepped,
+                natural,
+            );
+            assert!(solved, "{set_aside:?} set aside");
+            for (a, l) in stepped.iter().zip(&lambda) {
+                assert!((a - l).abs() <= 1e-12 * (1.0 + l.abs()), "{a} against {l}");
+            }
+            stepped.clone_from(&b);
+        }
+        (f.layout, lambda, residual)
+    };
+    let mut f = Factored::default();
+    let (layout, first_lambda, residual) = solve(&[3, 7, 8, 15], &mut f);
+    assert_eq!(layout, Layout::Held);
+    assert!(residual <= 1e-12, "held rows met to {residual:e}");
+    for r in [3, 7, 8, 15] {
+        assert_eq!(first_lambda[r], b[r], "row {r} set aside");
+    }
+    // Another set, every row held, and the first set again: the pattern
+    // made again each time, the first answer to the bit.
+    let (_, _, residual) = solve(&[0, 1, 23], &mut f);
+    assert!(residual <= 1e-12, "held rows met to {residual:e}");
+    let (layout, _, residual) = solve(&[], &mut f);
+    assert_eq!(layout, Layout::Sparse);
+    assert!(residual <= 1e-12, "every row met to {residual:e}");
+    let (_, again, _) = solve(&[3, 7, 8, 15], &mut f);
+    assert_eq!(again, first_lambda);
+    // All rows but one set aside, and all of them.
+    let all_but_one: Vec<usize> = (1..n).collect();
+    let (_, lambda, residual) = solve(&all_but_one, &mut f);
+    assert!(residual <= 1e-12, "the one row met to {residual:e}");
+    assert!(lambda.iter().all(|x| x.is_finite()));
+    let all: Vec<usize> = (0..n).collect();
+    let (_, lambda, _) = solve(&all, &mut f);
+    assert_eq!(lambda, b);
 }

@@ -252,6 +252,28 @@ fn a_two_bead_cart_on_a_rough_line_stops_at_the_coulomb_distance_and_sticks() {
     }
 }
 
+/// One bead of 1 kg on a one-sided floor (the line `y = 0`, pushing up)
+/// of restitution `restitution`, its row set aside till it lands.
+fn floor(restitution: f64) -> Island {
+    let mut island = Island::new(
+        &[1.0],
+        vec![wire(0, WireShape::Line(Line), Pose::IDENTITY)],
+        vec![],
+    )
+    .unwrap();
+    island.set_side(0, crate::geometry::Side::Positive, restitution);
+    island
+}
+
+/// When the first landing among `events` happened.
+fn landed_at(mut events: impl Iterator<Item = crate::solver::ContactEvent>) -> Option<f64> {
+    use crate::solver::ContactEvent;
+    events.find_map(|e| match e {
+        ContactEvent::Landed { time, .. } => Some(time),
+        ContactEvent::Left { .. } => None,
+    })
+}
+
 /// A bead thrown onto a one-sided floor lands where a lone bead does: an
 /// island of its one row locates the landing within the step as
 /// [`step_surface`](crate::solver::step_surface) does, and goes on from
@@ -259,13 +281,7 @@ fn a_two_bead_cart_on_a_rough_line_stops_at_the_coulomb_distance_and_sticks() {
 #[test]
 fn an_island_lands_within_the_step_where_a_lone_bead_does() {
     use crate::geometry::{FixedTrack, Side, Surface};
-    use crate::solver::{Contact, ContactEvent, step_surface};
-    fn landed_at(mut events: impl Iterator<Item = ContactEvent>) -> Option<f64> {
-        events.find_map(|e| match e {
-            ContactEvent::Landed { time, .. } => Some(time),
-            ContactEvent::Left { .. } => None,
-        })
-    }
+    use crate::solver::{Contact, step_surface};
     let line = Line;
     let track = FixedTrack(&line);
     let start = BeadState {
@@ -284,13 +300,7 @@ fn an_island_lands_within_the_step_where_a_lone_bead_does() {
                 restitution,
                 ..Surface::PLAIN
             };
-            let mut island = Island::new(
-                &[1.0],
-                vec![wire(0, WireShape::Line(Line), Pose::IDENTITY)],
-                vec![],
-            )
-            .unwrap();
-            island.set_side(0, Side::Positive, restitution);
+            let island = floor(restitution);
             let s = settings(method, 1.0 / 60.0);
             let (mut lone, mut contact) = (start, Contact::InFlight);
             let mut states = vec![start];
@@ -326,6 +336,58 @@ fn an_island_lands_within_the_step_where_a_lone_bead_does() {
             assert!(
                 gap < 1e-9,
                 "{method}, e = {restitution}: the island is {gap:e} from the lone bead"
+            );
+        }
+    }
+}
+
+/// A bead at rest 0.4 g dt² above a one-sided floor, RATTLE at 1/60 s:
+/// free fall crosses the floor within the step, at `dt √0.8`. At
+/// restitution 0 it reaches the floor no faster than the step's weight
+/// moves it, so it lands at the step's end, on the floor to 1e-12 m and at
+/// rest across it to 1e-12 m/s, its speed along the floor kept to 1e-12;
+/// at restitution ½ the landing is located at its instant to 1e-9 s.
+#[test]
+fn a_bead_that_reaches_its_floor_slowly_lands_at_the_step_end() {
+    let dt = 1.0 / 60.0;
+    let gap = 0.4 * 9.81 * dt * dt;
+    for restitution in [0.0, 0.5] {
+        let island = floor(restitution);
+        let mut states = vec![BeadState {
+            position: DVec2::new(0.0, gap),
+            velocity: DVec2::new(0.5, 0.0),
+        }];
+        let mut work = IslandWork::default();
+        island
+            .step_at(
+                0.0,
+                &mut states,
+                &weights(&[1.0]),
+                &settings(Method::Rattle, dt),
+                &mut work,
+            )
+            .unwrap();
+        let landed = landed_at(work.events().iter().map(|e| e.2));
+        let landed = landed.expect("the bead lands within its first step");
+        if restitution == 0.0 {
+            assert_eq!(landed, dt, "a slow landing is taken at the step's end");
+            let BeadState { position, velocity } = states[0];
+            assert!(position.y.abs() < 1e-12, "{} m off the floor", position.y);
+            assert!(
+                velocity.y.abs() < 1e-12,
+                "{} m/s across the floor",
+                velocity.y
+            );
+            assert!(
+                (velocity.x - 0.5).abs() < 1e-12,
+                "{} m/s along it",
+                velocity.x
+            );
+        } else {
+            let instant = dt * 0.8f64.sqrt();
+            assert!(
+                (landed - instant).abs() < 1e-9,
+                "e = ½: landed at {landed} s, not {instant} s"
             );
         }
     }
