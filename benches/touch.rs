@@ -7,15 +7,23 @@
 //!   pass through each other, each stepping alone). Throughput is
 //!   bead-steps per second. The plugin as a game gets it: Bevy's
 //!   executor, parallel loops from `ParallelStep::default()`.
+//! - `pile`: 500 beads of 2 cm poured in rows of 23 into a one-sided bowl
+//!   at `e = 0` (`ScenePreset::pile`, RATTLE at 240 Hz), one step at a
+//!   time from 0.2 s on, as the pile lands in the bowl and strikes
+//!   itself: each step is several seconds, so ten are timed, each once.
 
 use std::time::Duration;
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use criterion::measurement::WallTime;
+use criterion::{
+    BenchmarkGroup, BenchmarkId, Criterion, SamplingMode, Throughput, criterion_group,
+    criterion_main,
+};
 use wirebead::headless::Headless;
 use wirebead::prelude::*;
-use wirebead::{BeadRadius, Integrator, SimClock};
+use wirebead::{BeadRadius, Integrator, ScenePreset, SimClock};
 
 /// Rings in the abacus.
 const RINGS: usize = 100;
@@ -70,18 +78,51 @@ fn abacus_group(c: &mut Criterion) {
     group.warm_up_time(Duration::from_secs(1));
     group.measurement_time(Duration::from_secs(4));
     for (name, touching) in [("touching", true), ("passing-through", false)] {
-        let mut app = abacus(touching);
-        group.bench_function(BenchmarkId::new(name, n), |b| {
-            b.iter(|| app.world_mut().run_schedule(FixedUpdate));
-        });
-        let world = app.world_mut();
-        let stopped = world.query::<&Diverged>().iter(world).count();
-        let steps = world.resource::<SimClock>().steps;
-        eprintln!("abacus/{name}: {steps} steps, {stopped} beads stopped");
-        assert_eq!(stopped, 0, "no bead may stop");
+        time_steps(&mut group, abacus(touching), (name, n));
     }
     group.finish();
 }
 
-criterion_group!(benches, abacus_group);
+/// Times `app`'s steps in `group` as `(name, beads)`, then checks that no
+/// bead stopped.
+fn time_steps(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    mut app: App,
+    (name, beads): (&str, usize),
+) {
+    group.bench_function(BenchmarkId::new(name, beads), |b| {
+        b.iter(|| app.world_mut().run_schedule(FixedUpdate));
+    });
+    let world = app.world_mut();
+    let stopped = world.query::<&Diverged>().iter(world).count();
+    let steps = world.resource::<SimClock>().steps;
+    eprintln!("{name}: {steps} steps, {stopped} beads stopped");
+    assert_eq!(stopped, 0, "no bead may stop");
+}
+
+/// Beads in the pile.
+const PILE: usize = 500;
+/// Steps poured before the timing starts: 0.2 s at 240 Hz.
+const POURED: usize = 48;
+
+fn pile_group(c: &mut Criterion) {
+    let preset = ScenePreset::pile(PILE, 23).expect("the pile");
+    let plugin = WireBeadPlugin::new(preset.params.clone()).expect("valid parameters");
+    let mut app = Headless::new(plugin).build();
+    preset.spawn(&mut app.world_mut().commands());
+    app.world_mut().flush();
+    for _ in 0..POURED {
+        app.world_mut().run_schedule(FixedUpdate);
+    }
+    let mut group = c.benchmark_group("pile");
+    group.throughput(Throughput::Elements(PILE as u64));
+    group.sampling_mode(SamplingMode::Flat);
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_millis(1));
+    group.measurement_time(Duration::from_millis(1));
+    time_steps(&mut group, app, ("pouring", PILE));
+    group.finish();
+}
+
+criterion_group!(benches, abacus_group, pile_group);
 criterion_main!(benches);

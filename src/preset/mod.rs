@@ -27,6 +27,7 @@
 
 mod error;
 mod format;
+mod pile;
 mod plugin;
 mod space;
 #[cfg(test)]
@@ -40,6 +41,7 @@ pub use format::{
     BeadPreset, ConstraintPreset, ContactsPreset, PinPreset, RodPreset, SceneLink, ScenePreset,
     SpringPreset, WirePreset,
 };
+pub use pile::PILE_RADIUS;
 pub use plugin::{
     ActivePreset, LoadPreset, ScenePresetLoader, ScenePresetPlugin, apply_loaded_preset,
     load_requested_preset, report_preset_errors,

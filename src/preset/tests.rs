@@ -176,3 +176,26 @@ fn a_broken_file_and_bad_tracks_in_a_file_are_refused_in_words() {
         "{spline}"
     );
 }
+
+/// A pile has as many beads as it is asked for, each of
+/// [`PILE_RADIUS`](super::PILE_RADIUS), inside the bowl by more than a
+/// radius and no two touching (23 to a row are 2.04 radii apart at the
+/// least, the jitter taken off 2.17); none to a row is taken as one.
+#[test]
+fn a_pile_has_its_beads_apart_inside_the_bowl() {
+    let r = super::PILE_RADIUS;
+    for (n, per_row) in [(46, 23), (500, 23), (3, 0)] {
+        let pile = ScenePreset::pile(n, per_row).unwrap_or_else(|e| panic!("{e}"));
+        let beads: Vec<_> = pile.all_beads().collect();
+        assert_eq!(beads.len(), n);
+        for (i, a) in beads.iter().enumerate() {
+            assert_eq!(a.radius, r);
+            let from_centre = a.initial_position.length();
+            assert!(from_centre < 1.0 - r, "{} at {from_centre} m", a.name);
+            for b in &beads[i + 1..] {
+                let apart = (a.initial_position - b.initial_position).length();
+                assert!(apart > 2.0 * r, "{} and {}: {apart} m", a.name, b.name);
+            }
+        }
+    }
+}

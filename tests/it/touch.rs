@@ -324,11 +324,17 @@ fn shipped(name: &str) -> (App, Vec<Entity>, ScenePreset) {
 /// contacts: the app, the beads in the file's order and the scene.
 fn spawned(text: &str) -> (App, Vec<Entity>, ScenePreset) {
     let preset = ScenePreset::from_ron(text).unwrap_or_else(|e| panic!("{e}"));
+    let (app, beads) = spawned_from(&preset);
+    (app, beads, preset)
+}
+
+/// [`spawned`] for a scene already made.
+fn spawned_from(preset: &ScenePreset) -> (App, Vec<Entity>) {
     let plugin = WireBeadPlugin::new(preset.params.clone()).expect("valid params");
     let mut app = Headless::new(plugin).single_threaded().build();
     let beads = preset.spawn(&mut app.world_mut().commands());
     app.world_mut().flush();
-    (app, beads, preset)
+    (app, beads)
 }
 
 /// The worst overlap of any two beads with radii, as a share of the
@@ -736,22 +742,8 @@ fn a_pile_poured_into_a_bowl_lies_pressed_together_without_overlap() {
     } else {
         (46, 23, 720)
     };
-    let r = 0.02;
-    let beads: String = (0..n)
-        .map(|k| {
-            let (i, j) = (k % cols, k / cols);
-            let jitter = 0.003 * ((k * 7919 % 13) as f64 / 13.0 - 0.5);
-            let x = -0.5 + (i as f64 + 0.5) / cols as f64 + jitter;
-            let y = -0.8 + 2.3 * r * j as f64;
-            format!("(name: \"b{k}\", mass: 1.0, radius: {r}, initial_position: ({x}, {y})),")
-        })
-        .collect();
-    let text = format!(
-        "(name: \"pile\", params: (timestep: {}, integrator: Rattle), contacts: (restitution: 0.0), \
-         wires: [(shape: Circle((radius: 1.0)), side: Negative, beads: [{beads}])])",
-        1.0 / 240.0
-    );
-    let (mut app, spawned, _) = spawned(&text);
+    let preset = ScenePreset::pile(n, cols).unwrap_or_else(|e| panic!("{e}"));
+    let (mut app, spawned) = spawned_from(&preset);
     let energy = |app: &App| -> f64 {
         let islands = app.world().resource::<Islands>();
         islands.iter().map(|i| i.energy).sum()
