@@ -48,6 +48,33 @@ fn factor_dropping(
     Ok(l_values.iter().filter(|&&v| v == DROPPED_PIVOT).count())
 }
 
+/// The scratch memory faer's `LDLᵀ` under `symbolic` needs, to factor
+/// and to solve.
+fn ldlt_memory(symbolic: &SymbolicCholesky<usize>) -> MemBuffer {
+    MemBuffer::new(
+        symbolic
+            .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
+    )
+}
+
+/// Solves `L D Lᵀ x = b` in place in `x` with the factor `l_values` of
+/// `symbolic`.
+fn ldlt_solve(
+    symbolic: &SymbolicCholesky<usize>,
+    l_values: &[f64],
+    memory: &mut MemBuffer,
+    x: &mut [f64],
+) {
+    let n = x.len();
+    LdltRef::new(symbolic, l_values).solve_in_place_with_conj(
+        Conj::No,
+        MatMut::from_column_major_slice_mut(x, n, 1),
+        Par::Seq,
+        MemStack::new(memory),
+    );
+}
+
 impl NormalMatrix {
     /// `LDLᵀ` of the scaled `A` (filled into `f.values`) by faer's sparse
     /// Cholesky under `symbolic`'s ordering: a pivot at or below
@@ -181,11 +208,7 @@ impl NormalMatrix {
         let symbolic =
             factorize_symbolic_cholesky(pattern.as_ref(), Side::Upper, order, Default::default())
                 .map_err(|_| first)?;
-        held.memory = Some(MemBuffer::new(
-            symbolic
-                .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
-                .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
-        ));
+        held.memory = Some(ldlt_memory(&symbolic));
         held.symbolic = Some((pattern, symbolic));
         Ok(())
     }
@@ -209,12 +232,7 @@ impl NormalMatrix {
         part.extend(rows.iter().map(|&r| rhs[r]));
         match (symbolic, memory) {
             (Some((_, symbolic)), Some(memory)) => {
-                LdltRef::new(symbolic, &f.l_values).solve_in_place_with_conj(
-                    Conj::No,
-                    MatMut::from_column_major_slice_mut(part, rows.len(), 1),
-                    Par::Seq,
-                    MemStack::new(memory),
-                );
+                ldlt_solve(symbolic, &f.l_values, memory, part);
             }
             _ => {
                 if let (Some(b), Some(d)) = (part.first_mut(), values.first()) {
@@ -241,14 +259,8 @@ impl NormalMatrix {
         for (b, s) in rhs.iter_mut().zip(&f.scale) {
             *b *= s;
         }
-        let ldlt = LdltRef::new(symbolic, &f.l_values);
         let memory = self.scratch(symbolic, &mut f.scratch);
-        ldlt.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, self.n, 1),
-            Par::Seq,
-            MemStack::new(memory),
-        );
+        ldlt_solve(symbolic, &f.l_values, memory, rhs);
         for (b, s) in rhs.iter_mut().zip(&f.scale) {
             *b *= s;
         }
@@ -265,12 +277,6 @@ impl NormalMatrix {
             scratch.memory = None;
             scratch.owner = self.id;
         }
-        scratch.memory.get_or_insert_with(|| {
-            MemBuffer::new(
-                symbolic
-                    .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
-                    .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
-            )
-        })
+        scratch.memory.get_or_insert_with(|| ldlt_memory(symbolic))
     }
 }
