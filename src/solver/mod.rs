@@ -62,8 +62,8 @@ pub use solve::{SolveError, Solved, lambda, solve};
 pub use state::{Advance, BeadState, LinearForce};
 pub use step::{StepOutput, constraint_state, constraint_state_on, step, step_on};
 pub use touch::{
-    MAX_IMPACTS_PER_STEP, Pressed, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody,
-    TouchError, may_touch, overlapping, settle_touches,
+    MAX_IMPACTS_PER_STEP, NEAR_MEETING, Pressed, StepSpan, StruckPair, TOUCHING, TouchBead,
+    TouchBody, TouchError, may_touch, overlapping, settle_touches,
 };
 
 /// What the solver's unit tests share.

@@ -11,7 +11,7 @@ use super::{
 use crate::geometry::Coordinates;
 use crate::solver::contact::locate_between;
 use crate::solver::coupled::{
-    closes, ends_in_touch, meets_slowly, opening_rate, parts, step_speed,
+    closes, ends_in_touch, meets_near, meets_slowly, opening_rate, parts, step_speed,
 };
 use crate::solver::impact::{Response, Strike, Touch, resolve_impacts, rub};
 use crate::solver::solve::SolveError;
@@ -244,10 +244,14 @@ impl<'a, V: Coordinates> Group<'a, V> {
                     continue; // its contact row keeps it from closing
                 }
                 // In touch: struck now if it closes, else left resting;
-                // one that meets slowly and that its body's step ends in
-                // touch (its row held) has met within the step.
-                if self.closing(pair).is_some() {
-                    if !(self.meets_slowly(bodies, pair, (a0, b0)) && ends_in_touch(end, r)) {
+                // one that meets slowly or near the step's start and
+                // that its body's step ends in touch (its row held) has
+                // met within the step.
+                if let Some(speed) = self.closing(pair) {
+                    let within = self.meets_slowly(bodies, pair, (a0, b0))
+                        || (self.pressable(bodies, pair)
+                            && meets_near(0.0, g0, speed, self.span.dt));
+                    if !(within && ends_in_touch(end, r)) {
                         return Ok(Some((0.0, pair)));
                     }
                     continue;

@@ -108,6 +108,26 @@ pub(crate) fn meets_slowly(restitution: f64, closing: f64, moved: f64) -> bool {
     restitution == 0.0 && closing <= moved
 }
 
+/// The part of a step within which a pair at `e = 0` that meets is
+/// taken by the step rather than struck at its instant: 1/16. Such a
+/// pair, `gap` apart and closing at `v`, meets within `gap / v ≤ dt / 16`
+/// of the step's start; its body's step holds its contact row where the
+/// pair would end overlapping (see [`Island::step_at`]).
+pub const NEAR_MEETING: f64 = 1.0 / 16.0;
+
+/// Whether a pair of restitution `restitution`, `gap` apart and closing
+/// at `closing` (m/s), meets near the start of a step of `dt` (or of a
+/// part of it, `dt` still the whole step's): at `e = 0`, within
+/// [`NEAR_MEETING`] of `dt`. Its body's step holds
+/// its row (a plastic impact over the step: for two free beads on a line
+/// exactly the one at its instant, elsewhere apart from it by the
+/// constraint force over the `gap / v` before it), so a pile whose beads
+/// pass their momentum on across gaps of a hair does not cut its step at
+/// each (inelastic collapse).
+pub(crate) fn meets_near(restitution: f64, gap: f64, closing: f64, dt: f64) -> bool {
+    restitution == 0.0 && closing > 0.0 && gap <= NEAR_MEETING * closing * dt
+}
+
 /// The speed a step of `dt` gives two beads under `pushes` (each bead's
 /// acceleration from its forces, `f / m`): `(|p_a| + |p_b|) dt`, the
 /// `moved` of [`meets_slowly`].
@@ -472,8 +492,9 @@ impl<V: WireSpace> Island<V> {
     }
 
     /// Gives contact row `row` its pair's restitution (the two beads'
-    /// least; 1 until told). A pair at `e = 0` whose beads meet slowly is
-    /// held by the step rather than struck where it meets (see
+    /// least; 1 until told). A pair at `e = 0` whose beads meet slowly, or
+    /// near the step's start, is held by the step rather than struck where
+    /// it meets (see
     /// [`Island::step_at`]). Rows of other kinds are left as they are.
     pub fn set_contact_restitution(&mut self, row: usize, restitution: f64) {
         if self.is_contact(row)

@@ -9,7 +9,7 @@ use super::projection::Restore;
 use super::{
     CALM_STEPS, CONTACT_PASSES, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow, TOUCHING,
 };
-use super::{closes, meets_slowly, step_speed};
+use super::{closes, meets_near, meets_slowly, step_speed};
 use crate::solver::contact::locate;
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use crate::solver::method::Method;
@@ -80,7 +80,8 @@ impl<V: WireSpace> Island<V> {
     /// let go by the step taken again, so the passes end: at most 16 more
     /// than the island has rows. A step that keeps its rows on their
     /// constraints (RATTLE, or one that projects) holds in the same way
-    /// a row whose beads are apart and meet slowly at `e = 0`
+    /// a row whose beads meet slowly at `e = 0`, or within
+    /// [`NEAR_MEETING`](super::NEAR_MEETING) of the step's start
     /// ([`Island::set_contact_restitution`]): they end the step in touch.
     /// A bead in flight that reaches a one-sided wire of restitution 0 no
     /// faster than the step's forces move it lands at the step's end, not
@@ -255,9 +256,10 @@ impl<V: WireSpace> Island<V> {
     /// beads overlapping: those whose beads touch at `states` (the step's
     /// start) and do not close within the step ([`closes`]), and, for a
     /// step that keeps its rows on their constraints (RATTLE, or one that
-    /// projects), those whose beads are apart and meet slowly at `e = 0`
-    /// ([`Island::slow_meeting`]). A pair in touch that closes, or one
-    /// apart that meets faster, is the touch settlement's to strike.
+    /// projects), those whose beads meet slowly or near the step's start
+    /// at `e = 0` ([`Island::slow_meeting`]). A pair in touch that closes,
+    /// or one apart that meets later and faster, is the touch
+    /// settlement's to strike.
     fn touching(
         &self,
         states: &[BeadState<V>],
@@ -292,14 +294,17 @@ impl<V: WireSpace> Island<V> {
     /// one of `whole`) no faster than a whole step's forces move them
     /// (each bead's `|f| / m` times `whole`, summed), where the pair's
     /// restitution is 0 (see [`Island::set_contact_restitution`] and
-    /// [`meets_slowly`]). Such a pair is not struck at
+    /// [`meets_slowly`]), or meets within [`NEAR_MEETING`](super::NEAR_MEETING) of the step's
+    /// start ([`meets_near`]). Such a pair is not struck at
     /// the instant it meets: the step holds its row, as it does a pair
     /// pressed together, so that it ends the step in touch (the pair
     /// meets within the step, a plastic impact spread over it). A pile
     /// settling at `e = 0` so takes its countless slow meetings within
     /// its steps, where cutting the step at each would not end
-    /// (inelastic collapse); a strike faster than its forces is still
-    /// located at its instant.
+    /// (inelastic collapse), as it takes the meetings across gaps of a
+    /// hair by which its beads pass their momentum on; a strike faster
+    /// than its forces and later in the step is still located at its
+    /// instant.
     fn slow_meeting(
         &self,
         r: usize,
@@ -316,7 +321,9 @@ impl<V: WireSpace> Island<V> {
             _ => V::ZERO,
         };
         let slow = step_speed([push(a), push(b)], whole);
-        meets_slowly(self.sides[r].1, -rate, slow) && gap <= 2.0 * slow * dt
+        let restitution = self.sides[r].1;
+        (meets_slowly(restitution, -rate, slow) && gap <= 2.0 * slow * dt)
+            || meets_near(restitution, gap, -rate, whole)
     }
 
     /// Marks the one-sided wire rows whose beads are off their wires at
