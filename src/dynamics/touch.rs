@@ -98,8 +98,11 @@ impl Contacts {
     /// across the line between their centres with an impulse of at most
     /// `μ p`, as much as stops it where that is less (see
     /// [`rub`](crate::solver::rub)), pairs struck together at `e = 0` as
-    /// well as pairs struck one by one. Pressed pairs do not rub between
-    /// strikes.
+    /// well as pairs struck one by one. Pairs pressed together rub between
+    /// strikes as a bead on a rough wire does: `μ |λ|` against their slip,
+    /// and in the plane held still where they stop slipping while `μ |λ|`
+    /// can hold them (see
+    /// [`Island::set_contact_friction`](crate::solver::Island::set_contact_friction)).
     pub fn with_friction(self, friction: f64) -> Result<Self, ParamError> {
         non_negative("friction", friction).map(|friction| Self { friction, ..self })
     }

@@ -8,10 +8,10 @@ use bevy::prelude::*;
 
 use super::{CachedIsland, ContactRow, InIsland, IslandReport, Islands, LinkRows, WireRow, touch};
 use crate::dynamics::{
-    Bead, BeadMotion, BeadRadius, CatchesBeads, Dimension, DivergenceReason, Joint, OnWire, Pin,
-    Rod, SimParams, SpaceBead, Spring, WirePose, WireRows,
+    Bead, BeadMotion, BeadRadius, CatchesBeads, Contacts, Dimension, DivergenceReason, Joint,
+    OnWire, Pin, Rod, SimParams, SpaceBead, Spring, WirePose, WireRows,
 };
-use crate::geometry::{Side, Surface};
+use crate::geometry::{Friction, Side, Surface};
 use crate::plugin::clock::SimClock;
 use crate::plugin::report::Divergences;
 use crate::solver::{self, BeadState, Island, IslandRow, IslandWork, RowKind, SpringLink};
@@ -141,6 +141,7 @@ pub(super) fn prepare_islands<V: Dimension>(
     mut divergences: Divergences,
     clock: Res<SimClock>,
     params: Res<SimParams>,
+    contacts: Res<Contacts>,
 ) {
     islands.dirty = false;
     // Whether each bead's wire rows held it, where the islands being
@@ -274,15 +275,25 @@ pub(super) fn prepare_islands<V: Dimension>(
             (r > 0.0).then(|| (entity, bead.state(), r))
         })
         .collect();
+    // A pair with friction in the plane gets a second row, to hold it
+    // while static friction can (set aside while it slips); in space a
+    // pair has no one direction to be held in.
+    let sticks = contacts.friction() > 0.0 && V::stick_axis(V::AXES[0]).is_some();
     for (i, j) in touch::near(&with_radius, params.timestep) {
         let ((a, _, ra), (b, _, rb)) = (with_radius[i], with_radius[j]);
+        let row = IslandRow {
+            kind: RowKind::Rod { length: ra + rb },
+            beads: vec![0, 1],
+        };
+        let rows = if sticks {
+            vec![row.clone(), row]
+        } else {
+            vec![row]
+        };
         named.push((
             Pending {
                 entity: a,
-                rows: vec![IslandRow {
-                    kind: RowKind::Rod { length: ra + rb },
-                    beads: vec![0, 1],
-                }],
+                rows,
                 pin: false,
                 anchored: false,
                 contact: Some(ra + rb),
@@ -389,15 +400,16 @@ pub(super) fn prepare_islands<V: Dimension>(
         } = wired;
         let mut link_rows = Vec::new();
         let mut anchored = Vec::new();
-        let mut contacts = Vec::new();
+        let mut pair_rows = Vec::new();
         for (pending, local) in links {
             let start = rows.len();
             if pending.anchored {
                 anchored.push((start, pending.entity));
             }
             if let Some(reach) = pending.contact {
-                contacts.push(ContactRow {
+                pair_rows.push(ContactRow {
                     row: start,
+                    stick: (pending.rows.len() > 1).then_some(start + 1),
                     a: local[0].min(local[1]),
                     b: local[0].max(local[1]),
                     reach,
@@ -436,10 +448,17 @@ pub(super) fn prepare_islands<V: Dimension>(
             None => Island::new(&masses, rows, springs)
                 .map_err(|e| DivergenceReason::InvalidConstraint(e.to_string())),
         };
-        contacts.sort_unstable_by_key(|c| (c.a, c.b));
+        pair_rows.sort_unstable_by_key(|c| (c.a, c.b));
+        let pair_friction = Friction {
+            static_coefficient: contacts.friction(),
+            kinetic_coefficient: contacts.friction(),
+        };
         let built = built.map(|mut island| {
-            for contact in &contacts {
+            for contact in &pair_rows {
                 island.set_contact(contact.row);
+                if pair_friction.is_some() {
+                    island.set_contact_friction(contact.row, pair_friction, contact.stick);
+                }
             }
             for &row in &catching {
                 island.set_catching(row);
@@ -481,7 +500,7 @@ pub(super) fn prepare_islands<V: Dimension>(
                     links: link_rows,
                     wire_rows,
                     anchored,
-                    contacts,
+                    contacts: pair_rows,
                     outcome: None,
                     touching: Vec::new(),
                     start: Vec::new(),

@@ -127,11 +127,13 @@ pub struct PressedPair {
     pub force: f64,
 }
 
-/// A contact row of an island: the row, its two beads (`a < b`, their
-/// indices in the island) and the sum of their radii.
+/// A contact row of an island: the row, the row that holds the pair by
+/// static friction (where it has friction, in the plane), its two beads
+/// (`a < b`, their indices in the island) and the sum of their radii.
 #[derive(Clone, Copy, Debug)]
 struct ContactRow {
     row: usize,
+    stick: Option<usize>,
     a: usize,
     b: usize,
     reach: f64,

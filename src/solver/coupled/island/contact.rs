@@ -13,7 +13,7 @@ use crate::solver::friction;
 use crate::solver::settings::Gains;
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
-use crate::solver::wire_normal::usable;
+use crate::solver::wire_normal::{along, usable};
 
 impl<V: WireSpace> Island<V> {
     /// Eq. (17) on the island at the step's start (λ from
@@ -32,6 +32,12 @@ impl<V: WireSpace> Island<V> {
         let mut slides = Vec::new();
         for (r, rough) in self.rough.iter().enumerate() {
             let Some(rough) = rough else { continue };
+            if self.contacts[r] {
+                if let Some(slide) = self.resist_pair(r, rough, states, forces, work) {
+                    slides.push(slide);
+                }
+                continue;
+            }
             let bead = self.entry_bead[self.row_start[r]];
             if work.inactive[r] {
                 // In flight: nothing to rub against, nothing to stick to.
@@ -88,10 +94,81 @@ impl<V: WireSpace> Island<V> {
         slides
     }
 
+    /// [`Island::resist`] for contact row `r` with friction: a pair apart
+    /// rubs nothing and holds nothing; a pair its stick row holds stays
+    /// held while static friction can; a pair that slips, or at rest
+    /// starts to, gets kinetic friction, `μk |λ|` against its slip, on
+    /// each bead. Row `r`, the pair's second bead, its slip at the start,
+    /// and whether static friction let go of it this step; none where the
+    /// stick held or the pair is apart.
+    fn resist_pair(
+        &self,
+        r: usize,
+        rough: &RoughRow,
+        states: &[BeadState<V>],
+        forces: &mut [LinearForce<V>],
+        work: &mut IslandWork<V>,
+    ) -> Option<(usize, usize, V, bool)> {
+        let (a, b, _) = self.contact_pair(r)?;
+        if work.inactive[r] {
+            if let Some(s) = rough.stick {
+                work.inactive[s] = true;
+            }
+            return None;
+        }
+        let (n, sliding) = self.pair_slip(r, states)?;
+        let press = work.lambda[r].abs();
+        // At rest it is rubbed against the way it starts to slip (the
+        // pair's accelerations at the step's start, from `leave`).
+        let accelerations = (work.acceleration.get(a), work.acceleration.get(b));
+        let mut direction = match (sliding == V::ZERO, accelerations) {
+            (true, (Some(&aa), Some(&ab))) => along(n, 1.0, ab - aa),
+            _ => sliding,
+        };
+        let mut released = false;
+        if let Some(s) = rough.stick
+            && !work.inactive[s]
+        {
+            let hold = work.lambda[s];
+            if friction::holds(&rough.friction, hold.abs(), press) {
+                return None; // held still
+            }
+            work.inactive[s] = true;
+            released = true;
+            if let Some(Some((axis, _))) = work.sticks.get(s) {
+                direction = *axis * -hold;
+            }
+        }
+        let speed = direction.dot(direction).sqrt();
+        if speed > 0.0 {
+            let rub = friction::kinetic(&rough.friction, press, direction, speed);
+            forces[b].force += rub;
+            forces[a].force -= rub;
+        }
+        Some((r, b, sliding, released))
+    }
+
+    /// Contact row `r`'s unit normal from its first bead to its second,
+    /// and the second's slip across it relative to the first, at `states`;
+    /// none for a row of another kind or a pair at one point.
+    fn pair_slip(&self, r: usize, states: &[BeadState<V>]) -> Option<(V, V)> {
+        let (a, b, _) = self.contact_pair(r)?;
+        let (sa, sb) = (states.get(a)?, states.get(b)?);
+        let d = sb.position - sa.position;
+        let nn = d.dot(d);
+        if !usable(nn) {
+            return None;
+        }
+        let n = d / nn.sqrt();
+        Some((n, along(n, 1.0, sb.velocity - sa.velocity)))
+    }
+
     /// Where friction stopped a sliding bead during the step (its sliding
     /// velocity reversed), puts its stick row across the wire there and
     /// projects the island's velocities onto the rows with it: the bead
-    /// stays put while static friction can hold it.
+    /// stays put while static friction can hold it. A pair of beads
+    /// pressed together stops in the same way, its stick row placed
+    /// across the line between their centres.
     pub(super) fn stop(
         &self,
         time: f64,
@@ -110,6 +187,26 @@ impl<V: WireSpace> Island<V> {
                 continue;
             };
             if work.inactive[r] || self.paths[r].is_some() || !friction.is_some() {
+                continue;
+            }
+            if self.contacts[r] {
+                // A pair: held across the contact where its slip reversed.
+                let Some((n, sliding)) = self.pair_slip(r, states) else {
+                    continue;
+                };
+                // Its slip reversed, or it was at rest and static
+                // friction did not let go of it: held at the step's end.
+                let reversed = before != V::ZERO && sliding.dot(before) < 0.0;
+                let started = before == V::ZERO && sliding != V::ZERO && !released;
+                let Some(axis) = V::stick_axis(n).filter(|_| reversed || started) else {
+                    continue;
+                };
+                let Some((a, b, _)) = self.contact_pair(r) else {
+                    continue;
+                };
+                let offset = axis.dot(states[b].position - states[a].position);
+                self.place_stick(s, axis, offset, work);
+                stopped = true;
                 continue;
             }
             let row = self.wire_row(r, states, time);

@@ -504,6 +504,41 @@ impl<V: WireSpace> Island<V> {
         }
     }
 
+    /// Gives contact row `row` Coulomb friction between its two beads,
+    /// as [`Island::set_rough`] gives a wire: while the pair is pressed
+    /// together their slip across the contact is opposed by `μk |λ|`
+    /// (held at its value at the step's start), and where the slip stops
+    /// within a step `stick` holds it: a row of the same two beads (any
+    /// kind; a rod of the pair's reach will do), placed as
+    /// `t·(x_b − x_a) = offset` across the contact where they stopped,
+    /// set aside while they slide and let go again when the force it needs
+    /// passes `μs |λ|`. A pair in space has no one direction to be held
+    /// in: friction slows its slip, and `stick` is not used. Rows that are
+    /// not contacts, and a `stick` that does not join the same two beads,
+    /// are left as they were.
+    pub fn set_contact_friction(&mut self, row: usize, friction: Friction, stick: Option<usize>) {
+        let Some((a, b, _)) = self.contact_pair(row) else {
+            return;
+        };
+        let stick = stick.filter(|&s| {
+            s < self.rows() && s != row && {
+                let entries = &self.entry_bead[self.row_start[s]..self.row_start[s + 1]];
+                entries == [a, b] || entries == [b, a]
+            }
+        });
+        if let Some(slot) = self.rough.get_mut(row) {
+            let was = slot.replace(RoughRow {
+                friction,
+                damping: 0.0,
+                stick,
+                partner: None,
+            });
+            if was.is_none() {
+                self.rough_rows += 1;
+            }
+        }
+    }
+
     /// Whether row `row` is a contact (see [`Island::set_contact`]).
     pub fn is_contact(&self, row: usize) -> bool {
         self.contacts.get(row).copied().unwrap_or(false)

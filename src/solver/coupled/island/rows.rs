@@ -179,10 +179,22 @@ impl<V: WireSpace> Island<V> {
                 continue;
             }
             if let Some(Some((axis, offset))) = sticks.get(r) {
-                // A stick row, placed where its bead stopped.
-                let bead = self.entry_bead[range.start];
-                gradient[range.start] = *axis;
-                (c[r], curvature[r], bias[r]) = (axis.dot(x[bead]) - offset, 0.0, 0.0);
+                // A stick row, placed where its bead stopped: `t·x`, or
+                // `t·(x_b − x_a)` for a pair's.
+                let beads = &self.entry_bead[range.clone()];
+                let value = match *beads {
+                    [bead] => {
+                        gradient[range.start] = *axis;
+                        axis.dot(x[bead])
+                    }
+                    [a, b] => {
+                        gradient[range.start] = -*axis;
+                        gradient[range.start + 1] = *axis;
+                        axis.dot(x[b] - x[a])
+                    }
+                    _ => *offset,
+                };
+                (c[r], curvature[r], bias[r]) = (value - offset, 0.0, 0.0);
                 continue;
             }
             let path = if self.moving > 0 {

@@ -573,7 +573,7 @@ impl<V: WireSpace> Island<V> {
                 continue;
             };
             let bead = self.entry_bead[self.row_start[r]];
-            if work.inactive[r] || self.paths[r].is_some() || !whole {
+            if work.inactive[r] || self.paths[r].is_some() || !whole || self.contacts[r] {
                 continue;
             }
             let row = self.wire_row(r, states, time);
@@ -581,6 +581,26 @@ impl<V: WireSpace> Island<V> {
                 && let Some(axis) = row.tangent()
             {
                 self.place_stick(*s, axis, axis.dot(states[bead].position), work);
+            }
+        }
+        // A pair with friction touching at rest starts pressed together
+        // (rubbing from its first step), held by static friction where
+        // it has a stick row.
+        for (r, rough) in self.rough.iter().enumerate() {
+            let (Some(rough), true) = (rough, whole) else {
+                continue;
+            };
+            let Some((a, b, reach)) = self.contact_pair(r) else {
+                continue;
+            };
+            let d = states[b].position - states[a].position;
+            let touches = (d.dot(d).sqrt() - reach).abs() <= TOUCHING * reach;
+            if !touches || states[a].velocity != states[b].velocity {
+                continue;
+            }
+            work.inactive[r] = false;
+            if let (Some(s), Some(axis)) = (rough.stick, V::stick_axis(d / d.dot(d).sqrt())) {
+                self.place_stick(s, axis, axis.dot(d), work);
             }
         }
     }
