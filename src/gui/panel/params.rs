@@ -118,9 +118,7 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
     ui.separator();
     egui::Grid::new("values").num_columns(4).show(ui, |ui| {
         let row = RowValues {
-            c: diagnostics.c,
-            c_dot: diagnostics.c_dot,
-            lambda: diagnostics.lambda,
+            wire: on_wire.map(|_| [diagnostics.c, diagnostics.c_dot, diagnostics.lambda]),
             energy: diagnostics.energy(),
         };
         value_rows(ui, Some(row), &view.clock);
@@ -135,25 +133,27 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
     outcome
 }
 
-/// A bead's wire row and energy, as the panel shows them.
+/// A bead's wire row (`C`, `Ċ`, λ; none for a bead on no wire) and its
+/// energy, as the panel shows them.
 pub(super) struct RowValues {
-    pub(super) c: f64,
-    pub(super) c_dot: f64,
-    pub(super) lambda: f64,
+    pub(super) wire: Option<[f64; 3]>,
     pub(super) energy: f64,
 }
 
 /// The rows of a bead's values in a four-column grid: `C` and `Ċ`, λ and
-/// the energy (where there are any), then the time and the steps.
+/// the energy (a bead on no wire has no `C`, `Ċ` or λ to show), then the
+/// time and the steps.
 pub(super) fn value_rows(ui: &mut egui::Ui, row: Option<RowValues>, clock: &SimClock) {
     if let Some(row) = row {
-        ui.label("C");
-        ui.monospace(format!("{:+.3e}", row.c));
-        ui.label("Ċ");
-        ui.monospace(format!("{:+.3e}", row.c_dot));
-        ui.end_row();
-        ui.label("λ");
-        ui.monospace(format!("{:+.3e}", row.lambda));
+        if let Some([c, c_dot, lambda]) = row.wire {
+            ui.label("C");
+            ui.monospace(format!("{c:+.3e}"));
+            ui.label("Ċ");
+            ui.monospace(format!("{c_dot:+.3e}"));
+            ui.end_row();
+            ui.label("λ");
+            ui.monospace(format!("{lambda:+.3e}"));
+        }
         ui.label("E");
         ui.monospace(format!("{:+.4}", row.energy));
         ui.end_row();

@@ -7,7 +7,7 @@ use std::collections::VecDeque;
 use bevy::math::DVec3;
 use bevy::prelude::*;
 use bevy_egui::egui;
-use egui_plot::{Line, Plot, PlotPoints};
+use egui_plot::{Line, Plot, PlotPoints, uniform_grid_spacer};
 
 use crate::gui::drag::SelectedBead;
 use crate::{BeadDiagnostics, BeadsStruck, Islands, SimClock};
@@ -90,45 +90,146 @@ pub fn record_history(
 }
 
 /// A plot of the last seconds with labelled axes: time in seconds, the
-/// value (its unit is in the heading above) with tick labels in scientific
-/// notation, so that a range of 1e-16 reads as rounding noise and not as a
-/// swing.
+/// value (its unit is in the heading above) with tick labels that tell
+/// neighbouring ticks apart at any scale ([`tick_label`]), so that a range
+/// of 1e-16 reads as rounding noise and not as a swing. On a log scale
+/// the points are `log10 |value|` and the ticks whole decades
+/// ([`decade_label`]).
 fn plot(
     ui: &mut egui::Ui,
     id: &str,
     name: &str,
     points: impl Iterator<Item = [f64; 2]>,
     colour: egui::Color32,
+    log: bool,
 ) {
+    let points: PlotPoints = if log {
+        points.map(|[t, v]| [t, log_magnitude(v)]).collect()
+    } else {
+        points.collect()
+    };
     Plot::new(id)
-        .height(90.0)
+        .height(PLOT_HEIGHT)
         .allow_drag(false)
         .allow_zoom(false)
         .allow_scroll(false)
         .x_axis_label("t (s)")
         .y_axis_min_width(48.0)
-        .y_axis_formatter(|mark, _| format!("{:.1e}", mark.value))
+        .y_grid_spacer(uniform_grid_spacer(move |input| {
+            grid_steps(input.bounds, log)
+        }))
+        .y_axis_formatter(move |mark, _| {
+            if log {
+                decade_label(mark.value)
+            } else {
+                tick_label(mark.value, mark.step_size)
+            }
+        })
         .show(ui, |plot_ui| {
-            plot_ui.line(Line::new(name, points.collect::<PlotPoints>()).color(colour));
+            plot_ui.line(Line::new(name, points).color(colour));
         });
+}
+
+/// How tall a plot is (points): room for three or four labelled ticks.
+const PLOT_HEIGHT: f32 = 110.0;
+
+/// How many labelled ticks a plot's value axis aims at.
+const LABELLED_TICKS: f64 = 3.5;
+
+/// The three steps of a value axis's grid over `bounds`, finest first:
+/// the middle one a 1, 2 or 5 times a power of ten that puts about
+/// [`LABELLED_TICKS`] labelled ticks on the axis, a fifth (a quarter for
+/// a 2) of it between them, and ten of it. On a log scale (decades) the
+/// steps are whole decades.
+pub fn grid_steps(bounds: (f64, f64), log: bool) -> [f64; 3] {
+    let span = bounds.1 - bounds.0;
+    let wanted = if span.is_finite() && span > 0.0 {
+        span / LABELLED_TICKS
+    } else {
+        1.0
+    };
+    let decade = 10f64.powf(wanted.log10().floor());
+    let (step, fine) = [(1.0, 5.0), (2.0, 4.0), (5.0, 5.0), (10.0, 5.0)]
+        .into_iter()
+        .map(|(m, parts)| (m * decade, parts))
+        .find(|&(step, _)| step >= wanted)
+        .unwrap_or((10.0 * decade, 5.0));
+    if log {
+        let step = step.max(1.0).round();
+        return [1.0f64.min(step), step, 10.0 * step];
+    }
+    [step / fine, step, 10.0 * step]
+}
+
+/// The smallest magnitude a log scale shows: a drift of exactly zero is
+/// drawn here, below every drift rounding leaves.
+const LOG_FLOOR: f64 = 1e-20;
+
+/// `log10 |value|`, from [`LOG_FLOOR`] up.
+pub fn log_magnitude(value: f64) -> f64 {
+    value.abs().max(LOG_FLOOR).log10()
+}
+
+/// The label of a tick at `exponent` on a log scale: `1e-16` at a whole
+/// decade, none between.
+pub fn decade_label(exponent: f64) -> String {
+    let whole = exponent.round();
+    if (exponent - whole).abs() > 1e-9 {
+        return String::new();
+    }
+    format!("1e{}", whole as i64)
+}
+
+/// The label of an axis tick at `value`, ticks `step` apart: plain
+/// decimals (`69.25`, `150`) for values from 1e-3 to 1e5 that need no more
+/// than six decimals, else scientific notation (`1.4e-16`), each with just
+/// the digits that tell it from the next tick; `0` for a tick within a
+/// millionth of a step of zero.
+pub fn tick_label(value: f64, step: f64) -> String {
+    if !value.is_finite() {
+        return format!("{value}");
+    }
+    let step = step.abs();
+    if value == 0.0 || (step > 0.0 && value.abs() < 1e-6 * step) {
+        return "0".to_owned();
+    }
+    // The decade of the step's last digit, and of the value's first.
+    let last = if step > 0.0 && step.is_finite() {
+        step.log10().floor() as i32
+    } else {
+        value.abs().log10().floor() as i32 - 2
+    };
+    let first = value.abs().log10().floor() as i32;
+    let decimals = (-last).max(0);
+    if (1e-3..1e5).contains(&value.abs()) && decimals <= 6 {
+        format!("{value:.*}", decimals as usize)
+    } else {
+        format!("{value:.*e}", (first - last).clamp(0, 15) as usize)
+    }
 }
 
 /// Plots of the selected bead's last seconds, each with its axes labelled.
 pub(super) fn plots_section(ui: &mut egui::Ui, history: &PlotHistory) {
     ui.separator();
     let samples = &history.samples;
-    for (id, label, unit, colour, value) in [
+    for (id, label, unit, colour, value, log) in [
         (
             "plot-c",
-            "drift C",
-            "m",
+            "drift |C|",
+            "m, log scale",
             egui::Color32::LIGHT_BLUE,
             (|s: &PlotSample| s.c) as fn(&PlotSample) -> f64,
+            true,
         ),
-        ("plot-e", "energy E", "J", egui::Color32::LIGHT_GREEN, |s| {
-            s.energy
-        }),
-        ("plot-l", "λ", "N", egui::Color32::GOLD, |s| s.lambda),
+        (
+            "plot-e",
+            "energy E",
+            "J",
+            egui::Color32::LIGHT_GREEN,
+            |s| s.energy,
+            false,
+        ),
+        ("plot-l", "λ", "N", egui::Color32::GOLD, |s| s.lambda, false),
     ] {
         ui.label(format!("{label} ({unit})"));
         plot(
@@ -137,6 +238,7 @@ pub(super) fn plots_section(ui: &mut egui::Ui, history: &PlotHistory) {
             label,
             samples.iter().map(|s| [s.t, value(s)]),
             colour,
+            log,
         );
     }
 }
@@ -169,4 +271,89 @@ pub fn record_strikes(
         }
     }
     recent.0.truncate(STRIKES_SHOWN);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{decade_label, grid_steps, log_magnitude, tick_label};
+
+    #[test]
+    fn tick_labels_read_at_every_scale() {
+        assert_eq!(tick_label(69.25, 0.05), "69.25");
+        assert_eq!(tick_label(69.5, 0.5), "69.5");
+        assert_eq!(tick_label(150.0, 50.0), "150");
+        assert_eq!(tick_label(1.4e-16, 2e-17), "1.4e-16");
+        assert_eq!(tick_label(-3e-16, 1e-16), "-3e-16");
+        assert_eq!(tick_label(2.5e6, 5e5), "2.5e6");
+        assert_eq!(tick_label(0.0, 1e-16), "0");
+        assert_eq!(tick_label(1e-25, 1e-16), "0");
+    }
+
+    /// The labelled step puts two to four ticks on any span (never closer
+    /// than a plot's height allows labels), and their labels tell them
+    /// apart.
+    #[test]
+    fn grid_steps_put_a_few_readable_ticks_on_any_span() {
+        for (low, high) in [
+            (3.6, 3.7),
+            (68.9, 69.4),
+            (-1e-16, 3e-16),
+            (0.0, 1e2),
+            (-5.0, 12.0),
+            (1e6, 1.3e6),
+        ] {
+            let [fine, step, coarse] = grid_steps((low, high), false);
+            let first = (low / step).ceil();
+            let ticks = (high / step).floor() - first + 1.0;
+            assert!(
+                (2.0..=4.0).contains(&ticks),
+                "{ticks} ticks of {step:e} on [{low}, {high}]"
+            );
+            assert!(fine < step && step < coarse);
+            let labels: Vec<String> = (0..ticks as i64)
+                .map(|k| tick_label((first + k as f64) * step, step))
+                .collect();
+            for pair in labels.windows(2) {
+                assert_ne!(pair[0], pair[1], "on [{low}, {high}]");
+            }
+        }
+        assert_eq!(grid_steps((-16.0, -2.0), true)[1], 5.0);
+        assert_eq!(grid_steps((-3.0, -2.5), true)[1], 1.0);
+        assert!(grid_steps((1.0, 1.0), false)[1].is_finite());
+    }
+
+    #[test]
+    fn a_log_scale_reads_in_whole_decades() {
+        assert_eq!(log_magnitude(-3e-16), 3e-16f64.log10());
+        assert_eq!(log_magnitude(0.0), -20.0);
+        assert_eq!(decade_label(-16.0), "1e-16");
+        assert_eq!(decade_label(2.0), "1e2");
+        assert_eq!(decade_label(-15.5), "");
+    }
+
+    /// Neighbouring ticks never share a label, and each label reads back
+    /// within a tenth of a step of its tick, from steps of 1e-17 to 1e6
+    /// and ticks far from zero.
+    #[test]
+    fn neighbouring_ticks_have_labels_that_tell_them_apart() {
+        for exponent in -17..=6 {
+            for mantissa in [1.0, 2.0, 5.0] {
+                let step = mantissa * 10f64.powi(exponent);
+                for offset in [0.0, 7.0, 1234.0, -40.0, 1e6] {
+                    let ticks: Vec<f64> = (0..6).map(|k| (offset + k as f64) * step).collect();
+                    let labels: Vec<String> = ticks.iter().map(|&t| tick_label(t, step)).collect();
+                    for (pair, ticks) in labels.windows(2).zip(ticks.windows(2)) {
+                        assert_ne!(pair[0], pair[1], "ticks {ticks:?} at step {step:e}");
+                    }
+                    for (label, &tick) in labels.iter().zip(&ticks) {
+                        let read: f64 = label.parse().expect("a number");
+                        assert!(
+                            (read - tick).abs() <= 0.1 * step,
+                            "{label} for {tick:e} at step {step:e}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 }

@@ -81,9 +81,7 @@ pub(super) fn space_bead_section(
         .num_columns(4)
         .show(ui, |ui| {
             let row = diagnostics.map(|d| RowValues {
-                c: d.c,
-                c_dot: d.c_dot,
-                lambda: d.lambda,
+                wire: on_wire.map(|_| [d.c, d.c_dot, d.lambda]),
                 energy: d.energy(),
             });
             value_rows(ui, row, &view.clock);
