@@ -1,6 +1,7 @@
 //! The egui panel: every parameter of the assignment's panel plus gravity, wire
 //! shape and size, integrator and stabilization; a marker while edits are
-//! pending; live plots of `C`, energy and λ; the last strikes between
+//! pending; live plots of `C`, energy and λ, and of any two quantities
+//! against each other (the phase portrait); the last strikes between
 //! beads that touch; divergence and scene-file errors in plain words.
 //!
 //! Edits go through the plugin's validating setters: an invalid value is
@@ -9,6 +10,7 @@
 
 mod constraints;
 mod params;
+mod phase;
 mod plots;
 mod space;
 mod view;
@@ -17,6 +19,7 @@ mod window;
 use bevy::prelude::*;
 use bevy_egui::EguiPrimaryContextPass;
 
+pub use phase::{PhasePlot, Quantity, circle_angle, separatrix};
 pub use plots::{PlotHistory, PlotSample, RecentStrikes, record_history, record_strikes};
 pub use view::{PanelActions, PanelView};
 pub use window::panel;
@@ -92,6 +95,7 @@ impl Plugin for PanelPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<PresetCatalog>()
             .init_resource::<PlotHistory>()
+            .init_resource::<PhasePlot>()
             .init_resource::<SelectedBead>()
             .init_resource::<RecentStrikes>()
             .add_systems(

@@ -9,8 +9,12 @@ use bevy::prelude::*;
 use bevy_egui::egui;
 use egui_plot::{Line, Plot, PlotPoints, uniform_grid_spacer};
 
+use super::phase::circle_angle;
 use crate::gui::drag::SelectedBead;
-use crate::{BeadDiagnostics, BeadsStruck, Islands, SimClock};
+use crate::{
+    BeadDiagnostics, BeadPosition, BeadVelocity, BeadsStruck, Islands, OnWire, SimClock, SimParams,
+    Wire, WireShape, pose_of,
+};
 
 /// One plotted sample of the selected bead.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -19,10 +23,19 @@ pub struct PlotSample {
     pub t: f64,
     /// Drift `C`.
     pub c: f64,
+    /// Its rate `Ċ`.
+    pub c_dot: f64,
     /// Energy.
     pub energy: f64,
     /// λ.
     pub lambda: f64,
+    /// Where the bead was (`z` zero in the plane).
+    pub position: DVec3,
+    /// How fast it moved.
+    pub velocity: DVec3,
+    /// On a circle in the plane: the angle from its lowest point and its
+    /// rate ([`circle_angle`](super::phase::circle_angle)).
+    pub on_circle: Option<(f64, f64)>,
 }
 
 /// The last seconds of the selected bead's diagnostics.
@@ -32,6 +45,9 @@ pub struct PlotHistory {
     pub seconds: f64,
     /// The samples, oldest first.
     pub samples: VecDeque<PlotSample>,
+    /// Where the bead rides a circle in the plane: the size of gravity and
+    /// the circle's radius (for the pendulum's separatrix).
+    pub circle: Option<(f64, f64)>,
     bead: Option<Entity>,
 }
 
@@ -40,33 +56,77 @@ impl Default for PlotHistory {
         Self {
             seconds: 10.0,
             samples: VecDeque::new(),
+            circle: None,
             bead: None,
         }
     }
 }
 
+/// What [`record_history`] reads of a bead in the plane: its state, its
+/// diagnostics and its wire.
+type PlaneBead = (
+    &'static BeadPosition,
+    &'static BeadVelocity,
+    &'static BeadDiagnostics,
+    Option<&'static OnWire>,
+);
+
+/// What [`record_history`] reads of a bead in space.
+type SpaceBeadRead = (
+    &'static BeadPosition<DVec3>,
+    &'static BeadVelocity<DVec3>,
+    &'static BeadDiagnostics<DVec3>,
+);
+
 /// Appends the selected bead's diagnostics (in the plane or in space) to
 /// the plot history; for a bead joined to others, the energy is its
 /// island's (a rod does work on each of its beads, not on the two
 /// together).
+#[allow(clippy::too_many_arguments)]
 pub fn record_history(
     selected: Res<SelectedBead>,
     clock: Res<SimClock>,
-    beads: Query<&BeadDiagnostics>,
-    space_beads: Query<&BeadDiagnostics<DVec3>>,
+    params: Res<SimParams>,
+    beads: Query<PlaneBead>,
+    space_beads: Query<SpaceBeadRead>,
+    wires: Query<(&Wire, &Transform)>,
     islands: Res<Islands>,
     space_islands: Res<Islands<DVec3>>,
     mut history: ResMut<PlotHistory>,
 ) {
     let Some(entity) = selected.0 else { return };
-    let plane = beads.get(entity).ok().map(|d| (d.c, d.lambda, d.energy()));
-    let space = || {
-        let d = space_beads.get(entity).ok()?;
-        Some((d.c, d.lambda, d.energy()))
+    // On a circle in the plane: its centre and radius.
+    let circle = |on: Option<&OnWire>| {
+        let (wire, transform) = wires.get(on?.0).ok()?;
+        let WireShape::Circle(c) = wire.shape() else {
+            return None;
+        };
+        Some((pose_of(transform).ok()?.origin, c.radius))
     };
-    let Some((c, lambda, own)) = plane.or_else(space) else {
+    let plane = beads.get(entity).ok().map(|(x, v, d, on)| {
+        let circle = circle(on);
+        let on_circle =
+            circle.and_then(|(centre, _)| circle_angle(centre, params.gravity, x.0, v.0));
+        let sample = (x.0.extend(0.0), v.0.extend(0.0), on_circle);
+        (
+            d.c,
+            d.c_dot,
+            d.lambda,
+            d.energy(),
+            sample,
+            circle.map(|c| c.1),
+        )
+    });
+    let space = || {
+        let (x, v, d) = space_beads.get(entity).ok()?;
+        Some((d.c, d.c_dot, d.lambda, d.energy(), (x.0, v.0, None), None))
+    };
+    let Some((c, c_dot, lambda, own, (position, velocity, on_circle), radius)) =
+        plane.or_else(space)
+    else {
         return;
     };
+    history.circle = radius.map(|r| (params.gravity.length(), r));
     let t = clock.time;
     if history.bead != Some(entity) || history.samples.back().is_some_and(|s| s.t > t) {
         history.samples.clear();
@@ -80,8 +140,12 @@ pub fn record_history(
     history.samples.push_back(PlotSample {
         t,
         c,
+        c_dot,
         energy,
         lambda,
+        position,
+        velocity,
+        on_circle,
     });
     let horizon = t - history.seconds;
     while history.samples.front().is_some_and(|s| s.t < horizon) {

@@ -6,6 +6,7 @@ use bevy::math::DVec3;
 use bevy::prelude::*;
 
 use super::PresetCatalog;
+use super::phase::PhasePlot;
 use super::plots::{PlotHistory, RecentStrikes};
 use crate::controls::{ControlKeys, StepRequests};
 use crate::gui::drag::SelectedBead;
@@ -83,6 +84,7 @@ pub struct PanelActions<'w, 's> {
     pub(super) steps: ResMut<'w, StepRequests>,
     pub(super) restarts: MessageWriter<'w, Restart>,
     pub(super) loads: MessageWriter<'w, LoadPreset>,
+    pub(super) phase: ResMut<'w, PhasePlot>,
     pub(super) commands: Commands<'w, 's>,
 }
 

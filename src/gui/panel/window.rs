@@ -6,6 +6,7 @@ use bevy_egui::{EguiContexts, egui};
 
 use super::constraints::{constraints_section, strikes_section};
 use super::params::{Edit, bead_section, solver_section};
+use super::phase::phase_section;
 use super::plots::plots_section;
 use super::space::space_bead_section;
 use super::view::{PanelActions, PanelView};
@@ -49,6 +50,7 @@ pub fn panel(
             let solver = solver_section(ui, &mut actions.pending, view.active.in_space);
             outcome = solver.or(bead);
             plots_section(ui, &view.history);
+            phase_section(ui, &view.history, &mut actions.phase);
         });
     match outcome {
         Some(Ok(())) => *refused = None,
