@@ -149,6 +149,18 @@ pub fn separatrix(g: f64, radius: f64, points: usize) -> [Vec<[f64; 2]>; 2] {
     [upper, lower]
 }
 
+/// The force with which a frictionless circle of `radius` holds a bead
+/// of `mass` at angle `theta` from its lowest point, toward its centre,
+/// under gravity of size `g`, the bead having started at `start`
+/// (`(θ0, θ̇0)`) and been left alone since: energy kept gives
+/// `R θ̇² = R θ̇0² + 2 g (cos θ − cos θ0)`, so
+/// `N = m (R θ̇0² + g (3 cos θ − 2 cos θ0))`, the pendulum's
+/// `m g (3 cos θ − 2 cos θ0)` when let go from rest.
+pub fn circle_normal_force(mass: f64, g: f64, radius: f64, start: (f64, f64), theta: f64) -> f64 {
+    let (theta0, rate0) = start;
+    mass * (radius * rate0 * rate0 + g * (3.0 * theta.cos() - 2.0 * theta0.cos()))
+}
+
 /// The phase plot's section: a menu for each axis, then the recorded
 /// samples of `y` against `x`, the latest marked; on a circle's
 /// `(θ, θ̇)` the separatrix too, dashed.
@@ -165,7 +177,7 @@ pub(super) fn phase_section(ui: &mut egui::Ui, history: &PlotHistory, choice: &m
         .filter_map(|s| Some([choice.x.of(s)?, choice.y.of(s)?]))
         .collect();
     if points.is_empty() {
-        ui.label("Nothing to plot: the bead is not on a circle.");
+        ui.label("Nothing to plot: θ and dθ/dt need a bead on a circle; pick other quantities.");
         return;
     }
     let last = points[points.len() - 1];
@@ -194,15 +206,41 @@ pub(super) fn phase_section(ui: &mut egui::Ui, history: &PlotHistory, choice: &m
                     );
                 }
             }
-            plot_ui.line(
-                Line::new("recorded", PlotPoints::from(points)).color(egui::Color32::LIGHT_BLUE),
-            );
+            for (k, piece) in unwrapped(&points, (choice.x, choice.y))
+                .into_iter()
+                .enumerate()
+            {
+                let name = if k == 0 { "recorded" } else { "" };
+                plot_ui.line(
+                    Line::new(name, PlotPoints::from(piece)).color(egui::Color32::LIGHT_BLUE),
+                );
+            }
             plot_ui.points(
                 Points::new("now", vec![last])
                     .radius(3.0)
                     .color(egui::Color32::ORANGE),
             );
         });
+}
+
+/// `points` cut into pieces where an angle among `axes` wraps round
+/// (jumps by more than π from one sample to the next, as a bead going
+/// over the top of its circle does), so no line is drawn across the plot.
+pub fn unwrapped(points: &[[f64; 2]], axes: (Quantity, Quantity)) -> Vec<Vec<[f64; 2]>> {
+    let angle = [axes.0 == Quantity::Angle, axes.1 == Quantity::Angle];
+    let mut pieces: Vec<Vec<[f64; 2]>> = Vec::new();
+    let mut last: Option<[f64; 2]> = None;
+    for &p in points {
+        let wraps = last.is_some_and(|q| {
+            (0..2).any(|i| angle[i] && (p[i] - q[i]).abs() > std::f64::consts::PI)
+        });
+        match pieces.last_mut() {
+            Some(piece) if !wraps => piece.push(p),
+            _ => pieces.push(vec![p]),
+        }
+        last = Some(p);
+    }
+    pieces
 }
 
 /// A menu of every quantity, choosing `value`.
@@ -253,6 +291,34 @@ mod tests {
     }
 
     #[test]
+    fn a_bead_going_over_the_top_is_drawn_in_pieces() {
+        let axes = (Quantity::Angle, Quantity::AngularSpeed);
+        let points = [[3.0, 1.0], [3.1, 1.0], [-3.1, 1.0], [-3.0, 1.0]];
+        let pieces = unwrapped(&points, axes);
+        assert_eq!(pieces, vec![points[..2].to_vec(), points[2..].to_vec()]);
+        let path = unwrapped(&points, (Quantity::X, Quantity::Y));
+        assert_eq!(path.len(), 1, "no angle, no cut");
+    }
+
+    /// Let go from rest level with the centre, a pendulum's bob pulls on
+    /// it with three times its weight at the bottom and nothing where it
+    /// started; sent round from the bottom at `v`, the circle holds it
+    /// with `m v² / R + m g` there.
+    #[test]
+    fn the_circle_holds_the_bead_as_energy_kept_says() {
+        let (m, g, r) = (2.0, 9.81, 0.5);
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        assert!((circle_normal_force(m, g, r, (half_pi, 0.0), 0.0) - 3.0 * m * g).abs() <= 1e-12);
+        assert!(circle_normal_force(m, g, r, (half_pi, 0.0), half_pi).abs() <= 1e-12);
+        let v = 4.0;
+        let bottom = circle_normal_force(m, g, r, (0.0, v / r), 0.0);
+        assert!(
+            (bottom - (m * v * v / r + m * g)).abs() <= 1e-12,
+            "{bottom}"
+        );
+    }
+
+    #[test]
     fn every_quantity_reads_its_own_value() {
         let sample = PlotSample {
             t: 1.0,
@@ -263,6 +329,9 @@ mod tests {
             position: DVec3::new(6.0, 7.0, 0.0),
             velocity: DVec3::new(8.0, 9.0, 0.0),
             on_circle: Some((10.0, 11.0)),
+            kinetic: 12.0,
+            potential: 13.0,
+            normal_force: None,
         };
         let values: Vec<f64> = Quantity::ALL
             .iter()

@@ -7,13 +7,16 @@ use std::collections::VecDeque;
 use bevy::math::DVec3;
 use bevy::prelude::*;
 use bevy_egui::egui;
-use egui_plot::{Line, Plot, PlotPoints, uniform_grid_spacer};
+use egui_plot::{
+    AxisHints, Bar, BarChart, Legend, Line, LineStyle, Plot, PlotPoints, uniform_grid_spacer,
+};
 
-use super::phase::circle_angle;
+use super::phase::{circle_angle, circle_normal_force};
+use crate::geometry::Coordinates;
 use crate::gui::drag::SelectedBead;
 use crate::{
-    BeadDiagnostics, BeadPosition, BeadVelocity, BeadsStruck, Islands, OnWire, SimClock, SimParams,
-    Wire, WireShape, pose_of,
+    BeadDiagnostics, BeadParams, BeadPosition, BeadVelocity, BeadsStruck, Islands, OnWire,
+    SimClock, SimParams, Wire, WireShape, pose_of,
 };
 
 /// One plotted sample of the selected bead.
@@ -36,6 +39,34 @@ pub struct PlotSample {
     /// On a circle in the plane: the angle from its lowest point and its
     /// rate ([`circle_angle`](super::phase::circle_angle)).
     pub on_circle: Option<(f64, f64)>,
+    /// The bead's own kinetic energy `½ m |v|²`.
+    pub kinetic: f64,
+    /// Its own potential energy `−m g·x`.
+    pub potential: f64,
+    /// On a circle in the plane: the force holding the bead toward the
+    /// centre, as simulated and as energy kept from its start says
+    /// ([`circle_normal_force`](super::phase::circle_normal_force)).
+    pub normal_force: Option<(f64, f64)>,
+}
+
+impl PlotSample {
+    /// A sample at time `t` of a bead's diagnostics `d`, at rest at the
+    /// origin and on no circle until told where it is.
+    fn of<V: Coordinates>(t: f64, d: &BeadDiagnostics<V>) -> Self {
+        Self {
+            t,
+            c: d.c,
+            c_dot: d.c_dot,
+            energy: d.energy(),
+            lambda: d.lambda,
+            position: DVec3::ZERO,
+            velocity: DVec3::ZERO,
+            on_circle: None,
+            kinetic: d.kinetic,
+            potential: d.potential,
+            normal_force: None,
+        }
+    }
 }
 
 /// The last seconds of the selected bead's diagnostics.
@@ -68,6 +99,7 @@ type PlaneBead = (
     &'static BeadPosition,
     &'static BeadVelocity,
     &'static BeadDiagnostics,
+    &'static BeadParams,
     Option<&'static OnWire>,
 );
 
@@ -103,50 +135,53 @@ pub fn record_history(
         };
         Some((pose_of(transform).ok()?.origin, c.radius))
     };
-    let plane = beads.get(entity).ok().map(|(x, v, d, on)| {
+    let g = params.gravity;
+    let plane = beads.get(entity).ok().map(|(x, v, d, start, on)| {
         let circle = circle(on);
-        let on_circle =
-            circle.and_then(|(centre, _)| circle_angle(centre, params.gravity, x.0, v.0));
-        let sample = (x.0.extend(0.0), v.0.extend(0.0), on_circle);
-        (
-            d.c,
-            d.c_dot,
-            d.lambda,
-            d.energy(),
-            sample,
-            circle.map(|c| c.1),
-        )
+        let on_circle = circle.and_then(|(centre, _)| circle_angle(centre, g, x.0, v.0));
+        let normal_force = circle
+            .zip(on_circle)
+            .and_then(|((centre, radius), (theta, _))| {
+                let from = circle_angle(centre, g, start.initial_position, start.initial_velocity)?;
+                let inward = (centre - x.0).try_normalize()?;
+                let expected = circle_normal_force(start.mass, g.length(), radius, from, theta);
+                Some((d.constraint_force.dot(inward), expected))
+            });
+        let sample = PlotSample {
+            position: x.0.extend(0.0),
+            velocity: v.0.extend(0.0),
+            on_circle,
+            normal_force,
+            ..PlotSample::of(clock.time, d)
+        };
+        (sample, circle.map(|c| c.1))
     });
     let space = || {
         let (x, v, d) = space_beads.get(entity).ok()?;
-        Some((d.c, d.c_dot, d.lambda, d.energy(), (x.0, v.0, None), None))
+        let sample = PlotSample {
+            position: x.0,
+            velocity: v.0,
+            ..PlotSample::of(clock.time, d)
+        };
+        Some((sample, None))
     };
-    let Some((c, c_dot, lambda, own, (position, velocity, on_circle), radius)) =
-        plane.or_else(space)
-    else {
+    let Some((mut sample, radius)) = plane.or_else(space) else {
         return;
     };
-    history.circle = radius.map(|r| (params.gravity.length(), r));
+    history.circle = radius.map(|r| (g.length(), r));
     let t = clock.time;
     if history.bead != Some(entity) || history.samples.back().is_some_and(|s| s.t > t) {
         history.samples.clear();
         history.bead = Some(entity);
     }
-    let energy = islands
+    if let Some(island) = islands
         .of(entity)
         .or_else(|| space_islands.of(entity))
         .filter(|island| island.rows > 0)
-        .map_or(own, |island| island.energy);
-    history.samples.push_back(PlotSample {
-        t,
-        c,
-        c_dot,
-        energy,
-        lambda,
-        position,
-        velocity,
-        on_circle,
-    });
+    {
+        sample.energy = island.energy;
+    }
+    history.samples.push_back(sample);
     let horizon = t - history.seconds;
     while history.samples.front().is_some_and(|s| s.t < horizon) {
         history.samples.pop_front();
@@ -159,20 +194,9 @@ pub fn record_history(
 /// of 1e-16 reads as rounding noise and not as a swing. On a log scale
 /// the points are `log10 |value|` and the ticks whole decades
 /// ([`decade_label`]).
-fn plot(
-    ui: &mut egui::Ui,
-    id: &str,
-    name: &str,
-    points: impl Iterator<Item = [f64; 2]>,
-    colour: egui::Color32,
-    log: bool,
-) {
-    let points: PlotPoints = if log {
-        points.map(|[t, v]| [t, log_magnitude(v)]).collect()
-    } else {
-        points.collect()
-    };
-    Plot::new(id)
+fn plot(ui: &mut egui::Ui, id: &str, lines: Vec<PlotLine>, log: bool) {
+    let legend = lines.len() > 1;
+    let plot = Plot::new(id)
         .height(PLOT_HEIGHT)
         .allow_drag(false)
         .allow_zoom(false)
@@ -188,10 +212,54 @@ fn plot(
             } else {
                 tick_label(mark.value, mark.step_size)
             }
-        })
-        .show(ui, |plot_ui| {
-            plot_ui.line(Line::new(name, points).color(colour));
         });
+    let plot = if legend {
+        plot.legend(Legend::default())
+    } else {
+        plot
+    };
+    plot.show(ui, |plot_ui| {
+        for PlotLine {
+            name,
+            points,
+            colour,
+            dashed,
+        } in lines
+        {
+            let points: PlotPoints = if log {
+                points.iter().map(|&[t, v]| [t, log_magnitude(v)]).collect()
+            } else {
+                points.into()
+            };
+            let line = Line::new(name, points).color(colour);
+            plot_ui.line(if dashed {
+                line.style(LineStyle::dashed_loose())
+            } else {
+                line
+            });
+        }
+    });
+}
+
+/// One line of a [`plot`]: its name (in the legend where there are
+/// several), its points `[t, value]`, its colour and whether it is dashed.
+struct PlotLine {
+    name: &'static str,
+    points: Vec<[f64; 2]>,
+    colour: egui::Color32,
+    dashed: bool,
+}
+
+impl PlotLine {
+    /// A solid line.
+    fn solid(name: &'static str, points: Vec<[f64; 2]>, colour: egui::Color32) -> Self {
+        Self {
+            name,
+            points,
+            colour,
+            dashed: false,
+        }
+    }
 }
 
 /// How tall a plot is (points): room for three or four labelled ticks.
@@ -296,15 +364,84 @@ pub(super) fn plots_section(ui: &mut egui::Ui, history: &PlotHistory) {
         ("plot-l", "λ", "N", egui::Color32::GOLD, |s| s.lambda, false),
     ] {
         ui.label(format!("{label} ({unit})"));
-        plot(
-            ui,
-            id,
-            label,
-            samples.iter().map(|s| [s.t, value(s)]),
-            colour,
-            log,
-        );
+        let points = samples.iter().map(|s| [s.t, value(s)]).collect();
+        plot(ui, id, vec![PlotLine::solid(label, points, colour)], log);
     }
+    // On a circle: the force that holds the bead, against energy kept.
+    let held: Vec<(f64, (f64, f64))> = samples
+        .iter()
+        .filter_map(|s| Some((s.t, s.normal_force?)))
+        .collect();
+    if !held.is_empty() {
+        ui.label("force toward the centre (N), and from energy kept:");
+        ui.label("m(R ω0² + g(3 cos θ − 2 cos θ0))");
+        let simulated = held.iter().map(|&(t, (n, _))| [t, n]).collect();
+        let kept = held.iter().map(|&(t, (_, n))| [t, n]).collect();
+        let lines = vec![
+            PlotLine::solid("simulated", simulated, egui::Color32::GOLD),
+            PlotLine {
+                name: "energy kept",
+                points: kept,
+                colour: egui::Color32::GRAY,
+                dashed: true,
+            },
+        ];
+        plot(ui, "plot-n", lines, false);
+    }
+    if let (Some(first), Some(last)) = (samples.front(), samples.back()) {
+        energy_bars(ui, first, last);
+    }
+}
+
+/// The selected bead's energy now as bars: kinetic, potential and their
+/// sum, and how much the plotted energy (its island's, where it is
+/// joined to others) changed over the plotted seconds: what drift,
+/// damping, friction or a drag added (up) or removed (down).
+fn energy_bars(ui: &mut egui::Ui, first: &PlotSample, last: &PlotSample) {
+    let bars = [
+        ("kinetic", last.kinetic, egui::Color32::LIGHT_BLUE),
+        ("potential", last.potential, egui::Color32::LIGHT_GREEN),
+        ("total", last.kinetic + last.potential, egui::Color32::WHITE),
+        (
+            "change",
+            last.energy - first.energy,
+            egui::Color32::LIGHT_RED,
+        ),
+    ];
+    ui.label(format!(
+        "energy now (J); change over the last {:.1} s",
+        last.t - first.t
+    ));
+    let chart = BarChart::new(
+        "energy",
+        bars.iter()
+            .enumerate()
+            .map(|(k, &(name, value, colour))| {
+                Bar::new(k as f64, value).name(name).fill(colour).width(0.6)
+            })
+            .collect(),
+    );
+    Plot::new("plot-energy-bars")
+        .height(PLOT_HEIGHT)
+        .allow_drag(false)
+        .allow_zoom(false)
+        .allow_scroll(false)
+        .y_axis_min_width(48.0)
+        .y_grid_spacer(uniform_grid_spacer(|input| grid_steps(input.bounds, false)))
+        .y_axis_formatter(|mark, _| tick_label(mark.value, mark.step_size))
+        .x_grid_spacer(uniform_grid_spacer(|_| [1.0, 1.0, 10.0]))
+        .custom_x_axes(vec![
+            AxisHints::new_x()
+                .label_spacing(20.0..=30.0)
+                .formatter(move |mark, _| {
+                    let k = mark.value.round();
+                    match bars.get(k as usize) {
+                        Some(bar) if (mark.value - k).abs() < 1e-9 && k >= 0.0 => bar.0.to_owned(),
+                        _ => String::new(),
+                    }
+                }),
+        ])
+        .show(ui, |plot_ui| plot_ui.bar_chart(chart));
 }
 
 /// How many of the last strikes the panel lists.
