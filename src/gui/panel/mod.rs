@@ -19,7 +19,7 @@ mod window;
 use bevy::prelude::*;
 use bevy_egui::EguiPrimaryContextPass;
 
-pub use phase::{PhasePlot, Quantity, circle_angle, circle_normal_force, separatrix};
+pub use phase::{PhasePlot, Quantity};
 pub use plots::{PlotHistory, PlotSample, RecentStrikes, record_history, record_strikes};
 pub use view::{PanelActions, PanelView};
 pub use window::panel;

@@ -2,7 +2,6 @@
 //! each other: its phase portrait (on a circle `(θ, θ̇)`, with the
 //! pendulum's separatrix), its path `(x, y)`, or any of them against time.
 
-use bevy::math::DVec2;
 #[cfg(test)]
 use bevy::math::DVec3;
 use bevy::prelude::*;
@@ -10,6 +9,7 @@ use bevy_egui::egui;
 use egui_plot::{Legend, Line, LineStyle, Plot, PlotPoints, Points, uniform_grid_spacer};
 
 use super::plots::{PlotHistory, PlotSample, grid_steps, tick_label};
+use crate::reference::separatrix;
 
 /// A quantity of the selected bead that the panel can plot.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -106,59 +106,6 @@ impl Default for PhasePlot {
             y: Quantity::AngularSpeed,
         }
     }
-}
-
-/// Where a bead at `position` moving at `velocity` is on a circle about
-/// `centre` in the plane, under gravity `gravity`: the angle `θ` from the
-/// circle's lowest point (positive turning anticlockwise, in `(−π, π]`)
-/// and `θ̇`. Measured from straight up where there is no gravity; none at
-/// the centre.
-pub fn circle_angle(
-    centre: DVec2,
-    gravity: DVec2,
-    position: DVec2,
-    velocity: DVec2,
-) -> Option<(f64, f64)> {
-    let r = position - centre;
-    let rr = r.length_squared();
-    if !(rr > 0.0 && rr.is_finite()) {
-        return None;
-    }
-    let down = gravity.try_normalize().unwrap_or(DVec2::NEG_Y);
-    let angle = down.perp_dot(r).atan2(down.dot(r));
-    Some((angle, r.perp_dot(velocity) / rr))
-}
-
-/// The pendulum's separatrix on a circle of `radius` under gravity of
-/// size `g`: `θ̇ = ±√(2 g / R · (1 + cos θ))`, the motion that just comes
-/// to rest at the top, as two branches of `points` points each over
-/// `θ ∈ [−π, π]`.
-pub fn separatrix(g: f64, radius: f64, points: usize) -> [Vec<[f64; 2]>; 2] {
-    let points = points.max(2);
-    let upper: Vec<[f64; 2]> = (0..points)
-        .map(|k| {
-            let theta =
-                -std::f64::consts::PI + std::f64::consts::TAU * k as f64 / (points - 1) as f64;
-            [
-                theta,
-                (2.0 * g / radius * (1.0 + theta.cos())).max(0.0).sqrt(),
-            ]
-        })
-        .collect();
-    let lower = upper.iter().map(|&[t, w]| [t, -w]).collect();
-    [upper, lower]
-}
-
-/// The force with which a frictionless circle of `radius` holds a bead
-/// of `mass` at angle `theta` from its lowest point, toward its centre,
-/// under gravity of size `g`, the bead having started at `start`
-/// (`(θ0, θ̇0)`) and been left alone since: energy kept gives
-/// `R θ̇² = R θ̇0² + 2 g (cos θ − cos θ0)`, so
-/// `N = m (R θ̇0² + g (3 cos θ − 2 cos θ0))`, the pendulum's
-/// `m g (3 cos θ − 2 cos θ0)` when let go from rest.
-pub fn circle_normal_force(mass: f64, g: f64, radius: f64, start: (f64, f64), theta: f64) -> f64 {
-    let (theta0, rate0) = start;
-    mass * (radius * rate0 * rate0 + g * (3.0 * theta.cos() - 2.0 * theta0.cos()))
 }
 
 /// The phase plot's section: a menu for each axis, then the recorded
@@ -259,38 +206,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_angle_on_a_circle_is_measured_from_its_lowest_point() {
-        let g = DVec2::new(0.0, -9.81);
-        let c = DVec2::new(1.0, 2.0);
-        let (bottom, _) = circle_angle(c, g, c + DVec2::new(0.0, -0.5), DVec2::X).unwrap();
-        assert!(bottom.abs() <= 1e-15);
-        let (right, w) =
-            circle_angle(c, g, c + DVec2::new(0.5, 0.0), DVec2::new(0.0, 1.0)).unwrap();
-        assert!(
-            (right - std::f64::consts::FRAC_PI_2).abs() <= 1e-15,
-            "{right}"
-        );
-        assert!((w - 2.0).abs() <= 1e-15, "turns at {w} rad/s");
-        let (top, _) = circle_angle(c, g, c + DVec2::new(0.0, 0.5), DVec2::ZERO).unwrap();
-        assert!((top.abs() - std::f64::consts::PI).abs() <= 1e-15);
-        assert!(circle_angle(c, g, c, DVec2::X).is_none());
-    }
-
-    /// On the separatrix the energy per unit mass, `½ R² θ̇² − g R cos θ`,
-    /// is the top's at rest, `g R`, to rounding.
-    #[test]
-    fn the_separatrix_has_the_energy_of_rest_at_the_top() {
-        let (g, r) = (9.81, 0.75);
-        let [upper, lower] = separatrix(g, r, 61);
-        assert_eq!(upper.len(), 61);
-        for &[theta, w] in upper.iter().chain(&lower) {
-            let energy = 0.5 * r * r * w * w - g * r * theta.cos();
-            assert!((energy - g * r).abs() <= 1e-12, "at θ = {theta}: {energy}");
-        }
-        assert!(upper[30][1] > 0.0 && lower[30][1] < 0.0);
-    }
-
-    #[test]
     fn a_bead_going_over_the_top_is_drawn_in_pieces() {
         let axes = (Quantity::Angle, Quantity::AngularSpeed);
         let points = [[3.0, 1.0], [3.1, 1.0], [-3.1, 1.0], [-3.0, 1.0]];
@@ -298,24 +213,6 @@ mod tests {
         assert_eq!(pieces, vec![points[..2].to_vec(), points[2..].to_vec()]);
         let path = unwrapped(&points, (Quantity::X, Quantity::Y));
         assert_eq!(path.len(), 1, "no angle, no cut");
-    }
-
-    /// Let go from rest level with the centre, a pendulum's bob pulls on
-    /// it with three times its weight at the bottom and nothing where it
-    /// started; sent round from the bottom at `v`, the circle holds it
-    /// with `m v² / R + m g` there.
-    #[test]
-    fn the_circle_holds_the_bead_as_energy_kept_says() {
-        let (m, g, r) = (2.0, 9.81, 0.5);
-        let half_pi = std::f64::consts::FRAC_PI_2;
-        assert!((circle_normal_force(m, g, r, (half_pi, 0.0), 0.0) - 3.0 * m * g).abs() <= 1e-12);
-        assert!(circle_normal_force(m, g, r, (half_pi, 0.0), half_pi).abs() <= 1e-12);
-        let v = 4.0;
-        let bottom = circle_normal_force(m, g, r, (0.0, v / r), 0.0);
-        assert!(
-            (bottom - (m * v * v / r + m * g)).abs() <= 1e-12,
-            "{bottom}"
-        );
     }
 
     #[test]

@@ -11,9 +11,9 @@ use egui_plot::{
     AxisHints, Bar, BarChart, Legend, Line, LineStyle, Plot, PlotPoints, uniform_grid_spacer,
 };
 
-use super::phase::{circle_angle, circle_normal_force};
 use crate::geometry::Coordinates;
 use crate::gui::drag::SelectedBead;
+use crate::reference::{circle_angle, circle_normal_force};
 use crate::{
     BeadDiagnostics, BeadParams, BeadPosition, BeadVelocity, BeadsStruck, Islands, OnWire,
     SimClock, SimParams, Wire, WireShape, pose_of,
@@ -37,7 +37,7 @@ pub struct PlotSample {
     /// How fast it moved.
     pub velocity: DVec3,
     /// On a circle in the plane: the angle from its lowest point and its
-    /// rate ([`circle_angle`](super::circle_angle)).
+    /// rate ([`circle_angle`](crate::reference::circle_angle)).
     pub on_circle: Option<(f64, f64)>,
     /// The bead's own kinetic energy `½ m |v|²`.
     pub kinetic: f64,
@@ -45,7 +45,7 @@ pub struct PlotSample {
     pub potential: f64,
     /// On a circle in the plane: the force holding the bead toward the
     /// centre, as simulated and as energy kept from its start says
-    /// ([`circle_normal_force`](super::circle_normal_force)).
+    /// ([`circle_normal_force`](crate::reference::circle_normal_force)).
     pub normal_force: Option<(f64, f64)>,
 }
 
