@@ -1,6 +1,8 @@
 //! Keyboard controls: Space restarts (applying pending edits), P pauses and
-//! resumes, N advances one step while paused. No rendering needed: the
-//! controls read `ButtonInput<KeyCode>`, so headless tests press keys too.
+//! resumes, N advances one step while paused, `[` and `]` slow the run
+//! down to 1/20 of real time and back up to it ([`SPEEDS`]). No rendering
+//! needed: the controls read `ButtonInput<KeyCode>`, so headless tests
+//! press keys too.
 
 use bevy::input::InputSystems;
 use bevy::prelude::*;
@@ -16,6 +18,43 @@ pub struct ControlKeys {
     pub pause: KeyCode,
     /// Advance one fixed step while paused.
     pub step: KeyCode,
+    /// Run slower (the next of [`SPEEDS`] down).
+    pub slower: KeyCode,
+    /// Run faster (the next of [`SPEEDS`] up, to real time).
+    pub faster: KeyCode,
+}
+
+/// The speeds the run may go at, as fractions of real time: slow motion
+/// from 1/20 up to real time.
+pub const SPEEDS: [f64; 5] = [0.05, 0.1, 0.2, 0.5, 1.0];
+
+/// The speed of [`SPEEDS`] next to `speed`: the next slower, or the next
+/// faster, staying within them (a speed between two goes to the nearer
+/// one in that direction).
+pub fn next_speed(speed: f64, faster: bool) -> f64 {
+    if faster {
+        SPEEDS
+            .iter()
+            .copied()
+            .find(|&s| s > speed * (1.0 + 1e-9))
+            .unwrap_or(SPEEDS[SPEEDS.len() - 1])
+    } else {
+        SPEEDS
+            .iter()
+            .rev()
+            .copied()
+            .find(|&s| s < speed * (1.0 - 1e-9))
+            .unwrap_or(SPEEDS[0])
+    }
+}
+
+/// A speed as the panel and the help line show it: `1×`, `1/2×`, `1/20×`.
+pub fn speed_label(speed: f64) -> String {
+    if speed >= 1.0 - 1e-9 {
+        "1×".to_owned()
+    } else {
+        format!("1/{}×", (1.0 / speed).round())
+    }
 }
 
 impl Default for ControlKeys {
@@ -24,6 +63,8 @@ impl Default for ControlKeys {
             restart: KeyCode::Space,
             pause: KeyCode::KeyP,
             step: KeyCode::KeyN,
+            slower: KeyCode::BracketLeft,
+            faster: KeyCode::BracketRight,
         }
     }
 }
@@ -32,17 +73,25 @@ impl ControlKeys {
     /// A one-line description for an on-screen help line.
     pub fn help(&self) -> String {
         format!(
-            "{}: restart and apply edits · {}: pause/resume · {}: one step while paused · drag a bead with the mouse",
+            "{}: restart and apply edits · {}: pause/resume · {}: one step while paused · {} and {}: slower, faster · drag a bead with the mouse",
             key_name(self.restart),
             key_name(self.pause),
-            key_name(self.step)
+            key_name(self.step),
+            key_name(self.slower),
+            key_name(self.faster)
         )
     }
 }
 
 fn key_name(key: KeyCode) -> String {
-    let name = format!("{key:?}");
-    name.strip_prefix("Key").map(str::to_owned).unwrap_or(name)
+    match key {
+        KeyCode::BracketLeft => "[".to_owned(),
+        KeyCode::BracketRight => "]".to_owned(),
+        _ => {
+            let name = format!("{key:?}");
+            name.strip_prefix("Key").map(str::to_owned).unwrap_or(name)
+        }
+    }
 }
 
 /// Fixed steps requested while paused, run by [`run_requested_steps`].
@@ -68,7 +117,8 @@ impl Plugin for KeyboardControlsPlugin {
     }
 }
 
-/// Reads the keys: sends [`Restart`], toggles the pause, requests a step.
+/// Reads the keys: sends [`Restart`], toggles the pause, requests a step,
+/// slows the run down or speeds it up.
 pub fn keyboard_controls(
     keys: Res<ButtonInput<KeyCode>>,
     bindings: Res<ControlKeys>,
@@ -89,6 +139,12 @@ pub fn keyboard_controls(
     if keys.just_pressed(bindings.step) && time.is_paused() {
         steps.0 += 1;
     }
+    for (key, faster) in [(bindings.slower, false), (bindings.faster, true)] {
+        if keys.just_pressed(key) {
+            let speed = next_speed(time.relative_speed_f64(), faster);
+            time.set_relative_speed_f64(speed);
+        }
+    }
 }
 
 /// Runs the requested single steps: the whole `FixedUpdate` schedule once
@@ -97,5 +153,28 @@ pub fn run_requested_steps(world: &mut World) {
     let n = std::mem::take(&mut world.resource_mut::<StepRequests>().0);
     for _ in 0..n {
         world.run_schedule(FixedUpdate);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn speeds_step_down_to_a_twentieth_and_up_to_real_time() {
+        let mut speed = 1.0;
+        let mut down = Vec::new();
+        for _ in 0..6 {
+            speed = next_speed(speed, false);
+            down.push(speed);
+        }
+        assert_eq!(down, [0.5, 0.2, 0.1, 0.05, 0.05, 0.05]);
+        assert_eq!(next_speed(0.05, true), 0.1);
+        assert_eq!(next_speed(1.0, true), 1.0);
+        assert_eq!(next_speed(0.3, true), 0.5);
+        assert_eq!(next_speed(0.3, false), 0.2);
+        assert_eq!(speed_label(1.0), "1×");
+        assert_eq!(speed_label(0.05), "1/20×");
+        assert_eq!(speed_label(0.5), "1/2×");
     }
 }

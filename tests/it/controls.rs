@@ -77,3 +77,27 @@ fn p_pauses_and_n_steps_exactly_once() {
     run_steps(&mut app, 10);
     assert_eq!(steps(&app), 21, "running again");
 }
+
+/// `[` halves the run's speed (slow motion: 10 frames of a step each run
+/// 5 steps), down to 1/20 of real time; `]` speeds it up again.
+#[test]
+fn brackets_slow_the_run_down_and_speed_it_up() {
+    let (mut app, _) = scene();
+    run_steps(&mut app, 10);
+    assert_eq!(steps(&app), 10, "real time: a step a frame");
+    press(&mut app, KeyCode::BracketLeft, 0);
+    let speed = |app: &App| app.world().resource::<Time<Virtual>>().relative_speed_f64();
+    assert_eq!(speed(&app), 0.5);
+    run_steps(&mut app, 10);
+    assert_eq!(steps(&app), 15, "half speed: five steps in ten frames");
+    for _ in 0..5 {
+        press(&mut app, KeyCode::BracketLeft, 0);
+    }
+    assert_eq!(speed(&app), 0.05, "no slower than 1/20");
+    press(&mut app, KeyCode::BracketRight, 0);
+    assert_eq!(speed(&app), 0.1);
+    for _ in 0..4 {
+        press(&mut app, KeyCode::BracketRight, 0);
+    }
+    assert_eq!(speed(&app), 1.0, "no faster than real time");
+}

@@ -258,10 +258,19 @@ fn wire_editor(ui: &mut egui::Ui, shape: &WireShape) -> Option<WireShape> {
     (format!("{edited:?}") != format!("{shape:?}")).then_some(edited)
 }
 
-/// The parameters every bead shares; gravity's third component in space.
+/// The parameters every bead shares; gravity's third component in space:
+/// a section that folds away.
 pub(super) fn solver_section(ui: &mut egui::Ui, pending: &mut NextParams, in_space: bool) -> Edit {
     ui.separator();
-    ui.strong("Solver");
+    egui::CollapsingHeader::new("Solver")
+        .default_open(true)
+        .show(ui, |ui| solver_grid(ui, pending, in_space))
+        .body_returned
+        .flatten()
+}
+
+/// The solver's parameters, one a row.
+fn solver_grid(ui: &mut egui::Ui, pending: &mut NextParams, in_space: bool) -> Edit {
     let mut draft = pending.get().clone();
     egui::Grid::new("solver").num_columns(2).show(ui, |ui| {
         number(ui, "timestep (s)", &mut draft.timestep, 0.0005);

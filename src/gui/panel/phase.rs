@@ -108,10 +108,18 @@ impl Default for PhasePlot {
     }
 }
 
-/// The phase plot's section: a menu for each axis, then the recorded
-/// samples of `y` against `x`, the latest marked; on a circle's
-/// `(θ, θ̇)` the separatrix too, dashed.
+/// The phase plot's section, which folds away: a menu for each axis,
+/// then the recorded samples of `y` against `x`, the latest marked; on a
+/// circle's `(θ, θ̇)` the separatrix too, dashed.
 pub(super) fn phase_section(ui: &mut egui::Ui, history: &PlotHistory, choice: &mut PhasePlot) {
+    ui.separator();
+    egui::CollapsingHeader::new("Phase plot")
+        .default_open(true)
+        .show(ui, |ui| phase_plot(ui, history, choice));
+}
+
+/// The menus and the plot of [`phase_section`].
+fn phase_plot(ui: &mut egui::Ui, history: &PlotHistory, choice: &mut PhasePlot) {
     ui.horizontal(|ui| {
         ui.label("plot");
         quantity_menu(ui, "phase-y", &mut choice.y);

@@ -340,9 +340,17 @@ pub fn tick_label(value: f64, step: f64) -> String {
     }
 }
 
-/// Plots of the selected bead's last seconds, each with its axes labelled.
+/// Plots of the selected bead's last seconds, each with its axes labelled:
+/// a section that folds away.
 pub(super) fn plots_section(ui: &mut egui::Ui, history: &PlotHistory) {
     ui.separator();
+    egui::CollapsingHeader::new("Plots")
+        .default_open(true)
+        .show(ui, |ui| plots(ui, history));
+}
+
+/// The plots of [`plots_section`].
+fn plots(ui: &mut egui::Ui, history: &PlotHistory) {
     let samples = &history.samples;
     for (id, label, unit, colour, value, log) in [
         (

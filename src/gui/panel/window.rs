@@ -11,7 +11,7 @@ use super::plots::plots_section;
 use super::space::space_bead_section;
 use super::view::{PanelActions, PanelView};
 use crate::Restart;
-use crate::controls::ControlKeys;
+use crate::controls::{ControlKeys, SPEEDS, speed_label};
 use crate::preset::LoadPreset;
 
 const ERROR_RED: egui::Color32 = egui::Color32::from_rgb(255, 90, 90);
@@ -68,7 +68,8 @@ fn help_line(ctx: &egui::Context, keys: &ControlKeys) {
     egui::Area::new(egui::Id::new("wirebead-help"))
         .anchor(egui::Align2::LEFT_BOTTOM, [8.0, -8.0])
         .show(ctx, |ui| {
-            ui.colored_label(egui::Color32::LIGHT_GRAY, keys.help());
+            let help = egui::RichText::new(keys.help()).color(egui::Color32::LIGHT_GRAY);
+            ui.add(egui::Label::new(help).extend());
         });
 }
 
@@ -124,6 +125,19 @@ fn scene_section(
         {
             actions.steps.0 += 1;
         }
+        let speed = time.relative_speed_f64();
+        egui::ComboBox::from_id_salt("speed")
+            .selected_text(format!("speed {}", speed_label(speed)))
+            .show_ui(ui, |ui| {
+                for s in SPEEDS.iter().rev() {
+                    if ui
+                        .selectable_label((s - speed).abs() < 1e-9, speed_label(*s))
+                        .clicked()
+                    {
+                        time.set_relative_speed_f64(*s);
+                    }
+                }
+            });
     });
     let edits_pending = actions.pending.get() != &*view.params
         || !view.pending_beads.is_empty()
