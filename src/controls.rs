@@ -1,12 +1,15 @@
 //! Keyboard controls: Space restarts (applying pending edits), P pauses and
 //! resumes, N advances one step while paused, `[` and `]` slow the run
-//! down to 1/20 of real time and back up to it ([`SPEEDS`]). No rendering
+//! down to 1/20 of real time and back up to it ([`SPEEDS`]), R reverses
+//! every bead's velocity (run backwards: RATTLE retraces its path). No rendering
 //! needed: the controls read `ButtonInput<KeyCode>`, so headless tests
 //! press keys too.
 
 use bevy::input::InputSystems;
+use bevy::math::DVec3;
 use bevy::prelude::*;
 
+use crate::BeadVelocity;
 use crate::plugin::{Restart, WireBeadSystems};
 
 /// The keys the controls listen to.
@@ -22,6 +25,8 @@ pub struct ControlKeys {
     pub slower: KeyCode,
     /// Run faster (the next of [`SPEEDS`] up, to real time).
     pub faster: KeyCode,
+    /// Reverse every bead's velocity: the run goes backwards.
+    pub reverse: KeyCode,
 }
 
 /// The speeds the run may go at, as fractions of real time: slow motion
@@ -65,6 +70,7 @@ impl Default for ControlKeys {
             step: KeyCode::KeyN,
             slower: KeyCode::BracketLeft,
             faster: KeyCode::BracketRight,
+            reverse: KeyCode::KeyR,
         }
     }
 }
@@ -73,17 +79,19 @@ impl ControlKeys {
     /// A one-line description for an on-screen help line.
     pub fn help(&self) -> String {
         format!(
-            "{}: restart and apply edits · {}: pause/resume · {}: one step while paused · {} and {}: slower, faster · drag a bead with the mouse",
+            "{}: restart and apply edits · {}: pause/resume · {}: one step while paused · {} and {}: slower, faster · {}: run backwards · drag a bead with the mouse",
             key_name(self.restart),
             key_name(self.pause),
             key_name(self.step),
             key_name(self.slower),
-            key_name(self.faster)
+            key_name(self.faster),
+            key_name(self.reverse)
         )
     }
 }
 
-fn key_name(key: KeyCode) -> String {
+/// A key as the help line names it: `P`, `Space`, `[`.
+pub(crate) fn key_name(key: KeyCode) -> String {
     match key {
         KeyCode::BracketLeft => "[".to_owned(),
         KeyCode::BracketRight => "]".to_owned(),
@@ -98,6 +106,11 @@ fn key_name(key: KeyCode) -> String {
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StepRequests(pub u32);
 
+/// Reversals of the run requested since the last frame, made by
+/// [`reverse_requested`] before the next step.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ReverseRequests(pub u32);
+
 /// Adds the keyboard controls. Needs [`WireBeadPlugin`](crate::WireBeadPlugin).
 #[derive(Default)]
 pub struct KeyboardControlsPlugin;
@@ -107,9 +120,11 @@ impl Plugin for KeyboardControlsPlugin {
         app.init_resource::<ButtonInput<KeyCode>>()
             .init_resource::<ControlKeys>()
             .init_resource::<StepRequests>()
+            .init_resource::<ReverseRequests>()
             .add_systems(
                 PreUpdate,
-                keyboard_controls
+                (keyboard_controls, reverse_requested)
+                    .chain()
                     .after(InputSystems)
                     .before(WireBeadSystems::Restart),
             )
@@ -118,13 +133,14 @@ impl Plugin for KeyboardControlsPlugin {
 }
 
 /// Reads the keys: sends [`Restart`], toggles the pause, requests a step,
-/// slows the run down or speeds it up.
+/// slows the run down or speeds it up, requests a reversal.
 pub fn keyboard_controls(
     keys: Res<ButtonInput<KeyCode>>,
     bindings: Res<ControlKeys>,
     mut restarts: MessageWriter<Restart>,
     mut time: ResMut<Time<Virtual>>,
     mut steps: ResMut<StepRequests>,
+    mut reversals: ResMut<ReverseRequests>,
 ) {
     if keys.just_pressed(bindings.restart) {
         restarts.write(Restart);
@@ -139,11 +155,35 @@ pub fn keyboard_controls(
     if keys.just_pressed(bindings.step) && time.is_paused() {
         steps.0 += 1;
     }
+    if keys.just_pressed(bindings.reverse) {
+        reversals.0 += 1;
+    }
     for (key, faster) in [(bindings.slower, false), (bindings.faster, true)] {
         if keys.just_pressed(key) {
             let speed = next_speed(time.relative_speed_f64(), faster);
             time.set_relative_speed_f64(speed);
         }
+    }
+}
+
+/// Makes the requested reversals: each turns every bead's velocity round
+/// (in the plane and in space), so the run goes on backwards. A method
+/// that is time-reversible (RATTLE) then retraces its path to rounding;
+/// one that is not (Euler, Baumgarte) does not, which is the lesson.
+pub fn reverse_requested(
+    mut requests: ResMut<ReverseRequests>,
+    mut beads: Query<&mut BeadVelocity>,
+    mut space_beads: Query<&mut BeadVelocity<DVec3>>,
+) {
+    let n = std::mem::take(&mut requests.0);
+    if n.is_multiple_of(2) {
+        return;
+    }
+    for mut v in &mut beads {
+        v.0 = -v.0;
+    }
+    for mut v in &mut space_beads {
+        v.0 = -v.0;
     }
 }
 

@@ -120,6 +120,11 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
         let row = RowValues {
             wire: on_wire.map(|_| [diagnostics.c, diagnostics.c_dot, diagnostics.lambda]),
             energy: diagnostics.energy(),
+            from_start: view
+                .positions
+                .get(entity)
+                .ok()
+                .map(|x| (x.0 - bead.initial_position).length()),
         };
         value_rows(ui, Some(row), &view.clock);
         if let Some(island) = view.islands.of(entity).filter(|i| i.rows > 0) {
@@ -133,11 +138,13 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
     outcome
 }
 
-/// A bead's wire row (`C`, `Ċ`, λ; none for a bead on no wire) and its
-/// energy, as the panel shows them.
+/// A bead's wire row (`C`, `Ċ`, λ; none for a bead on no wire), its
+/// energy and how far it is from where it started (a run turned round
+/// comes back to it), as the panel shows them.
 pub(super) struct RowValues {
     pub(super) wire: Option<[f64; 3]>,
     pub(super) energy: f64,
+    pub(super) from_start: Option<f64>,
 }
 
 /// The rows of a bead's values in a four-column grid: `C` and `Ċ`, λ and
@@ -157,6 +164,11 @@ pub(super) fn value_rows(ui: &mut egui::Ui, row: Option<RowValues>, clock: &SimC
         ui.label("E");
         ui.monospace(format!("{:+.4}", row.energy));
         ui.end_row();
+        if let Some(distance) = row.from_start {
+            ui.label("from start");
+            ui.monospace(format!("{distance:.3e} m"));
+            ui.end_row();
+        }
     }
     ui.label("t");
     ui.monospace(format!("{:.2} s", clock.time));

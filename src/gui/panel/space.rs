@@ -83,6 +83,11 @@ pub(super) fn space_bead_section(
             let row = diagnostics.map(|d| RowValues {
                 wire: on_wire.map(|_| [d.c, d.c_dot, d.lambda]),
                 energy: d.energy(),
+                from_start: view
+                    .space_positions
+                    .get(entity)
+                    .ok()
+                    .map(|x| (x.0 - bead.initial_position).length()),
             });
             value_rows(ui, row, &view.clock);
         });

@@ -8,14 +8,14 @@ use bevy::prelude::*;
 use super::PresetCatalog;
 use super::phase::PhasePlot;
 use super::plots::{PlotHistory, RecentStrikes};
-use crate::controls::{ControlKeys, StepRequests};
+use crate::controls::{ControlKeys, ReverseRequests, StepRequests};
 use crate::gui::drag::SelectedBead;
 use crate::gui::render::SceneStyle;
 use crate::preset::{ActivePreset, LoadPreset};
 use crate::{
-    BeadDiagnostics, BeadParams, ConstraintDiagnostics, Diverged, Islands, NextBeadParams,
-    NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, Restart, Rod, SimClock, SimParams,
-    SpaceWire, Wire, WireContact,
+    BeadDiagnostics, BeadParams, BeadPosition, ConstraintDiagnostics, Diverged, Islands,
+    NextBeadParams, NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, Restart, Rod,
+    SimClock, SimParams, SpaceWire, Wire, WireContact,
 };
 
 /// The read-only state the panel shows.
@@ -73,6 +73,8 @@ pub struct PanelView<'w, 's> {
         Query<'w, 's, (), Or<(With<NextBeadParams>, With<NextBeadParams<DVec3>>)>>,
     pub(super) pending_wires: Query<'w, 's, (), With<NextWireShape>>,
     pub(super) clock: Res<'w, SimClock>,
+    pub(super) positions: Query<'w, 's, &'static BeadPosition>,
+    pub(super) space_positions: Query<'w, 's, &'static BeadPosition<DVec3>>,
     pub(super) strikes: Res<'w, RecentStrikes>,
 }
 
@@ -82,6 +84,7 @@ pub struct PanelActions<'w, 's> {
     pub(super) pending: ResMut<'w, NextParams>,
     pub(super) time: ResMut<'w, Time<Virtual>>,
     pub(super) steps: ResMut<'w, StepRequests>,
+    pub(super) reversals: ResMut<'w, ReverseRequests>,
     pub(super) restarts: MessageWriter<'w, Restart>,
     pub(super) loads: MessageWriter<'w, LoadPreset>,
     pub(super) phase: ResMut<'w, PhasePlot>,

@@ -11,7 +11,7 @@ use super::plots::plots_section;
 use super::space::space_bead_section;
 use super::view::{PanelActions, PanelView};
 use crate::Restart;
-use crate::controls::{ControlKeys, SPEEDS, speed_label};
+use crate::controls::{ControlKeys, SPEEDS, key_name, speed_label};
 use crate::preset::LoadPreset;
 
 const ERROR_RED: egui::Color32 = egui::Color32::from_rgb(255, 90, 90);
@@ -124,6 +124,16 @@ fn scene_section(
             .clicked()
         {
             actions.steps.0 += 1;
+        }
+    });
+    // Time: backwards, and slow motion.
+    ui.horizontal(|ui| {
+        let time = &mut actions.time;
+        if ui
+            .button(format!("Reverse ({})", key_name(view.keys.reverse)))
+            .clicked()
+        {
+            actions.reversals.0 += 1;
         }
         let speed = time.relative_speed_f64();
         egui::ComboBox::from_id_salt("speed")
