@@ -151,7 +151,7 @@ impl<V: WireSpace> Island<V> {
     /// Contact row `r`'s unit normal from its first bead to its second,
     /// and the second's slip across it relative to the first, at `states`;
     /// none for a row of another kind or a pair at one point.
-    fn pair_slip(&self, r: usize, states: &[BeadState<V>]) -> Option<(V, V)> {
+    pub(super) fn pair_slip(&self, r: usize, states: &[BeadState<V>]) -> Option<(V, V)> {
         let (a, b, _) = self.contact_pair(r)?;
         let (sa, sb) = (states.get(a)?, states.get(b)?);
         let d = sb.position - sa.position;
@@ -198,15 +198,9 @@ impl<V: WireSpace> Island<V> {
                 // friction did not let go of it: held at the step's end.
                 let reversed = before != V::ZERO && sliding.dot(before) < 0.0;
                 let started = before == V::ZERO && sliding != V::ZERO && !released;
-                let Some(axis) = V::stick_axis(n).filter(|_| reversed || started) else {
-                    continue;
-                };
-                let Some((a, b, _)) = self.contact_pair(r) else {
-                    continue;
-                };
-                let offset = axis.dot(states[b].position - states[a].position);
-                self.place_stick(s, axis, offset, work);
-                stopped = true;
+                if reversed || started {
+                    stopped |= self.place_pair_stick(s, n, r, states, work);
+                }
                 continue;
             }
             let row = self.wire_row(r, states, time);
@@ -250,6 +244,26 @@ impl<V: WireSpace> Island<V> {
             }
         }
         Ok(())
+    }
+
+    /// Puts stick row `s` of contact row `r` across the line between its
+    /// beads (of unit normal `n`) where they are in `states`, as
+    /// `t·(x_b − x_a)` is there. Whether it could: a pair in space has no
+    /// one tangent to be held along.
+    pub(super) fn place_pair_stick(
+        &self,
+        s: usize,
+        n: V,
+        r: usize,
+        states: &[BeadState<V>],
+        work: &mut IslandWork<V>,
+    ) -> bool {
+        let (Some((a, b, _)), Some(axis)) = (self.contact_pair(r), V::stick_axis(n)) else {
+            return false;
+        };
+        let offset = axis.dot(states[b].position - states[a].position);
+        self.place_stick(s, axis, offset, work);
+        true
     }
 
     /// Takes stick row `s` back, as the line `axis·x = offset`.

@@ -586,21 +586,28 @@ impl<V: WireSpace> Island<V> {
         // A pair with friction touching at rest starts pressed together
         // (rubbing from its first step), held by static friction where
         // it has a stick row.
+        if !whole {
+            return;
+        }
+        work.x.clear();
+        work.x.extend(states.iter().map(|s| s.position));
         for (r, rough) in self.rough.iter().enumerate() {
-            let (Some(rough), true) = (rough, whole) else {
+            let Some(rough) = rough else { continue };
+            let touches = self
+                .contact_gap(r, &work.x)
+                .is_some_and(|(gap, reach)| gap.abs() <= TOUCHING * reach);
+            let Some((n, _)) = self.pair_slip(r, states).filter(|_| touches) else {
                 continue;
             };
-            let Some((a, b, reach)) = self.contact_pair(r) else {
+            let Some((a, b, _)) = self.contact_pair(r) else {
                 continue;
             };
-            let d = states[b].position - states[a].position;
-            let touches = (d.dot(d).sqrt() - reach).abs() <= TOUCHING * reach;
-            if !touches || states[a].velocity != states[b].velocity {
+            if states[a].velocity != states[b].velocity {
                 continue;
             }
             work.inactive[r] = false;
-            if let (Some(s), Some(axis)) = (rough.stick, V::stick_axis(d / d.dot(d).sqrt())) {
-                self.place_stick(s, axis, axis.dot(d), work);
+            if let Some(s) = rough.stick {
+                self.place_pair_stick(s, n, r, states, work);
             }
         }
     }
