@@ -6,9 +6,9 @@
 use bevy::math::DVec3;
 use bevy::prelude::*;
 use bevy_egui::egui;
-use egui_plot::{Legend, Line, LineStyle, Plot, PlotPoints, Points, uniform_grid_spacer};
+use egui_plot::{Legend, Line, LineStyle, PlotPoints, Points, uniform_grid_spacer};
 
-use super::plots::{PlotHistory, PlotSample, grid_steps, tick_label};
+use super::plots::{PlotHistory, PlotSample, grid_steps, panel_plot, tick_label};
 use crate::reference::separatrix;
 
 /// A quantity of the selected bead that the panel can plot.
@@ -137,18 +137,11 @@ fn phase_plot(ui: &mut egui::Ui, history: &PlotHistory, choice: &mut PhasePlot) 
     }
     let last = points[points.len() - 1];
     let portrait = (choice.x, choice.y) == (Quantity::Angle, Quantity::AngularSpeed);
-    Plot::new("plot-phase")
-        .height(160.0)
-        .allow_drag(false)
-        .allow_zoom(false)
-        .allow_scroll(false)
+    panel_plot("plot-phase", 160.0, false)
         .x_axis_label(choice.x.label())
         .y_axis_label(choice.y.label())
-        .y_axis_min_width(48.0)
         .x_grid_spacer(uniform_grid_spacer(|input| grid_steps(input.bounds, false)))
-        .y_grid_spacer(uniform_grid_spacer(|input| grid_steps(input.bounds, false)))
         .x_axis_formatter(|mark, _| tick_label(mark.value, mark.step_size))
-        .y_axis_formatter(|mark, _| tick_label(mark.value, mark.step_size))
         .legend(Legend::default())
         .show(ui, |plot_ui| {
             if let (true, Some((g, radius))) = (portrait, history.circle) {

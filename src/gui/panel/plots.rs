@@ -196,23 +196,7 @@ pub fn record_history(
 /// ([`decade_label`]).
 fn plot(ui: &mut egui::Ui, id: &str, lines: Vec<PlotLine>, log: bool) {
     let legend = lines.len() > 1;
-    let plot = Plot::new(id)
-        .height(PLOT_HEIGHT)
-        .allow_drag(false)
-        .allow_zoom(false)
-        .allow_scroll(false)
-        .x_axis_label("t (s)")
-        .y_axis_min_width(48.0)
-        .y_grid_spacer(uniform_grid_spacer(move |input| {
-            grid_steps(input.bounds, log)
-        }))
-        .y_axis_formatter(move |mark, _| {
-            if log {
-                decade_label(mark.value)
-            } else {
-                tick_label(mark.value, mark.step_size)
-            }
-        });
+    let plot = panel_plot(id, PLOT_HEIGHT, log).x_axis_label("t (s)");
     let plot = if legend {
         plot.legend(Legend::default())
     } else {
@@ -239,6 +223,29 @@ fn plot(ui: &mut egui::Ui, id: &str, lines: Vec<PlotLine>, log: bool) {
             });
         }
     });
+}
+
+/// A plot of the panel, `height` points tall and fixed (no drag, zoom or
+/// scroll), its value axis with room for its labels, stepped by
+/// [`grid_steps`] and labelled by [`tick_label`], or on a log scale in
+/// whole decades ([`decade_label`]).
+pub(super) fn panel_plot(id: &str, height: f32, log: bool) -> Plot<'static> {
+    Plot::new(id)
+        .height(height)
+        .allow_drag(false)
+        .allow_zoom(false)
+        .allow_scroll(false)
+        .y_axis_min_width(48.0)
+        .y_grid_spacer(uniform_grid_spacer(move |input| {
+            grid_steps(input.bounds, log)
+        }))
+        .y_axis_formatter(move |mark, _| {
+            if log {
+                decade_label(mark.value)
+            } else {
+                tick_label(mark.value, mark.step_size)
+            }
+        })
 }
 
 /// One line of a [`plot`]: its name (in the legend where there are
@@ -429,14 +436,7 @@ fn energy_bars(ui: &mut egui::Ui, first: &PlotSample, last: &PlotSample) {
             })
             .collect(),
     );
-    Plot::new("plot-energy-bars")
-        .height(PLOT_HEIGHT)
-        .allow_drag(false)
-        .allow_zoom(false)
-        .allow_scroll(false)
-        .y_axis_min_width(48.0)
-        .y_grid_spacer(uniform_grid_spacer(|input| grid_steps(input.bounds, false)))
-        .y_axis_formatter(|mark, _| tick_label(mark.value, mark.step_size))
+    panel_plot("plot-energy-bars", PLOT_HEIGHT, false)
         .x_grid_spacer(uniform_grid_spacer(|_| [1.0, 1.0, 10.0]))
         .custom_x_axes(vec![
             AxisHints::new_x()
