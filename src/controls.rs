@@ -1,5 +1,6 @@
 //! Keyboard controls: Space restarts (applying pending edits), P pauses and
-//! resumes, N advances one step while paused, `[` and `]` slow the run
+//! resumes, N advances one step while paused, B steps back one recorded
+//! step (with a [`TimelinePlugin`](crate::plugin::TimelinePlugin)), `[` and `]` slow the run
 //! down to 1/20 of real time and back up to it ([`SPEEDS`]), R reverses
 //! every bead's velocity (run backwards: RATTLE retraces its path). No rendering
 //! needed: the controls read `ButtonInput<KeyCode>`, so headless tests
@@ -10,7 +11,7 @@ use bevy::math::DVec3;
 use bevy::prelude::*;
 
 use crate::BeadVelocity;
-use crate::plugin::{Restart, WireBeadSystems};
+use crate::plugin::{Restart, TimelineSeek, WireBeadSystems};
 
 /// The keys the controls listen to.
 #[derive(Resource, Clone, Debug, PartialEq, Eq)]
@@ -21,6 +22,9 @@ pub struct ControlKeys {
     pub pause: KeyCode,
     /// Advance one fixed step while paused.
     pub step: KeyCode,
+    /// Go back one recorded step (see [`Timeline`](crate::plugin::Timeline)),
+    /// pausing the run.
+    pub back: KeyCode,
     /// Run slower (the next of [`SPEEDS`] down).
     pub slower: KeyCode,
     /// Run faster (the next of [`SPEEDS`] up, to real time).
@@ -68,6 +72,7 @@ impl Default for ControlKeys {
             restart: KeyCode::Space,
             pause: KeyCode::KeyP,
             step: KeyCode::KeyN,
+            back: KeyCode::KeyB,
             slower: KeyCode::BracketLeft,
             faster: KeyCode::BracketRight,
             reverse: KeyCode::KeyR,
@@ -79,9 +84,10 @@ impl ControlKeys {
     /// A one-line description for an on-screen help line.
     pub fn help(&self) -> String {
         format!(
-            "{}: restart and apply edits · {}: pause/resume · {}: one step while paused · {} and {}: slower, faster · {}: run backwards · drag a bead with the mouse",
+            "{}: restart and apply edits · {}: pause/resume · {} and {}: one step back, forward · {} and {}: slower, faster · {}: run backwards · drag a bead with the mouse",
             key_name(self.restart),
             key_name(self.pause),
+            key_name(self.back),
             key_name(self.step),
             key_name(self.slower),
             key_name(self.faster),
@@ -121,6 +127,7 @@ impl Plugin for KeyboardControlsPlugin {
             .init_resource::<ControlKeys>()
             .init_resource::<StepRequests>()
             .init_resource::<ReverseRequests>()
+            .add_message::<TimelineSeek>()
             .add_systems(
                 PreUpdate,
                 (keyboard_controls, reverse_requested)
@@ -141,6 +148,7 @@ pub fn keyboard_controls(
     mut time: ResMut<Time<Virtual>>,
     mut steps: ResMut<StepRequests>,
     mut reversals: ResMut<ReverseRequests>,
+    mut seeks: MessageWriter<TimelineSeek>,
 ) {
     if keys.just_pressed(bindings.restart) {
         restarts.write(Restart);
@@ -154,6 +162,9 @@ pub fn keyboard_controls(
     }
     if keys.just_pressed(bindings.step) && time.is_paused() {
         steps.0 += 1;
+    }
+    if keys.just_pressed(bindings.back) {
+        seeks.write(TimelineSeek::Back);
     }
     if keys.just_pressed(bindings.reverse) {
         reversals.0 += 1;

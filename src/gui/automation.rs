@@ -15,8 +15,12 @@ use crate::debug_render::{hatch_point, wire_points};
 use crate::geometry::Placed;
 use crate::gui::render::{FramedView, SceneCamera, hatch_length};
 use crate::gui::space::{SpaceCamera, WireDrawing};
+use crate::plugin::Timeline;
 use crate::preset::ActivePreset;
-use crate::{BeadPosition, Diverged, Pin, Rod, SpringAnchor, Wire, WireContact, pose_of};
+use crate::{
+    BeadPosition, BeadVelocity, Diverged, Pin, Rod, SimClock, SpringAnchor, Wire, WireContact,
+    pose_of,
+};
 
 /// Where one bead is.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -110,6 +114,30 @@ pub struct FrameReport {
     pub preset_error: Option<String>,
     /// Mean wall-clock frame time in milliseconds after the first 30 frames.
     pub mean_frame_ms: f64,
+    /// Where the run is on its timeline.
+    #[serde(default)]
+    pub timeline: Option<TimelineReport>,
+}
+
+/// Where the run is on its [`Timeline`], and every bead's state now and as
+/// recorded at that step, bit for bit.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TimelineReport {
+    /// The step the run is at ([`SimClock::steps`]).
+    pub step: u64,
+    /// The first and last steps recorded.
+    pub recorded: [u64; 2],
+    /// Whether the run is at a recorded step before the newest.
+    pub stepped_back: bool,
+    /// Steps run again from a step back that came out as recorded.
+    pub matched: u64,
+    /// The step a run from a step back first differed at, if one did.
+    pub departed: Option<u64>,
+    /// Each bead's position and velocity now, as the bits of each number
+    /// in hex.
+    pub now: Vec<String>,
+    /// The same, as recorded at `step`.
+    pub at_step: Vec<String>,
 }
 
 /// Run `frames` frames, optionally screenshot, report and exit.
@@ -190,6 +218,18 @@ struct ReportView<'w, 's> {
     transforms: Query<'w, 's, &'static Transform>,
     view: Res<'w, FramedView>,
     active: Res<'w, ActivePreset>,
+    timeline: Option<Res<'w, Timeline>>,
+    clock: Res<'w, SimClock>,
+    states: Query<'w, 's, (Entity, &'static BeadPosition, &'static BeadVelocity)>,
+    space_states: Query<
+        'w,
+        's,
+        (
+            Entity,
+            &'static BeadPosition<DVec3>,
+            &'static BeadVelocity<DVec3>,
+        ),
+    >,
 }
 
 impl ReportView<'_, '_> {
@@ -285,7 +325,54 @@ impl ReportView<'_, '_> {
             preset: self.active.running.clone(),
             preset_error: self.active.error.clone(),
             mean_frame_ms,
+            timeline: self.timeline_report(),
         }
+    }
+
+    /// Where the run is on its timeline, with the beads' states now and as
+    /// recorded.
+    fn timeline_report(&self) -> Option<TimelineReport> {
+        let timeline = self.timeline.as_ref()?;
+        let (first, last) = timeline.span()?;
+        let step = self.clock.steps;
+        let bits = |x: DVec3, v: DVec3| {
+            [x.x, x.y, x.z, v.x, v.y, v.z]
+                .map(|n| format!("{:016x}", n.to_bits()))
+                .join(" ")
+        };
+        let mut now = Vec::new();
+        let mut at_step = Vec::new();
+        let mut entities: Vec<Entity> = self.states.iter().map(|(e, ..)| e).collect();
+        entities.extend(self.space_states.iter().map(|(e, ..)| e));
+        entities.sort_unstable();
+        for entity in entities {
+            let (x, v, recorded) = match self.states.get(entity) {
+                Ok((_, x, v)) => (
+                    x.0.extend(0.0),
+                    v.0.extend(0.0),
+                    timeline
+                        .bead(step, entity)
+                        .map(|(x, v)| (x.extend(0.0), v.extend(0.0))),
+                ),
+                Err(_) => {
+                    let (_, x, v) = self.space_states.get(entity).ok()?;
+                    (x.0, v.0, timeline.space_bead(step, entity))
+                }
+            };
+            now.push(format!("{entity}: {}", bits(x, v)));
+            if let Some((x, v)) = recorded {
+                at_step.push(format!("{entity}: {}", bits(x, v)));
+            }
+        }
+        Some(TimelineReport {
+            step,
+            recorded: [first.steps, last.steps],
+            stepped_back: timeline.at().is_some(),
+            matched: timeline.matched(),
+            departed: timeline.departed(),
+            now,
+            at_step,
+        })
     }
 }
 

@@ -25,13 +25,14 @@ use bevy::picking::mesh_picking::MeshPickingPlugin;
 use bevy::prelude::*;
 use bevy_egui::{EguiGlobalSettings, EguiPlugin};
 
-pub use automation::{AutomationPlugin, FrameReport};
+pub use automation::{AutomationPlugin, FrameReport, TimelineReport};
 pub use drag::BeadDragPlugin;
 pub use panel::{PanelPlugin, PresetCatalog};
 pub use render::{SceneCamera, SceneRenderPlugin, SceneStyle};
 pub use space::{SpaceCamera, SpaceViewPlugin};
 
 use crate::controls::KeyboardControlsPlugin;
+use crate::plugin::TimelinePlugin;
 use crate::preset::ScenePresetPlugin;
 
 /// The whole interactive scene on top of the simulation.
@@ -63,6 +64,9 @@ impl Plugin for WireBeadGuiPlugin {
         }
         if !app.is_plugin_added::<KeyboardControlsPlugin>() {
             app.add_plugins(KeyboardControlsPlugin);
+        }
+        if !app.is_plugin_added::<TimelinePlugin>() {
+            app.add_plugins(TimelinePlugin);
         }
         app.add_plugins((
             SceneRenderPlugin,

@@ -26,6 +26,7 @@ mod report;
 mod restart;
 mod schedule;
 mod step;
+mod timeline;
 mod wires;
 mod writeback;
 
@@ -40,6 +41,7 @@ pub use params::ParamsPlugin;
 pub use restart::{Restart, RestartPlugin};
 pub use schedule::WireBeadSystems;
 pub use step::BeadStepPlugin;
+pub use timeline::{Timeline, TimelinePlugin, TimelineSeek};
 pub use wires::WirePosePlugin;
 pub use writeback::WritebackPlugin;
 

@@ -46,6 +46,12 @@ fn add_wire_poses<V: Dimension>(app: &mut App) {
 #[derive(Resource)]
 pub(crate) struct MovingWires<V>(EntityHashSet, PhantomData<V>);
 
+impl<V> Clone for MovingWires<V> {
+    fn clone(&self) -> Self {
+        Self(self.0.clone(), PhantomData)
+    }
+}
+
 impl<V> Default for MovingWires<V> {
     fn default() -> Self {
         Self(EntityHashSet::default(), PhantomData)

@@ -22,6 +22,7 @@ mod restart;
 mod scenes;
 mod space;
 mod space_plugin;
+mod timeline;
 mod touch;
 mod tracks;
 #[cfg(feature = "gui")]

@@ -320,3 +320,21 @@ fn screenshot_in_space_shows_the_hoop_and_its_bead_where_simulated() {
         away.len()
     );
 }
+
+#[test]
+#[ignore = "needs the key presses .ci/run makes under Xvfb"]
+fn keys_step_the_rope_back_and_forward_bit_for_bit() {
+    // Eight presses of B, then five of N.
+    let report = report("timeline.ron");
+    let timeline = report.timeline.expect("a timeline in the report");
+    assert!(timeline.stepped_back, "{timeline:?}");
+    assert_eq!(timeline.step + 3, timeline.recorded[1], "{timeline:?}");
+    assert_eq!(timeline.matched, 5, "{timeline:?}");
+    assert_eq!(timeline.departed, None);
+    assert!(
+        timeline.now.len() >= 10,
+        "the rope's beads: {:?}",
+        timeline.now
+    );
+    assert_eq!(timeline.now, timeline.at_step);
+}

@@ -13,6 +13,7 @@ mod params;
 mod phase;
 mod plots;
 mod space;
+mod timeline;
 mod view;
 mod window;
 

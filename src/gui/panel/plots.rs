@@ -170,9 +170,14 @@ pub fn record_history(
     };
     history.circle = radius.map(|r| (g.length(), r));
     let t = clock.time;
-    if history.bead != Some(entity) || history.samples.back().is_some_and(|s| s.t > t) {
+    if history.bead != Some(entity) {
         history.samples.clear();
         history.bead = Some(entity);
+    }
+    // Back at an earlier time (a restart, a step back): the plots go on
+    // from there.
+    while history.samples.back().is_some_and(|s| s.t >= t) {
+        history.samples.pop_back();
     }
     if let Some(island) = islands
         .of(entity)

@@ -11,12 +11,18 @@ use super::plots::{PlotHistory, RecentStrikes};
 use crate::controls::{ControlKeys, ReverseRequests, StepRequests};
 use crate::gui::drag::SelectedBead;
 use crate::gui::render::SceneStyle;
+use crate::plugin::{Timeline, TimelineSeek};
 use crate::preset::{ActivePreset, LoadPreset};
 use crate::{
     BeadDiagnostics, BeadParams, BeadPosition, ConstraintDiagnostics, Diverged, Islands,
     NextBeadParams, NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, Restart, Rod,
     SimClock, SimParams, SpaceWire, Wire, WireContact,
 };
+
+/// The colour of what waits on the user: edits pending, a run that
+/// changed from its recording.
+pub(super) const PENDING_ORANGE: bevy_egui::egui::Color32 =
+    bevy_egui::egui::Color32::from_rgb(255, 190, 60);
 
 /// The read-only state the panel shows.
 #[derive(SystemParam)]
@@ -88,6 +94,8 @@ pub struct PanelActions<'w, 's> {
     pub(super) restarts: MessageWriter<'w, Restart>,
     pub(super) loads: MessageWriter<'w, LoadPreset>,
     pub(super) phase: ResMut<'w, PhasePlot>,
+    pub(super) timeline: ResMut<'w, Timeline>,
+    pub(super) seeks: MessageWriter<'w, TimelineSeek>,
     pub(super) commands: Commands<'w, 's>,
 }
 

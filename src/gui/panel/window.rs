@@ -9,13 +9,13 @@ use super::params::{Edit, bead_section, solver_section};
 use super::phase::phase_section;
 use super::plots::plots_section;
 use super::space::space_bead_section;
-use super::view::{PanelActions, PanelView};
+use super::timeline::timeline_section;
+use super::view::{PENDING_ORANGE, PanelActions, PanelView};
 use crate::Restart;
 use crate::controls::{ControlKeys, SPEEDS, key_name, speed_label};
 use crate::preset::LoadPreset;
 
 const ERROR_RED: egui::Color32 = egui::Color32::from_rgb(255, 90, 90);
-const PENDING_ORANGE: egui::Color32 = egui::Color32::from_rgb(255, 190, 60);
 
 /// The panel: the scene and run state, the selected bead and its wire, the
 /// solver's parameters and the plots, in a window that scrolls when it is
@@ -40,6 +40,7 @@ pub fn panel(
         .vscroll(true)
         .show(ctx, |ui| {
             scene_section(ui, &view, &mut actions, refused.as_deref());
+            timeline_section(ui, &view, &mut actions);
             let bead = bead_section(ui, &view, &mut actions.commands).or(space_bead_section(
                 ui,
                 &view,

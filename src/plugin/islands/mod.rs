@@ -162,6 +162,7 @@ struct WireRow {
 }
 
 /// One island as the step keeps it.
+#[derive(Clone)]
 struct CachedIsland<V: Dimension> {
     report: IslandReport,
     island: Island<V>,
@@ -193,7 +194,10 @@ struct CachedIsland<V: Dimension> {
 /// springs, each solved as one system. Rebuilt when a link, a bead or a
 /// wire is added, changed or removed, or the run restarts. `Islands` are
 /// the plane's, `Islands<DVec3>` space's.
-#[derive(Resource)]
+///
+/// A clone (as the [`Timeline`](crate::plugin::Timeline) keeps one each
+/// step) steps on exactly as the original would.
+#[derive(Resource, Clone)]
 pub struct Islands<V: Dimension = DVec2> {
     cached: Vec<CachedIsland<V>>,
     dirty: bool,
@@ -217,6 +221,19 @@ impl<V: Dimension> Islands<V> {
     /// The report of the island holding `bead`, if it is in one.
     pub fn of(&self, bead: Entity) -> Option<&IslandReport> {
         self.iter().find(|r| r.beads.contains(&bead))
+    }
+
+    /// Roughly how much memory a clone of the islands takes, in bytes:
+    /// the step's buffers hold about twenty numbers per bead coordinate
+    /// and per row.
+    pub(crate) fn bytes(&self) -> usize {
+        self.cached
+            .iter()
+            .map(|c| {
+                20 * (c.states.len() * size_of::<V>() + c.report.rows * size_of::<f64>())
+                    + size_of::<CachedIsland<V>>()
+            })
+            .sum()
     }
 
     /// Asks for a rebuild before the next step.

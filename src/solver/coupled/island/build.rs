@@ -2,6 +2,7 @@
 //! out, and why one cannot be built ([`IslandError`]).
 
 use bevy::math::DVec2;
+use std::sync::Arc;
 
 use super::Island;
 use crate::geometry::WireSpace;
@@ -173,8 +174,9 @@ impl<V: WireSpace> Island<V> {
                 }
             }
         }
-        let normal =
-            NormalMatrix::new(&row_start, &entry_bead, beads).ok_or(IslandError::OutOfMemory)?;
+        let normal = NormalMatrix::new(&row_start, &entry_bead, beads)
+            .map(Arc::new)
+            .ok_or(IslandError::OutOfMemory)?;
         let paths = vec![None; kinds.len()];
         let sides = vec![(0.0, 0.0); kinds.len()];
         let rough = vec![None; kinds.len()];

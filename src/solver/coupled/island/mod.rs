@@ -14,6 +14,7 @@
 //! | `contact` | one-sided rows (leaving, landing, bouncing by the lone bead's rule) and friction (sliding, stopping, sticking: the lone bead's friction, with a stick row's multiplier for the pull) |
 
 use bevy::math::DVec2;
+use std::sync::Arc;
 
 use super::constraint::{RowKind, SpringLink};
 use super::normal::{Factored, LuWork, NormalMatrix};
@@ -160,6 +161,10 @@ pub struct RowReport {
 /// the topology, built once, and what it needs to solve eq. (12) fast (the
 /// pattern and symbolic factorization of `J W Jᵀ`). Positions, velocities
 /// and forces come with each step.
+///
+/// A clone shares the matrix's pattern and symbolic factorization (they
+/// never change) and copies the rest.
+#[derive(Clone)]
 pub struct Island<V: WireSpace = DVec2> {
     inverse_mass: Vec<f64>,
     rows: Vec<RowKind<V>>,
@@ -168,7 +173,7 @@ pub struct Island<V: WireSpace = DVec2> {
     /// The bead of each gradient entry.
     entry_bead: Vec<usize>,
     springs: Vec<SpringLink>,
-    normal: NormalMatrix,
+    normal: Arc<NormalMatrix>,
     /// The path of each wire row that moves (see [`Island::move_wire`]).
     paths: Vec<Option<V::Path>>,
     /// How many rows have a path: with none, a step looks at no path.
@@ -207,7 +212,12 @@ struct RoughRow {
 
 /// The buffers one island's step works in, kept between steps so a step
 /// allocates nothing. Also what the last step reported.
-#[derive(Default)]
+///
+/// A clone carries everything a step reads from the last one (see
+/// [`IslandMark`]) and what the last step reported, with fresh scratch
+/// memory: stepping a clone gives the same numbers, bit for bit, as
+/// stepping the original.
+#[derive(Clone, Default)]
 pub struct IslandWork<V: WireSpace = DVec2> {
     x0: Vec<V>,
     v0: Vec<V>,

@@ -108,6 +108,13 @@ struct Scratch {
     memory: Option<MemBuffer>,
 }
 
+/// A clone starts with no memory: it is made again when first needed.
+impl Clone for Scratch {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
 /// `A`'s pattern (upper triangle, by columns) and its symbolic
 /// factorization.
 pub(crate) struct NormalMatrix {
@@ -145,7 +152,7 @@ struct Unsymmetric {
 
 /// The numeric LU of `J₁ W J₀ᵀ` and its scratch memory, kept between
 /// solves so that a Newton iteration allocates nothing.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub(crate) struct LuWork {
     values: Vec<f64>,
     /// The right-hand side in a band's order of the rows.
@@ -179,8 +186,16 @@ struct HeldRows {
     memory: Option<MemBuffer>,
 }
 
+/// A clone starts with no pattern: it is made again, the same, for the
+/// rows held when first needed.
+impl Clone for HeldRows {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
 /// A factored `A`, kept between solves within a step.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub(crate) struct Factored {
     values: Vec<f64>,
     scale: Vec<f64>,
