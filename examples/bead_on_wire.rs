@@ -2,7 +2,8 @@
 //!
 //! Drag the bead with the mouse (a spring `k (cursor - bead)` pulls it),
 //! edit every parameter in the panel and press Space to apply them, watch the
-//! drift, energy and λ plots. P pauses, N steps once while paused.
+//! drift, energy and λ plots. P pauses, N steps once while paused, B steps
+//! back; E writes the run as CSV and S the scene with its edits.
 //!
 //! ```sh
 //! cargo run --release --example bead_on_wire
@@ -19,6 +20,7 @@ use clap::Parser;
 use wirebead::LoadPreset;
 use wirebead::gui::{AutomationPlugin, WireBeadGuiPlugin};
 use wirebead::prelude::*;
+use wirebead::preset::ExportDir;
 
 /// The interactive bead-on-a-wire scene.
 #[derive(Parser, Debug)]
@@ -46,6 +48,9 @@ struct Args {
     /// Window height in pixels.
     #[arg(long, default_value_t = 800)]
     height: u32,
+    /// Where E (export CSV) and S (save scene) write.
+    #[arg(long, default_value = "exports")]
+    export_dir: PathBuf,
 }
 
 fn main() -> AppExit {
@@ -68,6 +73,7 @@ fn main() -> AppExit {
                 }),
         )
         .add_plugins((WireBeadPlugin::default(), WireBeadGuiPlugin))
+        .insert_resource(ExportDir(args.export_dir))
         .add_plugins(AutomationPlugin {
             frames: args.frames,
             screenshot: args.screenshot,

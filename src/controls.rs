@@ -31,6 +31,11 @@ pub struct ControlKeys {
     pub faster: KeyCode,
     /// Reverse every bead's velocity: the run goes backwards.
     pub reverse: KeyCode,
+    /// Export the recorded run as CSV (see
+    /// [`ExportPlugin`](crate::preset::ExportPlugin)).
+    pub export_csv: KeyCode,
+    /// Save the scene, its edits included, as a scene file.
+    pub save_scene: KeyCode,
 }
 
 /// The speeds the run may go at, as fractions of real time: slow motion
@@ -76,6 +81,8 @@ impl Default for ControlKeys {
             slower: KeyCode::BracketLeft,
             faster: KeyCode::BracketRight,
             reverse: KeyCode::KeyR,
+            export_csv: KeyCode::KeyE,
+            save_scene: KeyCode::KeyS,
         }
     }
 }
@@ -84,14 +91,16 @@ impl ControlKeys {
     /// A one-line description for an on-screen help line.
     pub fn help(&self) -> String {
         format!(
-            "{}: restart and apply edits · {}: pause/resume · {} and {}: one step back, forward · {} and {}: slower, faster · {}: run backwards · drag a bead with the mouse",
+            "{}: restart and apply edits · {}: pause/resume · {} and {}: one step back, forward · {} and {}: slower, faster · {}: run backwards · {}: export CSV · {}: save scene · drag a bead",
             key_name(self.restart),
             key_name(self.pause),
             key_name(self.back),
             key_name(self.step),
             key_name(self.slower),
             key_name(self.faster),
-            key_name(self.reverse)
+            key_name(self.reverse),
+            key_name(self.export_csv),
+            key_name(self.save_scene)
         )
     }
 }
@@ -112,6 +121,17 @@ pub(crate) fn key_name(key: KeyCode) -> String {
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StepRequests(pub u32);
 
+/// Exports requested since the last frame: the recorded run as CSV, the
+/// scene with its edits as a scene file. Made by the
+/// [`ExportPlugin`](crate::preset::ExportPlugin).
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ExportRequests {
+    /// Requests for the run as CSV.
+    pub csv: u32,
+    /// Requests for the scene file.
+    pub scene: u32,
+}
+
 /// Reversals of the run requested since the last frame, made by
 /// [`reverse_requested`] before the next step.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -127,6 +147,7 @@ impl Plugin for KeyboardControlsPlugin {
             .init_resource::<ControlKeys>()
             .init_resource::<StepRequests>()
             .init_resource::<ReverseRequests>()
+            .init_resource::<ExportRequests>()
             .add_message::<TimelineSeek>()
             .add_systems(
                 PreUpdate,
@@ -149,6 +170,7 @@ pub fn keyboard_controls(
     mut steps: ResMut<StepRequests>,
     mut reversals: ResMut<ReverseRequests>,
     mut seeks: MessageWriter<TimelineSeek>,
+    mut exports: ResMut<ExportRequests>,
 ) {
     if keys.just_pressed(bindings.restart) {
         restarts.write(Restart);
@@ -165,6 +187,12 @@ pub fn keyboard_controls(
     }
     if keys.just_pressed(bindings.back) {
         seeks.write(TimelineSeek::Back);
+    }
+    if keys.just_pressed(bindings.export_csv) {
+        exports.csv += 1;
+    }
+    if keys.just_pressed(bindings.save_scene) {
+        exports.scene += 1;
     }
     if keys.just_pressed(bindings.reverse) {
         reversals.0 += 1;

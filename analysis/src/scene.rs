@@ -6,17 +6,13 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
-use bevy::math::{DVec2, DVec3};
-use bevy::prelude::{
-    Commands, Entity, FixedUpdate, IntoScheduleConfigs, Query, Res, ResMut, Resource,
-};
-use wirebead::geometry::{
-    ImplicitCurve, Placed, Pose, Pose3, SpaceMotion, SpaceShape, WireMotion, WireShape, WireSpace,
-};
+use bevy::prelude::{Entity, FixedUpdate, IntoScheduleConfigs, Query, Res, ResMut, Resource};
 use wirebead::headless::{Headless, idle, run_steps};
+use wirebead::preset::table;
+pub use wirebead::preset::table::{Measure, Scene, SceneRow, SceneRun, SceneSpace};
 use wirebead::{
-    BeadPosition, BeadVelocity, Dimension, Diverged, Method, ParamError, SceneFile, SceneLink,
-    ScenePreset, SimClock, SimParams, SpaceScene, WireBeadPlugin, WireBeadSystems, WireContact,
+    BeadPosition, BeadVelocity, Diverged, Method, ParamError, SceneFile, ScenePreset, SimClock,
+    SimParams, WireBeadPlugin, WireBeadSystems, WireContact,
 };
 
 use crate::AnalysisResult;
@@ -32,239 +28,6 @@ pub fn load_scene(path: &Path) -> AnalysisResult<ScenePreset> {
 pub fn load_scene_file(path: &Path) -> AnalysisResult<SceneFile> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     SceneFile::from_ron(&text).map_err(|e| format!("{}: {e}", path.display()).into())
-}
-
-/// The plane or space as the tool measures a scene in it: how far a bead
-/// is off its wire.
-pub trait SceneSpace: Dimension {
-    /// A wire as measured: its shape, resting pose and motion.
-    type WireCheck: Clone + std::fmt::Debug + Send + Sync + 'static;
-    /// `|C|` of a bead at `x` on `wire` at time `t`: in space, over a
-    /// curve's two rows, the length of its offset.
-    fn drift(wire: &Self::WireCheck, t: f64, x: Self) -> f64;
-}
-
-impl SceneSpace for DVec2 {
-    type WireCheck = (WireShape, Pose, WireMotion);
-    fn drift((shape, pose, motion): &Self::WireCheck, t: f64, x: Self) -> f64 {
-        Placed {
-            curve: shape.curve(),
-            pose: motion.at(*pose, t).0,
-        }
-        .value(x)
-        .abs()
-    }
-}
-
-impl SceneSpace for DVec3 {
-    type WireCheck = (SpaceShape, Pose3, SpaceMotion);
-    fn drift((shape, pose, motion): &Self::WireCheck, t: f64, x: Self) -> f64 {
-        let local = motion.at(*pose, t).0.to_local(x);
-        shape.rows().iter().fold(0.0, |offset, row| {
-            offset.hypot(DVec3::shape_geometry(row, local, None).c)
-        })
-    }
-}
-
-/// A scene of either dimension, as the tool runs it.
-pub trait Scene {
-    /// Its coordinates.
-    type V: SceneSpace;
-    /// Its parameters.
-    fn params(&self) -> &SimParams;
-    /// Its name.
-    fn name(&self) -> &str;
-    /// Each bead's name, in the file's order.
-    fn bead_names(&self) -> Vec<String>;
-    /// Spawns it; its beads in the file's order.
-    fn spawn(&self, commands: &mut Commands) -> Vec<Entity>;
-    /// Each bead's wire, mass, and the links.
-    fn measure(&self) -> Result<Measure<Self::V>, String>;
-}
-
-impl Scene for ScenePreset {
-    type V = DVec2;
-    fn params(&self) -> &SimParams {
-        &self.params
-    }
-    fn name(&self) -> &str {
-        &self.name
-    }
-    fn bead_names(&self) -> Vec<String> {
-        ScenePreset::bead_names(self)
-    }
-    fn spawn(&self, commands: &mut Commands) -> Vec<Entity> {
-        ScenePreset::spawn(self, commands)
-    }
-    fn measure(&self) -> Result<Measure<DVec2>, String> {
-        let wires = self.wires.iter().map(|wire| {
-            let pose = Pose::new(wire.position, wire.angle_degrees.to_radians());
-            ((wire.shape.clone(), pose, wire.motion), wire.beads.len())
-        });
-        Ok(Measure::new(
-            wires,
-            self.links().map_err(|e| e.to_string())?,
-            self.all_beads().map(|b| b.mass).collect(),
-            self.params.gravity,
-        ))
-    }
-}
-
-impl Scene for SpaceScene {
-    type V = DVec3;
-    fn params(&self) -> &SimParams {
-        &self.params.0
-    }
-    fn name(&self) -> &str {
-        &self.name
-    }
-    fn bead_names(&self) -> Vec<String> {
-        SpaceScene::bead_names(self)
-    }
-    fn spawn(&self, commands: &mut Commands) -> Vec<Entity> {
-        SpaceScene::spawn(self, commands)
-    }
-    fn measure(&self) -> Result<Measure<DVec3>, String> {
-        let mut wires = Vec::new();
-        for wire in &self.wires {
-            let pose = wire.pose().map_err(|e| e.to_string())?;
-            let check = (wire.shape.shape(), pose, wire.motion.motion());
-            wires.push((check, wire.beads.len()));
-        }
-        Ok(Measure::new(
-            wires.into_iter(),
-            self.links().map_err(|e| e.to_string())?,
-            self.all_beads().map(|b| b.mass).collect(),
-            self.params.0.gravity_in_space(),
-        ))
-    }
-}
-
-/// One constraint to measure, with beads as indices in the file's order.
-#[derive(Clone, Debug)]
-enum Check<V: SceneSpace> {
-    /// A bead on a wire.
-    Wire(usize, V::WireCheck),
-    Rod(usize, usize, f64),
-    Pin(usize, V),
-}
-
-/// What a scene's rows are measured against: its constraints, springs and
-/// masses.
-#[derive(Clone, Debug)]
-pub struct Measure<V: SceneSpace> {
-    checks: Vec<Check<V>>,
-    springs: Vec<(usize, usize, f64, f64)>,
-    masses: Vec<f64>,
-    gravity: V,
-}
-
-/// `|v|`.
-fn length<V: SceneSpace>(v: V) -> f64 {
-    v.dot(v).sqrt()
-}
-
-impl<V: SceneSpace> Measure<V> {
-    /// A scene's measure: each wire with its number of beads (the wires'
-    /// beads come first in the file's order), the links, every bead's
-    /// mass and gravity.
-    fn new(
-        wires: impl Iterator<Item = (V::WireCheck, usize)>,
-        links: Vec<SceneLink<V>>,
-        masses: Vec<f64>,
-        gravity: V,
-    ) -> Self {
-        let mut checks = Vec::new();
-        let mut bead = 0;
-        for (wire, count) in wires {
-            for _ in 0..count {
-                checks.push(Check::Wire(bead, wire.clone()));
-                bead += 1;
-            }
-        }
-        let mut springs = Vec::new();
-        for link in links {
-            match link {
-                SceneLink::Rod { a, b, length } => checks.push(Check::Rod(a, b, length)),
-                SceneLink::Pin { bead, at } => checks.push(Check::Pin(bead, at)),
-                SceneLink::Spring { a, b, spring } => {
-                    springs.push((a, b, spring.rest_length, spring.stiffness))
-                }
-            }
-        }
-        Self {
-            checks,
-            springs,
-            masses,
-            gravity,
-        }
-    }
-
-    /// The largest `|C|` at time `t` of every constraint, wires included
-    /// (a bead in flight off its wire left out).
-    fn max_abs_c(&self, t: f64, x: &[V], on: &[bool]) -> f64 {
-        self.checks
-            .iter()
-            .map(|check| match check {
-                Check::Wire(b, _) if !on[*b] => 0.0,
-                Check::Wire(b, wire) => V::drift(wire, t, x[*b]),
-                Check::Rod(a, b, rod) => (length(x[*a] - x[*b]) - rod).abs(),
-                Check::Pin(b, at) => length(x[*b] - *at),
-            })
-            .fold(0.0, f64::max)
-    }
-
-    /// Kinetic plus gravitational energy of every bead.
-    fn energy(&self, x: &[V], v: &[V]) -> f64 {
-        self.masses
-            .iter()
-            .zip(x.iter().zip(v))
-            .map(|(m, (x, v))| 0.5 * m * v.dot(*v) - m * self.gravity.dot(*x))
-            .sum()
-    }
-
-    /// The energy stored in the springs.
-    fn spring_energy(&self, x: &[V]) -> f64 {
-        self.springs
-            .iter()
-            .map(|&(a, b, rest, k)| {
-                let stretch = length(x[a] - x[b]) - rest;
-                0.5 * k * stretch * stretch
-            })
-            .sum()
-    }
-}
-
-/// One row of a scene run: after a step, or at t = 0.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SceneRow<V = DVec2> {
-    /// Time.
-    pub t: f64,
-    /// Every bead's position, in the file's order.
-    pub positions: Vec<V>,
-    /// Every bead's velocity.
-    pub velocities: Vec<V>,
-    /// Whether each bead is held on its wire (false in flight off a
-    /// one-sided wire, and for a bead on no wire).
-    pub on: Vec<bool>,
-    /// Kinetic plus gravitational energy of all beads.
-    pub energy: f64,
-    /// The energy stored in the springs (not a CSV column; `compare` adds
-    /// it to `energy`).
-    pub spring_energy: f64,
-    /// The largest `|C|` of all constraints, wires included.
-    pub max_abs_c: f64,
-}
-
-/// What a scene run produced.
-#[derive(Clone, Debug, Default)]
-pub struct SceneRun<V = DVec2> {
-    /// Every bead's name, in the file's order.
-    pub names: Vec<String>,
-    /// One row per step from t = 0, up to a divergence.
-    pub rows: Vec<SceneRow<V>>,
-    /// When a bead diverged, and why, if one did.
-    pub diverged: Option<(f64, String)>,
 }
 
 #[derive(Resource)]
@@ -296,15 +59,7 @@ impl<V: SceneSpace> Recorder<V> {
                 }
             }
         }
-        self.rows.push(SceneRow {
-            t,
-            energy: self.measure.energy(&x, &v),
-            spring_energy: self.measure.spring_energy(&x),
-            max_abs_c: self.measure.max_abs_c(t, &x, &on),
-            positions: x,
-            velocities: v,
-            on,
-        });
+        self.rows.push(self.measure.row(t, x, v, on));
     }
 }
 
@@ -391,37 +146,11 @@ pub fn simulate_scene<S: Scene>(
     })
 }
 
-/// Writes a scene run as CSV: `t`, then for each bead in the file's order
-/// `<name>.x,<name>.y,<name>.vx,<name>.vy,<name>.on` in the plane, or
-/// `<name>.x,<name>.y,<name>.z,<name>.vx,<name>.vy,<name>.vz,<name>.on` in
-/// space (`on` 1 while held on its wire, 0 in flight off a one-sided wire
-/// or on no wire), then `energy,max_abs_c`.
+/// Writes a scene run as CSV to `path` (the columns of
+/// [`write_scene_csv`](wirebead::preset::table::write_scene_csv)).
 pub fn write_scene_csv<V: SceneSpace>(path: &Path, run: &SceneRun<V>) -> AnalysisResult<()> {
-    let mut writer =
-        csv::Writer::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let axes = &["x", "y", "z"][..V::DIMENSION];
-    let mut header = vec!["t".to_owned()];
-    for name in &run.names {
-        let columns = axes
-            .iter()
-            .map(|a| a.to_string())
-            .chain(axes.iter().map(|a| format!("v{a}")))
-            .chain(["on".to_owned()]);
-        header.extend(columns.map(|c| format!("{name}.{c}")));
-    }
-    header.extend(["energy".to_owned(), "max_abs_c".to_owned()]);
-    writer.write_record(&header)?;
-    for row in &run.rows {
-        let mut record = vec![row.t];
-        for ((x, v), on) in row.positions.iter().zip(&row.velocities).zip(&row.on) {
-            record.extend(&x.xyz().to_array()[..V::DIMENSION]);
-            record.extend(&v.xyz().to_array()[..V::DIMENSION]);
-            record.push(f64::from(u8::from(*on)));
-        }
-        record.extend([row.energy, row.max_abs_c]);
-        writer.write_record(record.iter().map(|v| format!("{v:e}")))?;
-    }
-    writer.flush()?;
+    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    table::write_scene_csv(file, run).map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(())
 }
 

@@ -444,3 +444,59 @@ fn simulate_scene_stops_where_strikes_never_settle() {
     assert_eq!(run.rows.len(), 1, "only the t = 0 row precedes it");
     assert!(!why.contains('\n'));
 }
+
+/// `simulate --scene`'s CSV of `scene` over `steps` steps, and the CSV the
+/// window's export writes of the same run recorded by a [`TimelinePlugin`].
+fn both_csvs<S: analysis::Scene>(
+    scene: &S,
+    file: &wirebead::SceneFile,
+    steps: u32,
+) -> (String, String) {
+    use wirebead::headless::{Headless, idle, run_steps};
+    use wirebead::plugin::{Timeline, TimelinePlugin};
+    let params = scene.params().clone();
+    let dt = params.timestep;
+    let run = analysis::simulate_scene(scene, params.clone(), f64::from(steps) * dt).unwrap();
+    let mut simulated = Vec::new();
+    wirebead::preset::table::write_scene_csv(&mut simulated, &run).unwrap();
+
+    let mut app = Headless::new(WireBeadPlugin::new(params).unwrap()).build();
+    app.add_plugins(TimelinePlugin);
+    let beads = scene.spawn(&mut app.world_mut().commands());
+    app.world_mut().flush();
+    idle(&mut app);
+    run_steps(&mut app, steps);
+    let timeline = app.world().resource::<Timeline>();
+    let mut exported = Vec::new();
+    let rows =
+        wirebead::preset::table::write_recorded_csv(&mut exported, file, &beads, timeline).unwrap();
+    assert_eq!(rows, steps as usize + 1, "t = 0 and every step");
+    (
+        String::from_utf8(simulated).unwrap(),
+        String::from_utf8(exported).unwrap(),
+    )
+}
+
+#[test]
+fn the_recorded_run_exports_the_rows_simulate_writes() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes");
+    for name in [
+        "rope",
+        "newtons_cradle",
+        "marble_run",
+        "rotating_hoop",
+        "rope_in_space",
+    ] {
+        let file = analysis::load_scene_file(&dir.join(format!("{name}.scene.ron"))).unwrap();
+        let (simulated, exported) = match &file {
+            wirebead::SceneFile::Plane(scene) => both_csvs(scene, &file, 120),
+            wirebead::SceneFile::Space(scene) => both_csvs(scene, &file, 120),
+        };
+        assert_eq!(
+            simulated.lines().count(),
+            122,
+            "{name}: the header and 121 rows"
+        );
+        assert_eq!(exported, simulated, "{name}");
+    }
+}

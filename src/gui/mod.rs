@@ -33,7 +33,7 @@ pub use space::{SpaceCamera, SpaceViewPlugin};
 
 use crate::controls::KeyboardControlsPlugin;
 use crate::plugin::TimelinePlugin;
-use crate::preset::ScenePresetPlugin;
+use crate::preset::{ExportPlugin, ScenePresetPlugin};
 
 /// The whole interactive scene on top of the simulation.
 #[derive(Default)]
@@ -67,6 +67,9 @@ impl Plugin for WireBeadGuiPlugin {
         }
         if !app.is_plugin_added::<TimelinePlugin>() {
             app.add_plugins(TimelinePlugin);
+        }
+        if !app.is_plugin_added::<ExportPlugin>() {
+            app.add_plugins(ExportPlugin);
         }
         app.add_plugins((
             SceneRenderPlugin,

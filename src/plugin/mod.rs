@@ -41,7 +41,7 @@ pub use params::ParamsPlugin;
 pub use restart::{Restart, RestartPlugin};
 pub use schedule::WireBeadSystems;
 pub use step::BeadStepPlugin;
-pub use timeline::{Timeline, TimelinePlugin, TimelineSeek};
+pub use timeline::{RecordedBead, Timeline, TimelinePlugin, TimelineSeek};
 pub use wires::WirePosePlugin;
 pub use writeback::WritebackPlugin;
 

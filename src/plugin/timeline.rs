@@ -161,12 +161,25 @@ impl Timeline {
     /// A bead's recorded position and velocity after step `step`
     /// ([`SimClock::steps`]), in the plane.
     pub fn bead(&self, step: u64, bead: Entity) -> Option<(DVec2, DVec2)> {
-        self.frame(step)?.plane.bead(bead)
+        self.recorded(step, bead).map(|b| (b.position, b.velocity))
     }
 
     /// A bead's recorded position and velocity after step `step`, in space.
     pub fn space_bead(&self, step: u64, bead: Entity) -> Option<(DVec3, DVec3)> {
-        self.frame(step)?.space.bead(bead)
+        self.space_recorded(step, bead)
+            .map(|b| (b.position, b.velocity))
+    }
+
+    /// A bead in the plane as recorded after step `step`.
+    pub fn recorded(&self, step: u64, bead: Entity) -> Option<RecordedBead<DVec2>> {
+        let frame = self.frame(step)?;
+        frame.plane.bead(bead, frame.clock.time)
+    }
+
+    /// A bead in space as recorded after step `step`.
+    pub fn space_recorded(&self, step: u64, bead: Entity) -> Option<RecordedBead<DVec3>> {
+        let frame = self.frame(step)?;
+        frame.space.bead(bead, frame.clock.time)
     }
 
     /// Forgets everything recorded.
@@ -215,6 +228,22 @@ impl Timeline {
     }
 }
 
+/// One bead as a [`Timeline`] recorded it after a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RecordedBead<V> {
+    /// The time after the step ([`SimClock::time`]).
+    pub time: f64,
+    /// Its position.
+    pub position: V,
+    /// Its velocity.
+    pub velocity: V,
+    /// Whether it was held on its wire (not in flight off a one-sided
+    /// wire, and on a wire at all).
+    pub on_wire: bool,
+    /// When it diverged, if it had.
+    pub diverged: Option<f64>,
+}
+
 /// The whole state after one step.
 struct Frame {
     clock: SimClock,
@@ -242,9 +271,16 @@ struct Scene<V: Dimension> {
 }
 
 impl<V: Dimension> Scene<V> {
-    fn bead(&self, bead: Entity) -> Option<(V, V)> {
+    fn bead(&self, bead: Entity, time: f64) -> Option<RecordedBead<V>> {
         let i = self.beads.binary_search_by_key(&bead, |b| b.entity).ok()?;
-        Some((self.beads[i].position, self.beads[i].velocity))
+        let b = &self.beads[i];
+        Some(RecordedBead {
+            time,
+            position: b.position,
+            velocity: b.velocity,
+            on_wire: b.contact.is_some_and(|c| c.is_on()),
+            diverged: b.diverged.as_ref().map(|d| d.time),
+        })
     }
 
     fn same(&self, other: &Self) -> bool {

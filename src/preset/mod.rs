@@ -26,6 +26,7 @@
 //! records the error in [`ActivePreset::error`].
 
 mod error;
+mod export;
 mod format;
 mod pile;
 mod plugin;
@@ -33,10 +34,12 @@ mod space;
 #[cfg(test)]
 mod space_tests;
 mod spawn;
+pub mod table;
 #[cfg(test)]
 mod tests;
 
 pub use error::PresetError;
+pub use export::{ExportDir, ExportPlugin, LastExport, scene_ron, scene_stem, with_edits};
 pub use format::{
     BeadPreset, ConstraintPreset, ContactsPreset, PinPreset, RodPreset, SceneLink, ScenePreset,
     SpringPreset, WirePreset,

@@ -51,6 +51,8 @@ pub struct ActivePreset {
     pub in_space: bool,
     /// Why the last load failed, if it did; cleared by a good load.
     pub error: Option<String>,
+    /// The running scene's beads, in the file's order.
+    pub beads: Vec<Entity>,
 }
 
 /// Asks to load and run the preset at an asset path.
@@ -151,7 +153,7 @@ pub fn apply_loaded_preset(
     for entity in &existing {
         commands.entity(entity).try_despawn();
     }
-    preset.spawn(&mut commands);
+    active.beads = preset.spawn(&mut commands);
     active.running = Some(preset.name().to_owned());
     active.in_space = preset.in_space();
     active.error = None;

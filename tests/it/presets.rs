@@ -242,3 +242,71 @@ fn malformed_preset_reports_its_error_and_the_scene_runs_on() {
     assert_eq!(after.len(), 4);
     assert_ne!(after, before);
 }
+
+#[test]
+fn the_run_exports_as_csv_and_the_scene_saves_with_its_edits() {
+    use wirebead::controls::ExportRequests;
+    use wirebead::plugin::TimelinePlugin;
+    use wirebead::preset::{ExportDir, ExportPlugin, LastExport};
+    use wirebead::{NextBeadParams, NextParams, NextWireShape, SceneFile, Wire, WireShape};
+
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("presets_export");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(
+        shipped_dir().join("pendulum_on_cart.scene.ron"),
+        dir.join("cart.scene.ron"),
+    )
+    .unwrap();
+    let mut app = asset_app(&dir);
+    app.add_plugins((TimelinePlugin, ExportPlugin))
+        .insert_resource(ExportDir(dir.join("out")));
+    app.world_mut()
+        .write_message(LoadPreset("cart.scene.ron".into()));
+    wait_for(&mut app, |a| a.running.is_some());
+    run_steps(&mut app, 30);
+
+    // Edits, pending: the bob heavier, a smaller step, the rail a circle.
+    let order = app.world().resource::<ActivePreset>().beads.clone();
+    assert_eq!(order.len(), 2, "the cart, then the bob");
+    let mut bob = *app.world().get::<BeadParams>(order[1]).unwrap();
+    bob.mass = 3.5;
+    let edit = NextBeadParams::new(bob).unwrap();
+    app.world_mut().entity_mut(order[1]).insert(edit);
+    let rail = app.world().get::<OnWire>(order[0]).unwrap().0;
+    let circle = Wire::circle(2.5).unwrap();
+    app.world_mut()
+        .entity_mut(rail)
+        .insert(NextWireShape::new(circle.shape().clone()).unwrap());
+    app.world_mut()
+        .resource_mut::<NextParams>()
+        .update(|p| p.timestep = 1.0 / 240.0)
+        .unwrap();
+
+    let mut requests = app.world_mut().resource_mut::<ExportRequests>();
+    requests.csv += 1;
+    requests.scene += 1;
+    idle(&mut app);
+    let last = app.world().resource::<LastExport>().0.clone();
+    let message = last.expect("an export").expect("written");
+    assert!(!message.contains('\n'), "{message}");
+    assert!(message.contains("cart.csv (31 rows)"), "{message}");
+
+    let csv = std::fs::read_to_string(dir.join("out/cart.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 32, "the header and t = 0 to step 30");
+    assert!(csv.starts_with("t,cart.x,cart.y,cart.vx,cart.vy,cart.on,bob.x"));
+
+    let text = std::fs::read_to_string(dir.join("out/cart.scene.ron")).unwrap();
+    let SceneFile::Plane(saved) = SceneFile::from_ron(&text).expect("the saved scene loads") else {
+        panic!("a scene in the plane");
+    };
+    assert_eq!(saved.params.timestep, 1.0 / 240.0);
+    assert_eq!(saved.all_beads().nth(1).unwrap().mass, 3.5);
+    assert_eq!(
+        saved.all_beads().next().unwrap().mass,
+        2.0,
+        "the cart as it was"
+    );
+    assert!(matches!(&saved.wires[0].shape, WireShape::Circle(c) if c.radius == 2.5));
+    assert_eq!(saved.constraints.len(), 1, "the rod kept");
+}

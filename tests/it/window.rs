@@ -338,3 +338,24 @@ fn keys_step_the_rope_back_and_forward_bit_for_bit() {
     );
     assert_eq!(timeline.now, timeline.at_step);
 }
+
+#[test]
+#[ignore = "needs the export .ci/run makes under Xvfb"]
+fn the_csv_exported_from_the_window_is_the_one_simulate_writes() {
+    let read = |name: &str| {
+        let path = dir().join(name);
+        std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    };
+    let exported = read("exports/rope.csv");
+    let rows = exported.lines().count() - 1;
+    assert!(rows > 30, "{rows} rows exported");
+    for simulated in ["rope_simulated.csv", "rope_saved_simulated.csv"] {
+        let simulated = read(simulated);
+        let differ = exported
+            .lines()
+            .zip(simulated.lines())
+            .position(|(a, b)| a != b);
+        assert_eq!(differ, None, "the first line that differs");
+        assert_eq!(simulated.lines().count(), rows + 1);
+    }
+}

@@ -4,7 +4,7 @@
 
 use bevy_egui::egui;
 
-use super::view::{PENDING_ORANGE, PanelActions, PanelView};
+use super::view::{ERROR_RED, PENDING_ORANGE, PanelActions, PanelView};
 use crate::controls::key_name;
 use crate::plugin::TimelineSeek;
 
@@ -72,6 +72,7 @@ fn timeline(ui: &mut egui::Ui, view: &PanelView, actions: &mut PanelActions) {
             actions.timeline.max_bytes as f64 / 1e6
         ));
     });
+    data_out(ui, view, actions);
     let timeline = &actions.timeline;
     if let Some(step) = timeline.departed() {
         ui.colored_label(
@@ -93,5 +94,34 @@ fn timeline(ui: &mut egui::Ui, view: &PanelView, actions: &mut PanelActions) {
             "{} steps back from the newest. Step or resume to run on from here.",
             last.steps - at.steps
         ));
+    }
+}
+
+/// The run as CSV and the scene as a file, and what the last export wrote.
+fn data_out(ui: &mut egui::Ui, view: &PanelView, actions: &mut PanelActions) {
+    ui.horizontal(|ui| {
+        if ui
+            .button(format!("Export CSV ({})", key_name(view.keys.export_csv)))
+            .on_hover_text("The recorded run, as simulate --scene writes it")
+            .clicked()
+        {
+            actions.exports.csv += 1;
+        }
+        if ui
+            .button(format!("Save scene ({})", key_name(view.keys.save_scene)))
+            .on_hover_text("The scene with its edits, applied and pending, as a scene file")
+            .clicked()
+        {
+            actions.exports.scene += 1;
+        }
+    });
+    match &view.last_export.0 {
+        Some(Ok(message)) => {
+            ui.label(format!("Exports: {message}."));
+        }
+        Some(Err(message)) => {
+            ui.colored_label(ERROR_RED, format!("Export: {message}."));
+        }
+        None => {}
     }
 }

@@ -8,16 +8,21 @@ use bevy::prelude::*;
 use super::PresetCatalog;
 use super::phase::PhasePlot;
 use super::plots::{PlotHistory, RecentStrikes};
-use crate::controls::{ControlKeys, ReverseRequests, StepRequests};
+use crate::controls::{ControlKeys, ExportRequests, ReverseRequests, StepRequests};
 use crate::gui::drag::SelectedBead;
 use crate::gui::render::SceneStyle;
 use crate::plugin::{Timeline, TimelineSeek};
-use crate::preset::{ActivePreset, LoadPreset};
+use crate::preset::{ActivePreset, LastExport, LoadPreset};
 use crate::{
     BeadDiagnostics, BeadParams, BeadPosition, ConstraintDiagnostics, Diverged, Islands,
     NextBeadParams, NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, Restart, Rod,
     SimClock, SimParams, SpaceWire, Wire, WireContact,
 };
+
+/// The colour of what went wrong: a refused edit, a divergence, a failed
+/// export.
+pub(super) const ERROR_RED: bevy_egui::egui::Color32 =
+    bevy_egui::egui::Color32::from_rgb(255, 90, 90);
 
 /// The colour of what waits on the user: edits pending, a run that
 /// changed from its recording.
@@ -82,6 +87,7 @@ pub struct PanelView<'w, 's> {
     pub(super) positions: Query<'w, 's, &'static BeadPosition>,
     pub(super) space_positions: Query<'w, 's, &'static BeadPosition<DVec3>>,
     pub(super) strikes: Res<'w, RecentStrikes>,
+    pub(super) last_export: Res<'w, LastExport>,
 }
 
 /// What the panel's controls ask of the world this frame.
@@ -95,6 +101,7 @@ pub struct PanelActions<'w, 's> {
     pub(super) loads: MessageWriter<'w, LoadPreset>,
     pub(super) phase: ResMut<'w, PhasePlot>,
     pub(super) timeline: ResMut<'w, Timeline>,
+    pub(super) exports: ResMut<'w, ExportRequests>,
     pub(super) seeks: MessageWriter<'w, TimelineSeek>,
     pub(super) commands: Commands<'w, 's>,
 }

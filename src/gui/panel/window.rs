@@ -10,12 +10,10 @@ use super::phase::phase_section;
 use super::plots::plots_section;
 use super::space::space_bead_section;
 use super::timeline::timeline_section;
-use super::view::{PENDING_ORANGE, PanelActions, PanelView};
+use super::view::{ERROR_RED, PENDING_ORANGE, PanelActions, PanelView};
 use crate::Restart;
 use crate::controls::{ControlKeys, SPEEDS, key_name, speed_label};
 use crate::preset::LoadPreset;
-
-const ERROR_RED: egui::Color32 = egui::Color32::from_rgb(255, 90, 90);
 
 /// The panel: the scene and run state, the selected bead and its wire, the
 /// solver's parameters and the plots, in a window that scrolls when it is
