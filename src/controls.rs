@@ -36,6 +36,9 @@ pub struct ControlKeys {
     pub export_csv: KeyCode,
     /// Save the scene, its edits included, as a scene file.
     pub save_scene: KeyCode,
+    /// Add a ghost copy of the scene with another method (see
+    /// [`GhostPlugin`](crate::ghost::GhostPlugin)).
+    pub ghost: KeyCode,
 }
 
 /// The speeds the run may go at, as fractions of real time: slow motion
@@ -83,6 +86,7 @@ impl Default for ControlKeys {
             reverse: KeyCode::KeyR,
             export_csv: KeyCode::KeyE,
             save_scene: KeyCode::KeyS,
+            ghost: KeyCode::KeyG,
         }
     }
 }
@@ -91,7 +95,7 @@ impl ControlKeys {
     /// A one-line description for an on-screen help line.
     pub fn help(&self) -> String {
         format!(
-            "{}: restart and apply edits · {}: pause/resume · {} and {}: one step back, forward · {} and {}: slower, faster · {}: run backwards · {}: export CSV · {}: save scene · drag a bead",
+            "{}: restart and apply edits · {}: pause/resume · {} and {}: one step back, forward · {} and {}: slower, faster · {}: run backwards · {}: export CSV · {}: save scene · {}: add a ghost · drag a bead",
             key_name(self.restart),
             key_name(self.pause),
             key_name(self.back),
@@ -100,7 +104,8 @@ impl ControlKeys {
             key_name(self.faster),
             key_name(self.reverse),
             key_name(self.export_csv),
-            key_name(self.save_scene)
+            key_name(self.save_scene),
+            key_name(self.ghost)
         )
     }
 }
@@ -132,6 +137,11 @@ pub struct ExportRequests {
     pub scene: u32,
 }
 
+/// Ghosts requested by key since the last frame, added by the
+/// [`GhostPlugin`](crate::ghost::GhostPlugin) as the panel drafted them.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GhostRequests(pub u32);
+
 /// Reversals of the run requested since the last frame, made by
 /// [`reverse_requested`] before the next step.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -148,6 +158,7 @@ impl Plugin for KeyboardControlsPlugin {
             .init_resource::<StepRequests>()
             .init_resource::<ReverseRequests>()
             .init_resource::<ExportRequests>()
+            .init_resource::<GhostRequests>()
             .add_message::<TimelineSeek>()
             .add_systems(
                 PreUpdate,
@@ -171,6 +182,7 @@ pub fn keyboard_controls(
     mut reversals: ResMut<ReverseRequests>,
     mut seeks: MessageWriter<TimelineSeek>,
     mut exports: ResMut<ExportRequests>,
+    mut ghosts: ResMut<GhostRequests>,
 ) {
     if keys.just_pressed(bindings.restart) {
         restarts.write(Restart);
@@ -193,6 +205,9 @@ pub fn keyboard_controls(
     }
     if keys.just_pressed(bindings.save_scene) {
         exports.scene += 1;
+    }
+    if keys.just_pressed(bindings.ghost) {
+        ghosts.0 += 1;
     }
     if keys.just_pressed(bindings.reverse) {
         reversals.0 += 1;

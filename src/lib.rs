@@ -83,6 +83,7 @@ pub mod controls;
 pub mod debug_render;
 mod dynamics;
 pub mod geometry;
+pub mod ghost;
 #[cfg(feature = "gui")]
 pub mod gui;
 pub mod headless;

@@ -13,6 +13,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::debug_render::{hatch_point, wire_points};
 use crate::geometry::Placed;
+use crate::ghost::Ghosts;
+use crate::gui::ghost::ghost_beads;
 use crate::gui::render::{FramedView, SceneCamera, hatch_length};
 use crate::gui::space::{SpaceCamera, WireDrawing};
 use crate::plugin::Timeline;
@@ -117,6 +119,22 @@ pub struct FrameReport {
     /// Where the run is on its timeline.
     #[serde(default)]
     pub timeline: Option<TimelineReport>,
+    /// Each ghost bead drawn.
+    #[serde(default)]
+    pub ghost_beads: Vec<GhostBeadReport>,
+}
+
+/// Where one ghost bead is drawn.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GhostBeadReport {
+    /// Its simulated position (`z` zero in the plane).
+    pub world: [f64; 3],
+    /// Window position in physical pixels, from the top left.
+    pub pixel: [f32; 2],
+    /// The drawn radius in physical pixels.
+    pub radius_px: f32,
+    /// Its ghost's colour, sRGB and alpha.
+    pub colour: [f32; 4],
 }
 
 /// Where the run is on its [`Timeline`], and every bead's state now and as
@@ -219,6 +237,7 @@ struct ReportView<'w, 's> {
     view: Res<'w, FramedView>,
     active: Res<'w, ActivePreset>,
     timeline: Option<Res<'w, Timeline>>,
+    ghosts: Option<Res<'w, Ghosts>>,
     clock: Res<'w, SimClock>,
     states: Query<'w, 's, (Entity, &'static BeadPosition, &'static BeadVelocity)>,
     space_states: Query<
@@ -326,7 +345,49 @@ impl ReportView<'_, '_> {
             preset_error: self.active.error.clone(),
             mean_frame_ms,
             timeline: self.timeline_report(),
+            ghost_beads: self.ghost_beads(scale, &to_pixel),
         }
+    }
+
+    /// Where each ghost bead is drawn.
+    fn ghost_beads(
+        &self,
+        scale: f32,
+        to_pixel: &dyn Fn(DVec2) -> Option<[f32; 2]>,
+    ) -> Vec<GhostBeadReport> {
+        let Some(ghosts) = &self.ghosts else {
+            return Vec::new();
+        };
+        let in_space = self.active.in_space;
+        let colours = ghosts.list.iter().flat_map(|g| {
+            let n = g.positions().len();
+            std::iter::repeat_n(g.colour, n)
+        });
+        ghost_beads(ghosts, &self.active, &self.transforms)
+            .zip(colours)
+            .filter_map(|((at, radius, _), colour)| {
+                let (centre, rim) = if in_space {
+                    let right = self
+                        .space_cameras
+                        .iter()
+                        .next()
+                        .map_or(Vec3::X, |(_, t)| t.right().as_vec3());
+                    let centre = self.space_pixel(scale, at.as_vec3())?;
+                    let rim = self.space_pixel(scale, at.as_vec3() + right * radius)?;
+                    (centre.to_array(), rim.to_array())
+                } else {
+                    let centre = to_pixel(at.truncate())?;
+                    let rim = to_pixel(at.truncate() + DVec2::new(f64::from(radius), 0.0))?;
+                    (centre, rim)
+                };
+                Some(GhostBeadReport {
+                    world: at.to_array(),
+                    pixel: centre,
+                    radius_px: Vec2::from(centre).distance(Vec2::from(rim)),
+                    colour,
+                })
+            })
+            .collect()
     }
 
     /// Where the run is on its timeline, with the beads' states now and as

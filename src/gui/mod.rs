@@ -17,6 +17,7 @@
 
 pub mod automation;
 pub mod drag;
+pub mod ghost;
 pub mod panel;
 pub mod render;
 pub mod space;
@@ -25,7 +26,7 @@ use bevy::picking::mesh_picking::MeshPickingPlugin;
 use bevy::prelude::*;
 use bevy_egui::{EguiGlobalSettings, EguiPlugin};
 
-pub use automation::{AutomationPlugin, FrameReport, TimelineReport};
+pub use automation::{AutomationPlugin, FrameReport, GhostBeadReport, TimelineReport};
 pub use drag::BeadDragPlugin;
 pub use panel::{PanelPlugin, PresetCatalog};
 pub use render::{SceneCamera, SceneRenderPlugin, SceneStyle};
@@ -34,6 +35,7 @@ pub use space::{SpaceCamera, SpaceViewPlugin};
 use crate::controls::KeyboardControlsPlugin;
 use crate::plugin::TimelinePlugin;
 use crate::preset::{ExportPlugin, ScenePresetPlugin};
+use ghost::GhostViewPlugin;
 
 /// The whole interactive scene on top of the simulation.
 #[derive(Default)]
@@ -72,6 +74,7 @@ impl Plugin for WireBeadGuiPlugin {
             app.add_plugins(ExportPlugin);
         }
         app.add_plugins((
+            GhostViewPlugin,
             SceneRenderPlugin,
             SpaceViewPlugin,
             BeadDragPlugin,

@@ -117,14 +117,17 @@ pub fn scene_ron(scene: &SceneFile) -> Result<String, String> {
 }
 
 /// What the export reads of the beads: their parameters, applied and
-/// pending, and their wires' shapes.
-type BeadEdits = (
+/// pending, and their wires.
+pub(crate) type BeadEdits = (
     Option<&'static BeadParams>,
     Option<&'static NextBeadParams>,
     Option<&'static BeadParams<DVec3>>,
     Option<&'static NextBeadParams<DVec3>>,
     Option<&'static OnWire>,
 );
+
+/// The wires' shapes, applied and pending.
+pub(crate) type WireEdits<'w, 's> = Query<'w, 's, (&'static Wire, Option<&'static NextWireShape>)>;
 
 /// Makes the exports asked for.
 #[allow(clippy::too_many_arguments)]
@@ -136,7 +139,7 @@ fn export_requested(
     timeline: Option<Res<Timeline>>,
     pending: Res<NextParams>,
     beads: Query<BeadEdits>,
-    wires: Query<(&Wire, Option<&NextWireShape>)>,
+    wires: WireEdits,
     mut last: ResMut<LastExport>,
 ) {
     let requests = std::mem::take(&mut *requests);
@@ -161,7 +164,7 @@ fn export_requested(
             written.push(format!("{} ({rows} rows)", path.display()));
         }
         if requests.scene > 0 {
-            let edited = edited_scene(scene, &active.beads, &pending, &beads, &wires);
+            let edited = edited_scene(scene, &active.beads, pending.get(), true, &beads, &wires);
             let path = dir.0.join(format!("{stem}.scene.ron"));
             let text = scene_ron(&edited)?;
             std::fs::write(&path, text)
@@ -177,27 +180,30 @@ fn export_requested(
     last.0 = Some(outcome);
 }
 
-/// The running scene with every edit in it, applied or pending.
-fn edited_scene(
+/// The running scene (its beads `order` in the file's order) with
+/// `params` and each bead's and wire's edits: those applied, and where
+/// `pending` those waiting for a restart too.
+pub(crate) fn edited_scene(
     scene: &SceneFile,
     order: &[Entity],
-    pending: &NextParams,
+    params: &SimParams,
+    pending: bool,
     beads: &Query<BeadEdits>,
-    wires: &Query<(&Wire, Option<&NextWireShape>)>,
+    wires: &WireEdits,
 ) -> SceneFile {
     let edits: Vec<_> = order.iter().map(|&e| beads.get(e).ok()).collect();
     let plane = edits
         .iter()
         .map(|b| {
             let (now, next, ..) = (*b)?;
-            next.map(|n| *n.get()).or(now.copied())
+            next.filter(|_| pending).map(|n| *n.get()).or(now.copied())
         })
         .collect::<Vec<_>>();
     let space = edits
         .iter()
         .map(|b| {
             let (_, _, now, next, _) = (*b)?;
-            next.map(|n| *n.get()).or(now.copied())
+            next.filter(|_| pending).map(|n| *n.get()).or(now.copied())
         })
         .collect::<Vec<_>>();
     // Each wire of the file by its first bead.
@@ -215,11 +221,12 @@ fn edited_scene(
                     }
                     let (.., on) = beads.get(bead?).ok()?;
                     let (wire, next) = wires.get(on?.0).ok()?;
+                    let next = next.filter(|_| pending);
                     Some(next.map_or_else(|| wire.shape().clone(), |n| n.shape().clone()))
                 })
                 .collect()
         }
         SceneFile::Space(_) => Vec::new(),
     };
-    with_edits(scene, pending.get(), &plane, &space, &shapes)
+    with_edits(scene, params, &plane, &space, &shapes)
 }

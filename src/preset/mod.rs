@@ -39,6 +39,7 @@ pub mod table;
 mod tests;
 
 pub use error::PresetError;
+pub(crate) use export::{BeadEdits, WireEdits, edited_scene};
 pub use export::{ExportDir, ExportPlugin, LastExport, scene_ron, scene_stem, with_edits};
 pub use format::{
     BeadPreset, ConstraintPreset, ContactsPreset, PinPreset, RodPreset, SceneLink, ScenePreset,

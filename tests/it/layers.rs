@@ -28,6 +28,7 @@ const LAYERS: &[&str] = &[
     "controls",
     "preset",
     "headless",
+    "ghost",
     "debug_render",
     "gui",
 ];

@@ -11,6 +11,7 @@ mod curves;
 #[cfg(feature = "debug-render")]
 mod debug_render;
 mod fuzz;
+mod ghost;
 mod islands;
 mod layers;
 mod parallel;

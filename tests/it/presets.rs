@@ -143,14 +143,14 @@ fn coupled_presets_run_ten_seconds_on_their_constraints() {
 }
 
 /// A headless app with assets read from `dir`.
-fn asset_app(dir: &std::path::Path) -> App {
+pub(crate) fn asset_app(dir: &std::path::Path) -> App {
     let mut app = Headless::new(WireBeadPlugin::default()).assets(dir).build();
     idle(&mut app);
     app
 }
 
 /// Updates (with no fixed step) until `done` or 10 s pass.
-fn wait_for(app: &mut App, done: impl Fn(&ActivePreset) -> bool) {
+pub(crate) fn wait_for(app: &mut App, done: impl Fn(&ActivePreset) -> bool) {
     for _ in 0..1000 {
         idle(app);
         if done(app.world().resource::<ActivePreset>()) {

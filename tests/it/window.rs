@@ -359,3 +359,29 @@ fn the_csv_exported_from_the_window_is_the_one_simulate_writes() {
         assert_eq!(simulated.lines().count(), rows + 1);
     }
 }
+
+#[test]
+#[ignore = "needs the ghost .ci/run adds with G under Xvfb"]
+fn a_ghost_added_with_g_is_drawn_beside_the_bead() {
+    let (image, report) = screenshot("ghost");
+    beads_drawn_where_simulated(&image, &report);
+    assert_eq!(report.ghost_beads.len(), 1, "one ghost of one bead");
+    let style = wirebead::gui::SceneStyle::default();
+    let background = style.background.to_srgba();
+    for ghost in &report.ghost_beads {
+        // The ring's colour over the background, by its alpha.
+        let [r, g, b, a] = ghost.colour;
+        let over = |c: f32, bg: f32| ((a * c + (1.0 - a) * bg) * 255.0).round() as u8;
+        let colour = Rgb([
+            over(r, background.red),
+            over(g, background.green),
+            over(b, background.blue),
+        ]);
+        let reach = ghost.radius_px.round() as i32 + 2;
+        assert!(
+            colour_near(&image, ghost.pixel, reach, colour),
+            "no ring of {colour:?} around {:?}",
+            ghost.pixel
+        );
+    }
+}

@@ -9,6 +9,7 @@
 //! simulation.
 
 mod constraints;
+mod ghosts;
 mod params;
 mod phase;
 mod plots;

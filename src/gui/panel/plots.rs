@@ -12,6 +12,7 @@ use egui_plot::{
 };
 
 use crate::geometry::Coordinates;
+use crate::ghost::{GhostSample, Ghosts};
 use crate::gui::drag::SelectedBead;
 use crate::reference::{circle_angle, circle_normal_force};
 use crate::{
@@ -256,7 +257,7 @@ pub(super) fn panel_plot(id: &str, height: f32, log: bool) -> Plot<'static> {
 /// One line of a [`plot`]: its name (in the legend where there are
 /// several), its points `[t, value]`, its colour and whether it is dashed.
 struct PlotLine {
-    name: &'static str,
+    name: String,
     points: Vec<[f64; 2]>,
     colour: egui::Color32,
     dashed: bool,
@@ -264,9 +265,9 @@ struct PlotLine {
 
 impl PlotLine {
     /// A solid line.
-    fn solid(name: &'static str, points: Vec<[f64; 2]>, colour: egui::Color32) -> Self {
+    fn solid(name: impl Into<String>, points: Vec<[f64; 2]>, colour: egui::Color32) -> Self {
         Self {
-            name,
+            name: name.into(),
             points,
             colour,
             dashed: false,
@@ -354,16 +355,32 @@ pub fn tick_label(value: f64, step: f64) -> String {
 
 /// Plots of the selected bead's last seconds, each with its axes labelled:
 /// a section that folds away.
-pub(super) fn plots_section(ui: &mut egui::Ui, history: &PlotHistory) {
+pub(super) fn plots_section(ui: &mut egui::Ui, history: &PlotHistory, ghosts: &Ghosts) {
     ui.separator();
     egui::CollapsingHeader::new("Plots")
         .default_open(true)
-        .show(ui, |ui| plots(ui, history));
+        .show(ui, |ui| plots(ui, history, ghosts));
 }
 
 /// The plots of [`plots_section`].
-fn plots(ui: &mut egui::Ui, history: &PlotHistory) {
+fn plots(ui: &mut egui::Ui, history: &PlotHistory, ghosts: &Ghosts) {
     let samples = &history.samples;
+    // Each ghost's line beside the run's, in the ghost's colour.
+    let ghost_lines = |value: fn(&GhostSample) -> f64| -> Vec<PlotLine> {
+        ghosts
+            .list
+            .iter()
+            .map(|ghost| {
+                let points = ghost.samples.iter().map(|s| [s.t, value(s)]).collect();
+                let [r, g, b, _] = ghost.colour.map(|c| (c * 255.0).round() as u8);
+                PlotLine::solid(
+                    format!("ghost: {}", ghost.spec.label()),
+                    points,
+                    egui::Color32::from_rgb(r, g, b),
+                )
+            })
+            .collect()
+    };
     for (id, label, unit, colour, value, log) in [
         (
             "plot-c",
@@ -385,7 +402,13 @@ fn plots(ui: &mut egui::Ui, history: &PlotHistory) {
     ] {
         ui.label(format!("{label} ({unit})"));
         let points = samples.iter().map(|s| [s.t, value(s)]).collect();
-        plot(ui, id, vec![PlotLine::solid(label, points, colour)], log);
+        let mut lines = vec![PlotLine::solid(label, points, colour)];
+        match id {
+            "plot-c" => lines.extend(ghost_lines(|s| s.c)),
+            "plot-e" => lines.extend(ghost_lines(|s| s.energy)),
+            _ => {}
+        }
+        plot(ui, id, lines, log);
     }
     // On a circle: the force that holds the bead, against energy kept.
     let held: Vec<(f64, (f64, f64))> = samples
@@ -400,7 +423,7 @@ fn plots(ui: &mut egui::Ui, history: &PlotHistory) {
         let lines = vec![
             PlotLine::solid("simulated", simulated, egui::Color32::GOLD),
             PlotLine {
-                name: "energy kept",
+                name: "energy kept".to_owned(),
                 points: kept,
                 colour: egui::Color32::GRAY,
                 dashed: true,

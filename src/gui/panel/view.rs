@@ -9,6 +9,7 @@ use super::PresetCatalog;
 use super::phase::PhasePlot;
 use super::plots::{PlotHistory, RecentStrikes};
 use crate::controls::{ControlKeys, ExportRequests, ReverseRequests, StepRequests};
+use crate::ghost::{GhostDraft, GhostRequest, Ghosts};
 use crate::gui::drag::SelectedBead;
 use crate::gui::render::SceneStyle;
 use crate::plugin::{Timeline, TimelineSeek};
@@ -88,6 +89,7 @@ pub struct PanelView<'w, 's> {
     pub(super) space_positions: Query<'w, 's, &'static BeadPosition<DVec3>>,
     pub(super) strikes: Res<'w, RecentStrikes>,
     pub(super) last_export: Res<'w, LastExport>,
+    pub(super) ghosts: Res<'w, Ghosts>,
 }
 
 /// What the panel's controls ask of the world this frame.
@@ -102,6 +104,8 @@ pub struct PanelActions<'w, 's> {
     pub(super) phase: ResMut<'w, PhasePlot>,
     pub(super) timeline: ResMut<'w, Timeline>,
     pub(super) exports: ResMut<'w, ExportRequests>,
+    pub(super) ghost_draft: ResMut<'w, GhostDraft>,
+    pub(super) ghost_requests: MessageWriter<'w, GhostRequest>,
     pub(super) seeks: MessageWriter<'w, TimelineSeek>,
     pub(super) commands: Commands<'w, 's>,
 }

@@ -5,6 +5,7 @@ use bevy::prelude::*;
 use bevy_egui::{EguiContexts, egui};
 
 use super::constraints::{constraints_section, strikes_section};
+use super::ghosts::ghosts_section;
 use super::params::{Edit, bead_section, solver_section};
 use super::phase::phase_section;
 use super::plots::plots_section;
@@ -48,7 +49,8 @@ pub fn panel(
             strikes_section(ui, &view);
             let solver = solver_section(ui, &mut actions.pending, view.active.in_space);
             outcome = solver.or(bead);
-            plots_section(ui, &view.history);
+            ghosts_section(ui, &view, &mut actions);
+            plots_section(ui, &view.history, &view.ghosts);
             phase_section(ui, &view.history, &mut actions.phase);
         });
     match outcome {
