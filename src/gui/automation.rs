@@ -15,6 +15,7 @@ use crate::debug_render::{hatch_point, wire_points};
 use crate::geometry::Placed;
 use crate::ghost::Ghosts;
 use crate::gui::ghost::ghost_beads;
+use crate::gui::panel::PhasePlotFrame;
 use crate::gui::render::{FramedView, SceneCamera, hatch_length};
 use crate::gui::space::{SpaceCamera, WireDrawing};
 use crate::plugin::Timeline;
@@ -122,6 +123,19 @@ pub struct FrameReport {
     /// Each ghost bead drawn.
     #[serde(default)]
     pub ghost_beads: Vec<GhostBeadReport>,
+    /// Where the phase plot is drawn, if it is.
+    #[serde(default)]
+    pub phase_plot: Option<PlotReport>,
+}
+
+/// Where a plot is drawn and what it spans.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PlotReport {
+    /// Left, top, right and bottom, in physical pixels.
+    pub rect_px: [f32; 4],
+    /// The values at the left and right edges, then at the bottom and the
+    /// top.
+    pub bounds: [f64; 4],
 }
 
 /// Where one ghost bead is drawn.
@@ -238,6 +252,7 @@ struct ReportView<'w, 's> {
     active: Res<'w, ActivePreset>,
     timeline: Option<Res<'w, Timeline>>,
     ghosts: Option<Res<'w, Ghosts>>,
+    phase: Option<Res<'w, PhasePlotFrame>>,
     clock: Res<'w, SimClock>,
     states: Query<'w, 's, (Entity, &'static BeadPosition, &'static BeadVelocity)>,
     space_states: Query<
@@ -346,6 +361,10 @@ impl ReportView<'_, '_> {
             mean_frame_ms,
             timeline: self.timeline_report(),
             ghost_beads: self.ghost_beads(scale, &to_pixel),
+            phase_plot: self.phase.as_ref().and_then(|p| p.0).map(|p| PlotReport {
+                rect_px: p.rect,
+                bounds: p.bounds,
+            }),
         }
     }
 

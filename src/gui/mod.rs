@@ -26,7 +26,7 @@ use bevy::picking::mesh_picking::MeshPickingPlugin;
 use bevy::prelude::*;
 use bevy_egui::{EguiGlobalSettings, EguiPlugin};
 
-pub use automation::{AutomationPlugin, FrameReport, GhostBeadReport, TimelineReport};
+pub use automation::{AutomationPlugin, FrameReport, GhostBeadReport, PlotReport, TimelineReport};
 pub use drag::BeadDragPlugin;
 pub use panel::{PanelPlugin, PresetCatalog};
 pub use render::{SceneCamera, SceneRenderPlugin, SceneStyle};

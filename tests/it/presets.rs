@@ -15,6 +15,7 @@ use crate::common::{BeadNow, bead};
 
 pub(crate) const SHIPPED: &[&str] = &[
     "assignment_circle.scene.ron",
+    "pendulum.scene.ron",
     "ellipse.scene.ron",
     "sine_track.scene.ron",
     "multi_bead.scene.ron",

@@ -385,3 +385,44 @@ fn a_ghost_added_with_g_is_drawn_beside_the_bead() {
         );
     }
 }
+
+#[test]
+#[ignore = "needs the screenshot .ci/run makes under Xvfb"]
+fn the_pendulums_phase_portrait_draws_its_closed_orbit() {
+    let (image, report) = screenshot("phase");
+    let plot = report.phase_plot.expect("the phase plot is drawn");
+    let [left, top, right, bottom] = plot.rect_px;
+    let [x0, x1, y0, y1] = plot.bounds;
+    let pixel = |x: f64, y: f64| {
+        [
+            left + ((x - x0) / (x1 - x0)) as f32 * (right - left),
+            bottom - ((y - y0) / (y1 - y0)) as f32 * (bottom - top),
+        ]
+    };
+    // The scene: from rest at 60° on a unit circle, g = 9.81. Energy kept:
+    // θ̇² = 2 g/R (cos θ − cos θ0).
+    let (g, r, theta0) = (9.81_f64, 1.0_f64, 60f64.to_radians());
+    let recorded = rgb(bevy::color::Color::srgb_u8(173, 216, 230));
+    let mut on_orbit = 0;
+    let n = 60;
+    for k in 0..n {
+        let theta = theta0 * (-1.0 + 2.0 * (k as f64 + 0.5) / n as f64);
+        let speed = (2.0 * g / r * (theta.cos() - theta0.cos())).sqrt();
+        for sign in [1.0, -1.0] {
+            if colour_near(&image, pixel(theta, sign * speed), 3, recorded) {
+                on_orbit += 1;
+            }
+        }
+    }
+    eprintln!("the orbit's colour at {on_orbit} of {} points", 2 * n);
+    assert!(
+        on_orbit >= 2 * n * 9 / 10,
+        "the orbit's colour at {on_orbit} of {} points",
+        2 * n
+    );
+    // Inside the orbit, at rest at the bottom, nothing is drawn.
+    assert!(
+        !colour_near(&image, pixel(0.0, 0.0), 2, recorded),
+        "the orbit's colour at its centre: a blot, not an orbit"
+    );
+}

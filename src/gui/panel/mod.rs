@@ -21,7 +21,7 @@ mod window;
 use bevy::prelude::*;
 use bevy_egui::EguiPrimaryContextPass;
 
-pub use phase::{PhasePlot, Quantity};
+pub use phase::{PhasePlot, PhasePlotFrame, PlotFrame, Quantity};
 pub use plots::{PlotHistory, PlotSample, RecentStrikes, record_history, record_strikes};
 pub use view::{PanelActions, PanelView};
 pub use window::panel;
@@ -45,6 +45,7 @@ impl Default for PresetCatalog {
                 ("Sine track", "scenes/sine_track.scene.ron"),
                 ("Many beads", "scenes/multi_bead.scene.ron"),
                 ("Bead at rest", "scenes/resting.scene.ron"),
+                ("Pendulum from 60°", "scenes/pendulum.scene.ron"),
                 ("Pendulum on a cart", "scenes/pendulum_on_cart.scene.ron"),
                 ("Double pendulum", "scenes/double_pendulum.scene.ron"),
                 ("Rope on a rail", "scenes/rope.scene.ron"),
@@ -98,6 +99,7 @@ impl Plugin for PanelPlugin {
         app.init_resource::<PresetCatalog>()
             .init_resource::<PlotHistory>()
             .init_resource::<PhasePlot>()
+            .init_resource::<PhasePlotFrame>()
             .init_resource::<SelectedBead>()
             .init_resource::<RecentStrikes>()
             .add_systems(

@@ -108,18 +108,48 @@ impl Default for PhasePlot {
     }
 }
 
+/// Where the phase plot was last drawn: its frame on screen, in physical
+/// pixels, and the values at its edges, for scripts that check what it
+/// shows.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhasePlotFrame(pub Option<PlotFrame>);
+
+/// A plot's frame on screen and the values at its edges.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlotFrame {
+    /// Left, top, right and bottom, in physical pixels.
+    pub rect: [f32; 4],
+    /// The values at the left and right edges, then at the bottom and the
+    /// top.
+    pub bounds: [f64; 4],
+}
+
 /// The phase plot's section, which folds away: a menu for each axis,
 /// then the recorded samples of `y` against `x`, the latest marked; on a
 /// circle's `(θ, θ̇)` the separatrix too, dashed.
-pub(super) fn phase_section(ui: &mut egui::Ui, history: &PlotHistory, choice: &mut PhasePlot) {
+pub(super) fn phase_section(
+    ui: &mut egui::Ui,
+    history: &PlotHistory,
+    choice: &mut PhasePlot,
+    frame: &mut PhasePlotFrame,
+) {
     ui.separator();
-    egui::CollapsingHeader::new("Phase plot")
+    let drawn = egui::CollapsingHeader::new("Phase plot")
         .default_open(true)
-        .show(ui, |ui| phase_plot(ui, history, choice));
+        .show(ui, |ui| phase_plot(ui, history, choice))
+        .body_returned
+        .flatten();
+    if frame.0 != drawn {
+        frame.0 = drawn;
+    }
 }
 
 /// The menus and the plot of [`phase_section`].
-fn phase_plot(ui: &mut egui::Ui, history: &PlotHistory, choice: &mut PhasePlot) {
+fn phase_plot(
+    ui: &mut egui::Ui,
+    history: &PlotHistory,
+    choice: &mut PhasePlot,
+) -> Option<PlotFrame> {
     ui.horizontal(|ui| {
         ui.label("plot");
         quantity_menu(ui, "phase-y", &mut choice.y);
@@ -133,11 +163,11 @@ fn phase_plot(ui: &mut egui::Ui, history: &PlotHistory, choice: &mut PhasePlot) 
         .collect();
     if points.is_empty() {
         ui.label("Nothing to plot: θ and dθ/dt need a bead on a circle; pick other quantities.");
-        return;
+        return None;
     }
     let last = points[points.len() - 1];
     let portrait = (choice.x, choice.y) == (Quantity::Angle, Quantity::AngularSpeed);
-    panel_plot("plot-phase", 160.0, false)
+    let drawn = panel_plot("plot-phase", 160.0, false)
         .x_axis_label(choice.x.label())
         .y_axis_label(choice.y.label())
         .x_grid_spacer(uniform_grid_spacer(|input| grid_steps(input.bounds, false)))
@@ -169,6 +199,18 @@ fn phase_plot(ui: &mut egui::Ui, history: &PlotHistory, choice: &mut PhasePlot) 
                     .color(egui::Color32::ORANGE),
             );
         });
+    let scale = ui.ctx().pixels_per_point();
+    let rect = drawn.transform.frame();
+    let bounds = drawn.transform.bounds();
+    Some(PlotFrame {
+        rect: [rect.left(), rect.top(), rect.right(), rect.bottom()].map(|v| v * scale),
+        bounds: [
+            bounds.min()[0],
+            bounds.max()[0],
+            bounds.min()[1],
+            bounds.max()[1],
+        ],
+    })
 }
 
 /// `points` cut into pieces where an angle among `axes` wraps round

@@ -6,7 +6,7 @@ use bevy::math::DVec3;
 use bevy::prelude::*;
 
 use super::PresetCatalog;
-use super::phase::PhasePlot;
+use super::phase::{PhasePlot, PhasePlotFrame};
 use super::plots::{PlotHistory, RecentStrikes};
 use crate::controls::{ControlKeys, ExportRequests, ReverseRequests, StepRequests};
 use crate::ghost::{GhostDraft, GhostRequest, Ghosts};
@@ -102,6 +102,7 @@ pub struct PanelActions<'w, 's> {
     pub(super) restarts: MessageWriter<'w, Restart>,
     pub(super) loads: MessageWriter<'w, LoadPreset>,
     pub(super) phase: ResMut<'w, PhasePlot>,
+    pub(super) phase_frame: ResMut<'w, PhasePlotFrame>,
     pub(super) timeline: ResMut<'w, Timeline>,
     pub(super) exports: ResMut<'w, ExportRequests>,
     pub(super) ghost_draft: ResMut<'w, GhostDraft>,

@@ -51,7 +51,12 @@ pub fn panel(
             outcome = solver.or(bead);
             ghosts_section(ui, &view, &mut actions);
             plots_section(ui, &view.history, &view.ghosts);
-            phase_section(ui, &view.history, &mut actions.phase);
+            phase_section(
+                ui,
+                &view.history,
+                &mut actions.phase,
+                &mut actions.phase_frame,
+            );
         });
     match outcome {
         Some(Ok(())) => *refused = None,
