@@ -36,6 +36,8 @@ pub struct ControlKeys {
     pub export_csv: KeyCode,
     /// Save the scene, its edits included, as a scene file.
     pub save_scene: KeyCode,
+    /// Save the panel's plots, as shown, as a PNG.
+    pub save_plots: KeyCode,
     /// Add a ghost copy of the scene with another method (see
     /// [`GhostPlugin`](crate::ghost::GhostPlugin)).
     pub ghost: KeyCode,
@@ -86,6 +88,7 @@ impl Default for ControlKeys {
             reverse: KeyCode::KeyR,
             export_csv: KeyCode::KeyE,
             save_scene: KeyCode::KeyS,
+            save_plots: KeyCode::KeyI,
             ghost: KeyCode::KeyG,
         }
     }
@@ -95,7 +98,7 @@ impl ControlKeys {
     /// A one-line description for an on-screen help line.
     pub fn help(&self) -> String {
         format!(
-            "{}: restart and apply edits · {}: pause/resume · {} and {}: one step back, forward · {} and {}: slower, faster · {}: run backwards · {}: export CSV · {}: save scene · {}: add a ghost · drag a bead",
+            "{}: restart and apply edits · {}: pause/resume · {} and {}: one step back, forward · {} and {}: slower, faster · {}: run backwards · {}, {}, {}: export CSV, scene, plots · {}: add a ghost · drag a bead",
             key_name(self.restart),
             key_name(self.pause),
             key_name(self.back),
@@ -105,6 +108,7 @@ impl ControlKeys {
             key_name(self.reverse),
             key_name(self.export_csv),
             key_name(self.save_scene),
+            key_name(self.save_plots),
             key_name(self.ghost)
         )
     }
@@ -135,6 +139,8 @@ pub struct ExportRequests {
     pub csv: u32,
     /// Requests for the scene file.
     pub scene: u32,
+    /// Requests for the plots as a PNG (made by the window's panel).
+    pub plots: u32,
 }
 
 /// Ghosts requested by key since the last frame, added by the
@@ -205,6 +211,9 @@ pub fn keyboard_controls(
     }
     if keys.just_pressed(bindings.save_scene) {
         exports.scene += 1;
+    }
+    if keys.just_pressed(bindings.save_plots) {
+        exports.plots += 1;
     }
     if keys.just_pressed(bindings.ghost) {
         ghosts.0 += 1;

@@ -133,6 +133,9 @@ pub struct FrameReport {
 pub struct PlotReport {
     /// Left, top, right and bottom, in physical pixels.
     pub rect_px: [f32; 4],
+    /// The part of it on screen (the rest scrolled out of the panel's
+    /// view), the same way.
+    pub visible_px: [f32; 4],
     /// The values at the left and right edges, then at the bottom and the
     /// top.
     pub bounds: [f64; 4],
@@ -363,6 +366,7 @@ impl ReportView<'_, '_> {
             ghost_beads: self.ghost_beads(scale, &to_pixel),
             phase_plot: self.phase.as_ref().and_then(|p| p.0).map(|p| PlotReport {
                 rect_px: p.rect,
+                visible_px: p.visible,
                 bounds: p.bounds,
             }),
         }

@@ -142,7 +142,12 @@ fn export_requested(
     wires: WireEdits,
     mut last: ResMut<LastExport>,
 ) {
-    let requests = std::mem::take(&mut *requests);
+    // The plots' PNG is the window's to make.
+    let requests = ExportRequests {
+        csv: std::mem::take(&mut requests.csv),
+        scene: std::mem::take(&mut requests.scene),
+        plots: 0,
+    };
     if requests == ExportRequests::default() {
         return;
     }

@@ -13,6 +13,7 @@ mod ghosts;
 mod params;
 mod phase;
 mod plots;
+mod png;
 mod space;
 mod timeline;
 mod view;
@@ -22,7 +23,10 @@ use bevy::prelude::*;
 use bevy_egui::EguiPrimaryContextPass;
 
 pub use phase::{PhasePlot, PhasePlotFrame, PlotFrame, Quantity};
-pub use plots::{PlotHistory, PlotSample, RecentStrikes, record_history, record_strikes};
+pub use plots::{
+    PlotHistory, PlotSample, PlotsShown, RecentStrikes, record_history, record_strikes,
+};
+use png::save_plots;
 pub use view::{PanelActions, PanelView};
 pub use window::panel;
 
@@ -100,13 +104,14 @@ impl Plugin for PanelPlugin {
             .init_resource::<PlotHistory>()
             .init_resource::<PhasePlot>()
             .init_resource::<PhasePlotFrame>()
+            .init_resource::<PlotsShown>()
             .init_resource::<SelectedBead>()
             .init_resource::<RecentStrikes>()
             .add_systems(
                 FixedUpdate,
                 (record_history, record_strikes).after(WireBeadSystems::Writeback),
             )
-            .add_systems(Update, keep_selection)
+            .add_systems(Update, (keep_selection, save_plots))
             .add_systems(EguiPrimaryContextPass, panel);
     }
 }

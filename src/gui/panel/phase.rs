@@ -8,7 +8,7 @@ use bevy::prelude::*;
 use bevy_egui::egui;
 use egui_plot::{Legend, Line, LineStyle, PlotPoints, Points, uniform_grid_spacer};
 
-use super::plots::{PlotHistory, PlotSample, grid_steps, panel_plot, tick_label};
+use super::plots::{PlotHistory, PlotSample, grid_steps, panel_plot, shown, tick_label};
 use crate::reference::separatrix;
 
 /// A quantity of the selected bead that the panel can plot.
@@ -119,6 +119,9 @@ pub struct PhasePlotFrame(pub Option<PlotFrame>);
 pub struct PlotFrame {
     /// Left, top, right and bottom, in physical pixels.
     pub rect: [f32; 4],
+    /// The part of it the panel shows (the rest scrolled out of view), the
+    /// same way.
+    pub visible: [f32; 4],
     /// The values at the left and right edges, then at the bottom and the
     /// top.
     pub bounds: [f64; 4],
@@ -132,16 +135,16 @@ pub(super) fn phase_section(
     history: &PlotHistory,
     choice: &mut PhasePlot,
     frame: &mut PhasePlotFrame,
-) {
+) -> Option<egui::Rect> {
     ui.separator();
-    let drawn = egui::CollapsingHeader::new("Phase plot")
+    let section = egui::CollapsingHeader::new("Phase plot")
         .default_open(true)
-        .show(ui, |ui| phase_plot(ui, history, choice))
-        .body_returned
-        .flatten();
+        .show(ui, |ui| phase_plot(ui, history, choice));
+    let drawn = section.body_returned.flatten();
     if frame.0 != drawn {
         frame.0 = drawn;
     }
+    shown(ui, section.body_response?.rect)
 }
 
 /// The menus and the plot of [`phase_section`].
@@ -202,8 +205,10 @@ fn phase_plot(
     let scale = ui.ctx().pixels_per_point();
     let rect = drawn.transform.frame();
     let bounds = drawn.transform.bounds();
+    let edges = |r: egui::Rect| [r.left(), r.top(), r.right(), r.bottom()].map(|v| v * scale);
     Some(PlotFrame {
-        rect: [rect.left(), rect.top(), rect.right(), rect.bottom()].map(|v| v * scale),
+        rect: edges(*rect),
+        visible: edges(rect.intersect(ui.clip_rect())),
         bounds: [
             bounds.min()[0],
             bounds.max()[0],

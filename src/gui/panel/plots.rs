@@ -194,6 +194,12 @@ pub fn record_history(
     }
 }
 
+/// The part of the window the panel's plots and phase plot show in, in
+/// physical pixels (left, top, right, bottom): what a PNG of the plots
+/// holds. None while they are folded away or scrolled out of view.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlotsShown(pub Option<[f32; 4]>);
+
 /// A plot of the last seconds with labelled axes: time in seconds, the
 /// value (its unit is in the heading above) with tick labels that tell
 /// neighbouring ticks apart at any scale ([`tick_label`]), so that a range
@@ -355,11 +361,25 @@ pub fn tick_label(value: f64, step: f64) -> String {
 
 /// Plots of the selected bead's last seconds, each with its axes labelled:
 /// a section that folds away.
-pub(super) fn plots_section(ui: &mut egui::Ui, history: &PlotHistory, ghosts: &Ghosts) {
+///
+/// Returns the part of the section's body on screen, if any shows.
+pub(super) fn plots_section(
+    ui: &mut egui::Ui,
+    history: &PlotHistory,
+    ghosts: &Ghosts,
+) -> Option<egui::Rect> {
     ui.separator();
-    egui::CollapsingHeader::new("Plots")
+    let body = egui::CollapsingHeader::new("Plots")
         .default_open(true)
-        .show(ui, |ui| plots(ui, history, ghosts));
+        .show(ui, |ui| plots(ui, history, ghosts))
+        .body_response?;
+    shown(ui, body.rect)
+}
+
+/// The part of `rect` the panel shows (within its scrolled view), if any.
+pub(super) fn shown(ui: &egui::Ui, rect: egui::Rect) -> Option<egui::Rect> {
+    let visible = rect.intersect(ui.clip_rect());
+    (visible.width() > 1.0 && visible.height() > 1.0).then_some(visible)
 }
 
 /// The plots of [`plots_section`].

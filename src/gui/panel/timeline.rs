@@ -114,6 +114,13 @@ fn data_out(ui: &mut egui::Ui, view: &PanelView, actions: &mut PanelActions) {
         {
             actions.exports.scene += 1;
         }
+        if ui
+            .button(format!("Plots PNG ({})", key_name(view.keys.save_plots)))
+            .on_hover_text("The plots and the phase plot, as shown")
+            .clicked()
+        {
+            actions.exports.plots += 1;
+        }
     });
     match &view.last_export.0 {
         Some(Ok(message)) => {

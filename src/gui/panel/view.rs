@@ -7,6 +7,7 @@ use bevy::prelude::*;
 
 use super::PresetCatalog;
 use super::phase::{PhasePlot, PhasePlotFrame};
+use super::plots::PlotsShown;
 use super::plots::{PlotHistory, RecentStrikes};
 use crate::controls::{ControlKeys, ExportRequests, ReverseRequests, StepRequests};
 use crate::ghost::{GhostDraft, GhostRequest, Ghosts};
@@ -103,6 +104,7 @@ pub struct PanelActions<'w, 's> {
     pub(super) loads: MessageWriter<'w, LoadPreset>,
     pub(super) phase: ResMut<'w, PhasePlot>,
     pub(super) phase_frame: ResMut<'w, PhasePlotFrame>,
+    pub(super) plots_shown: ResMut<'w, PlotsShown>,
     pub(super) timeline: ResMut<'w, Timeline>,
     pub(super) exports: ResMut<'w, ExportRequests>,
     pub(super) ghost_draft: ResMut<'w, GhostDraft>,

@@ -50,13 +50,23 @@ pub fn panel(
             let solver = solver_section(ui, &mut actions.pending, view.active.in_space);
             outcome = solver.or(bead);
             ghosts_section(ui, &view, &mut actions);
-            plots_section(ui, &view.history, &view.ghosts);
-            phase_section(
+            let plots = plots_section(ui, &view.history, &view.ghosts);
+            let phase = phase_section(
                 ui,
                 &view.history,
                 &mut actions.phase,
                 &mut actions.phase_frame,
             );
+            let shown = match (plots, phase) {
+                (Some(a), Some(b)) => Some(a.union(b)),
+                (a, b) => a.or(b),
+            };
+            let scale = ui.ctx().pixels_per_point();
+            let shown =
+                shown.map(|r| [r.left(), r.top(), r.right(), r.bottom()].map(|v| v * scale));
+            if actions.plots_shown.0 != shown {
+                actions.plots_shown.0 = shown;
+            }
         });
     match outcome {
         Some(Ok(())) => *refused = None,
