@@ -18,6 +18,7 @@ use bevy::prelude::*;
 use bevy::window::WindowResolution;
 use clap::Parser;
 use wirebead::LoadPreset;
+use wirebead::controls::Presentation;
 use wirebead::gui::{AutomationPlugin, WireBeadGuiPlugin};
 use wirebead::prelude::*;
 use wirebead::preset::ExportDir;
@@ -48,6 +49,10 @@ struct Args {
     /// Window height in pixels.
     #[arg(long, default_value_t = 800)]
     height: u32,
+    /// Start in presentation mode (F5 turns it on and off): larger text,
+    /// the plots beside the scene.
+    #[arg(long)]
+    present: bool,
     /// Where E (export CSV) and S (save scene) write.
     #[arg(long, default_value = "exports")]
     export_dir: PathBuf,
@@ -74,6 +79,7 @@ fn main() -> AppExit {
         )
         .add_plugins((WireBeadPlugin::default(), WireBeadGuiPlugin))
         .insert_resource(ExportDir(args.export_dir))
+        .insert_resource(Presentation(args.present))
         .add_plugins(AutomationPlugin {
             frames: args.frames,
             screenshot: args.screenshot,

@@ -41,7 +41,14 @@ pub struct ControlKeys {
     /// Add a ghost copy of the scene with another method (see
     /// [`GhostPlugin`](crate::ghost::GhostPlugin)).
     pub ghost: KeyCode,
+    /// Turn presentation mode on or off ([`Presentation`]).
+    pub present: KeyCode,
 }
+
+/// Presentation mode, for a classroom's projector: the window's text
+/// larger and the plots in a column of their own beside the scene.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Presentation(pub bool);
 
 /// The speeds the run may go at, as fractions of real time: slow motion
 /// from 1/20 up to real time.
@@ -90,6 +97,7 @@ impl Default for ControlKeys {
             save_scene: KeyCode::KeyS,
             save_plots: KeyCode::KeyI,
             ghost: KeyCode::KeyG,
+            present: KeyCode::F5,
         }
     }
 }
@@ -98,7 +106,7 @@ impl ControlKeys {
     /// A one-line description for an on-screen help line.
     pub fn help(&self) -> String {
         format!(
-            "{}: restart and apply edits · {}: pause/resume · {} and {}: one step back, forward · {} and {}: slower, faster · {}: run backwards · {}, {}, {}: export CSV, scene, plots · {}: add a ghost · drag a bead",
+            "{}: restart and apply edits · {}: pause/resume · {} and {}: one step back, forward · {} and {}: slower, faster · {}: run backwards · {}, {}, {}: export CSV, scene, plots · {}: add a ghost · {}: presentation · drag a bead",
             key_name(self.restart),
             key_name(self.pause),
             key_name(self.back),
@@ -109,7 +117,8 @@ impl ControlKeys {
             key_name(self.export_csv),
             key_name(self.save_scene),
             key_name(self.save_plots),
-            key_name(self.ghost)
+            key_name(self.ghost),
+            key_name(self.present)
         )
     }
 }
@@ -165,6 +174,7 @@ impl Plugin for KeyboardControlsPlugin {
             .init_resource::<ReverseRequests>()
             .init_resource::<ExportRequests>()
             .init_resource::<GhostRequests>()
+            .init_resource::<Presentation>()
             .add_message::<TimelineSeek>()
             .add_systems(
                 PreUpdate,
@@ -189,6 +199,7 @@ pub fn keyboard_controls(
     mut seeks: MessageWriter<TimelineSeek>,
     mut exports: ResMut<ExportRequests>,
     mut ghosts: ResMut<GhostRequests>,
+    mut presentation: ResMut<Presentation>,
 ) {
     if keys.just_pressed(bindings.restart) {
         restarts.write(Restart);
@@ -214,6 +225,9 @@ pub fn keyboard_controls(
     }
     if keys.just_pressed(bindings.save_plots) {
         exports.plots += 1;
+    }
+    if keys.just_pressed(bindings.present) {
+        presentation.0 = !presentation.0;
     }
     if keys.just_pressed(bindings.ghost) {
         ghosts.0 += 1;

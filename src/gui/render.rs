@@ -10,6 +10,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_egui::PrimaryEguiContext;
 
+use crate::controls::Presentation;
 use crate::debug_render::{
     DebugRenderStyle, DebugRenderSystems, WireBeadDebugPlugin, wire_points, wire_pose,
 };
@@ -56,6 +57,24 @@ pub struct SceneStyle {
     /// Arrow length for a force equal to the bead's weight, as a fraction of
     /// the framed view's height.
     pub force_scale: f32,
+}
+
+/// How much larger the panel's text is in presentation mode.
+pub const PRESENTATION_ZOOM: f32 = 1.3;
+
+impl SceneStyle {
+    /// The widths, in logical pixels, of the panel on the right and of the
+    /// plots' column on the left (none but in presentation mode) in a
+    /// window `width` wide: the scene is framed in what is left.
+    pub fn side_widths(&self, presenting: bool, width: f32) -> (f32, f32) {
+        if presenting {
+            // The panel's width at the larger text, with its margins.
+            let side = (self.panel_width * PRESENTATION_ZOOM + 60.0).min(0.38 * width);
+            (side, side)
+        } else {
+            (self.panel_width, 0.0)
+        }
+    }
 }
 
 impl Default for SceneStyle {
@@ -298,6 +317,7 @@ pub fn frame_camera(
     on_wire: Query<(), With<OnWire>>,
     windows: Query<&Window>,
     style: Res<SceneStyle>,
+    presentation: Option<Res<Presentation>>,
     mut view: ResMut<FramedView>,
     mut cameras: Query<(&mut Transform, &mut Projection), (With<SceneCamera>, Without<Wire>)>,
 ) {
@@ -329,8 +349,10 @@ pub fn frame_camera(
     let Some(window) = windows.iter().next() else {
         return;
     };
+    let presenting = presentation.is_some_and(|p| p.0);
+    let (right, left) = style.side_widths(presenting, window.width());
     let free = Vec2::new(
-        (window.width() - style.panel_width).max(100.0),
+        (window.width() - right - left).max(100.0),
         window.height().max(100.0),
     );
     let world_per_px = (size.x / free.x).max(size.y / free.y);
@@ -339,7 +361,7 @@ pub fn frame_camera(
         size: free * world_per_px,
     };
     for (mut transform, mut projection) in &mut cameras {
-        transform.translation.x = center.x + 0.5 * style.panel_width * world_per_px;
+        transform.translation.x = center.x + 0.5 * (right - left) * world_per_px;
         transform.translation.y = center.y;
         if let Projection::Orthographic(ortho) = projection.as_mut() {
             ortho.scaling_mode = ScalingMode::WindowSize;

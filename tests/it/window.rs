@@ -389,7 +389,37 @@ fn a_ghost_added_with_g_is_drawn_beside_the_bead() {
 #[test]
 #[ignore = "needs the screenshot .ci/run makes under Xvfb"]
 fn the_pendulums_phase_portrait_draws_its_closed_orbit() {
-    let (image, report) = screenshot("phase");
+    closed_orbit_drawn("phase");
+}
+
+#[test]
+#[ignore = "needs the screenshot .ci/run makes under Xvfb"]
+fn presentation_mode_shows_the_phase_portrait_beside_the_scene_at_1280_by_800() {
+    let (image, report) = screenshot("present");
+    assert_eq!(report.window, [1280, 800]);
+    let plot = report.phase_plot.as_ref().expect("the phase plot is drawn");
+    assert_eq!(plot.visible_px, plot.rect_px, "the whole phase plot shows");
+    assert!(
+        plot.rect_px[2] < 640.0,
+        "the plots on the left: {:?}",
+        plot.rect_px
+    );
+    // The scene between the two columns, its bead where it is simulated.
+    beads_drawn_where_simulated(&image, &report);
+    for bead in &report.beads {
+        assert!(
+            bead.pixel[0] > plot.rect_px[2] && bead.pixel[0] < 1280.0 - 400.0,
+            "the bead at {:?}, under a column",
+            bead.pixel
+        );
+    }
+    closed_orbit_drawn("present");
+}
+
+/// The screenshot `name` of the pendulum scene shows the phase portrait's
+/// closed orbit.
+fn closed_orbit_drawn(name: &str) {
+    let (image, report) = screenshot(name);
     let plot = report.phase_plot.expect("the phase plot is drawn");
     let [left, top, right, bottom] = plot.rect_px;
     let [x0, x1, y0, y1] = plot.bounds;

@@ -9,7 +9,7 @@ use super::PresetCatalog;
 use super::phase::{PhasePlot, PhasePlotFrame};
 use super::plots::PlotsShown;
 use super::plots::{PlotHistory, RecentStrikes};
-use crate::controls::{ControlKeys, ExportRequests, ReverseRequests, StepRequests};
+use crate::controls::{ControlKeys, ExportRequests, Presentation, ReverseRequests, StepRequests};
 use crate::ghost::{GhostDraft, GhostRequest, Ghosts};
 use crate::gui::drag::SelectedBead;
 use crate::gui::render::SceneStyle;
@@ -91,6 +91,8 @@ pub struct PanelView<'w, 's> {
     pub(super) strikes: Res<'w, RecentStrikes>,
     pub(super) last_export: Res<'w, LastExport>,
     pub(super) ghosts: Res<'w, Ghosts>,
+    pub(super) presentation: Res<'w, Presentation>,
+    pub(super) windows: Query<'w, 's, &'static Window>,
 }
 
 /// What the panel's controls ask of the world this frame.

@@ -14,6 +14,7 @@ use super::timeline::timeline_section;
 use super::view::{ERROR_RED, PENDING_ORANGE, PanelActions, PanelView};
 use crate::Restart;
 use crate::controls::{ControlKeys, SPEEDS, key_name, speed_label};
+use crate::gui::render::PRESENTATION_ZOOM;
 use crate::preset::LoadPreset;
 
 /// The panel: the scene and run state, the selected bead and its wire, the
@@ -26,14 +27,35 @@ pub fn panel(
     mut refused: Local<Option<String>>,
 ) -> Result {
     let ctx = contexts.ctx_mut()?;
-    help_line(ctx, &view.keys);
+    // Presentation mode: larger text, and the plots in a column of their
+    // own on the left.
+    let presenting = view.presentation.0;
+    let zoom = if presenting { PRESENTATION_ZOOM } else { 1.0 };
+    if ctx.zoom_factor() != zoom {
+        ctx.set_zoom_factor(zoom);
+    }
+    let width = view.windows.iter().next().map_or(1280.0, |w| w.width());
+    let (right, left) = view.style.side_widths(presenting, width);
+    help_line(ctx, &view.keys, presenting);
     // The window scrolls its content within the screen's height, less the
     // title bar and the margins, so nothing is cut off at the bottom.
     let height = (ctx.content_rect().height() - 80.0).max(200.0);
     let mut outcome: Edit = None;
+    let mut plots_at = None;
+    if presenting {
+        egui::Window::new("plots")
+            .anchor(egui::Align2::LEFT_TOP, [6.0, 6.0])
+            .fixed_size([left / zoom - 30.0, height])
+            .resizable(false)
+            .collapsible(false)
+            .vscroll(true)
+            .show(ctx, |ui| {
+                plots_at = plots_and_phase(ui, &view, &mut actions, true);
+            });
+    }
     egui::Window::new("wirebead")
         .anchor(egui::Align2::RIGHT_TOP, [-6.0, 6.0])
-        .fixed_size([view.style.panel_width - 30.0, height])
+        .fixed_size([right / zoom - 30.0, height])
         .resizable(false)
         .collapsible(true)
         .vscroll(true)
@@ -50,24 +72,13 @@ pub fn panel(
             let solver = solver_section(ui, &mut actions.pending, view.active.in_space);
             outcome = solver.or(bead);
             ghosts_section(ui, &view, &mut actions);
-            let plots = plots_section(ui, &view.history, &view.ghosts);
-            let phase = phase_section(
-                ui,
-                &view.history,
-                &mut actions.phase,
-                &mut actions.phase_frame,
-            );
-            let shown = match (plots, phase) {
-                (Some(a), Some(b)) => Some(a.union(b)),
-                (a, b) => a.or(b),
-            };
-            let scale = ui.ctx().pixels_per_point();
-            let shown =
-                shown.map(|r| [r.left(), r.top(), r.right(), r.bottom()].map(|v| v * scale));
-            if actions.plots_shown.0 != shown {
-                actions.plots_shown.0 = shown;
+            if !presenting {
+                plots_at = plots_and_phase(ui, &view, &mut actions, false);
             }
         });
+    if actions.plots_shown.0 != plots_at {
+        actions.plots_shown.0 = plots_at;
+    }
     match outcome {
         Some(Ok(())) => *refused = None,
         Some(Err(error)) => {
@@ -79,13 +90,53 @@ pub fn panel(
     Ok(())
 }
 
+/// The plots and the phase plot, and where they show on screen (physical
+/// pixels: left, top, right, bottom).
+/// The phase plot comes first where `phase_first` (in presentation mode).
+fn plots_and_phase(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    actions: &mut PanelActions,
+    phase_first: bool,
+) -> Option<[f32; 4]> {
+    let mut phase = |ui: &mut egui::Ui| {
+        phase_section(
+            ui,
+            &view.history,
+            &mut actions.phase,
+            &mut actions.phase_frame,
+        )
+    };
+    let (plots, phase) = if phase_first {
+        let phase = phase(ui);
+        (plots_section(ui, &view.history, &view.ghosts), phase)
+    } else {
+        let plots = plots_section(ui, &view.history, &view.ghosts);
+        (plots, phase(ui))
+    };
+    let shown = match (plots, phase) {
+        (Some(a), Some(b)) => Some(a.union(b)),
+        (a, b) => a.or(b),
+    };
+    let scale = ui.ctx().pixels_per_point();
+    shown.map(|r| [r.left(), r.top(), r.right(), r.bottom()].map(|v| v * scale))
+}
+
 /// The keys, at the bottom left of the window.
-fn help_line(ctx: &egui::Context, keys: &ControlKeys) {
+fn help_line(ctx: &egui::Context, keys: &ControlKeys, wrap: bool) {
+    let width = ctx.content_rect().width() - 16.0;
     egui::Area::new(egui::Id::new("wirebead-help"))
         .anchor(egui::Align2::LEFT_BOTTOM, [8.0, -8.0])
         .show(ctx, |ui| {
             let help = egui::RichText::new(keys.help()).color(egui::Color32::LIGHT_GRAY);
-            ui.add(egui::Label::new(help).extend());
+            // On one line; in presentation mode's larger text, over as
+            // many as it takes.
+            if wrap {
+                ui.set_max_width(width);
+                ui.add(egui::Label::new(help).wrap());
+            } else {
+                ui.add(egui::Label::new(help).extend());
+            }
         });
 }
 

@@ -12,6 +12,7 @@ use bevy::render::render_resource::Face;
 
 use super::shapes::{curve_points, fitted_surface_mesh};
 use super::{Orbit, SPACE_LAYER, SpaceGizmos};
+use crate::controls::Presentation;
 use crate::debug_render::force_unit;
 use crate::geometry::{Side, SpaceShape};
 use crate::gui::render::{BeadSizes, SceneStyle, Trail};
@@ -171,11 +172,14 @@ pub fn frame_scene(
     transforms: Query<&Transform>,
     windows: Query<&Window>,
     style: Res<SceneStyle>,
+    presentation: Option<Res<Presentation>>,
     mut orbit: ResMut<Orbit>,
 ) {
-    if added.is_empty() {
+    let toggled = presentation.as_ref().is_some_and(|p| p.is_changed());
+    if added.is_empty() && !toggled {
         return;
     }
+    let presenting = presentation.is_some_and(|p| p.0);
     let mut points: Vec<Vec3> = beads.iter().map(|b| b.initial_position.as_vec3()).collect();
     points.extend(
         pins.iter()
@@ -215,14 +219,15 @@ pub fn frame_scene(
         .iter()
         .next()
         .map_or((1280.0, 800.0), |w| (w.width(), w.height()));
-    let free = (width - style.panel_width).max(100.0) / height.max(100.0);
+    let (right, left) = style.side_widths(presenting, width);
+    let free = (width - right - left).max(100.0) / height.max(100.0);
     let half_fov = 0.4f32;
     let across = (half_fov.tan() * free).atan();
     orbit.distance = 1.1 * radius / half_fov.min(across).sin();
     orbit.focus = centre;
     // Half the panel's width, at the focus: the scene sits in the free
     // part of the window.
-    orbit.shift = style.panel_width * half_fov.tan() / height.max(100.0);
+    orbit.shift = (right - left) * half_fov.tan() / height.max(100.0);
     orbit.size = radius;
 }
 
