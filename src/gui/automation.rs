@@ -382,13 +382,8 @@ impl ReportView<'_, '_> {
             return Vec::new();
         };
         let in_space = self.active.in_space;
-        let colours = ghosts.list.iter().flat_map(|g| {
-            let n = g.positions().len();
-            std::iter::repeat_n(g.colour, n)
-        });
         ghost_beads(ghosts, &self.active, &self.transforms)
-            .zip(colours)
-            .filter_map(|((at, radius, _), colour)| {
+            .filter_map(|(at, radius, colour)| {
                 let (centre, rim) = if in_space {
                     let right = self
                         .space_cameras

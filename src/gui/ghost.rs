@@ -27,6 +27,12 @@ pub fn ghost_colour(colour: [f32; 4]) -> Color {
     Color::srgba(colour[0], colour[1], colour[2], colour[3])
 }
 
+/// A ghost's colour in the panel, opaque.
+pub fn ghost_colour32(colour: [f32; 4]) -> bevy_egui::egui::Color32 {
+    let [r, g, b, _] = colour.map(|c| (c * 255.0).round() as u8);
+    bevy_egui::egui::Color32::from_rgb(r, g, b)
+}
+
 /// The ghosts record the selected bead.
 fn follow_selection(selected: Res<SelectedBead>, mut focus: ResMut<GhostFocus>) {
     if focus.0 != selected.0 {
@@ -35,14 +41,14 @@ fn follow_selection(selected: Res<SelectedBead>, mut focus: ResMut<GhostFocus>) 
 }
 
 /// Where each ghost bead is drawn and how large: at its position, as large
-/// as the run's bead in its place, in the ghost's colour.
+/// as the run's bead in its place, in the ghost's colour (sRGB and alpha).
 pub(crate) fn ghost_beads<'a>(
     ghosts: &'a Ghosts,
     active: &'a ActivePreset,
     radii: &'a Query<&Transform>,
-) -> impl Iterator<Item = (DVec3, f32, Color)> + 'a {
+) -> impl Iterator<Item = (DVec3, f32, [f32; 4])> + 'a {
     ghosts.list.iter().flat_map(move |ghost| {
-        let colour = ghost_colour(ghost.colour);
+        let colour = ghost.colour;
         ghost
             .positions()
             .into_iter()
@@ -63,6 +69,7 @@ fn draw_ghosts(
     mut gizmos: Gizmos,
 ) {
     for (at, radius, colour) in ghost_beads(&ghosts, &active, &radii) {
+        let colour = ghost_colour(colour);
         if active.in_space {
             let at = Isometry3d::from_translation(at.as_vec3());
             gizmos.sphere(at, radius, colour);

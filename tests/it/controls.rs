@@ -7,7 +7,7 @@ use wirebead::controls::KeyboardControlsPlugin;
 use wirebead::prelude::*;
 use wirebead::{Integrator, NextBeadParams, NextParams, Stabilization};
 
-fn press(app: &mut App, key: KeyCode, steps: u32) {
+pub(crate) fn press(app: &mut App, key: KeyCode, steps: u32) {
     app.world_mut()
         .resource_mut::<ButtonInput<KeyCode>>()
         .press(key);

@@ -9,6 +9,8 @@ use wirebead::plugin::{Timeline, TimelinePlugin, TimelineSeek};
 use wirebead::prelude::*;
 use wirebead::{Integrator, KeyboardControlsPlugin, Restart, SceneFile, SimClock};
 
+use crate::common::{self, circle_bead};
+use crate::controls::press;
 use crate::presets::shipped_dir;
 
 /// Every bead's position and velocity, as bits, by entity.
@@ -116,31 +118,16 @@ fn every_shipped_scene_runs_on_from_a_step_back_bit_for_bit() {
     );
 }
 
-/// A bead on a circle, with the timeline.
+/// A bead on a circle, let go level with its centre, with RATTLE and the
+/// timeline.
 fn circle() -> (App, Entity) {
     let params = SimParams {
         method: Method::new(Integrator::Rattle, None).unwrap(),
         ..SimParams::default()
     };
-    let mut app = Headless::new(WireBeadPlugin::new(params).unwrap())
-        .single_threaded()
-        .build();
+    let mut app = common::app(params);
     app.add_plugins(TimelinePlugin);
-    let wire = app
-        .world_mut()
-        .spawn((Wire::circle(1.0).unwrap(), Transform::default()))
-        .id();
-    let bead = app
-        .world_mut()
-        .spawn((
-            Bead::new(BeadParams {
-                initial_position: DVec2::new(1.0, 0.0),
-                ..default()
-            })
-            .unwrap(),
-            OnWire(wire),
-        ))
-        .id();
+    let bead = circle_bead(&mut app, 1.0, DVec2::new(1.0, 0.0), DVec2::ZERO);
     idle(&mut app);
     (app, bead)
 }
@@ -204,17 +191,6 @@ fn timeline_bead(app: &App, step: u64, bead: Entity) -> (DVec2, DVec2) {
     history(app).bead(step, bead).unwrap()
 }
 
-/// Presses `key` for one update of one step (none while paused).
-fn tap(app: &mut App, key: KeyCode) {
-    app.world_mut()
-        .resource_mut::<ButtonInput<KeyCode>>()
-        .press(key);
-    run_steps(app, 1);
-    let mut keys = app.world_mut().resource_mut::<ButtonInput<KeyCode>>();
-    keys.release(key);
-    keys.clear();
-}
-
 #[test]
 fn b_steps_back_and_n_runs_forward_the_same() {
     let (mut app, bead) = circle();
@@ -223,7 +199,7 @@ fn b_steps_back_and_n_runs_forward_the_same() {
     // The first press comes in a frame that steps (to 41): it goes back
     // from there, after the step.
     for _ in 0..5 {
-        tap(&mut app, KeyCode::KeyB);
+        press(&mut app, KeyCode::KeyB, 1);
     }
     assert!(app.world().resource::<Time<Virtual>>().is_paused());
     assert_eq!(app.world().resource::<SimClock>().steps, 36);
@@ -231,7 +207,7 @@ fn b_steps_back_and_n_runs_forward_the_same() {
     assert_eq!(app.world().get::<BeadPosition>(bead).unwrap().0, x36);
     assert_eq!(app.world().get::<BeadVelocity>(bead).unwrap().0, v36);
     for _ in 0..3 {
-        tap(&mut app, KeyCode::KeyN);
+        press(&mut app, KeyCode::KeyN, 1);
     }
     assert_eq!(app.world().resource::<SimClock>().steps, 39);
     let (x39, v39) = history(&app).bead(39, bead).unwrap();

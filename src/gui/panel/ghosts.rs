@@ -7,6 +7,7 @@ use bevy_egui::egui;
 use super::view::{ERROR_RED, PanelActions, PanelView};
 use crate::controls::key_name;
 use crate::ghost::{GhostRequest, MAX_GHOSTS, default_ghost};
+use crate::gui::ghost::ghost_colour32;
 use crate::solver::Method;
 
 /// The ghosts section, folded until opened.
@@ -61,8 +62,7 @@ fn ghosts(ui: &mut egui::Ui, view: &PanelView, actions: &mut PanelActions) {
     }
     for (i, ghost) in view.ghosts.list.iter().enumerate() {
         ui.horizontal(|ui| {
-            let [r, g, b, _] = ghost.colour.map(|c| (c * 255.0).round() as u8);
-            ui.colored_label(egui::Color32::from_rgb(r, g, b), "◯");
+            ui.colored_label(ghost_colour32(ghost.colour), "◯");
             ui.label(ghost.spec.label());
             if ui.small_button("remove").clicked() {
                 actions.ghost_requests.write(GhostRequest::Remove(i));

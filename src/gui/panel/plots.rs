@@ -14,6 +14,7 @@ use egui_plot::{
 use crate::geometry::Coordinates;
 use crate::ghost::{GhostSample, Ghosts};
 use crate::gui::drag::SelectedBead;
+use crate::gui::ghost::ghost_colour32;
 use crate::reference::{circle_angle, circle_normal_force};
 use crate::{
     BeadDiagnostics, BeadParams, BeadPosition, BeadVelocity, BeadsStruck, Islands, OnWire,
@@ -392,11 +393,10 @@ fn plots(ui: &mut egui::Ui, history: &PlotHistory, ghosts: &Ghosts) {
             .iter()
             .map(|ghost| {
                 let points = ghost.samples.iter().map(|s| [s.t, value(s)]).collect();
-                let [r, g, b, _] = ghost.colour.map(|c| (c * 255.0).round() as u8);
                 PlotLine::solid(
                     format!("ghost: {}", ghost.spec.label()),
                     points,
-                    egui::Color32::from_rgb(r, g, b),
+                    ghost_colour32(ghost.colour),
                 )
             })
             .collect()
