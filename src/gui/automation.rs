@@ -15,14 +15,14 @@ use crate::debug_render::{hatch_point, wire_points};
 use crate::geometry::Placed;
 use crate::ghost::Ghosts;
 use crate::gui::ghost::ghost_beads;
-use crate::gui::panel::PhasePlotFrame;
+use crate::gui::panel::{FocusTrail, PhasePlotFrame, PlotsShown};
 use crate::gui::render::{FramedView, SceneCamera, hatch_length};
 use crate::gui::space::{SpaceCamera, WireDrawing};
 use crate::plugin::Timeline;
 use crate::preset::ActivePreset;
 use crate::{
-    BeadPosition, BeadVelocity, Diverged, Pin, Rod, SimClock, SpringAnchor, Wire, WireContact,
-    pose_of,
+    BeadParams, BeadPosition, BeadVelocity, Diverged, Pin, Rod, SimClock, SpringAnchor, Wire,
+    WireContact, pose_of,
 };
 
 /// Where one bead is.
@@ -39,6 +39,9 @@ pub struct BeadReport {
     /// Whether it is in flight off a one-sided wire.
     #[serde(default)]
     pub in_flight: bool,
+    /// Its mass (kg), as the run uses it.
+    #[serde(default)]
+    pub mass: f64,
 }
 
 /// Where one bead in space is.
@@ -126,6 +129,14 @@ pub struct FrameReport {
     /// Where the phase plot is drawn, if it is.
     #[serde(default)]
     pub phase_plot: Option<PlotReport>,
+    /// The part of the window the plots and the phase plot show in, in
+    /// physical pixels (left, top, right, bottom), if they show.
+    #[serde(default)]
+    pub plots_shown: Option<[f32; 4]>,
+    /// The panel's controls the keyboard went to, oldest first
+    /// ([`FocusTrail`]).
+    #[serde(default)]
+    pub focus_trail: Vec<String>,
 }
 
 /// Where a plot is drawn and what it spans.
@@ -233,6 +244,7 @@ struct ReportView<'w, 's> {
             Option<&'static Diverged>,
             &'static Transform,
             Option<&'static WireContact>,
+            &'static BeadParams,
         ),
     >,
     wires: Query<'w, 's, (&'static Wire, &'static Transform)>,
@@ -256,6 +268,8 @@ struct ReportView<'w, 's> {
     timeline: Option<Res<'w, Timeline>>,
     ghosts: Option<Res<'w, Ghosts>>,
     phase: Option<Res<'w, PhasePlotFrame>>,
+    plots_shown: Option<Res<'w, PlotsShown>>,
+    focus: Option<Res<'w, FocusTrail>>,
     clock: Res<'w, SimClock>,
     states: Query<'w, 's, (Entity, &'static BeadPosition, &'static BeadVelocity)>,
     space_states: Query<
@@ -293,13 +307,14 @@ impl ReportView<'_, '_> {
             beads: self
                 .beads
                 .iter()
-                .filter_map(|(bead, _, diverged, transform, contact)| {
+                .filter_map(|(bead, _, diverged, transform, contact, params)| {
                     Some(BeadReport {
                         world: bead.to_array(),
                         pixel: to_pixel(bead.0)?,
                         radius_px: transform.scale.x / self.view.size.y.max(1e-9) * size[1] as f32,
                         diverged: diverged.map(|d| d.reason.to_string()),
                         in_flight: contact.is_some_and(|c| !c.is_on()),
+                        mass: params.mass,
                     })
                 })
                 .collect(),
@@ -369,6 +384,8 @@ impl ReportView<'_, '_> {
                 visible_px: p.visible,
                 bounds: p.bounds,
             }),
+            plots_shown: self.plots_shown.as_ref().and_then(|p| p.0),
+            focus_trail: self.focus.as_ref().map(|f| f.0.clone()).unwrap_or_default(),
         }
     }
 

@@ -54,6 +54,11 @@ pub struct SceneStyle {
     /// Pixels of the window's right edge covered by the panel: the wires are
     /// framed in the rest.
     pub panel_width: f32,
+    /// The window height (logical pixels) from which the plots sit in the
+    /// panel, under its settings; in a shorter window (1280×800, a laptop)
+    /// they take a column of their own left of the scene, so that nothing
+    /// of them is below the fold.
+    pub plots_in_panel_from: f32,
     /// Arrow length for a force equal to the bead's weight, as a fraction of
     /// the framed view's height.
     pub force_scale: f32,
@@ -64,13 +69,18 @@ pub const PRESENTATION_ZOOM: f32 = 1.3;
 
 impl SceneStyle {
     /// The widths, in logical pixels, of the panel on the right and of the
-    /// plots' column on the left (none but in presentation mode) in a
-    /// window `width` wide: the scene is framed in what is left.
-    pub fn side_widths(&self, presenting: bool, width: f32) -> (f32, f32) {
+    /// plots' column on the left (zero where the plots are in the panel)
+    /// in a window `width` by `height`: the scene is framed in what is
+    /// left. The plots take a column of their own in presentation mode,
+    /// and in a window shorter than [`plots_in_panel_from`](Self::plots_in_panel_from)
+    /// that is wide enough for three columns.
+    pub fn side_widths(&self, presenting: bool, width: f32, height: f32) -> (f32, f32) {
         if presenting {
             // The panel's width at the larger text, with its margins.
             let side = (self.panel_width * PRESENTATION_ZOOM + 60.0).min(0.38 * width);
             (side, side)
+        } else if height < self.plots_in_panel_from && width >= 3.0 * self.panel_width {
+            (self.panel_width, self.panel_width)
         } else {
             (self.panel_width, 0.0)
         }
@@ -95,6 +105,7 @@ impl Default for SceneStyle {
             bead_radius: 0.025,
             trail_seconds: 2.0,
             panel_width: 340.0,
+            plots_in_panel_from: 1100.0,
             force_scale: 0.06,
         }
     }
@@ -109,10 +120,10 @@ pub struct SceneCamera;
 pub struct BeadVisual;
 
 /// A bead's recent positions, newest last, each with whether the bead was
-/// in flight off its wire there: `Trail` in the plane, `Trail<Vec3>` in
-/// space.
+/// in flight off its wire there and the simulated time: `Trail` in the
+/// plane, `Trail<Vec3>` in space.
 #[derive(Component, Clone, Debug)]
-pub struct Trail<P = Vec2>(pub VecDeque<(P, bool)>);
+pub struct Trail<P = Vec2>(pub VecDeque<(P, bool, f64)>);
 
 impl<P> Default for Trail<P> {
     fn default() -> Self {
@@ -121,20 +132,31 @@ impl<P> Default for Trail<P> {
 }
 
 impl<P: Copy> Trail<P> {
-    /// Appends where the bead is (in flight or not) and drops what is more
-    /// than `keep` points old (keeping two at least).
-    pub fn record(&mut self, at: P, flying: bool, keep: usize) {
-        self.0.push_back((at, flying));
+    /// Appends where the bead is (in flight or not) at `time` and drops
+    /// what is more than `keep` points old (keeping two at least). Back at
+    /// an earlier time (a step back on the timeline), the trail goes on
+    /// from there.
+    pub fn record(&mut self, at: P, flying: bool, time: f64, keep: usize) {
+        while self.0.back().is_some_and(|p| p.2 >= time) {
+            self.0.pop_back();
+        }
+        self.0.push_back((at, flying, time));
         while self.0.len() > keep.max(2) {
             self.0.pop_front();
         }
     }
 
-    /// Its points, each in the trail's colour (the flight colour where the
+    /// Its points up to the time `now` (a step back on the timeline hides
+    /// the rest), each in the trail's colour (the flight colour where the
     /// bead was off its wire) fading with age.
-    pub fn coloured<'a>(&'a self, style: &'a SceneStyle) -> impl Iterator<Item = (P, Color)> + 'a {
-        let n = self.0.len().max(1) as f32;
-        self.0.iter().enumerate().map(move |(i, &(p, flying))| {
+    pub fn coloured<'a>(
+        &'a self,
+        style: &'a SceneStyle,
+        now: f64,
+    ) -> impl Iterator<Item = (P, Color)> + 'a {
+        let shown = self.0.iter().take_while(move |p| p.2 <= now);
+        let n = shown.clone().count().max(1) as f32;
+        shown.enumerate().map(move |(i, &(p, flying, _))| {
             let colour = if flying { style.flight } else { style.trail };
             (p, colour.with_alpha((i as f32 + 1.0) / n))
         })
@@ -250,11 +272,13 @@ pub fn add_bead_visuals(
 pub fn record_trails(
     params: Res<crate::SimParams>,
     style: Res<SceneStyle>,
+    clock: Res<crate::SimClock>,
     mut beads: Query<(&BeadPosition, &mut Trail, Option<&WireContact>)>,
 ) {
     let keep = style.trail_points(params.timestep);
     for (bead, mut trail, contact) in &mut beads {
-        trail.record(bead.as_vec2(), contact.is_some_and(|c| !c.is_on()), keep);
+        let flying = contact.is_some_and(|c| !c.is_on());
+        trail.record(bead.as_vec2(), flying, clock.time, keep);
     }
 }
 
@@ -350,7 +374,7 @@ pub fn frame_camera(
         return;
     };
     let presenting = presentation.is_some_and(|p| p.0);
-    let (right, left) = style.side_widths(presenting, window.width());
+    let (right, left) = style.side_widths(presenting, window.width(), window.height());
     let free = Vec2::new(
         (window.width() - right - left).max(100.0),
         window.height().max(100.0),
@@ -474,9 +498,14 @@ impl SceneStyle {
 
 /// Draws each trail fading with age, in the flight colour where the bead
 /// was off its wire.
-fn draw_trails(beads: Query<&Trail>, style: Res<SceneStyle>, mut gizmos: Gizmos) {
+fn draw_trails(
+    beads: Query<&Trail>,
+    style: Res<SceneStyle>,
+    clock: Res<crate::SimClock>,
+    mut gizmos: Gizmos,
+) {
     for trail in &beads {
-        gizmos.linestrip_gradient_2d(trail.coloured(&style));
+        gizmos.linestrip_gradient_2d(trail.coloured(&style, clock.time));
     }
 }
 
@@ -490,4 +519,23 @@ pub fn screen_to_world(
         .viewport_to_world_2d(camera_transform, screen)
         .ok()
         .map(|p| p.as_dvec2())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SceneStyle;
+
+    /// The plots take a column of their own in a window too short for them
+    /// under the panel's settings, or in presentation mode; not where the
+    /// window is tall, or too narrow for three columns.
+    #[test]
+    fn the_plots_go_beside_the_scene_in_a_short_window() {
+        let style = SceneStyle::default();
+        assert_eq!(style.side_widths(false, 1280.0, 1750.0), (340.0, 0.0));
+        assert_eq!(style.side_widths(false, 1280.0, 800.0), (340.0, 340.0));
+        assert_eq!(style.side_widths(false, 900.0, 800.0), (340.0, 0.0));
+        let (right, left) = style.side_widths(true, 1280.0, 1750.0);
+        assert_eq!(right, left);
+        assert!(right > 340.0 && right <= 0.38 * 1280.0, "{right}");
+    }
 }

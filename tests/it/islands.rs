@@ -83,6 +83,26 @@ fn the_plugin_steps_a_pendulum_on_a_cart_as_the_island_solver_does() {
     assert_eq!(transform.translation.x, states[1].position.x as f32);
 }
 
+/// An island's drift is the largest `|C|` of its rows: here the
+/// rod's or the cart's wire row, with the assignment's semi-implicit Euler
+/// and Baumgarte, which leave a drift to see.
+#[test]
+fn an_islands_drift_is_its_largest_row_drift() {
+    let mut app = app(params(Method::default(), 1.0 / 60.0));
+    let (cart, bob, rod) = cart_and_bob(&mut app);
+    run_steps(&mut app, 120);
+    let rod = app.world().get::<ConstraintDiagnostics>(rod).unwrap().c;
+    let wire = app.world().get::<BeadDiagnostics>(cart).unwrap().c;
+    let islands = app.world().resource::<Islands>();
+    let report = islands.of(bob).expect("the bob is in an island");
+    assert_eq!(report.drift, rod.abs().max(wire.abs()));
+    assert!(
+        report.drift > 1e-6 && report.drift < 0.1,
+        "drift {:e}",
+        report.drift
+    );
+}
+
 #[test]
 fn a_free_bead_flies_a_parabola() {
     // RK4 is exact for constant acceleration.

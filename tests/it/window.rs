@@ -494,3 +494,112 @@ fn i_saves_the_plots_as_shown_as_a_png() {
     assert!(has(Rgb([173, 216, 230])), "no recorded phase line");
     assert!(has(Rgb([144, 238, 144])), "no energy line");
 }
+
+/// Pixels of `colour` inside `rect` (physical pixels: left, top, right,
+/// bottom).
+fn pixels_of(image: &RgbImage, rect: [f32; 4], colour: Rgb<u8>) -> usize {
+    let [l, t, r, b] = rect.map(|v| v.round().max(0.0) as u32);
+    (t..b.min(image.height()))
+        .flat_map(|y| (l..r.min(image.width())).map(move |x| (x, y)))
+        .filter(|&(x, y)| close(*image.get_pixel(x, y), colour, 30))
+        .count()
+}
+
+#[test]
+#[ignore = "needs the screenshot .ci/run makes under Xvfb"]
+fn at_1280_by_800_the_ropes_plots_show_beside_the_scene() {
+    let (image, report) = screenshot("rope");
+    assert_eq!(report.window, [1280, 800]);
+    // The plots in a column of their own on the left, whole in the window
+    // and tall enough for the drift and energy plots.
+    let plots = report.plots_shown.expect("the plots show");
+    let [left, top, right, bottom] = plots;
+    assert!(left >= 0.0 && right < 640.0, "the plots at {plots:?}");
+    assert!(top >= 0.0 && bottom <= 800.0, "the plots at {plots:?}");
+    assert!(bottom - top >= 400.0, "the plots at {plots:?}");
+    // The drift line (the rods' largest |C|) and the energy line are drawn.
+    let drift = pixels_of(&image, plots, Rgb([173, 216, 230]));
+    let energy = pixels_of(&image, plots, Rgb([144, 238, 144]));
+    assert!(drift >= 100, "{drift} pixels of the drift line");
+    assert!(energy >= 100, "{energy} pixels of the energy line");
+    // The rope between the columns, drawn where it is simulated.
+    assert_eq!(report.beads.len(), 21);
+    beads_drawn_where_simulated(&image, &report);
+    for bead in &report.beads {
+        assert!(
+            bead.pixel[0] > right && bead.pixel[0] < 1280.0 - 340.0,
+            "the bead at {:?}, under a column",
+            bead.pixel
+        );
+    }
+}
+
+/// The panel's controls, in the order Tab reaches them, in the assignment's
+/// scene.
+const CONTROLS: [&str; 30] = [
+    "menu: The assignment's circle",
+    "button: Restart (Space)",
+    "button: Reverse (R)",
+    "menu: speed 1×",
+    "section: Timeline",
+    "button: ◀ Back (B)",
+    "button: Step (N) ▶",
+    "slider: scrub",
+    "number: seconds kept",
+    "button: Export CSV (E)",
+    "button: Save scene (S)",
+    "button: Plots PNG (I)",
+    "number: mass",
+    "number: initial position x",
+    "number: initial position y",
+    "number: initial velocity x",
+    "number: initial velocity y",
+    "menu: circle",
+    "number: radius",
+    "section: Solver",
+    "number: timestep (s)",
+    "number: spring constant α",
+    "number: damping constant β",
+    "number: drag scale k",
+    "number: gravity x",
+    "number: gravity y",
+    "menu: semi-implicit-euler",
+    "menu: baumgarte",
+    "section: Ghosts (0)",
+    "section: Plots",
+];
+
+#[test]
+#[ignore = "needs the Tab presses .ci/run makes under Xvfb"]
+fn tab_reaches_every_control_of_the_panel_in_order() {
+    let trail = report("keys.ron").focus_trail;
+    let mut rest = trail.iter();
+    for control in CONTROLS {
+        assert!(
+            rest.any(|c| c == control),
+            "Tab never reached {control} (in order) in {trail:?}"
+        );
+    }
+    // The phase plot's menus too, in its column.
+    for control in [
+        "section: Phase plot",
+        "menu: dθ/dt (rad/s)",
+        "menu: θ (rad)",
+    ] {
+        assert!(trail.iter().any(|c| c == control), "no {control}");
+    }
+}
+
+#[test]
+#[ignore = "needs the keys .ci/run presses under Xvfb"]
+fn a_mass_typed_with_the_keyboard_alone_applies_with_space() {
+    let before = report("keys.ron");
+    let after = report("keys_edit.ron");
+    assert_eq!(before.beads[0].mass, 1.0);
+    assert_eq!(
+        after.focus_trail.last().map(String::as_str),
+        Some("number: mass")
+    );
+    // A bead's mass changes only when Space applies the pending edits.
+    assert_eq!(after.beads[0].mass, 0.25);
+}

@@ -45,37 +45,61 @@ pub(super) fn strikes_section(ui: &mut egui::Ui, view: &PanelView) {
         });
 }
 
+/// How many rods and pins the panel's list shows before it scrolls.
+const CONSTRAINT_ROWS_SHOWN: f32 = 6.0;
+
 /// Every rod and pin with its drift `C` and multiplier λ (a rod under
-/// tension pulls: λ < 0).
+/// tension pulls: λ < 0), under a line naming the largest drift: a list
+/// that scrolls past six rows, so a rope's rods leave room for the rest.
 pub(super) fn constraints_section(ui: &mut egui::Ui, view: &PanelView) {
     if view.rods.is_empty() && view.pins.is_empty() {
         return;
     }
+    let rows: Vec<(String, &ConstraintDiagnostics)> = view
+        .rods
+        .iter()
+        .map(|(rod, d)| {
+            let [a, b] = rod.beads().map(|e| view.name(e));
+            (format!("rod {a}–{b}"), d)
+        })
+        .chain(
+            view.pins
+                .iter()
+                .map(|(pin, d)| (format!("pin {}", view.name(pin.bead())), d)),
+        )
+        .collect();
     ui.separator();
-    egui::CollapsingHeader::new("Constraints")
+    egui::CollapsingHeader::new(format!("Constraints ({})", rows.len()))
+        .id_salt("constraints")
         .default_open(true)
         .show(ui, |ui| {
-            egui::Grid::new("constraints")
-                .num_columns(3)
-                .striped(true)
+            if let Some((label, d)) = rows
+                .iter()
+                .max_by(|a, b| a.1.c.abs().total_cmp(&b.1.c.abs()))
+            {
+                ui.label(format!("largest drift: |C| = {:.2e} m, {label}", d.c.abs()));
+            }
+            let row_height =
+                ui.text_style_height(&egui::TextStyle::Monospace) + ui.spacing().item_spacing.y;
+            egui::ScrollArea::vertical()
+                .id_salt("constraint-rows")
+                .max_height(row_height * (CONSTRAINT_ROWS_SHOWN + 1.0))
                 .show(ui, |ui| {
-                    ui.strong("");
-                    ui.strong("C");
-                    ui.strong("λ");
-                    ui.end_row();
-                    let mut row = |label: String, d: &ConstraintDiagnostics| {
-                        ui.label(label);
-                        ui.monospace(format!("{:+.2e}", d.c));
-                        ui.monospace(format!("{:+.3e}", d.lambda));
-                        ui.end_row();
-                    };
-                    for (rod, d) in &view.rods {
-                        let [a, b] = rod.beads().map(|e| view.name(e));
-                        row(format!("rod {a}–{b}"), d);
-                    }
-                    for (pin, d) in &view.pins {
-                        row(format!("pin {}", view.name(pin.bead())), d);
-                    }
+                    egui::Grid::new("constraints")
+                        .num_columns(3)
+                        .striped(true)
+                        .show(ui, |ui| {
+                            ui.strong("");
+                            ui.strong("C");
+                            ui.strong("λ");
+                            ui.end_row();
+                            for (label, d) in &rows {
+                                ui.label(label);
+                                ui.monospace(format!("{:+.2e}", d.c));
+                                ui.monospace(format!("{:+.3e}", d.lambda));
+                                ui.end_row();
+                            }
+                        });
                 });
         });
 }

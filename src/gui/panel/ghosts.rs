@@ -4,6 +4,7 @@
 
 use bevy_egui::egui;
 
+use super::keyboard::number_field;
 use super::view::{ERROR_RED, PanelActions, PanelView};
 use crate::controls::key_name;
 use crate::ghost::{GhostRequest, MAX_GHOSTS, default_ghost};
@@ -43,7 +44,7 @@ fn ghosts(ui: &mut egui::Ui, view: &PanelView, actions: &mut PanelActions) {
                 ("timestep (s)", &mut draft.timestep, 0.0005),
             ] {
                 ui.label(label);
-                ui.add(egui::DragValue::new(value).speed(speed));
+                number_field(ui, value, &format!("ghost {label}"), |d| d.speed(speed));
                 ui.end_row();
             }
         });

@@ -10,6 +10,7 @@
 
 mod constraints;
 mod ghosts;
+mod keyboard;
 mod params;
 mod phase;
 mod plots;
@@ -22,9 +23,10 @@ mod window;
 use bevy::prelude::*;
 use bevy_egui::EguiPrimaryContextPass;
 
+pub use keyboard::{FOCUS_KEPT, FocusTrail};
 pub use phase::{PhasePlot, PhasePlotFrame, PlotFrame, Quantity};
 pub use plots::{
-    PlotHistory, PlotSample, PlotsShown, RecentStrikes, record_history, record_strikes,
+    HeldBy, PlotHistory, PlotSample, PlotsShown, RecentStrikes, record_history, record_strikes,
 };
 use png::save_plots;
 pub use view::{PanelActions, PanelView};
@@ -112,7 +114,11 @@ impl Plugin for PanelPlugin {
                 (record_history, record_strikes).after(WireBeadSystems::Writeback),
             )
             .add_systems(Update, (keep_selection, save_plots))
-            .add_systems(EguiPrimaryContextPass, panel);
+            .add_systems(
+                EguiPrimaryContextPass,
+                (panel, keyboard::record_focus).chain(),
+            );
+        keyboard::build(app);
     }
 }
 

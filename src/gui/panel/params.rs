@@ -4,6 +4,7 @@
 use bevy::prelude::*;
 use bevy_egui::egui;
 
+use super::keyboard::number_field;
 use super::view::PanelView;
 use crate::geometry::{Coordinates, Cycloid};
 use crate::{
@@ -17,7 +18,7 @@ pub(super) type Edit = Option<Result<(), ParamError>>;
 
 fn number(ui: &mut egui::Ui, label: &str, value: &mut f64, speed: f64) {
     ui.label(label);
-    ui.add(egui::DragValue::new(value).speed(speed).max_decimals(6));
+    number_field(ui, value, label, |d| d.speed(speed).max_decimals(6));
     ui.end_row();
 }
 
@@ -43,7 +44,8 @@ fn vector<V: Coordinates>(ui: &mut egui::Ui, label: &str, value: &mut V, speed: 
     ui.label(label);
     ui.horizontal(|ui| {
         for (axis, component) in ["x ", "y ", "z "].into_iter().zip(value.components_mut()) {
-            ui.add(egui::DragValue::new(component).speed(speed).prefix(axis));
+            let name = format!("{label} {}", axis.trim());
+            number_field(ui, component, &name, |d| d.speed(speed).prefix(axis));
         }
     });
     ui.end_row();

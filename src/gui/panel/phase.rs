@@ -252,6 +252,7 @@ fn quantity_menu(ui: &mut egui::Ui, id: &str, value: &mut Quantity) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gui::panel::plots::HeldBy;
 
     #[test]
     fn a_bead_going_over_the_top_is_drawn_in_pieces() {
@@ -267,6 +268,7 @@ mod tests {
     fn every_quantity_reads_its_own_value() {
         let sample = PlotSample {
             t: 1.0,
+            held_by: HeldBy::Wire,
             c: 2.0,
             c_dot: 3.0,
             energy: 4.0,

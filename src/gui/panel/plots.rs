@@ -21,12 +21,28 @@ use crate::{
     SimClock, SimParams, Wire, WireShape, pose_of,
 };
 
+/// What holds a plotted bead, and so what its drift `C` and λ are.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum HeldBy {
+    /// Its wire: `C`, `Ċ` and λ are its wire's.
+    #[default]
+    Wire,
+    /// Rods or pins only, no wire: `C` is the largest drift of its island
+    /// ([`IslandReport::drift`](crate::IslandReport::drift)); it has no
+    /// λ of its own (the panel lists each rod's).
+    Links,
+    /// Nothing: a free bead has no `C` or λ.
+    Nothing,
+}
+
 /// One plotted sample of the selected bead.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlotSample {
     /// Simulated time.
     pub t: f64,
-    /// Drift `C`.
+    /// What holds the bead ([`HeldBy`]).
+    pub held_by: HeldBy,
+    /// Drift `C`: its wire's, or its island's largest.
     pub c: f64,
     /// Its rate `Ċ`.
     pub c_dot: f64,
@@ -57,6 +73,7 @@ impl PlotSample {
     fn of<V: Coordinates>(t: f64, d: &BeadDiagnostics<V>) -> Self {
         Self {
             t,
+            held_by: HeldBy::Wire,
             c: d.c,
             c_dot: d.c_dot,
             energy: d.energy(),
@@ -110,6 +127,7 @@ type SpaceBeadRead = (
     &'static BeadPosition<DVec3>,
     &'static BeadVelocity<DVec3>,
     &'static BeadDiagnostics<DVec3>,
+    Option<&'static OnWire>,
 );
 
 /// Appends the selected bead's diagnostics (in the plane or in space) to
@@ -139,6 +157,7 @@ pub fn record_history(
     };
     let g = params.gravity;
     let plane = beads.get(entity).ok().map(|(x, v, d, start, on)| {
+        let on_wire = on.is_some();
         let circle = circle(on);
         let on_circle = circle.and_then(|(centre, _)| circle_angle(centre, g, x.0, v.0));
         let normal_force = circle
@@ -150,6 +169,11 @@ pub fn record_history(
                 Some((d.constraint_force.dot(inward), expected))
             });
         let sample = PlotSample {
+            held_by: if on_wire {
+                HeldBy::Wire
+            } else {
+                HeldBy::Nothing
+            },
             position: x.0.extend(0.0),
             velocity: v.0.extend(0.0),
             on_circle,
@@ -159,8 +183,13 @@ pub fn record_history(
         (sample, circle.map(|c| c.1))
     });
     let space = || {
-        let (x, v, d) = space_beads.get(entity).ok()?;
+        let (x, v, d, on) = space_beads.get(entity).ok()?;
         let sample = PlotSample {
+            held_by: if on.is_some() {
+                HeldBy::Wire
+            } else {
+                HeldBy::Nothing
+            },
             position: x.0,
             velocity: v.0,
             ..PlotSample::of(clock.time, d)
@@ -187,6 +216,11 @@ pub fn record_history(
         .filter(|island| island.rows > 0)
     {
         sample.energy = island.energy;
+        // A bead held by rods or pins alone: its island's drift.
+        if sample.held_by == HeldBy::Nothing {
+            sample.held_by = HeldBy::Links;
+            sample.c = island.drift;
+        }
     }
     history.samples.push_back(sample);
     let horizon = t - history.seconds;
@@ -209,9 +243,26 @@ pub struct PlotsShown(pub Option<[f32; 4]>);
 /// ([`decade_label`]).
 fn plot(ui: &mut egui::Ui, id: &str, lines: Vec<PlotLine>, log: bool) {
     let legend = lines.len() > 1;
-    let plot = panel_plot(id, PLOT_HEIGHT, log).x_axis_label("t (s)");
+    let plot = panel_plot(id, PLOT_HEIGHT, log)
+        .x_axis_label("t (s)")
+        .x_grid_spacer(uniform_grid_spacer(|input| grid_steps(input.bounds, false)));
     let plot = if legend {
         plot.legend(Legend::default())
+    } else {
+        plot
+    };
+    // On a log scale, whole decades at both ends: a range within one
+    // decade still has a labelled tick.
+    let (low, high) = lines
+        .iter()
+        .flat_map(|line| &line.points)
+        .map(|&[_, v]| log_magnitude(v))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    let plot = if log && low.is_finite() && high.is_finite() {
+        plot.include_y(low.floor())
+            .include_y(high.ceil().max(low.floor() + 1.0))
     } else {
         plot
     };
@@ -239,7 +290,7 @@ fn plot(ui: &mut egui::Ui, id: &str, lines: Vec<PlotLine>, log: bool) {
 }
 
 /// A plot of the panel, `height` points tall and fixed (no drag, zoom or
-/// scroll), its value axis with room for its labels, stepped by
+/// scroll, and no stop for the keyboard's Tab), its value axis with room for its labels, stepped by
 /// [`grid_steps`] and labelled by [`tick_label`], or on a log scale in
 /// whole decades ([`decade_label`]).
 pub(super) fn panel_plot(id: &str, height: f32, log: bool) -> Plot<'static> {
@@ -248,6 +299,8 @@ pub(super) fn panel_plot(id: &str, height: f32, log: bool) -> Plot<'static> {
         .allow_drag(false)
         .allow_zoom(false)
         .allow_scroll(false)
+        .allow_axis_zoom_drag(false)
+        .sense(egui::Sense::hover())
         .y_axis_min_width(48.0)
         .y_grid_spacer(uniform_grid_spacer(move |input| {
             grid_steps(input.bounds, log)
@@ -401,25 +454,56 @@ fn plots(ui: &mut egui::Ui, history: &PlotHistory, ghosts: &Ghosts) {
             })
             .collect()
     };
-    for (id, label, unit, colour, value, log) in [
+    let held_by = samples.back().map_or(HeldBy::Wire, |s| s.held_by);
+    let drift = match held_by {
+        HeldBy::Wire => Some("drift |C|"),
+        HeldBy::Links => Some("drift, largest |C| of its rods and pins"),
+        HeldBy::Nothing => None,
+    };
+    match held_by {
+        HeldBy::Wire => {}
+        HeldBy::Links => {
+            ui.label("It rides no wire: no λ of its own (each rod's is under Constraints).");
+        }
+        HeldBy::Nothing => {
+            ui.label("A free bead: no wire, rod or pin, so no drift C or λ.");
+        }
+    }
+    let lines: [(
+        &str,
+        Option<&str>,
+        &str,
+        egui::Color32,
+        fn(&PlotSample) -> f64,
+        bool,
+    ); 3] = [
         (
             "plot-c",
-            "drift |C|",
+            drift,
             "m, log scale",
             egui::Color32::LIGHT_BLUE,
-            (|s: &PlotSample| s.c) as fn(&PlotSample) -> f64,
+            |s| s.c,
             true,
         ),
         (
             "plot-e",
-            "energy E",
+            Some("energy E"),
             "J",
             egui::Color32::LIGHT_GREEN,
             |s| s.energy,
             false,
         ),
-        ("plot-l", "λ", "N", egui::Color32::GOLD, |s| s.lambda, false),
-    ] {
+        (
+            "plot-l",
+            (held_by == HeldBy::Wire).then_some("λ"),
+            "N",
+            egui::Color32::GOLD,
+            |s| s.lambda,
+            false,
+        ),
+    ];
+    for (id, label, unit, colour, value, log) in lines {
+        let Some(label) = label else { continue };
         ui.label(format!("{label} ({unit})"));
         let points = samples.iter().map(|s| [s.t, value(s)]).collect();
         let mut lines = vec![PlotLine::solid(label, points, colour)];

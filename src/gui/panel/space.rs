@@ -5,6 +5,7 @@
 use bevy::prelude::*;
 use bevy_egui::egui;
 
+use super::keyboard::number_field;
 use super::params::{Edit, RowValues, bead_start_editor, keep_bead_edit, value_rows};
 use super::view::PanelView;
 use crate::PrescribedMotion;
@@ -46,12 +47,9 @@ pub(super) fn space_bead_section(
                 let mut omega = angular_velocity;
                 ui.horizontal(|ui| {
                     ui.label("spins at ω");
-                    ui.add(
-                        egui::DragValue::new(&mut omega)
-                            .speed(0.05)
-                            .suffix(" rad/s")
-                            .max_decimals(3),
-                    );
+                    number_field(ui, &mut omega, "spins at ω", |d| {
+                        d.speed(0.05).suffix(" rad/s").max_decimals(3)
+                    });
                 });
                 ui.label(format!(
                     "about ({:.2}, {:.2}, {:.2}); a change applies at once",

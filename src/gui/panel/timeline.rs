@@ -4,6 +4,7 @@
 
 use bevy_egui::egui;
 
+use super::keyboard::number_field;
 use super::view::{ERROR_RED, PENDING_ORANGE, PanelActions, PanelView};
 use crate::controls::key_name;
 use crate::plugin::TimelineSeek;
@@ -61,12 +62,9 @@ fn timeline(ui: &mut egui::Ui, view: &PanelView, actions: &mut PanelActions) {
     ui.horizontal(|ui| {
         ui.label("Keep the last");
         let seconds = &mut actions.timeline.seconds;
-        ui.add(
-            egui::DragValue::new(seconds)
-                .range(timestep..=3600.0)
-                .speed(1.0)
-                .suffix(" s"),
-        );
+        number_field(ui, seconds, "seconds kept", |d| {
+            d.range(timestep..=3600.0).speed(1.0).suffix(" s")
+        });
         ui.label(format!(
             "(up to {:.0} MB)",
             actions.timeline.max_bytes as f64 / 1e6

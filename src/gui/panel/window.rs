@@ -28,34 +28,30 @@ pub fn panel(
 ) -> Result {
     let ctx = contexts.ctx_mut()?;
     // Presentation mode: larger text, and the plots in a column of their
-    // own on the left.
+    // own on the left (as in a window too short for them under the
+    // panel's settings).
     let presenting = view.presentation.0;
     let zoom = if presenting { PRESENTATION_ZOOM } else { 1.0 };
     if ctx.zoom_factor() != zoom {
         ctx.set_zoom_factor(zoom);
     }
-    let width = view.windows.iter().next().map_or(1280.0, |w| w.width());
-    let (right, left) = view.style.side_widths(presenting, width);
-    help_line(ctx, &view.keys, presenting);
+    let (width, height) = view
+        .windows
+        .iter()
+        .next()
+        .map_or((1280.0, 800.0), |w| (w.width(), w.height()));
+    let (right, left) = view.style.side_widths(presenting, width, height);
+    // The plots in a column of their own on the left, or in the panel.
+    let beside = left > 0.0;
+    help_line(ctx, &view.keys);
     // The window scrolls its content within the screen's height, less the
     // title bar and the margins, so nothing is cut off at the bottom.
-    let height = (ctx.content_rect().height() - 80.0).max(200.0);
+    let column = (ctx.content_rect().height() - 80.0).max(200.0);
     let mut outcome: Edit = None;
     let mut plots_at = None;
-    if presenting {
-        egui::Window::new("plots")
-            .anchor(egui::Align2::LEFT_TOP, [6.0, 6.0])
-            .fixed_size([left / zoom - 30.0, height])
-            .resizable(false)
-            .collapsible(false)
-            .vscroll(true)
-            .show(ctx, |ui| {
-                plots_at = plots_and_phase(ui, &view, &mut actions, true);
-            });
-    }
     egui::Window::new("wirebead")
         .anchor(egui::Align2::RIGHT_TOP, [-6.0, 6.0])
-        .fixed_size([right / zoom - 30.0, height])
+        .fixed_size([right / zoom - 30.0, column])
         .resizable(false)
         .collapsible(true)
         .vscroll(true)
@@ -72,10 +68,23 @@ pub fn panel(
             let solver = solver_section(ui, &mut actions.pending, view.active.in_space);
             outcome = solver.or(bead);
             ghosts_section(ui, &view, &mut actions);
-            if !presenting {
+            if !beside {
                 plots_at = plots_and_phase(ui, &view, &mut actions, false);
             }
         });
+    // Drawn after the panel: Tab goes through the panel's controls first
+    // (each plot's axes are stops of their own).
+    if beside {
+        egui::Window::new("plots")
+            .anchor(egui::Align2::LEFT_TOP, [6.0, 6.0])
+            .fixed_size([left / zoom - 30.0, column])
+            .resizable(false)
+            .collapsible(false)
+            .vscroll(true)
+            .show(ctx, |ui| {
+                plots_at = plots_and_phase(ui, &view, &mut actions, presenting);
+            });
+    }
     if actions.plots_shown.0 != plots_at {
         actions.plots_shown.0 = plots_at;
     }
@@ -122,21 +131,16 @@ fn plots_and_phase(
     shown.map(|r| [r.left(), r.top(), r.right(), r.bottom()].map(|v| v * scale))
 }
 
-/// The keys, at the bottom left of the window.
-fn help_line(ctx: &egui::Context, keys: &ControlKeys, wrap: bool) {
+/// The keys, at the bottom left of the window, over as many lines as the
+/// window's width takes.
+fn help_line(ctx: &egui::Context, keys: &ControlKeys) {
     let width = ctx.content_rect().width() - 16.0;
     egui::Area::new(egui::Id::new("wirebead-help"))
         .anchor(egui::Align2::LEFT_BOTTOM, [8.0, -8.0])
         .show(ctx, |ui| {
             let help = egui::RichText::new(keys.help()).color(egui::Color32::LIGHT_GRAY);
-            // On one line; in presentation mode's larger text, over as
-            // many as it takes.
-            if wrap {
-                ui.set_max_width(width);
-                ui.add(egui::Label::new(help).wrap());
-            } else {
-                ui.add(egui::Label::new(help).extend());
-            }
+            ui.set_max_width(width);
+            ui.add(egui::Label::new(help).wrap());
         });
 }
 

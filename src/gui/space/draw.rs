@@ -219,7 +219,7 @@ pub fn frame_scene(
         .iter()
         .next()
         .map_or((1280.0, 800.0), |w| (w.width(), w.height()));
-    let (right, left) = style.side_widths(presenting, width);
+    let (right, left) = style.side_widths(presenting, width, height);
     let free = (width - right - left).max(100.0) / height.max(100.0);
     let half_fov = 0.4f32;
     let across = (half_fov.tan() * free).atan();
@@ -349,11 +349,13 @@ pub fn draw_links(
 pub fn record_trails(
     params: Res<SimParams>,
     style: Res<SceneStyle>,
+    clock: Res<crate::SimClock>,
     mut beads: Query<(&BeadPosition<DVec3>, &mut Trail<Vec3>, Option<&WireContact>)>,
 ) {
     let keep = style.trail_points(params.timestep);
     for (bead, mut trail, contact) in &mut beads {
-        trail.record(bead.0.as_vec3(), contact.is_some_and(|c| !c.is_on()), keep);
+        let flying = contact.is_some_and(|c| !c.is_on());
+        trail.record(bead.0.as_vec3(), flying, clock.time, keep);
     }
 }
 
@@ -362,9 +364,10 @@ pub fn record_trails(
 pub fn draw_trails(
     beads: Query<&Trail<Vec3>>,
     style: Res<SceneStyle>,
+    clock: Res<crate::SimClock>,
     mut gizmos: Gizmos<SpaceGizmos>,
 ) {
     for trail in &beads {
-        gizmos.linestrip_gradient(trail.coloured(&style));
+        gizmos.linestrip_gradient(trail.coloured(&style, clock.time));
     }
 }

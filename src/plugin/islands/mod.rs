@@ -104,6 +104,10 @@ pub struct IslandReport {
     /// Kinetic and gravitational energy of its beads plus the energy in
     /// its springs, after the last step.
     pub energy: f64,
+    /// The largest drift `|C|` of the rows that held after the last step
+    /// (rods, pins, wires and contacts; not a one-sided wire its bead has
+    /// left).
+    pub drift: f64,
     /// How many rows the last solve dropped as redundant.
     pub redundant: usize,
     /// How many substeps the last step took (more than one where a Newton

@@ -242,6 +242,9 @@ pub(super) fn step_islands<V: Dimension>(
                 });
             }
         }
+        cached.report.drift = (0..rows.len())
+            .filter(|&row| cached.work.holds(row))
+            .fold(0.0, |drift, row| f64::max(drift, rows[row].c.abs()));
         cached.report.energy = cached.island.energy(&cached.states, gravity);
         cached.report.redundant = cached.work.redundant();
         cached.report.substeps = cached.work.substeps();
