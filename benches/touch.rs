@@ -6,7 +6,9 @@
 //!   RATTLE, dt = 1/60 s), against the same beads without radii (they
 //!   pass through each other, each stepping alone). Throughput is
 //!   bead-steps per second. The plugin as a game gets it: Bevy's
-//!   executor, parallel loops from `ParallelStep::default()`.
+//!   executor, parallel loops from `ParallelStep::default()`. Each also
+//!   with the window's [`TimelinePlugin`] recording every step (its 30 s
+//!   held to 256 MB), for what the timeline costs.
 //! - `pile`: 500 beads of 2 cm poured in rows of 23 into a one-sided bowl
 //!   at `e = 0` (`ScenePreset::pile`, RATTLE at 240 Hz), one step at a
 //!   time from 0.2 s on, as the pile lands in the bowl and strikes
@@ -22,6 +24,7 @@ use criterion::{
     criterion_main,
 };
 use wirebead::headless::Headless;
+use wirebead::plugin::{Timeline, TimelinePlugin};
 use wirebead::prelude::*;
 use wirebead::{BeadRadius, Integrator, ScenePreset, SimClock};
 
@@ -30,15 +33,18 @@ const RINGS: usize = 100;
 /// Beads on each ring.
 const PER_RING: usize = 10;
 
-/// The abacus, its beads with radii or not, stepped once so that its
-/// islands are built.
-fn abacus(touching: bool) -> App {
+/// The abacus, its beads with radii or not, recorded on a timeline or not,
+/// stepped once so that its islands are built.
+fn abacus(touching: bool, recorded: bool) -> App {
     let params = SimParams {
         gravity: DVec2::ZERO,
         method: Method::new(Integrator::Rattle, None).expect("RATTLE"),
         ..SimParams::default()
     };
     let mut app = Headless::new(WireBeadPlugin::new(params).expect("valid parameters")).build();
+    if recorded {
+        app.add_plugins(TimelinePlugin);
+    }
     let world = app.world_mut();
     for ring in 0..RINGS {
         let centre = DVec2::new(3.0 * (ring % 10) as f64, 3.0 * (ring / 10) as f64);
@@ -77,8 +83,23 @@ fn abacus_group(c: &mut Criterion) {
     group.sample_size(20);
     group.warm_up_time(Duration::from_secs(1));
     group.measurement_time(Duration::from_secs(4));
-    for (name, touching) in [("touching", true), ("passing-through", false)] {
-        time_steps(&mut group, abacus(touching), (name, n));
+    for (name, touching, recorded) in [
+        ("touching", true, false),
+        ("touching-recorded", true, true),
+        ("passing-through", false, false),
+        ("passing-through-recorded", false, true),
+    ] {
+        let mut app = abacus(touching, recorded);
+        time_steps(&mut group, &mut app, (name, n));
+        if recorded {
+            let timeline = app.world().resource::<Timeline>();
+            eprintln!(
+                "{name}: {} steps kept, {:.0} MB, {:.0} kB a step",
+                timeline.len(),
+                timeline.bytes() as f64 / 1e6,
+                timeline.bytes() as f64 / 1e3 / timeline.len().max(1) as f64
+            );
+        }
     }
     group.finish();
 }
@@ -87,7 +108,7 @@ fn abacus_group(c: &mut Criterion) {
 /// bead stopped.
 fn time_steps(
     group: &mut BenchmarkGroup<'_, WallTime>,
-    mut app: App,
+    app: &mut App,
     (name, beads): (&str, usize),
 ) {
     group.bench_function(BenchmarkId::new(name, beads), |b| {
@@ -120,7 +141,7 @@ fn pile_group(c: &mut Criterion) {
     group.sample_size(10);
     group.warm_up_time(Duration::from_millis(1));
     group.measurement_time(Duration::from_millis(1));
-    time_steps(&mut group, app, ("pouring", PILE));
+    time_steps(&mut group, &mut app, ("pouring", PILE));
     group.finish();
 }
 

@@ -85,12 +85,40 @@ pub(super) fn keep_bead_edit<V: Coordinates + Reflect + TypePath>(
     })
 }
 
+/// The bead the panel shows, picked from every bead by its name (in the
+/// plane and in space), as clicking or dragging a bead picks it: a menu
+/// the keyboard reaches. Returns the bead picked, if another was.
+pub(super) fn bead_menu(ui: &mut egui::Ui, view: &PanelView) -> Option<Entity> {
+    let selected = view.selected.0?;
+    let mut beads: Vec<Entity> = view
+        .beads
+        .iter()
+        .map(|b| b.0)
+        .chain(view.space_beads.iter().map(|b| b.0))
+        .collect();
+    beads.sort();
+    let mut chosen = selected;
+    ui.separator();
+    ui.horizontal(|ui| {
+        ui.strong("Bead");
+        egui::ComboBox::from_id_salt("bead")
+            .selected_text(view.name(selected))
+            .show_ui(ui, |ui| {
+                for bead in beads {
+                    ui.selectable_value(&mut chosen, bead, view.name(bead));
+                }
+            });
+        if view.space_beads.contains(selected) {
+            ui.label("in space");
+        }
+    });
+    (chosen != selected).then_some(chosen)
+}
+
 /// The selected bead's parameters, its wire's shape, and its diagnostics.
 pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) -> Edit {
     let (entity, bead, diagnostics, on_wire, pending_bead, _) =
         view.selected.0.and_then(|e| view.beads.get(e).ok())?;
-    ui.separator();
-    ui.strong(format!("Bead {}", view.name(entity)));
     let (before, mut draft) = bead_start_editor(ui, "bead", bead, pending_bead);
     let mut outcome = None;
     if let Some(on_wire) = on_wire

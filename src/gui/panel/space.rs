@@ -19,8 +19,6 @@ pub(super) fn space_bead_section(
 ) -> Edit {
     let (entity, bead, diagnostics, on_wire, pending, _) =
         view.selected.0.and_then(|e| view.space_beads.get(e).ok())?;
-    ui.separator();
-    ui.strong(format!("Bead {} (in space)", view.name(entity)));
     let (before, draft) = bead_start_editor(ui, "space-bead", bead, pending);
     let mut outcome = keep_bead_edit(commands, entity, before, draft);
     if let Some(on_wire) = on_wire

@@ -6,7 +6,7 @@ use bevy_egui::{EguiContexts, egui};
 
 use super::constraints::{constraints_section, strikes_section};
 use super::ghosts::ghosts_section;
-use super::params::{Edit, bead_section, solver_section};
+use super::params::{Edit, bead_menu, bead_section, solver_section};
 use super::phase::phase_section;
 use super::plots::plots_section;
 use super::space::space_bead_section;
@@ -14,6 +14,7 @@ use super::timeline::timeline_section;
 use super::view::{ERROR_RED, PENDING_ORANGE, PanelActions, PanelView};
 use crate::Restart;
 use crate::controls::{ControlKeys, SPEEDS, key_name, speed_label};
+use crate::gui::drag::SelectedBead;
 use crate::gui::render::PRESENTATION_ZOOM;
 use crate::preset::LoadPreset;
 
@@ -58,6 +59,9 @@ pub fn panel(
         .show(ctx, |ui| {
             scene_section(ui, &view, &mut actions, refused.as_deref());
             timeline_section(ui, &view, &mut actions);
+            if let Some(bead) = bead_menu(ui, &view) {
+                actions.commands.insert_resource(SelectedBead(Some(bead)));
+            }
             let bead = bead_section(ui, &view, &mut actions.commands).or(space_bead_section(
                 ui,
                 &view,
