@@ -60,6 +60,59 @@ pub fn circle_angle(
     Some((angle, r.perp_dot(velocity) / rr))
 }
 
+/// Where a bead is along its wire, for plots: `s`, how far along the wire
+/// it has come since `s` began (m), and its rate `ṡ` (m/s), with the
+/// position and the unit tangent they were measured at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AlongWire {
+    /// How far along the wire, from where `s` began.
+    pub s: f64,
+    /// Its rate.
+    pub s_dot: f64,
+    /// Where the bead was.
+    pub position: DVec2,
+    /// The wire's unit tangent there, turned as `s` grows.
+    pub tangent: DVec2,
+}
+
+/// A bead at `position` moving at `velocity` on a wire whose normal there
+/// is `normal` (`∇C`), along the wire from `previous` (the last step's), or
+/// at `s = 0` where there is none. Each step adds its chord measured along
+/// the mean of the two tangents, so on a circle `s` is the arc `R θ` to a
+/// relative `Δθ²/24` for steps of `Δθ`. The tangent keeps the turn of
+/// `previous`'s; a first one points right (up, on an upright wire): on a
+/// circle's bottom, anticlockwise, as θ grows. None where the normal
+/// vanishes or is not finite.
+pub fn along_wire(
+    previous: Option<&AlongWire>,
+    position: DVec2,
+    velocity: DVec2,
+    normal: DVec2,
+) -> Option<AlongWire> {
+    let mut tangent = normal.try_normalize()?.perp();
+    let s = match previous {
+        Some(p) => {
+            if tangent.dot(p.tangent) < 0.0 {
+                tangent = -tangent;
+            }
+            let mean = (tangent + p.tangent).try_normalize().unwrap_or(tangent);
+            p.s + (position - p.position).dot(mean)
+        }
+        None => {
+            if tangent.x < 0.0 || (tangent.x == 0.0 && tangent.y < 0.0) {
+                tangent = -tangent;
+            }
+            0.0
+        }
+    };
+    Some(AlongWire {
+        s,
+        s_dot: velocity.dot(tangent),
+        position,
+        tangent,
+    })
+}
+
 /// The pendulum's separatrix on a circle of `radius` under gravity of
 /// size `g`: `θ̇ = ±√(2 g / R · (1 + cos θ))`, the motion that just comes
 /// to rest at the top, as two branches of `points` points each over
@@ -194,5 +247,38 @@ mod tests {
             1.7,
             max_relative = 1e-4
         );
+    }
+
+    /// On a unit circle, steps of 0.05 rad anticlockwise from the bottom:
+    /// `s` is the arc to the chord's `Δθ²/24`, `ṡ` is `R ω`, and the
+    /// tangent keeps its turn past the side of the circle.
+    #[test]
+    fn along_a_circle_s_is_its_arc() {
+        let (radius, step, omega) = (2.0, 0.05_f64, 1.5);
+        let mut along = None;
+        for k in 0..=100 {
+            let theta = step * k as f64;
+            let out = DVec2::new(theta.sin(), -theta.cos());
+            let position = radius * out;
+            let velocity = radius * omega * out.perp();
+            along = super::along_wire(along.as_ref(), position, velocity, out);
+        }
+        let along = along.expect("a tangent");
+        let arc = radius * step * 100.0;
+        assert!(
+            ((along.s - arc) / arc).abs() <= step * step / 24.0 * 1.01,
+            "s = {} against the arc {arc}",
+            along.s
+        );
+        assert!(
+            (along.s_dot - radius * omega).abs() < 1e-12,
+            "{}",
+            along.s_dot
+        );
+        assert!(super::along_wire(None, DVec2::ZERO, DVec2::X, DVec2::ZERO).is_none());
+        // On a level line, s grows to the right.
+        let first = super::along_wire(None, DVec2::ZERO, DVec2::X, DVec2::Y).unwrap();
+        let next = super::along_wire(Some(&first), DVec2::X, DVec2::X, DVec2::NEG_Y).unwrap();
+        assert_eq!((first.s_dot, next.s, next.s_dot), (1.0, 1.0, 1.0));
     }
 }

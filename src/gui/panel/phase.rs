@@ -24,6 +24,10 @@ pub enum Quantity {
     Vx,
     /// Velocity along `y`.
     Vy,
+    /// On a wire in the plane: how far along it, `s`.
+    Along,
+    /// On a wire in the plane: how fast along it, `ṡ`.
+    AlongSpeed,
     /// On a circle: the angle from its lowest point (where gravity pulls).
     Angle,
     /// On a circle: how fast that angle turns.
@@ -40,12 +44,14 @@ pub enum Quantity {
 
 impl Quantity {
     /// Every quantity, in the order the panel lists them.
-    pub const ALL: [Self; 11] = [
+    pub const ALL: [Self; 13] = [
         Self::Time,
         Self::X,
         Self::Y,
         Self::Vx,
         Self::Vy,
+        Self::Along,
+        Self::AlongSpeed,
         Self::Angle,
         Self::AngularSpeed,
         Self::C,
@@ -62,6 +68,8 @@ impl Quantity {
             Self::Y => "y (m)",
             Self::Vx => "vx (m/s)",
             Self::Vy => "vy (m/s)",
+            Self::Along => "s (m)",
+            Self::AlongSpeed => "ds/dt (m/s)",
             Self::Angle => "θ (rad)",
             Self::AngularSpeed => "dθ/dt (rad/s)",
             Self::C => "C (m)",
@@ -79,6 +87,8 @@ impl Quantity {
             Self::Y => sample.position.y,
             Self::Vx => sample.velocity.x,
             Self::Vy => sample.velocity.y,
+            Self::Along => sample.along?.s,
+            Self::AlongSpeed => sample.along?.s_dot,
             Self::Angle => sample.on_circle?.0,
             Self::AngularSpeed => sample.on_circle?.1,
             Self::C => sample.c,
@@ -89,13 +99,17 @@ impl Quantity {
     }
 }
 
-/// The two quantities the phase plot draws, `y` against `x`.
+/// The two quantities the phase plot draws, `y` against `x`. A bead newly
+/// plotted opens on its phase portrait: `(θ, θ̇)` on a circle, `(s, ṡ)`
+/// on another wire, `(x, vx)` on none; the menus pick any other two.
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PhasePlot {
     /// Along the horizontal axis.
     pub x: Quantity,
     /// Along the vertical axis.
     pub y: Quantity,
+    /// The bead the axes were opened for.
+    opened_for: Option<Entity>,
 }
 
 impl Default for PhasePlot {
@@ -104,6 +118,21 @@ impl Default for PhasePlot {
         Self {
             x: Quantity::Angle,
             y: Quantity::AngularSpeed,
+            opened_for: None,
+        }
+    }
+}
+
+impl PhasePlot {
+    /// The axes of `sample`'s phase portrait: `(θ, θ̇)` on a circle,
+    /// `(s, ṡ)` on another wire, `(x, vx)` on none.
+    pub fn portrait_of(sample: &PlotSample) -> (Quantity, Quantity) {
+        if sample.on_circle.is_some() {
+            (Quantity::Angle, Quantity::AngularSpeed)
+        } else if sample.along.is_some() {
+            (Quantity::Along, Quantity::AlongSpeed)
+        } else {
+            (Quantity::X, Quantity::Vx)
         }
     }
 }
@@ -153,6 +182,12 @@ fn phase_plot(
     history: &PlotHistory,
     choice: &mut PhasePlot,
 ) -> Option<PlotFrame> {
+    if choice.opened_for != history.bead()
+        && let Some(last) = history.samples.back()
+    {
+        (choice.x, choice.y) = PhasePlot::portrait_of(last);
+        choice.opened_for = history.bead();
+    }
     ui.horizontal(|ui| {
         ui.label("plot");
         quantity_menu(ui, "phase-y", &mut choice.y);
@@ -165,7 +200,9 @@ fn phase_plot(
         .filter_map(|s| Some([choice.x.of(s)?, choice.y.of(s)?]))
         .collect();
     if points.is_empty() {
-        ui.label("Nothing to plot: θ and dθ/dt need a bead on a circle; pick other quantities.");
+        ui.label(
+            "Nothing to plot: θ and dθ/dt need a bead on a circle, s and ds/dt a bead on a wire; pick other quantities.",
+        );
         return None;
     }
     let last = points[points.len() - 1];
@@ -276,6 +313,12 @@ mod tests {
             position: DVec3::new(6.0, 7.0, 0.0),
             velocity: DVec3::new(8.0, 9.0, 0.0),
             on_circle: Some((10.0, 11.0)),
+            along: Some(crate::reference::AlongWire {
+                s: 14.0,
+                s_dot: 15.0,
+                position: bevy::math::DVec2::ZERO,
+                tangent: bevy::math::DVec2::X,
+            }),
             kinetic: 12.0,
             potential: 13.0,
             normal_force: None,
@@ -286,7 +329,9 @@ mod tests {
             .collect();
         assert_eq!(
             values,
-            [1.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0, 2.0, 3.0, 5.0, 4.0]
+            [
+                1.0, 6.0, 7.0, 8.0, 9.0, 14.0, 15.0, 10.0, 11.0, 2.0, 3.0, 5.0, 4.0
+            ]
         );
         let off = PlotSample {
             on_circle: None,

@@ -12,10 +12,11 @@ use egui_plot::{
 };
 
 use crate::geometry::Coordinates;
+use crate::geometry::{ImplicitCurve, Placed};
 use crate::ghost::{GhostSample, Ghosts};
 use crate::gui::drag::SelectedBead;
 use crate::gui::ghost::ghost_colour32;
-use crate::reference::{circle_angle, circle_normal_force};
+use crate::reference::{AlongWire, along_wire, circle_angle, circle_normal_force};
 use crate::{
     BeadDiagnostics, BeadParams, BeadPosition, BeadVelocity, BeadsStruck, Islands, OnWire,
     SimClock, SimParams, Wire, WireShape, pose_of,
@@ -57,6 +58,9 @@ pub struct PlotSample {
     /// On a circle in the plane: the angle from its lowest point and its
     /// rate ([`circle_angle`](crate::reference::circle_angle)).
     pub on_circle: Option<(f64, f64)>,
+    /// On a wire in the plane: how far along it the bead has come since
+    /// the plot began, and how fast ([`along_wire`]).
+    pub along: Option<AlongWire>,
     /// The bead's own kinetic energy `½ m |v|²`.
     pub kinetic: f64,
     /// Its own potential energy `−m g·x`.
@@ -81,6 +85,7 @@ impl PlotSample {
             position: DVec3::ZERO,
             velocity: DVec3::ZERO,
             on_circle: None,
+            along: None,
             kinetic: d.kinetic,
             potential: d.potential,
             normal_force: None,
@@ -99,6 +104,13 @@ pub struct PlotHistory {
     /// the circle's radius (for the pendulum's separatrix).
     pub circle: Option<(f64, f64)>,
     bead: Option<Entity>,
+}
+
+impl PlotHistory {
+    /// The bead plotted.
+    pub fn bead(&self) -> Option<Entity> {
+        self.bead
+    }
 }
 
 impl Default for PlotHistory {
@@ -168,6 +180,15 @@ pub fn record_history(
                 let expected = circle_normal_force(start.mass, g.length(), radius, from, theta);
                 Some((d.constraint_force.dot(inward), expected))
             });
+        // The wire's normal where the bead is, for how far along it is.
+        let normal = on.and_then(|on| {
+            let (wire, transform) = wires.get(on.0).ok()?;
+            let placed = Placed {
+                curve: wire.shape().curve(),
+                pose: pose_of(transform).ok()?,
+            };
+            Some(placed.gradient(x.0))
+        });
         let sample = PlotSample {
             held_by: if on_wire {
                 HeldBy::Wire
@@ -180,7 +201,7 @@ pub fn record_history(
             normal_force,
             ..PlotSample::of(clock.time, d)
         };
-        (sample, circle.map(|c| c.1))
+        (sample, circle.map(|c| c.1), normal)
     });
     let space = || {
         let (x, v, d, on) = space_beads.get(entity).ok()?;
@@ -194,9 +215,9 @@ pub fn record_history(
             velocity: v.0,
             ..PlotSample::of(clock.time, d)
         };
-        Some((sample, None))
+        Some((sample, None, None))
     };
-    let Some((mut sample, radius)) = plane.or_else(space) else {
+    let Some((mut sample, radius, normal)) = plane.or_else(space) else {
         return;
     };
     history.circle = radius.map(|r| (g.length(), r));
@@ -209,6 +230,11 @@ pub fn record_history(
     // from there.
     while history.samples.back().is_some_and(|s| s.t >= t) {
         history.samples.pop_back();
+    }
+    if let Some(normal) = normal {
+        let previous = history.samples.back().and_then(|s| s.along);
+        let (x, v) = (sample.position.truncate(), sample.velocity.truncate());
+        sample.along = along_wire(previous.as_ref(), x, v, normal);
     }
     if let Some(island) = islands
         .of(entity)
