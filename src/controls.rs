@@ -106,7 +106,7 @@ impl ControlKeys {
     /// A one-line description for an on-screen help line.
     pub fn help(&self) -> String {
         format!(
-            "{}: restart and apply edits · {}: pause/resume · {} and {}: one step back, forward · {} and {}: slower, faster · {}: run backwards · {}, {}, {}: export CSV, scene, plots · {}: add a ghost · {}: presentation · Tab, Esc: into the panel, out · drag a bead",
+            "{}: restart and apply edits · {}: pause/resume · {} and {}: one step back, forward · {} and {}: slower, faster · {}: run backwards · {}, {}, {}: export CSV, scene, plots · {}: add a ghost · {}: presentation · Tab, Esc: into the panel, out · drag a bead or pull it with the arrows",
             key_name(self.restart),
             key_name(self.pause),
             key_name(self.back),

@@ -6,6 +6,11 @@
 //! A drag grabs the bead the picking ray hit or, failing that, the bead
 //! whose drawn disc the press landed in (a forgiving grab for a small bead,
 //! and robust when the window's hover state was reset by the press).
+//!
+//! The keyboard pulls too: while an arrow key is held, the selected bead
+//! in the plane gets a [`SpringAnchor`] that starts where the bead is and
+//! moves in the arrows' direction at a quarter of the view's height a second, a
+//! cursor moved by the keys; letting go of the arrows lets go of the bead.
 
 use bevy::math::DVec3;
 use bevy::prelude::*;
@@ -29,9 +34,11 @@ impl Plugin for BeadDragPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<SelectedBead>()
             .init_resource::<Grabbed>()
+            .init_resource::<KeyPull>()
             .add_observer(start_drag)
             .add_observer(follow_drag)
-            .add_observer(end_drag);
+            .add_observer(end_drag)
+            .add_systems(Update, pull_with_arrows);
     }
 }
 
@@ -117,5 +124,84 @@ pub fn end_drag(
         && let Ok(mut entity) = commands.get_entity(bead)
     {
         entity.remove::<(SpringAnchor, SpringAnchor<DVec3>)>();
+    }
+}
+
+/// The bead the arrow keys are pulling, if any.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct KeyPull(pub Option<Entity>);
+
+/// How fast the arrow keys move the drag target, in view heights a
+/// second.
+pub const KEY_PULL_SPEED: f32 = 0.25;
+
+/// The direction the arrow keys held point in (zero for none, or for
+/// opposite keys together).
+pub fn arrow_direction(keys: &ButtonInput<KeyCode>) -> Vec2 {
+    [
+        (KeyCode::ArrowRight, Vec2::X),
+        (KeyCode::ArrowLeft, Vec2::NEG_X),
+        (KeyCode::ArrowUp, Vec2::Y),
+        (KeyCode::ArrowDown, Vec2::NEG_Y),
+    ]
+    .into_iter()
+    .filter(|(key, _)| keys.pressed(*key))
+    .map(|(_, direction)| direction)
+    .sum::<Vec2>()
+    .normalize_or_zero()
+}
+
+/// Pulls the selected bead in the plane with the arrow keys while no mouse
+/// drag holds a bead: the target starts at the bead and moves with the
+/// keys; it goes when no arrow is held.
+#[allow(clippy::too_many_arguments)]
+pub fn pull_with_arrows(
+    keys: Res<ButtonInput<KeyCode>>,
+    time: Res<Time<Real>>,
+    view: Res<crate::gui::render::FramedView>,
+    selected: Res<SelectedBead>,
+    grabbed: Res<Grabbed>,
+    mut pull: ResMut<KeyPull>,
+    mut beads: Query<(&BeadPosition, Option<&mut SpringAnchor>)>,
+    mut commands: Commands,
+) {
+    let direction = arrow_direction(&keys);
+    let held = keys.any_pressed([
+        KeyCode::ArrowRight,
+        KeyCode::ArrowLeft,
+        KeyCode::ArrowUp,
+        KeyCode::ArrowDown,
+    ]);
+    if !held || grabbed.0.is_some() {
+        if let Some(bead) = pull.0.take()
+            && grabbed.0 != Some(bead)
+            && let Ok(mut entity) = commands.get_entity(bead)
+        {
+            entity.remove::<SpringAnchor>();
+        }
+        return;
+    }
+    let Some(bead) = selected.0 else { return };
+    let Ok((position, anchor)) = beads.get_mut(bead) else {
+        return;
+    };
+    let step = (direction * KEY_PULL_SPEED * view.size.y * time.delta_secs()).as_dvec2();
+    match (pull.0 == Some(bead), anchor) {
+        (true, Some(mut anchor)) => {
+            if let Ok(next) = SpringAnchor::new(anchor.get() + step) {
+                *anchor = next;
+            }
+        }
+        _ => {
+            if let Some(old) = pull.0.replace(bead)
+                && old != bead
+                && let Ok(mut entity) = commands.get_entity(old)
+            {
+                entity.remove::<SpringAnchor>();
+            }
+            if let Ok(start) = SpringAnchor::new(position.0 + step) {
+                commands.entity(bead).insert(start);
+            }
+        }
     }
 }

@@ -149,6 +149,22 @@ fn a_real_mouse_drag_pulls_the_bead_toward_the_cursor() {
 }
 
 #[test]
+#[ignore = "needs the arrow key .ci/run holds under Xvfb"]
+fn the_arrow_keys_pull_the_bead_as_the_mouse_does() {
+    let drag = report("keypull.ron")
+        .drag
+        .expect("the arrow key never pulled the bead");
+    // Pulled to the right, along its circle.
+    assert!(
+        drag.target[0] > drag.bead_start[0] + 0.2,
+        "the target moved from {:?} to {:?}",
+        drag.bead_start,
+        drag.target
+    );
+    drag_pulled_the_bead("keypull.ron");
+}
+
+#[test]
 #[ignore = "needs the xdotool drag .ci/run makes under Xvfb"]
 fn a_real_mouse_drag_pulls_a_bead_in_space_toward_the_cursor() {
     let ready = report("space_drag_ready.ron");
