@@ -135,20 +135,23 @@ pub struct KeyPull(pub Option<Entity>);
 /// second.
 pub const KEY_PULL_SPEED: f32 = 0.25;
 
+/// The arrow keys and the directions they pull in.
+const ARROWS: [(KeyCode, Vec2); 4] = [
+    (KeyCode::ArrowRight, Vec2::X),
+    (KeyCode::ArrowLeft, Vec2::NEG_X),
+    (KeyCode::ArrowUp, Vec2::Y),
+    (KeyCode::ArrowDown, Vec2::NEG_Y),
+];
+
 /// The direction the arrow keys held point in (zero for none, or for
 /// opposite keys together).
 pub fn arrow_direction(keys: &ButtonInput<KeyCode>) -> Vec2 {
-    [
-        (KeyCode::ArrowRight, Vec2::X),
-        (KeyCode::ArrowLeft, Vec2::NEG_X),
-        (KeyCode::ArrowUp, Vec2::Y),
-        (KeyCode::ArrowDown, Vec2::NEG_Y),
-    ]
-    .into_iter()
-    .filter(|(key, _)| keys.pressed(*key))
-    .map(|(_, direction)| direction)
-    .sum::<Vec2>()
-    .normalize_or_zero()
+    ARROWS
+        .into_iter()
+        .filter(|(key, _)| keys.pressed(*key))
+        .map(|(_, direction)| direction)
+        .sum::<Vec2>()
+        .normalize_or_zero()
 }
 
 /// Pulls the selected bead in the plane with the arrow keys while no mouse
@@ -166,12 +169,7 @@ pub fn pull_with_arrows(
     mut commands: Commands,
 ) {
     let direction = arrow_direction(&keys);
-    let held = keys.any_pressed([
-        KeyCode::ArrowRight,
-        KeyCode::ArrowLeft,
-        KeyCode::ArrowUp,
-        KeyCode::ArrowDown,
-    ]);
+    let held = keys.any_pressed(ARROWS.map(|(key, _)| key));
     if !held || grabbed.0.is_some() {
         if let Some(bead) = pull.0.take()
             && grabbed.0 != Some(bead)

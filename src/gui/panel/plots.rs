@@ -36,6 +36,18 @@ pub enum HeldBy {
     Nothing,
 }
 
+impl HeldBy {
+    /// A bead's hold as its wire says: [`HeldBy::Wire`] on one, else
+    /// [`HeldBy::Nothing`] until its island says it is joined to others.
+    fn on(wire: Option<&OnWire>) -> Self {
+        if wire.is_some() {
+            Self::Wire
+        } else {
+            Self::Nothing
+        }
+    }
+}
+
 /// One plotted sample of the selected bead.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlotSample {
@@ -159,18 +171,18 @@ pub fn record_history(
     mut history: ResMut<PlotHistory>,
 ) {
     let Some(entity) = selected.0 else { return };
-    // On a circle in the plane: its centre and radius.
-    let circle = |on: Option<&OnWire>| {
-        let (wire, transform) = wires.get(on?.0).ok()?;
-        let WireShape::Circle(c) = wire.shape() else {
-            return None;
-        };
-        Some((pose_of(transform).ok()?.origin, c.radius))
-    };
     let g = params.gravity;
     let plane = beads.get(entity).ok().map(|(x, v, d, start, on)| {
-        let on_wire = on.is_some();
-        let circle = circle(on);
+        // Its wire's shape and pose, looked up once.
+        let wire = on.and_then(|on| {
+            let (wire, transform) = wires.get(on.0).ok()?;
+            Some((wire.shape(), pose_of(transform).ok()?))
+        });
+        // On a circle: its centre and radius.
+        let circle = wire.and_then(|(shape, pose)| match shape {
+            WireShape::Circle(c) => Some((pose.origin, c.radius)),
+            _ => None,
+        });
         let on_circle = circle.and_then(|(centre, _)| circle_angle(centre, g, x.0, v.0));
         let normal_force = circle
             .zip(on_circle)
@@ -181,20 +193,12 @@ pub fn record_history(
                 Some((d.constraint_force.dot(inward), expected))
             });
         // The wire's normal where the bead is, for how far along it is.
-        let normal = on.and_then(|on| {
-            let (wire, transform) = wires.get(on.0).ok()?;
-            let placed = Placed {
-                curve: wire.shape().curve(),
-                pose: pose_of(transform).ok()?,
-            };
-            Some(placed.gradient(x.0))
+        let normal = wire.map(|(shape, pose)| {
+            let curve = shape.curve();
+            Placed { curve, pose }.gradient(x.0)
         });
         let sample = PlotSample {
-            held_by: if on_wire {
-                HeldBy::Wire
-            } else {
-                HeldBy::Nothing
-            },
+            held_by: HeldBy::on(on),
             position: x.0.extend(0.0),
             velocity: v.0.extend(0.0),
             on_circle,
@@ -206,11 +210,7 @@ pub fn record_history(
     let space = || {
         let (x, v, d, on) = space_beads.get(entity).ok()?;
         let sample = PlotSample {
-            held_by: if on.is_some() {
-                HeldBy::Wire
-            } else {
-                HeldBy::Nothing
-            },
+            held_by: HeldBy::on(on),
             position: x.0,
             velocity: v.0,
             ..PlotSample::of(clock.time, d)
@@ -481,19 +481,19 @@ fn plots(ui: &mut egui::Ui, history: &PlotHistory, ghosts: &Ghosts) {
             .collect()
     };
     let held_by = samples.back().map_or(HeldBy::Wire, |s| s.held_by);
-    let drift = match held_by {
-        HeldBy::Wire => Some("drift |C|"),
-        HeldBy::Links => Some("drift, largest |C| of its rods and pins"),
-        HeldBy::Nothing => None,
+    let (drift, note) = match held_by {
+        HeldBy::Wire => (Some("drift |C|"), None),
+        HeldBy::Links => (
+            Some("drift, largest |C| of its rods and pins"),
+            Some("It rides no wire: no λ of its own (each rod's is under Constraints)."),
+        ),
+        HeldBy::Nothing => (
+            None,
+            Some("A free bead: no wire, rod or pin, so no drift C or λ."),
+        ),
     };
-    match held_by {
-        HeldBy::Wire => {}
-        HeldBy::Links => {
-            ui.label("It rides no wire: no λ of its own (each rod's is under Constraints).");
-        }
-        HeldBy::Nothing => {
-            ui.label("A free bead: no wire, rod or pin, so no drift C or λ.");
-        }
+    if let Some(note) = note {
+        ui.label(note);
     }
     let lines: [(
         &str,
