@@ -15,7 +15,7 @@ use bevy::prelude::*;
 use crate::controls::GhostRequests;
 use crate::dynamics::{BeadDiagnostics, BeadPosition, Dimension, SimParams, SpringAnchor};
 use crate::headless::{Headless, idle};
-use crate::plugin::{Islands, SimClock, WireBeadPlugin};
+use crate::plugin::{SceneEnergy, SimClock, WireBeadPlugin};
 use crate::preset::{ActivePreset, BeadEdits, SceneFile, WireEdits, edited_scene};
 use crate::solver::Method;
 use crate::validate::ParamError;
@@ -145,7 +145,8 @@ pub struct GhostSample {
     pub t: f64,
     /// The bead's `C`.
     pub c: f64,
-    /// Its energy (its island's, where it is joined to others).
+    /// The ghost scene's energy ([`SceneEnergy`]), as the run's plot
+    /// shows the run's.
     pub energy: f64,
 }
 
@@ -339,6 +340,7 @@ fn sync_ghosts(
 fn build_world(scene: &SceneFile, params: SimParams, id: AssetId<SceneFile>) -> GhostWorld {
     let plugin = WireBeadPlugin::new(params).unwrap_or_default();
     let mut app = Headless::new(plugin).single_threaded().build();
+    app.init_resource::<SceneEnergy>();
     let beads = scene.spawn(&mut app.world_mut().commands());
     app.world_mut().flush();
     idle(&mut app);
@@ -371,24 +373,24 @@ impl GhostWorld {
         let bead = *self.beads.get(focus?)?;
         let world = &self.world;
         let t = world.resource::<SimClock>().time;
-        let (c, energy) = if self.dimension == 2 {
+        let (c, own) = if self.dimension == 2 {
             diagnosed::<DVec2>(world, bead)?
         } else {
             diagnosed::<DVec3>(world, bead)?
         };
+        // Before its first step the scene's is not measured yet.
+        let energy = world
+            .get_resource::<SceneEnergy>()
+            .filter(|e| e.time == t)
+            .map_or(own, |e| e.total);
         Some(GhostSample { t, c, energy })
     }
 }
 
-/// A bead's `C` and energy (its island's where it is joined to others).
+/// A bead's `C` and its own energy.
 fn diagnosed<V: Dimension>(world: &World, bead: Entity) -> Option<(f64, f64)> {
     let d = world.get::<BeadDiagnostics<V>>(bead)?;
-    let island = world
-        .resource::<Islands<V>>()
-        .of(bead)
-        .filter(|island| island.rows > 0)
-        .map(|island| island.energy);
-    Some((d.c, island.unwrap_or(d.energy())))
+    Some((d.c, d.energy()))
 }
 
 /// Sets or takes away a bead's drag anchor, touching it only on a change.

@@ -45,6 +45,7 @@
 //! | [`SpringAnchor`] | a point a spring `k (anchor - x)` pulls a bead toward (the assignment's mouse drag) |
 //! | [`BeadDiagnostics`], [`Diverged`], [`BeadDiverged`] | `C`, `Ċ`, λ and energy each step; divergence reports |
 //! | [`SimClock`], [`ParallelStep`] | steps and seconds since the last restart; when the step splits over threads |
+//! | [`SceneEnergy`] | the whole scene's energy after each step, for a plot that jumps only where energy is taken or given |
 //! | [`ScenePresetPlugin`], [`ScenePreset`] | scenes as RON assets (`*.scene.ron`), hot-reloaded |
 //! | `debug_render::WireBeadDebugPlugin` | gizmo drawing of wires, beads, links and forces (feature `debug-render`) |
 //! | `gui::WireBeadGuiPlugin` | the windowed scene (feature `gui`): picking drag, egui panel, plots |
@@ -107,8 +108,8 @@ pub use geometry::{
     Friction, ImplicitCurve, Oscillate, Side, Spin, Surface, WireKind, WireMotion, WireShape,
 };
 pub use plugin::{
-    IslandReport, Islands, ParallelStep, PressedPair, Restart, SimClock, WireBeadPlugin,
-    WireBeadSystems,
+    IslandReport, Islands, ParallelStep, PressedPair, Restart, SceneEnergy, SimClock,
+    WireBeadPlugin, WireBeadSystems,
 };
 pub use preset::{
     ActivePreset, LoadPreset, SceneFile, SceneLink, ScenePreset, ScenePresetPlugin, SpaceScene,

@@ -10,7 +10,7 @@
 //! | [`BeadStepPlugin`] | `step` | the step of each bead alone on a wire, batched and in parallel |
 //! | [`IslandPlugin`] | `islands` | [`Islands`]: beads joined by rods, pins, joints and springs, stepped together |
 //! | [`RestartPlugin`] | `restart` | [`Restart`]: the pending edits applied, every bead back to its start |
-//! | [`WritebackPlugin`] | `writeback` | `Transform`s from the `f64` state |
+//! | [`WritebackPlugin`] | `writeback` | `Transform`s from the `f64` state; the [`SceneEnergy`] where the app asks for it (`energy`) |
 //!
 //! Shared pieces live in leaf files: `schedule` ([`WireBeadSystems`]),
 //! `parallel` ([`ParallelStep`]), `report` (divergence and contact
@@ -18,6 +18,7 @@
 //! systems against the sets.
 
 mod clock;
+mod energy;
 mod forces;
 mod islands;
 mod parallel;
@@ -34,6 +35,7 @@ use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
 
 pub use clock::{ClockPlugin, SimClock};
+pub use energy::SceneEnergy;
 pub use forces::SpringAnchorPlugin;
 pub use islands::{IslandPlugin, IslandReport, Islands, PressedPair};
 pub use parallel::{ParallelStep, StepSplit, compute_on_all_cores, use_single_threaded_executors};

@@ -8,6 +8,7 @@ use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 
 use super::clock::SimClock;
+use super::energy::{SceneEnergy, measure_scene_energy};
 use super::parallel::ParallelStep;
 use super::schedule::WireBeadSystems;
 use crate::dynamics::{
@@ -17,7 +18,8 @@ use crate::dynamics::{
 use crate::geometry::{SpaceShape, WireSpace};
 
 /// Keeps each bead's `Transform` at its position where the step did not
-/// write it itself (a restart, a game's own edit).
+/// write it itself (a restart, a game's own edit), and the
+/// [`SceneEnergy`] where the app has it.
 #[derive(Default)]
 pub struct WritebackPlugin;
 
@@ -37,6 +39,13 @@ impl Plugin for WritebackPlugin {
                     )
                         .chain(),
                 )
+                    .in_set(WireBeadSystems::Writeback),
+            )
+            .register_type::<SceneEnergy>()
+            .add_systems(
+                FixedUpdate,
+                measure_scene_energy
+                    .run_if(resource_exists::<SceneEnergy>)
                     .in_set(WireBeadSystems::Writeback),
             );
     }

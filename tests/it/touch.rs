@@ -7,7 +7,8 @@ use wirebead::headless::{Headless, bead_state, idle, run_steps};
 use wirebead::prelude::*;
 use wirebead::solver::{BeadState, NEAR_MEETING};
 use wirebead::{
-    CatchesBeads, Integrator, Islands, Restitution, ScenePreset, WireContact, preset::PILE_RADIUS,
+    CatchesBeads, Integrator, Islands, Restitution, SceneEnergy, ScenePreset, SimClock,
+    WireContact, preset::PILE_RADIUS,
 };
 
 /// A headless app at `dt` with RATTLE, no gravity along the track.
@@ -285,6 +286,45 @@ fn cradle(k: usize) -> (App, Vec<Entity>) {
         balls.push(ball);
     }
     (app, balls)
+}
+
+/// The shipped Newton's cradle for 5 s (3,000 steps): the scene's energy
+/// ([`SceneEnergy`], which the panel plots) stays within 1e-4 J of where
+/// it started, while the island of the first ball gains and loses the
+/// balls it strikes, so that the island's own energy (which the panel
+/// plotted for a bead joined to others) jumps by joules.
+#[test]
+fn the_cradles_scene_energy_is_kept_while_its_islands_gain_and_lose_balls() {
+    let (mut app, beads, _) = shipped("newtons_cradle.scene.ron");
+    app.init_resource::<SceneEnergy>();
+    let first_ball = beads[5];
+    run_steps(&mut app, 1);
+    let e0 = app.world().resource::<SceneEnergy>().total;
+    let island = |app: &App| {
+        let islands = app.world().resource::<Islands>();
+        islands.of(first_ball).expect("the ball's island").energy
+    };
+    let (mut low, mut high) = (island(&app), island(&app));
+    let mut worst = 0.0f64;
+    for _ in 1..3000 {
+        run_steps(&mut app, 1);
+        let scene = app.world().resource::<SceneEnergy>();
+        let time = app.world().resource::<SimClock>().time;
+        assert_eq!(scene.time, time, "measured after each step");
+        worst = worst.max((scene.total - e0).abs());
+        let e = island(&app);
+        (low, high) = (low.min(e), high.max(e));
+    }
+    eprintln!(
+        "cradle: scene energy kept to {worst:e} J; the first ball's island from {low} to {high} J"
+    );
+    assert!(worst <= 1e-4, "the scene's energy changed by {worst:e} J");
+    assert!(
+        high - low >= 1.0,
+        "the first ball's island kept its energy ({low} to {high} J): no merging to tell apart"
+    );
+    let world = app.world_mut();
+    assert_eq!(world.query::<&Diverged>().iter(world).count(), 0);
 }
 
 /// `k` balls released from 30° send out `k`: the ones struck last rise
@@ -835,20 +875,29 @@ fn a_pile_poured_into_a_bowl_lies_pressed_together_without_overlap() {
 
 /// Five hundred beads of 2 cm and 1 kg at `e = 0` poured in rows of 23
 /// into a one-sided bowl of radius 1 m ([`ScenePreset::pile`]), RATTLE at
-/// 240 Hz, through the pour: in 0.45 s every bead comes down onto the
-/// bowl or onto the beads below (the last at 0.39 s), and at no step do
-/// two overlap by more than 1e-9 of a radius (measured 1.95e-10 over the
-/// first 0.6 s). Minutes in a debug build; `.ci/run` runs it in release.
+/// 240 Hz, one island that time-steps its meetings and landings: in
+/// 0.45 s every bead comes down onto the bowl or onto the beads below
+/// (the last at 0.39 s), at no step do two overlap by more than 1e-9 of
+/// a radius (measured 4e-14), and the scene's energy ([`SceneEnergy`])
+/// never rises from one step to the next by more than 1e-9 of the
+/// pile's weight times a radius: the landings and meetings at `e = 0`
+/// take energy, nothing gives it. Seconds in release, minutes in a
+/// debug build; `.ci/run` runs it in release.
 #[test]
 #[cfg_attr(
     debug_assertions,
     ignore = "minutes in a debug build: run with --release"
 )]
-fn a_pile_of_500_beads_poured_into_a_bowl_never_overlaps() {
+fn a_pile_of_500_beads_poured_into_a_bowl_never_overlaps_nor_gains_energy() {
     let preset = ScenePreset::pile(500, 23).unwrap_or_else(|e| panic!("{e}"));
     let (mut app, spawned) = spawned_from(&preset);
+    app.init_resource::<SceneEnergy>();
     let mut landed = vec![false; spawned.len()];
     let mut worst = f64::MIN;
+    let r = PILE_RADIUS;
+    let weight = 500.0 * 9.81;
+    let mut energy = None;
+    let mut rise = 0.0f64;
     for step in 1..=108 {
         run_steps(&mut app, 1);
         let overlap = worst_overlap(&mut app);
@@ -857,12 +906,16 @@ fn a_pile_of_500_beads_poured_into_a_bowl_never_overlaps() {
             "step {step}: beads overlap by {overlap:e} of a radius"
         );
         worst = worst.max(overlap);
+        let e = app.world().resource::<SceneEnergy>().total;
+        if let Some(before) = energy {
+            rise = rise.max(e - before);
+        }
+        energy = Some(e);
         // Down: on the bowl, or touching another bead.
         let at: Vec<DVec2> = spawned
             .iter()
             .map(|&b| bead_state(app.world(), b).expect("a bead").position)
             .collect();
-        let r = PILE_RADIUS;
         for (k, &x) in at.iter().enumerate() {
             let on_bowl = (x.length() - 1.0).abs() <= 1e-6 * r;
             landed[k] |= on_bowl
@@ -873,10 +926,24 @@ fn a_pile_of_500_beads_poured_into_a_bowl_never_overlaps() {
         }
     }
     let world = app.world_mut();
-    assert_eq!(world.query::<&Diverged>().iter(world).count(), 0);
+    let stopped: Vec<String> = world
+        .query::<&Diverged>()
+        .iter(world)
+        .map(|d| format!("at {} s: {}", d.time, d.reason))
+        .collect();
+    assert!(
+        stopped.is_empty(),
+        "{} beads stopped, the first {:?}",
+        stopped.len(),
+        stopped.first()
+    );
     let aloft = landed.iter().filter(|&&l| !l).count();
     assert_eq!(aloft, 0, "beads that never came down");
-    eprintln!("500 beads poured: overlap {worst:e}");
+    eprintln!("500 beads poured: overlap {worst:e}, energy rose by at most {rise:e} J in a step");
+    assert!(
+        rise <= 1e-9 * weight * r,
+        "the scene's energy rose by {rise:e} J in one step"
+    );
 }
 
 /// A straight ramp that ends in mid-air (an open Catmull–Rom spline,

@@ -104,6 +104,7 @@ impl Plugin for PanelPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<PresetCatalog>()
             .init_resource::<PlotHistory>()
+            .init_resource::<crate::plugin::SceneEnergy>()
             .init_resource::<PhasePlot>()
             .init_resource::<PhasePlotFrame>()
             .init_resource::<PlotsShown>()

@@ -309,6 +309,8 @@ mod tests {
             c: 2.0,
             c_dot: 3.0,
             energy: 4.0,
+            own_energy: false,
+            scene_energy: 4.0,
             lambda: 5.0,
             position: DVec3::new(6.0, 7.0, 0.0),
             velocity: DVec3::new(8.0, 9.0, 0.0),

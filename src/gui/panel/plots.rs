@@ -16,6 +16,7 @@ use crate::geometry::{ImplicitCurve, Placed};
 use crate::ghost::{GhostSample, Ghosts};
 use crate::gui::drag::SelectedBead;
 use crate::gui::ghost::ghost_colour32;
+use crate::plugin::SceneEnergy;
 use crate::reference::{AlongWire, along_wire, circle_angle, circle_normal_force};
 use crate::{
     BeadDiagnostics, BeadParams, BeadPosition, BeadVelocity, BeadsStruck, Islands, OnWire,
@@ -59,8 +60,15 @@ pub struct PlotSample {
     pub c: f64,
     /// Its rate `Ċ`.
     pub c_dot: f64,
-    /// Energy.
+    /// The bead's own energy, kinetic plus gravitational.
     pub energy: f64,
+    /// Whether the bead's own energy is worth a line of its own beside
+    /// the scene's: it is joined to no other bead by a rod, pin or
+    /// contact, and the scene holds more than it.
+    pub own_energy: bool,
+    /// The scene's energy ([`SceneEnergy`]): what changes only by
+    /// damping, friction, inelastic strikes, drift and a drag.
+    pub scene_energy: f64,
     /// λ.
     pub lambda: f64,
     /// Where the bead was (`z` zero in the plane).
@@ -93,6 +101,8 @@ impl PlotSample {
             c: d.c,
             c_dot: d.c_dot,
             energy: d.energy(),
+            own_energy: false,
+            scene_energy: d.energy(),
             lambda: d.lambda,
             position: DVec3::ZERO,
             velocity: DVec3::ZERO,
@@ -155,9 +165,10 @@ type SpaceBeadRead = (
 );
 
 /// Appends the selected bead's diagnostics (in the plane or in space) to
-/// the plot history; for a bead joined to others, the energy is its
-/// island's (a rod does work on each of its beads, not on the two
-/// together).
+/// the plot history, with the scene's energy ([`SceneEnergy`]): an
+/// island's own jumps as contacts join and part its beads, and a rod does
+/// work on each of its beads, not on the two together, so the bead's own
+/// is kept only for a bead joined to nothing.
 #[allow(clippy::too_many_arguments)]
 pub fn record_history(
     selected: Res<SelectedBead>,
@@ -168,6 +179,7 @@ pub fn record_history(
     wires: Query<(&Wire, &Transform)>,
     islands: Res<Islands>,
     space_islands: Res<Islands<DVec3>>,
+    scene_energy: Option<Res<SceneEnergy>>,
     mut history: ResMut<PlotHistory>,
 ) {
     let Some(entity) = selected.0 else { return };
@@ -236,17 +248,23 @@ pub fn record_history(
         let (x, v) = (sample.position.truncate(), sample.velocity.truncate());
         sample.along = along_wire(previous.as_ref(), x, v, normal);
     }
-    if let Some(island) = islands
+    let joined = islands
         .of(entity)
         .or_else(|| space_islands.of(entity))
-        .filter(|island| island.rows > 0)
-    {
-        sample.energy = island.energy;
+        .filter(|island| island.rows > 0);
+    if let Some(island) = joined {
         // A bead held by rods or pins alone: its island's drift.
         if sample.held_by == HeldBy::Nothing {
             sample.held_by = HeldBy::Links;
             sample.c = island.drift;
         }
+    }
+    // Measured at this time: a sample taken before the first step of a
+    // restarted run has the bead's own.
+    if let Some(scene) = scene_energy.filter(|e| e.time == t) {
+        sample.scene_energy = scene.total;
+        let apart = (scene.total - sample.energy).abs() > 1e-12 * scene.total.abs().max(1.0);
+        sample.own_energy = joined.is_none() && apart;
     }
     history.samples.push_back(sample);
     let horizon = t - history.seconds;
@@ -513,10 +531,10 @@ fn plots(ui: &mut egui::Ui, history: &PlotHistory, ghosts: &Ghosts) {
         ),
         (
             "plot-e",
-            Some("energy E"),
+            Some("energy E of the scene"),
             "J",
             egui::Color32::LIGHT_GREEN,
-            |s| s.energy,
+            |s| s.scene_energy,
             false,
         ),
         (
@@ -535,7 +553,13 @@ fn plots(ui: &mut egui::Ui, history: &PlotHistory, ghosts: &Ghosts) {
         let mut lines = vec![PlotLine::solid(label, points, colour)];
         match id {
             "plot-c" => lines.extend(ghost_lines(|s| s.c)),
-            "plot-e" => lines.extend(ghost_lines(|s| s.energy)),
+            "plot-e" => {
+                if samples.back().is_some_and(|s| s.own_energy) {
+                    let own = samples.iter().map(|s| [s.t, s.energy]).collect();
+                    lines.push(PlotLine::solid("the bead's own", own, egui::Color32::KHAKI));
+                }
+                lines.extend(ghost_lines(|s| s.energy));
+            }
             _ => {}
         }
         plot(ui, id, lines, log);
@@ -567,17 +591,17 @@ fn plots(ui: &mut egui::Ui, history: &PlotHistory, ghosts: &Ghosts) {
 }
 
 /// The selected bead's energy now as bars: kinetic, potential and their
-/// sum, and how much the plotted energy (its island's, where it is
-/// joined to others) changed over the plotted seconds: what drift,
-/// damping, friction or a drag added (up) or removed (down).
+/// sum, and how much the scene's energy changed over the plotted seconds:
+/// what drift, damping, friction, inelastic strikes or a drag added (up)
+/// or removed (down).
 fn energy_bars(ui: &mut egui::Ui, first: &PlotSample, last: &PlotSample) {
     let bars = [
         ("kinetic", last.kinetic, egui::Color32::LIGHT_BLUE),
         ("potential", last.potential, egui::Color32::LIGHT_GREEN),
         ("total", last.kinetic + last.potential, egui::Color32::WHITE),
         (
-            "change",
-            last.energy - first.energy,
+            "scene's change",
+            last.scene_energy - first.scene_energy,
             egui::Color32::LIGHT_RED,
         ),
     ];

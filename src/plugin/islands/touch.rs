@@ -112,6 +112,10 @@ impl<V: Dimension> TouchBody<V> for IslandBody<'_, V> {
         Some(self.cached.mark.holds(row))
     }
 
+    fn time_steps(&self) -> bool {
+        self.settings.method.ends_on_constraints() && self.cached.island.time_steps()
+    }
+
     fn hold(&mut self, a: usize, b: usize, held: bool) {
         if let Some(row) = self.cached.contact_row(a, b) {
             self.cached.mark.hold(row, held);

@@ -250,7 +250,8 @@ impl<'a, V: Coordinates> Group<'a, V> {
                 if let Some(speed) = self.closing(pair) {
                     let within = self.meets_slowly(bodies, pair, (a0, b0))
                         || (self.pressable(bodies, pair)
-                            && meets_near(0.0, g0, speed, self.span.dt));
+                            && (meets_near(0.0, g0, speed, self.span.dt)
+                                || bodies[self.bodies[self.slot(pair.0)]].time_steps()));
                     if !(within && ends_in_touch(end, r)) {
                         return Ok(Some((0.0, pair)));
                     }

@@ -138,6 +138,13 @@ pub trait TouchBody<V: Coordinates> {
         let _ = (time, states);
         Ok(None)
     }
+    /// Whether the body takes the meetings of its beads at `e = 0` that a
+    /// contact row joins by time-stepping (see
+    /// [`Island::time_steps`](crate::solver::Island)): such a pair in touch
+    /// that closes is its step's to hold, not struck at its instant.
+    fn time_steps(&self) -> bool {
+        false
+    }
     /// Holds the contact between beads `a` and `b` in the steps from the
     /// last [`TouchBody::keep`] (a strike left them in touch), or sets it
     /// aside (they bounced or part). A body without the row ignores it.

@@ -193,6 +193,7 @@ impl<V: WireSpace> Island<V> {
             moving: 0,
             sides,
             contacts,
+            contact_rows: 0,
             catching,
             ended: 0,
             rough,

@@ -155,6 +155,19 @@ impl<V: WireSpace> Island<V> {
     ) -> Result<(), SolveError> {
         let n = self.beads();
         let start = work.time;
+        let stepped = self.time_steps();
+        // The rows a dense island may let go for pulling once its solve
+        // has a root: those set aside where the step began (held since
+        // by it; a row held from an earlier step is the velocity solve's
+        // to let go), each at most once a step, so that a row pulling by
+        // rounding is not let go and held again without end.
+        let mut let_go: Vec<bool> = if stepped {
+            (0..self.rows())
+                .map(|r| !(work.inactive[r] || work.stepped_holds.get(r) == Some(&true)))
+                .collect()
+        } else {
+            Vec::new()
+        };
         // Each pass holds one contact row more at least, or lets go one.
         let mut unsolved = None;
         for _ in 0..self.rows() + CONTACT_PASSES {
@@ -181,7 +194,10 @@ impl<V: WireSpace> Island<V> {
                 solved => solved?,
             }
             unsolved = None;
-            if !self.hold_overlapping(work) {
+            // A dense island's rows held from the step's start that would
+            // pull are let go, and the solve taken again.
+            let released = stepped && self.let_go_pulling_once(work, &mut let_go);
+            if !self.hold_overlapping(work) && !released {
                 break;
             }
         }
@@ -213,16 +229,43 @@ impl<V: WireSpace> Island<V> {
     }
 
     /// Lets go of every held contact row whose multiplier in `work.lambda`
-    /// pulls its beads together: where Newton's method found no root with
-    /// a pile's contacts all held (more of them than its beads can meet
-    /// at once), those that would have to pull are not pressed. Whether
-    /// there were any.
+    /// pulls its beads together, and, in an island that time-steps
+    /// ([`Island::time_steps`]), every held one-sided wire row whose
+    /// multiplier pulls its bead onto the wire: where Newton's method
+    /// found no root with a pile's contacts all held (more of them than
+    /// its beads can meet at once), those that would have to pull are not
+    /// pressed. Whether there were any.
     fn let_go_pulling(&self, work: &mut IslandWork<V>) -> bool {
         let mut any = false;
+        let stepped = self.time_steps();
         for r in 0..self.rows() {
-            if self.contacts[r] && !work.inactive[r] && work.lambda.get(r).is_some_and(|&l| l < 0.0)
-            {
+            let (side, _) = self.sides[r];
+            if (self.contacts[r] || (stepped && side != 0.0)) && self.pulls(r, work) {
                 work.inactive[r] = true;
+                any = true;
+            }
+        }
+        any
+    }
+
+    /// Whether row `r` is held and its multiplier in `work.lambda` pulls
+    /// (the sign its side cannot push with).
+    fn pulls(&self, r: usize, work: &IslandWork<V>) -> bool {
+        let side = self.sides[r].0;
+        !work.inactive[r] && work.lambda.get(r).is_some_and(|&l| side * l < 0.0)
+    }
+
+    /// [`Island::let_go_pulling`] after a solve that found its root, in
+    /// an island that time-steps: lets go of each held one-sided row whose
+    /// multiplier pulls and that it has not let go before in this step
+    /// nor held from an earlier one (marked in `let_go`). Whether there
+    /// were any.
+    fn let_go_pulling_once(&self, work: &mut IslandWork<V>, let_go: &mut [bool]) -> bool {
+        let mut any = false;
+        for (r, done) in let_go.iter_mut().enumerate() {
+            if !*done && self.sides[r].0 != 0.0 && self.pulls(r, work) {
+                work.inactive[r] = true;
+                *done = true;
                 any = true;
             }
         }

@@ -7,7 +7,9 @@
 //! | `mod` | [`Island`] and what may change between steps (wires, axes, sides, friction), [`IslandWork<V>`], [`RowReport`] |
 //! | `build` | [`Island::new`]: the rows and springs checked and laid out, [`IslandRow<V>`], [`IslandError`] |
 //! | `rows` | each row's `C`, gradient, `J̇q̇` and bias (eq. 15 for a moving wire), and the products with `J` |
-//! | `step` | [`Island::step`]: the step's outline, the Euler steps and the drift check (the lone bead's, bead by bead and row by row), substeps and halvings |
+//! | `step` | [`Island::step`]: the step's outline, the rows a fresh island starts with, the Euler steps and the drift check (the lone bead's, bead by bead and row by row), substeps and halvings |
+//! | `holding` | which rows a step may hold where it would end violating them: pairs in touch, meetings and landings at `e = 0` taken by the step (time-stepped in a dense island) |
+//! | `events` | events located within a step, as a lone bead's are: landings, leaving at an end |
 //! | `integrators` | eq. (12) on an island (λ and the accelerations), RK4, RATTLE: each bead by the lone bead's formulas, the multipliers by matrix solves |
 //! | `newton` | the Newton position solve (a matrix solve for the multipliers at each step, stopped by the lone bead's test row by row) and its check that the root continues the start |
 //! | `projection` | post-stabilization, eq. (13), and the velocity projection |
@@ -24,6 +26,8 @@ use crate::solver::state::BeadState;
 
 mod build;
 mod contact;
+mod events;
+mod holding;
 mod integrators;
 mod newton;
 mod projection;
@@ -136,6 +140,10 @@ pub(crate) fn step_speed<V: crate::geometry::Coordinates>(pushes: [V; 2], dt: f6
     pushes.iter().map(|p| p.dot(*p).sqrt()).sum::<f64>() * dt
 }
 
+/// How many contact rows make an island dense: from this many up it
+/// time-steps its meetings at `e = 0` ([`Island::time_steps`]).
+pub(crate) const DENSE_CONTACTS: usize = 8;
+
 /// How many more times than the island has rows a step, a position
 /// solve or a velocity projection is taken again for contacts that
 /// overlap, pull or close (see [`Island::set_contact`]).
@@ -184,6 +192,9 @@ pub struct Island<V: WireSpace = DVec2> {
     /// Whether each row is a contact between two beads that touch (see
     /// [`Island::set_contact`]).
     contacts: Vec<bool>,
+    /// How many rows are contacts: from [`DENSE_CONTACTS`] up, the island
+    /// time-steps its meetings at `e = 0` ([`Island::time_steps`]).
+    contact_rows: usize,
     /// Whether each wire row catches its bead rather than holds it from
     /// the start (see [`Island::set_catching`]).
     catching: Vec<bool>,
@@ -245,6 +256,10 @@ pub struct IslandWork<V: WireSpace = DVec2> {
     /// closing: the step holds them where it would leave them overlapping
     /// (see [`Island::step_at`]).
     touching: Vec<bool>,
+    /// The rows an island that time-steps holds from the step's start
+    /// before its first pass ([`Island::closing_within`]): set aside where
+    /// the step began, so its position solve may let them go again.
+    stepped_holds: Vec<bool>,
     /// The one-sided wire rows whose beads, in flight where the step
     /// began, reach their wires slowly: the step lands them at its end
     /// instead of at the instant (see [`Island::lands_slowly`]).
@@ -497,8 +512,25 @@ impl<V: WireSpace> Island<V> {
             self.contacts.get_mut(row),
         ) {
             *slot = (1.0, 1.0);
+            if !*contact {
+                self.contact_rows += 1;
+            }
             *contact = true;
         }
+    }
+
+    /// Whether the island takes its meetings at `e = 0` by time-stepping:
+    /// it has at least [`DENSE_CONTACTS`] contact rows (a pile, a train of
+    /// marbles, beads in a bowl). Its step holds from its start every
+    /// contact row at `e = 0`, and every one-sided wire row of
+    /// restitution 0 whose bead is in flight, that the step would end
+    /// overlapping or behind its wire, and takes the step again (see
+    /// [`Island::step_at`]): the meeting or landing is a plastic impact
+    /// spread over the step, not located at its instant. An island with
+    /// fewer contact rows (a pair of gliders, a cart on a floor) locates
+    /// each at its instant.
+    pub(crate) fn time_steps(&self) -> bool {
+        self.contact_rows >= DENSE_CONTACTS
     }
 
     /// Gives contact row `row` its pair's restitution (the two beads'

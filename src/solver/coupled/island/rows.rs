@@ -27,6 +27,16 @@ impl<V: WireSpace> Island<V> {
         }
     }
 
+    /// How far wire row `r`'s bead at `x` is in front of its wire at
+    /// `time`: `side · C`, negative behind a one-sided wire (the row's own
+    /// units); none for a row of another kind.
+    pub(super) fn in_front(&self, r: usize, x: &[V], time: f64) -> Option<f64> {
+        let (shape, pose, _) = self.wire_at(r, time)?;
+        let at = *x.get(self.entry_bead[self.row_start[r]])?;
+        let g = placed_geometry(&pose, at, |local| V::shape_geometry(shape, local, None));
+        Some(self.sides[r].0 * g.c)
+    }
+
     /// Whether row `r` is a wire's that ends (an open curve): its bead
     /// leaves it past an end.
     pub(super) fn ends(&self, r: usize) -> bool {

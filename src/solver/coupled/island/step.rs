@@ -1,46 +1,21 @@
-//! [`Island::step`]: the outline of an island's step, the Euler steps and
-//! the divergence check, and the substeps a step is halved into where its
-//! Newton solve finds no root.
+//! [`Island::step`]: the outline of an island's step, the rows it starts
+//! with, the Euler steps and the divergence check, and the substeps a
+//! step is halved into where its Newton solve finds no root.
 
 use crate::geometry::WireSpace;
 
+use super::events::{Cut, Flight};
 use super::integrators::Stage;
 use super::projection::Restore;
 use super::{
     CALM_STEPS, CONTACT_PASSES, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow, TOUCHING,
 };
-use super::{closes, meets_near, meets_slowly, step_speed};
-use crate::solver::contact::locate;
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use crate::solver::method::Method;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::SolveError;
 use crate::solver::state::{BeadState, LinearForce};
 use crate::solver::step::drift_check;
-
-/// A step as [`Island::cut_within`] takes it again: where and when it
-/// started, its forces and settings, the substep level it started at, and
-/// the rows the event may happen on.
-struct Flight<'a, V> {
-    time: f64,
-    start: &'a [BeadState<V>],
-    forces: &'a [LinearForce<V>],
-    settings: &'a StepSettings,
-    level: u32,
-    calm: u32,
-    rows: &'a [usize],
-    /// The one-sided rows a bead may land on ([`Island::above`]).
-    above: &'a [usize],
-}
-
-/// What [`Island::cut_within`] cuts a step at.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Cut {
-    /// A bead in flight crosses its one-sided wire: it lands.
-    Landing,
-    /// A bead passes an end of its wire: it leaves it.
-    End,
-}
 
 impl<V: WireSpace> Island<V> {
     /// One step of every bead of the island under `settings`: `states`
@@ -111,21 +86,32 @@ impl<V: WireSpace> Island<V> {
         whole: f64,
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
+        let exact = settings.method.ends_on_constraints();
+        work.stepped_holds.clear();
         self.touching(states, forces, settings, whole, work);
-        self.landing_slowly(time, states, forces, (settings.dt, whole), work);
+        self.landing_slowly(time, states, forces, (settings.dt, whole), exact, work);
         if !work.touching.contains(&true) {
             // Nothing in touch: no row the step could press to hold.
             return self.step_holding(time, states, forces, settings, &[], work);
         }
         let start = states.to_vec();
         let mark = work.mark();
-        let mut hold = Vec::new();
+        let mut hold = if exact && self.time_steps() {
+            self.closing_within(time, states, forces, settings.dt, work)
+        } else {
+            Vec::new()
+        };
+        work.stepped_holds.resize(self.rows(), false);
+        for &r in &hold {
+            work.stepped_holds[r] = true;
+        }
         let passes = self.rows() + CONTACT_PASSES;
+        let end = time + settings.dt;
         for pass in 1..=passes {
             self.step_holding(time, states, forces, settings, &hold, work)?;
             work.x.clear();
             work.x.extend(states.iter().map(|s| s.position));
-            let more = self.overlapping(work);
+            let more = self.overlapping(work, end);
             if more.is_empty() || pass == passes {
                 break;
             }
@@ -133,32 +119,8 @@ impl<V: WireSpace> Island<V> {
             states.copy_from_slice(&start);
             work.rewind(&mark);
         }
+        self.report_stepped_landings((time, end), &start, states, &mark, work);
         Ok(())
-    }
-
-    /// The contact rows set aside whose beads touched where the step
-    /// began and overlap at `work.x` by more than [`TOUCHING`] of their
-    /// reach: those the step holds and is taken again with.
-    pub(super) fn overlapping(&self, work: &IslandWork<V>) -> Vec<usize> {
-        (0..self.rows())
-            .filter(|&r| {
-                work.inactive[r]
-                    && work.touching.get(r) == Some(&true)
-                    && self
-                        .contact_gap(r, &work.x)
-                        .is_some_and(|(gap, reach)| gap < -TOUCHING * reach)
-            })
-            .collect()
-    }
-
-    /// Holds the rows [`Island::overlapping`] finds. Whether there were
-    /// any.
-    pub(super) fn hold_overlapping(&self, work: &mut IslandWork<V>) -> bool {
-        let more = self.overlapping(work);
-        for &r in &more {
-            work.inactive[r] = false;
-        }
-        !more.is_empty()
     }
 
     /// One pass of [`Island::step_at`], the contact rows `hold` held from
@@ -249,271 +211,6 @@ impl<V: WireSpace> Island<V> {
             self.stop(time + settings.dt, states, &slides, work)?;
         }
         self.follow(time + settings.dt, states, work);
-        Ok(())
-    }
-
-    /// Marks the contact rows the step may hold where it would leave their
-    /// beads overlapping: those whose beads touch at `states` (the step's
-    /// start) and do not close within the step ([`closes`]), and, for a
-    /// step that keeps its rows on their constraints (RATTLE, or one that
-    /// projects), those whose beads meet slowly or near the step's start
-    /// at `e = 0` ([`Island::slow_meeting`]). A pair in touch that closes,
-    /// or one apart that meets later and faster, is the touch
-    /// settlement's to strike.
-    fn touching(
-        &self,
-        states: &[BeadState<V>],
-        forces: &[LinearForce<V>],
-        settings: &StepSettings,
-        whole: f64,
-        work: &mut IslandWork<V>,
-    ) {
-        work.touching.clear();
-        if !self.contacts.contains(&true) || states.len() != self.beads() {
-            return;
-        }
-        let exact = settings.method.ends_on_constraints();
-        let dt = settings.dt;
-        work.x.clear();
-        work.x.extend(states.iter().map(|s| s.position));
-        for r in 0..self.rows() {
-            let (Some((gap, reach)), Some((rate, _, speeds))) =
-                (self.contact_gap(r, &work.x), self.opening(r, states))
-            else {
-                work.touching.push(false);
-                continue;
-            };
-            let holds = (gap <= TOUCHING * reach && !closes(rate, reach, speeds, dt))
-                || (exact && self.slow_meeting(r, (gap, rate), states, forces, (dt, whole)));
-            work.touching.push(holds);
-        }
-    }
-
-    /// Whether contact row `r`'s beads, `gap` apart and opening at `rate`
-    /// where they are in `states`, meet within a step of `dt` (a part of
-    /// one of `whole`) no faster than a whole step's forces move them
-    /// (each bead's `|f| / m` times `whole`, summed), where the pair's
-    /// restitution is 0 (see [`Island::set_contact_restitution`] and
-    /// [`meets_slowly`]), or meets within [`NEAR_MEETING`](super::NEAR_MEETING) of the step's
-    /// start ([`meets_near`]). Such a pair is not struck at
-    /// the instant it meets: the step holds its row, as it does a pair
-    /// pressed together, so that it ends the step in touch (the pair
-    /// meets within the step, a plastic impact spread over it). A pile
-    /// settling at `e = 0` so takes its countless slow meetings within
-    /// its steps, where cutting the step at each would not end
-    /// (inelastic collapse), as it takes the meetings across gaps of a
-    /// hair by which its beads pass their momentum on; a strike faster
-    /// than its forces and later in the step is still located at its
-    /// instant.
-    fn slow_meeting(
-        &self,
-        r: usize,
-        (gap, rate): (f64, f64),
-        states: &[BeadState<V>],
-        forces: &[LinearForce<V>],
-        (dt, whole): (f64, f64),
-    ) -> bool {
-        let Some((a, b, _)) = self.contact_pair(r) else {
-            return false;
-        };
-        let push = |i: usize| match (forces.get(i), states.get(i)) {
-            (Some(force), Some(state)) => force.at(state.position) * self.inverse_mass[i],
-            _ => V::ZERO,
-        };
-        let slow = step_speed([push(a), push(b)], whole);
-        let restitution = self.sides[r].1;
-        (meets_slowly(restitution, -rate, slow) && gap <= 2.0 * slow * dt)
-            || meets_near(restitution, gap, -rate, whole)
-    }
-
-    /// Marks the one-sided wire rows whose beads are off their wires at
-    /// `states` (at `time`) and would land slowly
-    /// ([`Island::lands_slowly`]) in a step of `dt`, a part of one of
-    /// `whole`; whether a bead is in flight is the step's to say.
-    fn landing_slowly(
-        &self,
-        time: f64,
-        states: &[BeadState<V>],
-        forces: &[LinearForce<V>],
-        (dt, whole): (f64, f64),
-        work: &mut IslandWork<V>,
-    ) {
-        work.landing_slowly.clear();
-        work.landing_slowly.extend((0..self.rows()).map(|r| {
-            self.sides[r].0 != 0.0
-                && !self.contacts[r]
-                && self.lands_slowly(r, time, states, forces, (dt, whole))
-        }));
-    }
-
-    /// Whether one-sided wire row `r`'s bead, in flight in `states` at
-    /// `time`, reaches its wire within a step of `dt` (a part of one of
-    /// `whole`) no faster than a whole step's forces move it (`|f| / m`
-    /// times `whole`), where the wire's restitution is 0: within twice
-    /// that speed times the step of it and closing no faster ([`meets_slowly`],
-    /// as for a pair of beads). Such a landing is not located at its
-    /// instant: the bead lands at the step's end ([`Island::land`]), moved
-    /// back onto its wire by no more than its forces move it in the step.
-    /// The beads of a pile settling at `e = 0` in a one-sided bowl leave
-    /// it and land again countless times at such speeds, where cutting the
-    /// step at each would not end; a landing faster than its forces is
-    /// still located at its instant.
-    fn lands_slowly(
-        &self,
-        r: usize,
-        time: f64,
-        states: &[BeadState<V>],
-        forces: &[LinearForce<V>],
-        (dt, whole): (f64, f64),
-    ) -> bool {
-        let (side, restitution) = self.sides[r];
-        let bead = self.entry_bead[self.row_start[r]];
-        let (Some(state), Some(force)) = (states.get(bead), forces.get(bead)) else {
-            return false;
-        };
-        let row = self.wire_row(r, states, time);
-        let length = row.normal.dot(row.normal).sqrt();
-        if length.is_nan() || length <= 0.0 {
-            return false;
-        }
-        let gap = side * row.c / length;
-        let closing = -side * row.normal.dot(state.velocity - row.wire) / length;
-        let push = force.at(state.position) * self.inverse_mass[bead];
-        let slow = step_speed([push, V::ZERO], whole);
-        gap > 0.0 && meets_slowly(restitution, closing, slow) && gap <= 2.0 * slow * dt
-    }
-
-    /// The one-sided rows set aside that a bead may land on within the
-    /// step: those whose bead has not passed an end of the wire, and, on
-    /// a wire with ends or one that catches, is not behind it (off it on
-    /// the side it pushes toward, or on it). A bead behind a wire with no
-    /// end crossed it (it could not go round) and lands; one that went
-    /// round an end, or a marble under another track, does not.
-    fn above(&self, time: f64, states: &[BeadState<V>], work: &IslandWork<V>) -> Vec<usize> {
-        if states.len() != self.beads() {
-            return Vec::new();
-        }
-        (0..self.rows())
-            .filter(|&r| self.sides[r].0 != 0.0 && work.inactive[r] && !self.contacts[r])
-            .filter(|&r| {
-                let behind = || {
-                    self.sides[r].0 * self.wire_row(r, states, time).c
-                        < -OFF_THE_WIRE * self.rows[r].scale()
-                };
-                let strict = self.catching[r] || self.ends(r);
-                !(strict && behind()) && self.past_end(r, states, time, &work.hints) <= 0.0
-            })
-            .collect()
-    }
-
-    /// How far the nearest of `rows` is from crossing its wire at `time`:
-    /// the least `side · C` (not positive once one has crossed) of the
-    /// rows whose beads have not passed an end.
-    fn crossing(
-        &self,
-        time: f64,
-        states: &[BeadState<V>],
-        rows: &[usize],
-        work: &IslandWork<V>,
-    ) -> f64 {
-        rows.iter()
-            .filter(|&&r| self.past_end(r, states, time, &work.hints) <= 0.0)
-            .map(|&r| self.sides[r].0 * self.wire_row(r, states, time).c)
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    /// How far the bead of the nearest of `rows` is from an end of its
-    /// wire at `time`: the least `−past end` (negative once one has passed).
-    fn on_the_wire(
-        &self,
-        time: f64,
-        states: &[BeadState<V>],
-        rows: &[usize],
-        work: &IslandWork<V>,
-    ) -> f64 {
-        rows.iter()
-            .map(|&r| -self.past_end(r, states, time, &work.hints))
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    /// Sets aside each of `rows` whose bead is at or past an end of its
-    /// wire at `time`: the bead leaves the wire there.
-    fn leave_at_ends(
-        &self,
-        time: f64,
-        states: &[BeadState<V>],
-        rows: &[usize],
-        work: &mut IslandWork<V>,
-    ) {
-        for &r in rows {
-            if self.past_end(r, states, time, &work.hints) >= 0.0 {
-                work.inactive[r] = true;
-                self.report_left(r, time, states, work);
-            }
-        }
-    }
-
-    /// An event within the step located where it happens, as a lone
-    /// bead's is ([`locate`]): a flight that crossed a wire lands there
-    /// ([`Island::land`]); a bead that passed an end of its wire leaves it
-    /// there. The step is taken again to the instant, the event happens,
-    /// and the rest of the step follows from there. Each trial step starts
-    /// from the same substep level. If a trial step fails, the step is
-    /// kept as it was taken whole (to land at its end; a bead past an end
-    /// leaves at the next step's start).
-    fn cut_within(
-        &self,
-        flight: &Flight<V>,
-        cut: Cut,
-        states: &mut [BeadState<V>],
-        work: &mut IslandWork<V>,
-    ) -> Result<(), SolveError> {
-        let Flight {
-            time,
-            start,
-            forces,
-            settings,
-            rows,
-            ..
-        } = *flight;
-        let whole = states.to_vec();
-        let (level, calm, events) = (work.level, work.calm, work.events.len());
-        let inactive = work.inactive.clone();
-        let trial = |tau: f64, states: &mut [BeadState<V>], work: &mut IslandWork<V>| {
-            states.copy_from_slice(start);
-            (work.level, work.calm) = (flight.level, flight.calm);
-            self.substeps(time, states, forces, &settings.part(tau), work)
-        };
-        let measure = |time: f64, states: &[BeadState<V>], work: &IslandWork<V>| match cut {
-            Cut::Landing => self.crossing(time, states, rows, work),
-            Cut::End => self.on_the_wire(time, states, rows, work),
-        };
-        let mut probe = start.to_vec();
-        let g0 = measure(time, start, work);
-        let located = locate(settings.dt, g0, |tau| {
-            trial(tau, &mut probe, work)?;
-            Ok(measure(time + tau, &probe, work))
-        });
-        let cut_there = located.and_then(|tau| {
-            trial(tau, states, work)?;
-            match cut {
-                Cut::Landing => {
-                    self.land(time + tau, states, forces, settings.dt, flight.above, work)?;
-                }
-                Cut::End => self.leave_at_ends(time + tau, states, rows, work),
-            }
-            let rest = settings.dt - tau;
-            if rest > 1e-13 * settings.dt {
-                self.substeps(time + tau, states, forces, &settings.part(rest), work)?;
-            }
-            Ok(())
-        });
-        if cut_there.is_err() {
-            states.copy_from_slice(&whole);
-            (work.level, work.calm) = (level, calm);
-            work.events.truncate(events);
-            work.inactive = inactive;
-        }
         Ok(())
     }
 
@@ -618,7 +315,7 @@ impl<V: WireSpace> Island<V> {
     /// solve finds no root, it and the rest of the step are taken at half
     /// the length, down to 2^[`MAX_HALVINGS`] substeps. On an error the
     /// states are left as they were.
-    fn substeps(
+    pub(super) fn substeps(
         &self,
         time: f64,
         states: &mut [BeadState<V>],

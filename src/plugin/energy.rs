@@ -1,0 +1,72 @@
+//! [`SceneEnergy`]: the energy of the whole scene after each step, for a
+//! plot a user can trust where islands gain and lose beads.
+
+use bevy::math::DVec3;
+use bevy::prelude::*;
+
+use super::clock::SimClock;
+use super::islands::{InIsland, Islands};
+use crate::dynamics::{BeadMass, BeadPosition, BeadVelocity, SimParams};
+use crate::solver::BeadState;
+
+/// The scene's energy after the last step: the kinetic and gravitational
+/// energy of every bead, in the plane and in space, and the energy stored
+/// in the springs between beads. It changes only by what damping,
+/// friction, inelastic strikes and landings, drift, a drag and moving
+/// wires take or give. An island's own energy
+/// ([`IslandReport::energy`](crate::plugin::IslandReport)) jumps where
+/// the island gains or loses beads as contacts close and open; this does
+/// not.
+///
+/// Kept up to date after each step where the app has the resource (the
+/// window adds it); a game that wants it adds it too:
+///
+/// ```
+/// use bevy::prelude::*;
+/// use wirebead::SceneEnergy;
+/// use wirebead::prelude::*;
+///
+/// let mut app = App::new();
+/// app.add_plugins((MinimalPlugins, WireBeadPlugin::default()))
+///     .init_resource::<SceneEnergy>();
+/// ```
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Reflect)]
+#[reflect(Resource)]
+pub struct SceneEnergy {
+    /// The energy, J.
+    pub total: f64,
+    /// The simulated time it was measured at, s.
+    pub time: f64,
+}
+
+/// Measures [`SceneEnergy`]: each island's energy (its beads' and its
+/// springs'), and each bead stepped alone on its wire.
+pub(super) fn measure_scene_energy(
+    mut energy: ResMut<SceneEnergy>,
+    params: Res<SimParams>,
+    clock: Res<SimClock>,
+    islands: Res<Islands>,
+    space_islands: Res<Islands<DVec3>>,
+    alone: Query<(&BeadPosition, &BeadVelocity, &BeadMass), Without<InIsland>>,
+) {
+    let joined: f64 = islands
+        .iter()
+        .map(|i| i.energy)
+        .chain(space_islands.iter().map(|i| i.energy))
+        .sum();
+    let lone: f64 = alone
+        .iter()
+        .map(|(x, v, m)| {
+            let state = BeadState {
+                position: x.0,
+                velocity: v.0,
+            };
+            let (kinetic, potential) = state.energy(m.get(), params.gravity);
+            kinetic + potential
+        })
+        .sum();
+    *energy = SceneEnergy {
+        total: joined + lone,
+        time: clock.time,
+    };
+}
