@@ -600,13 +600,13 @@ fn energy_bars(ui: &mut egui::Ui, first: &PlotSample, last: &PlotSample) {
         ("potential", last.potential, egui::Color32::LIGHT_GREEN),
         ("total", last.kinetic + last.potential, egui::Color32::WHITE),
         (
-            "scene's change",
+            "change",
             last.scene_energy - first.scene_energy,
             egui::Color32::LIGHT_RED,
         ),
     ];
     ui.label(format!(
-        "energy now (J); change over the last {:.1} s",
+        "energy now (J); the scene's change over the last {:.1} s",
         last.t - first.t
     ));
     let chart = BarChart::new(
