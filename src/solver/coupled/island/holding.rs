@@ -8,7 +8,7 @@
 use crate::geometry::WireSpace;
 
 use super::{Island, IslandMark, IslandWork, OFF_THE_WIRE, TOUCHING};
-use super::{closes, meets_near, meets_slowly, opening_rate, step_speed};
+use super::{closes, meets_near, meets_slowly, step_speed};
 use crate::solver::contact::ContactEvent;
 use crate::solver::settings::StepSettings;
 use crate::solver::state::{BeadState, LinearForce};
@@ -44,9 +44,9 @@ impl<V: WireSpace> Island<V> {
                 continue;
             }
             let bead = self.entry_bead[self.row_start[r]];
-            let row = self.wire_row(r, start, time);
-            let length = row.normal.dot(row.normal).sqrt().max(f64::MIN_POSITIVE);
-            let normal_speed = (row.normal.dot(start[bead].velocity - row.wire) / length).abs();
+            let normal_speed = self
+                .wire_gap(r, start, time)
+                .map_or(0.0, |(_, rate)| rate.abs());
             work.events.push((
                 r,
                 bead,
@@ -145,11 +145,14 @@ impl<V: WireSpace> Island<V> {
         states: &[BeadState<V>],
         forces: &[LinearForce<V>],
         dt: f64,
-        work: &IslandWork<V>,
+        work: &mut IslandWork<V>,
     ) -> Vec<usize> {
         if states.len() != self.beads() || forces.len() != self.beads() {
             return Vec::new();
         }
+        work.x.clear();
+        work.x.extend(states.iter().map(|s| s.position));
+        let work = &*work;
         let push = |i: usize| forces[i].at(states[i].position) * self.inverse_mass[i];
         (0..self.rows())
             .filter(|&r| {
@@ -159,25 +162,19 @@ impl<V: WireSpace> Island<V> {
             })
             .filter(|&r| {
                 let (gap, rate, slow) = match self.contact_pair(r) {
-                    Some((a, b, reach)) => {
-                        let (rate, _) = opening_rate(&states[a], &states[b]);
-                        let d = states[b].position - states[a].position;
-                        (
-                            d.dot(d).sqrt() - reach,
-                            rate,
-                            step_speed([push(a), push(b)], dt),
-                        )
+                    Some((a, b, _)) => {
+                        let (Some((gap, _)), Some((rate, ..))) =
+                            (self.contact_gap(r, &work.x), self.opening(r, states))
+                        else {
+                            return false;
+                        };
+                        (gap, rate, step_speed([push(a), push(b)], dt))
                     }
                     None => {
                         let bead = self.entry_bead[self.row_start[r]];
-                        let row = self.wire_row(r, states, time);
-                        let length = row.normal.dot(row.normal).sqrt();
-                        if length.is_nan() || length <= 0.0 {
+                        let Some((gap, rate)) = self.wire_gap(r, states, time) else {
                             return false;
-                        }
-                        let side = self.sides[r].0;
-                        let gap = side * row.c / length;
-                        let rate = side * row.normal.dot(states[bead].velocity - row.wire) / length;
+                        };
                         (gap, rate, step_speed([push(bead), V::ZERO], dt))
                     }
                 };
@@ -294,18 +291,15 @@ impl<V: WireSpace> Island<V> {
         forces: &[LinearForce<V>],
         (dt, whole): (f64, f64),
     ) -> bool {
-        let (side, restitution) = self.sides[r];
+        let restitution = self.sides[r].1;
         let bead = self.entry_bead[self.row_start[r]];
         let (Some(state), Some(force)) = (states.get(bead), forces.get(bead)) else {
             return false;
         };
-        let row = self.wire_row(r, states, time);
-        let length = row.normal.dot(row.normal).sqrt();
-        if length.is_nan() || length <= 0.0 {
+        let Some((gap, rate)) = self.wire_gap(r, states, time) else {
             return false;
-        }
-        let gap = side * row.c / length;
-        let closing = -side * row.normal.dot(state.velocity - row.wire) / length;
+        };
+        let closing = -rate;
         let push = force.at(state.position) * self.inverse_mass[bead];
         let slow = step_speed([push, V::ZERO], whole);
         gap > 0.0 && meets_slowly(restitution, closing, slow) && gap <= 2.0 * slow * dt

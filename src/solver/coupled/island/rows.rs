@@ -14,16 +14,25 @@ impl<V: WireSpace> Island<V> {
     /// Wire row `r` where its bead is in `states` at `time`, whether the
     /// row is held or not (zero for a row of another kind).
     pub(super) fn wire_row(&self, r: usize, states: &[BeadState<V>], time: f64) -> RowAt<V> {
-        let Some((shape, pose, twist, state)) = self.wire_and_bead(r, states, time) else {
+        let bead = self.entry_bead[self.row_start[r]];
+        states
+            .get(bead)
+            .map_or_else(RowAt::default, |s| self.wire_row_at(r, s.position, time))
+    }
+
+    /// Wire row `r` with its bead at `position` at `time` (zero for a row
+    /// of another kind).
+    fn wire_row_at(&self, r: usize, position: V, time: f64) -> RowAt<V> {
+        let Some((shape, pose, twist)) = self.wire_at(r, time) else {
             return RowAt::default();
         };
-        let g = placed_geometry(&pose, state.position, |local| {
+        let g = placed_geometry(&pose, position, |local| {
             V::shape_geometry(shape, local, None)
         });
         RowAt {
             c: g.c,
             normal: g.normal,
-            wire: twist.velocity_at(state.position),
+            wire: twist.velocity_at(position),
         }
     }
 
@@ -31,10 +40,31 @@ impl<V: WireSpace> Island<V> {
     /// `time`: `side · C`, negative behind a one-sided wire (the row's own
     /// units); none for a row of another kind.
     pub(super) fn in_front(&self, r: usize, x: &[V], time: f64) -> Option<f64> {
-        let (shape, pose, _) = self.wire_at(r, time)?;
+        self.wire_at(r, time)?;
         let at = *x.get(self.entry_bead[self.row_start[r]])?;
-        let g = placed_geometry(&pose, at, |local| V::shape_geometry(shape, local, None));
-        Some(self.sides[r].0 * g.c)
+        Some(self.sides[r].0 * self.wire_row_at(r, at, time).c)
+    }
+
+    /// How far wire row `r`'s bead in `states` is in front of its wire at
+    /// `time`, in metres along the wire's normal (negative behind a
+    /// one-sided wire), and how fast that grows (negative: it closes);
+    /// none for a row of another kind or where the normal vanishes.
+    pub(super) fn wire_gap(
+        &self,
+        r: usize,
+        states: &[BeadState<V>],
+        time: f64,
+    ) -> Option<(f64, f64)> {
+        self.wire_at(r, time)?;
+        let state = states.get(self.entry_bead[self.row_start[r]])?;
+        let row = self.wire_row_at(r, state.position, time);
+        let length = row.normal.dot(row.normal).sqrt();
+        if length.is_nan() || length <= 0.0 {
+            return None;
+        }
+        let side = self.sides[r].0;
+        let rate = side * row.normal.dot(state.velocity - row.wire) / length;
+        Some((side * row.c / length, rate))
     }
 
     /// Whether row `r` is a wire's that ends (an open curve): its bead
