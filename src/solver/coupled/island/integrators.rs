@@ -168,32 +168,33 @@ impl<V: WireSpace> Island<V> {
         } else {
             Vec::new()
         };
+        // A dense island finds the rows it holds before its first pass
+        // ([`Island::predict_holds`]), and each pass starts from the
+        // multipliers of the one before.
+        let mut warm = false;
+        if stepped {
+            self.drift(forces, h, start, work);
+            self.predict_holds(h, start, work);
+            warm = true;
+        }
         // Each pass holds one contact row more at least, or lets go one.
         let mut unsolved = None;
         for _ in 0..self.rows() + CONTACT_PASSES {
-            work.time = start;
-            self.evaluate_at_start(work, work.time);
+            self.evaluate_at_start(work, start);
             if self.rows() > 0 {
                 self.factor(work, true)?;
             }
-            self.applied(forces, &work.x0, &work.v0, &mut work.force);
-            work.x.clear();
-            work.v.clear();
-            for i in 0..n {
-                let start = (work.x0[i], work.v0[i]);
-                let m = self.inverse_mass[i].recip();
-                work.x.push(rattle_drift(start, work.force[i], m, h));
-                work.v.push(work.v0[i]);
-            }
-            work.time += h;
-            match self.newton(work, Direction::First) {
+            self.drift(forces, h, start, work);
+            match self.newton(work, Direction::First, warm) {
                 Err(failed @ SolveError::NoConvergence { .. }) if self.let_go_pulling(work) => {
                     unsolved = Some(failed);
+                    warm = false;
                     continue;
                 }
                 solved => solved?,
             }
             unsolved = None;
+            warm = stepped;
             // A dense island's rows held from the step's start that would
             // pull are let go, and the solve taken again.
             let released = stepped && self.let_go_pulling_once(work, &mut let_go);
@@ -226,6 +227,22 @@ impl<V: WireSpace> Island<V> {
             report.lambda += 0.5 * to_mu * nu;
         }
         Ok(())
+    }
+
+    /// RATTLE's drift from the step's start at `start`: each bead moved
+    /// by its applied forces alone over `h` into `work.x` (velocities
+    /// `work.v` the start's), the rows to be met at `start + h`.
+    fn drift(&self, forces: &[LinearForce<V>], h: f64, start: f64, work: &mut IslandWork<V>) {
+        self.applied(forces, &work.x0, &work.v0, &mut work.force);
+        work.x.clear();
+        work.v.clear();
+        for i in 0..self.beads() {
+            let from = (work.x0[i], work.v0[i]);
+            let m = self.inverse_mass[i].recip();
+            work.x.push(rattle_drift(from, work.force[i], m, h));
+            work.v.push(work.v0[i]);
+        }
+        work.time = start + h;
     }
 
     /// Lets go of every held contact row whose multiplier in `work.lambda`

@@ -11,6 +11,7 @@
 //! | `holding` | which rows a step may hold where it would end violating them: pairs in touch, meetings and landings at `e = 0` taken by the step (time-stepped in a dense island) |
 //! | `events` | events located within a step, as a lone bead's are: landings, leaving at an end |
 //! | `integrators` | eq. (12) on an island (λ and the accelerations), RK4, RATTLE: each bead by the lone bead's formulas, the multipliers by matrix solves |
+//! | `complementarity` | the rows a dense island's step holds, predicted by projected Gauss–Seidel on the linearized contact problem, warm from the last step |
 //! | `newton` | the Newton position solve (a matrix solve for the multipliers at each step, stopped by the lone bead's test row by row) and its check that the root continues the start |
 //! | `projection` | post-stabilization, eq. (13), and the velocity projection |
 //! | `contact` | one-sided rows (leaving, landing, bouncing by the lone bead's rule) and friction (sliding, stopping, sticking: the lone bead's friction, with a stick row's multiplier for the pull) |
@@ -25,6 +26,7 @@ use crate::solver::contact::ContactEvent;
 use crate::solver::state::BeadState;
 
 mod build;
+mod complementarity;
 mod contact;
 mod events;
 mod holding;
@@ -275,6 +277,9 @@ pub struct IslandWork<V: WireSpace = DVec2> {
     lambda: Vec<f64>,
     lu: LuWork,
     scratch: Vec<V>,
+    /// Each bead's `W Jᵀ μ` in a Gauss–Seidel iteration
+    /// ([`Island::gauss_seidel`]).
+    moved: Vec<V>,
     factored: Factored,
     reports: Vec<RowReport>,
     bead_forces: Vec<V>,

@@ -8,6 +8,13 @@
 use super::{CONTACT_PASSES, CONTACT_SLACK, EXACT_STEPS, Island, IslandWork};
 use crate::geometry::WireSpace;
 
+/// The most chord steps a dense island's RATTLE position solve takes.
+const CHORD_ITERATIONS: u32 = 60;
+
+/// A chord step that leaves `C` above this fraction of the last is not
+/// converging.
+const CHORD_STALL: f64 = 0.9;
+
 use crate::solver::newton::{NEWTON_MAX_ITERATIONS, newton_accepted, newton_within};
 use crate::solver::solve::SolveError;
 
@@ -25,16 +32,40 @@ impl<V: WireSpace> Island<V> {
     /// the band or sparse matrix) once the chord stops shrinking `C`
     /// fourfold per iteration. Two exact steps that do not shrink `C`, or
     /// [`EXACT_STEPS`] that do not reach the tolerance, mean no root near:
-    /// the step is halved. The iterations evaluate `C` and the gradients
-    /// only, not `J̇q̇` or the bias.
+    /// the step is halved. A dense island ([`Island::time_steps`]) stays
+    /// on the chord, up to [`CHORD_ITERATIONS`] steps, two that do not
+    /// shrink `C` by a tenth meaning no root near: the LU of its many rows
+    /// costs some thirty chord steps. The iterations evaluate `C` and the
+    /// gradients only, not `J̇q̇` or the bias.
+    ///
+    /// `warm` starts RATTLE's solve from the multipliers in
+    /// `work.lambda` (those of rows set aside dropped), the beads pushed
+    /// by them from the drift; otherwise from none.
     pub(super) fn newton(
         &self,
         work: &mut IslandWork<V>,
         direction: Direction,
+        warm: bool,
     ) -> Result<(), SolveError> {
         let rows = self.rows();
-        work.lambda.clear();
-        work.lambda.resize(rows, 0.0);
+        if warm && direction == Direction::First && work.lambda.len() == rows {
+            // From the multipliers in hand, those of rows set aside dropped.
+            for (mu, &inactive) in work.lambda.iter_mut().zip(&work.inactive) {
+                if inactive || !mu.is_finite() {
+                    *mu = 0.0;
+                }
+            }
+            self.push(&work.first_gradient, &work.lambda, &mut work.x);
+        } else {
+            work.lambda.clear();
+            work.lambda.resize(rows, 0.0);
+        }
+        let chord_only = direction == Direction::First && rows > 1 && self.time_steps();
+        let limit = if chord_only {
+            CHORD_ITERATIONS
+        } else {
+            NEWTON_MAX_ITERATIONS
+        };
         let mut exact = direction == Direction::First && rows == 1;
         let mut previous = f64::INFINITY;
         let mut previous_taken = f64::INFINITY;
@@ -43,7 +74,7 @@ impl<V: WireSpace> Island<V> {
         let mut i = 0;
         loop {
             self.evaluate_positions(work);
-            let last = i == NEWTON_MAX_ITERATIONS;
+            let last = i == limit;
             // Every row within the tolerance, as one bead's solve asks of
             // its wire; or the worst row, relative to its scale, accepted.
             let mut within = true;
@@ -65,13 +96,16 @@ impl<V: WireSpace> Island<V> {
             }
             if last || !worst.is_finite() {
                 return Err(SolveError::NoConvergence {
-                    iterations: NEWTON_MAX_ITERATIONS,
+                    iterations: limit,
                     residual: worst,
                 });
             }
-            if exact && direction == Direction::First && worst >= previous {
-                // Exact Newton steps converge fast near a root; two that do
-                // not shrink C mean there is none near: halve the step.
+            if (exact && direction == Direction::First && worst >= previous)
+                || (chord_only && worst > CHORD_STALL * previous)
+            {
+                // Exact Newton steps converge fast near a root, chord steps
+                // steadily; two that do not shrink C (or, on the chord, by
+                // a tenth) mean there is none near: halve the step.
                 rising += 1;
                 if rising == 2 {
                     return Err(SolveError::NoConvergence {
@@ -82,7 +116,7 @@ impl<V: WireSpace> Island<V> {
             } else {
                 rising = 0;
             }
-            exact |= direction == Direction::First && worst > 0.25 * previous;
+            exact |= !chord_only && direction == Direction::First && worst > 0.25 * previous;
             if exact && direction == Direction::First {
                 // Exact Newton steps converge quadratically near a root:
                 // this many that have not reached it mean there is none near.
@@ -136,7 +170,7 @@ impl<V: WireSpace> Island<V> {
         let start = work.x.clone();
         // Each pass holds one contact row more at least.
         for _ in 0..self.rows() + CONTACT_PASSES {
-            self.newton(work, Direction::Current)?;
+            self.newton(work, Direction::Current, false)?;
             if !self.hold_overlapping(work) {
                 break;
             }

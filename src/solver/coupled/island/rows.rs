@@ -356,13 +356,18 @@ impl<V: WireSpace> Island<V> {
                 // A row set aside, or one that moves nothing.
                 continue;
             }
-            let entries = self.row_start[r]..self.row_start[r + 1];
-            for (&bead, g) in self.entry_bead[entries.clone()]
-                .iter()
-                .zip(&gradient[entries])
-            {
-                out[bead] += *g * (m * self.inverse_mass[bead]);
-            }
+            self.move_along(gradient, r, m, out);
+        }
+    }
+
+    /// Adds `W Jᵣᵀ m` of row `r` alone (with `gradient`) to `out`.
+    pub(super) fn move_along(&self, gradient: &[V], r: usize, m: f64, out: &mut [V]) {
+        let entries = self.row_start[r]..self.row_start[r + 1];
+        for (&bead, g) in self.entry_bead[entries.clone()]
+            .iter()
+            .zip(&gradient[entries])
+        {
+            out[bead] += *g * (m * self.inverse_mass[bead]);
         }
     }
 }

@@ -264,6 +264,16 @@ impl NormalMatrix {
         self.factor_sparse(symbolic, f)
     }
 
+    /// `A`'s diagonal value of row `r`, `Σ w_bead |g|²` over its entries.
+    pub(crate) fn diagonal_value<V: Coordinates>(
+        &self,
+        r: usize,
+        inverse_mass: &[f64],
+        gradient: &[V],
+    ) -> f64 {
+        self.value(self.diagonal[r], inverse_mass, gradient)
+    }
+
     /// `A`'s value `k` (upper triangle): the sum of its terms
     /// `w_bead · g_i · g_j`.
     fn value<V: Coordinates>(&self, k: usize, inverse_mass: &[f64], gradient: &[V]) -> f64 {
