@@ -13,8 +13,9 @@
 //!   at `e = 0` (`ScenePreset::pile`, RATTLE at 240 Hz), one step at a
 //!   time from 0.2 s on, as the pile lands in the bowl and strikes
 //!   itself (`pouring`), and from 0.5 s on, the lower rows pressed into
-//!   the bowl and those above striking them (`piling`): ten steps each,
-//!   each timed once.
+//!   the bowl and those above striking them (`piling`), and from 1 s on,
+//!   the pile jammed and settling (`settling`): ten steps each, each
+//!   timed once.
 
 use std::time::Duration;
 
@@ -130,6 +131,9 @@ const POURED: usize = 48;
 /// Steps taken before the second timing: 0.5 s, the lower rows pressed
 /// into the bowl and those above striking them.
 const PILED: usize = 120;
+/// Steps taken before the third timing: 1 s, the pile jammed and
+/// settling.
+const SETTLING: usize = 240;
 
 fn pile_group(c: &mut Criterion) {
     let preset = ScenePreset::pile(PILE, 23).expect("the pile");
@@ -152,6 +156,11 @@ fn pile_group(c: &mut Criterion) {
         app.world_mut().run_schedule(FixedUpdate);
     }
     time_steps(&mut group, &mut app, ("piling", PILE));
+    let taken = app.world().resource::<SimClock>().steps as usize;
+    for _ in taken..SETTLING {
+        app.world_mut().run_schedule(FixedUpdate);
+    }
+    time_steps(&mut group, &mut app, ("settling", PILE));
     group.finish();
 }
 

@@ -21,15 +21,16 @@ const SETTLED: f64 = 1e-6;
 impl<V: WireSpace> Island<V> {
     /// Projected Gauss–Seidel on rows `candidate`: multipliers `mu` with
     /// `g = g0 + J W Jᵀ μ` (`J` the rows' `gradient`), each one-sided row
-    /// pushing only (`side·μ ≥ 0`), violated nowhere (`side·g ≥ 0`) and
-    /// pushing only where it is met (`μ·g = 0`), two-sided rows met
-    /// (`g = 0`). Rows not candidates keep `μ = 0`. `mu` comes in as the
-    /// warm start; `moved` is scratch for `W Jᵀ μ`, bead by bead.
+    /// (of `side(r)` ±1) pushing only (`side·μ ≥ 0`), violated nowhere
+    /// (`side·g ≥ 0`) and pushing only where it is met (`μ·g = 0`),
+    /// two-sided rows (`side(r) = 0`) met (`g = 0`). Rows not candidates
+    /// keep `μ = 0`. `mu` comes in as the warm start; `moved` is scratch
+    /// for `W Jᵀ μ`, bead by bead.
     pub(super) fn gauss_seidel(
         &self,
-        gradient: &[V],
-        g0: &[f64],
+        (gradient, g0): (&[V], &[f64]),
         candidate: &[bool],
+        side: impl Fn(usize) -> f64,
         mu: &mut [f64],
         moved: &mut Vec<V>,
     ) {
@@ -42,7 +43,7 @@ impl<V: WireSpace> Island<V> {
         moved.clear();
         moved.resize(self.beads(), V::ZERO);
         for (r, m) in mu.iter_mut().enumerate() {
-            let side = self.sides[r].0;
+            let side = side(r);
             if !live(r) || (side != 0.0 && side * *m < 0.0) {
                 *m = 0.0;
             }
@@ -57,7 +58,7 @@ impl<V: WireSpace> Island<V> {
                     continue;
                 }
                 let g = g0[r] + self.along(r, gradient, moved);
-                let side = self.sides[r].0;
+                let side = side(r);
                 let mut next = mu[r] - g / diagonal[r];
                 if side != 0.0 && side * next < 0.0 {
                     next = 0.0;
@@ -72,6 +73,38 @@ impl<V: WireSpace> Island<V> {
             }
             if change <= SETTLED * largest {
                 break;
+            }
+        }
+    }
+
+    /// Which contact rows a dense island's velocity projection holds,
+    /// from Gauss–Seidel on the velocity problem (`g = J v − bias +
+    /// J W Jᵀ ν`, the contacts pushing only) over the rows held: a contact
+    /// whose multiplier is zero is set aside in `work.inactive`, its
+    /// gradient and bias zeroed in `work`. The projection's pivoting
+    /// starts from there.
+    pub(super) fn predict_pushing(&self, work: &mut IslandWork<V>) {
+        let rows = self.rows();
+        let candidate: Vec<bool> = work.inactive.iter().map(|&i| !i).collect();
+        let g0: Vec<f64> = (0..rows)
+            .map(|r| self.rate(r, &work.gradient, &work.v, &work.bias))
+            .collect();
+        let mut nu = vec![0.0; rows];
+        let mut moved = std::mem::take(&mut work.moved);
+        let contact = |r: usize| if self.contacts[r] { 1.0 } else { 0.0 };
+        self.gauss_seidel(
+            (&work.gradient, &g0),
+            &candidate,
+            contact,
+            &mut nu,
+            &mut moved,
+        );
+        work.moved = moved;
+        for r in 0..rows {
+            if candidate[r] && self.contacts[r] && nu[r] <= 0.0 {
+                work.inactive[r] = true;
+                work.gradient[self.row_start[r]..self.row_start[r + 1]].fill(V::ZERO);
+                work.bias[r] = 0.0;
             }
         }
     }
@@ -108,7 +141,13 @@ impl<V: WireSpace> Island<V> {
             })
             .collect();
         let mut moved = std::mem::take(&mut work.moved);
-        self.gauss_seidel(&work.first_gradient, &g0, &candidate, &mut mu, &mut moved);
+        self.gauss_seidel(
+            (&work.first_gradient, &g0),
+            &candidate,
+            |r| self.sides[r].0,
+            &mut mu,
+            &mut moved,
+        );
         work.moved = moved;
         for r in 0..rows {
             let side = self.sides[r].0;
@@ -189,7 +228,13 @@ mod tests {
         let candidate = vec![true; island.rows()];
         let mut mu = vec![0.0; island.rows()];
         let mut moved = Vec::new();
-        island.gauss_seidel(&work.first_gradient, &g0, &candidate, &mut mu, &mut moved);
+        island.gauss_seidel(
+            (&work.first_gradient, &g0),
+            &candidate,
+            |r| island.sides[r].0,
+            &mut mu,
+            &mut moved,
+        );
         for (i, (&y, m)) in heights.iter().zip(&moved).enumerate() {
             let end = work.x[i].y + m.y;
             let expected = if i == 4 { y - delta } else { y };

@@ -298,7 +298,9 @@ impl<V: WireSpace> Island<V> {
     /// least-index rule (Murty's principal pivoting, which ends where
     /// `J W Jᵀ` is positive definite) for a pass when it has not for
     /// [`BLOCK_CHANCES`] passes; at most [`CONTACT_PASSES`] projections
-    /// more than twice the contact rows.
+    /// more than twice the contact rows. A dense island
+    /// ([`Island::time_steps`]) starts from the contacts Gauss–Seidel
+    /// finds pushing ([`Island::predict_pushing`]).
     pub(super) fn project_velocity_pushing(
         &self,
         work: &mut IslandWork<V>,
@@ -309,6 +311,10 @@ impl<V: WireSpace> Island<V> {
         let unprojected = work.v.clone();
         let (gradient, bias) = (work.gradient.clone(), work.bias.clone());
         let set_aside = work.inactive.clone();
+        if self.time_steps() {
+            // A dense island's pivoting starts from the contacts that push.
+            self.predict_pushing(work);
+        }
         let fastest = unprojected
             .iter()
             .map(|v| v.dot(*v).sqrt())
