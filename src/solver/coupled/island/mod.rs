@@ -4,7 +4,9 @@
 //!
 //! | file | what it holds |
 //! |---|---|
-//! | `mod` | [`Island`] and what may change between steps (wires, axes, sides, friction), [`IslandWork<V>`], [`RowReport`] |
+//! | `mod` | [`Island`] and what may change between steps (wires, axes, sides, friction), [`RowReport`] |
+//! | `work` | [`IslandWork<V>`], the buffers a step works in, and [`IslandMark`], what carries into the next step |
+//! | `pairs` | two beads in touch: when they touch, part, close, meet slowly or near a step's start |
 //! | `build` | [`Island::new`]: the rows and springs checked and laid out, [`IslandRow<V>`], [`IslandError`] |
 //! | `rows` | each row's `C`, gradient, `J̇q̇` and bias (eq. 15 for a moving wire), and the products with `J` |
 //! | `step` | [`Island::step`]: the step's outline, the rows a fresh island starts with, the Euler steps and the drift check (the lone bead's, bead by bead and row by row), substeps and halvings |
@@ -20,9 +22,8 @@ use bevy::math::DVec2;
 use std::sync::Arc;
 
 use super::constraint::{RowKind, SpringLink};
-use super::normal::{Factored, LuWork, NormalMatrix};
+use super::normal::NormalMatrix;
 use crate::geometry::{Friction, Side, WireSpace};
-use crate::solver::contact::ContactEvent;
 use crate::solver::state::BeadState;
 
 mod build;
@@ -32,11 +33,18 @@ mod events;
 mod holding;
 mod integrators;
 mod newton;
+mod pairs;
 mod projection;
 mod rows;
 mod step;
+mod work;
 
 pub use build::{IslandError, IslandRow};
+pub(crate) use pairs::{
+    CONTACT_SLACK, closes, ends_in_touch, meets_near, meets_slowly, opening_rate, parts, step_speed,
+};
+pub use pairs::{NEAR_MEETING, OPENING, TOUCHING};
+pub use work::{IslandMark, IslandWork};
 
 /// How far off a one-sided wire, on the side it pushes toward, a bead must
 /// start (in units of the wire's scale) to start in flight.
@@ -49,99 +57,6 @@ pub const MAX_HALVINGS: u32 = 6;
 /// After this many steps in a row that needed no more halvings than they
 /// started with, a step tries one halving fewer.
 pub const CALM_STEPS: u32 = 8;
-/// Two beads whose gap is at most this fraction of their radii touch.
-pub const TOUCHING: f64 = 1e-10;
-
-/// A contact row's beads part where their gap opens faster than this
-/// fraction of their reach (the two radii) plus their speeds, per second:
-/// slower is rounding, and the row holds on (see [`Island::set_contact`]).
-pub const OPENING: f64 = 1e-9;
-
-/// Whether a pair in touch whose gap opens at `rate`, of `reach` (the two
-/// radii) and `speeds` (the sum of its beads' speeds), parts (see
-/// [`OPENING`]).
-pub(crate) fn parts(rate: f64, reach: f64, speeds: f64) -> bool {
-    rate > OPENING * (reach + speeds)
-}
-
-/// How fast the gap between beads `a` and `b` opens (negative: closes),
-/// along the line between their centres, and the sum of their speeds.
-pub(crate) fn opening_rate<V: crate::geometry::Coordinates>(
-    a: &BeadState<V>,
-    b: &BeadState<V>,
-) -> (f64, f64) {
-    let d = b.position - a.position;
-    let rate = d.dot(b.velocity - a.velocity) / d.dot(d).sqrt();
-    let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
-    (rate, speeds)
-}
-
-/// A pair in touch closes (and strikes at once) where it closes faster
-/// than this fraction of its two beads' speeds: slower is rounding.
-const CLOSING: f64 = 1e-9;
-
-/// Whether a pair in touch whose gap opens at `rate`, of `reach` and
-/// `speeds` as in [`parts`], closes: faster than [`CLOSING`] of its
-/// speeds, and by more than what counts as touching ([`TOUCHING`] of its
-/// reach) within a step of `dt`. A pair that closes is the touch
-/// settlement's to strike; one that does not and presses is held.
-pub(crate) fn closes(rate: f64, reach: f64, speeds: f64, dt: f64) -> bool {
-    -rate > CLOSING * speeds && -rate * dt > TOUCHING * reach
-}
-
-/// How many times a wire's residual a held contact row's may be where a
-/// Newton solve stalls and takes it: 4e-10 of the two radii instead of
-/// [`NEWTON_ACCEPT`](crate::solver::newton::NEWTON_ACCEPT)'s 1e-10. Beads
-/// jammed among others can hold more contact rows than they can meet
-/// exactly at once, and there exact Newton steps stall a little above
-/// 1e-10 of the radii however short the step.
-pub(crate) const CONTACT_SLACK: f64 = 4.0;
-
-/// Whether a contact row's beads `gap` apart, of `reach` (the two radii),
-/// end a step in touch: within what a Newton solve takes of a held
-/// contact row ([`CONTACT_SLACK`] times
-/// [`NEWTON_ACCEPT`](crate::solver::newton::NEWTON_ACCEPT) of the reach).
-pub(crate) fn ends_in_touch(gap: f64, reach: f64) -> bool {
-    gap.abs() <= CONTACT_SLACK * crate::solver::newton::NEWTON_ACCEPT * reach
-}
-
-/// Whether a pair of restitution `restitution` whose gap closes at
-/// `closing` (m/s) meets slowly: at `e = 0`, no faster than `moved`, the
-/// speed one whole step's forces give its two beads (each `|f| / m`
-/// times the step, summed). Such a meeting is the island's step to hold,
-/// not the touch settlement's to strike at its instant (see
-/// [`Island::step_at`]).
-pub(crate) fn meets_slowly(restitution: f64, closing: f64, moved: f64) -> bool {
-    restitution == 0.0 && closing <= moved
-}
-
-/// The part of a step within which a pair at `e = 0` that meets is
-/// taken by the step rather than struck at its instant: 1/16. Such a
-/// pair, `gap` apart and closing at `v`, meets within `gap / v ≤ dt / 16`
-/// of the step's start; its body's step holds its contact row where the
-/// pair would end overlapping (see [`Island::step_at`]).
-pub const NEAR_MEETING: f64 = 1.0 / 16.0;
-
-/// Whether a pair of restitution `restitution`, `gap` apart and closing
-/// at `closing` (m/s), meets near the start of a step of `dt` (or of a
-/// part of it, `dt` still the whole step's): at `e = 0`, within
-/// [`NEAR_MEETING`] of `dt`. Its body's step holds
-/// its row (a plastic impact over the step: for two free beads on a line
-/// exactly the one at its instant, elsewhere apart from it by the
-/// constraint force over the `gap / v` before it), so a pile whose beads
-/// pass their momentum on across gaps of a hair does not cut its step at
-/// each (inelastic collapse).
-pub(crate) fn meets_near(restitution: f64, gap: f64, closing: f64, dt: f64) -> bool {
-    restitution == 0.0 && closing > 0.0 && gap <= NEAR_MEETING * closing * dt
-}
-
-/// The speed a step of `dt` gives two beads under `pushes` (each bead's
-/// acceleration from its forces, `f / m`): `(|p_a| + |p_b|) dt`, the
-/// `moved` of [`meets_slowly`].
-pub(crate) fn step_speed<V: crate::geometry::Coordinates>(pushes: [V; 2], dt: f64) -> f64 {
-    pushes.iter().map(|p| p.dot(*p).sqrt()).sum::<f64>() * dt
-}
-
 /// How many contact rows make an island dense: from this many up it
 /// time-steps its meetings at `e = 0` ([`Island::time_steps`]).
 pub(crate) const DENSE_CONTACTS: usize = 8;
@@ -221,190 +136,6 @@ struct RoughRow {
     /// The other row of a curve in space on the same bead (see
     /// [`Island::pair_rows`]): the two press and slide as one.
     partner: Option<usize>,
-}
-
-/// The buffers one island's step works in, kept between steps so a step
-/// allocates nothing. Also what the last step reported.
-///
-/// A clone carries everything a step reads from the last one (see
-/// [`IslandMark`]) and what the last step reported, with fresh scratch
-/// memory: stepping a clone gives the same numbers, bit for bit, as
-/// stepping the original.
-#[derive(Clone, Default)]
-pub struct IslandWork<V: WireSpace = DVec2> {
-    x0: Vec<V>,
-    v0: Vec<V>,
-    x: Vec<V>,
-    v: Vec<V>,
-    x_sum: Vec<V>,
-    v_sum: Vec<V>,
-    force: Vec<V>,
-    acceleration: Vec<V>,
-    gradient: Vec<V>,
-    first_gradient: Vec<V>,
-    c: Vec<f64>,
-    curvature: Vec<f64>,
-    /// Each row's `−∂C/∂t` (the moving wire's `∇C·w`; zero for the rest):
-    /// `Ċ = J v − bias`.
-    bias: Vec<f64>,
-    /// The time the rows are evaluated at.
-    time: f64,
-    /// The rows set aside: one-sided wires their beads have left.
-    inactive: Vec<bool>,
-    /// Whether each row starts held, where a fresh work is told (see
-    /// [`IslandWork::carry`]).
-    carried: Vec<Option<bool>>,
-    /// The contact rows whose beads touched where the step began without
-    /// closing: the step holds them where it would leave them overlapping
-    /// (see [`Island::step_at`]).
-    touching: Vec<bool>,
-    /// The rows an island that time-steps holds from the step's start
-    /// before its first pass ([`Island::closing_within`]): set aside where
-    /// the step began, so its position solve may let them go again.
-    stepped_holds: Vec<bool>,
-    /// The one-sided wire rows whose beads, in flight where the step
-    /// began, reach their wires slowly: the step lands them at its end
-    /// instead of at the instant (see [`Island::lands_slowly`]).
-    landing_slowly: Vec<bool>,
-    /// Each wire row's curve parameter where its bead was after the last
-    /// step (NaN: unknown), so a self-crossing track keeps it on its branch.
-    hints: Vec<f64>,
-    /// Where each stick row holds its bead: the line `axis·x = offset`.
-    sticks: Vec<Option<(V, f64)>>,
-    /// What the last step did to one-sided rows: (row, bead, event).
-    events: Vec<(usize, usize, ContactEvent<V>)>,
-    rhs: Vec<f64>,
-    lambda: Vec<f64>,
-    lu: LuWork,
-    scratch: Vec<V>,
-    /// Each bead's `W Jᵀ μ` in a Gauss–Seidel iteration
-    /// ([`Island::gauss_seidel`]).
-    moved: Vec<V>,
-    factored: Factored,
-    reports: Vec<RowReport>,
-    bead_forces: Vec<V>,
-    substeps: u32,
-    /// How many halvings deep the last step's substeps went; the next
-    /// step starts there (see [`Island::step`]).
-    level: u32,
-    /// Steps in a row that went no deeper than they started.
-    calm: u32,
-    /// The states at the start of a step, restored if it fails.
-    start: Vec<BeadState<V>>,
-}
-
-/// What of an island's [`IslandWork`] carries from one step into the
-/// next: which rows are set aside, where the beads were along their wires,
-/// where friction holds them, how finely the last step was cut. Kept
-/// before a step ([`IslandWork::mark`]) so that a part of the step can be
-/// taken again from its start ([`IslandWork::rewind`]).
-#[derive(Clone, Debug, Default)]
-pub struct IslandMark<V: WireSpace = DVec2> {
-    inactive: Vec<bool>,
-    hints: Vec<f64>,
-    sticks: Vec<Option<(V, f64)>>,
-    level: u32,
-    calm: u32,
-}
-
-impl<V: WireSpace> IslandMark<V> {
-    /// Holds contact row `row` from here (its beads press), or sets it
-    /// aside (they part), for the steps taken from this mark (see
-    /// [`Island::set_contact`]). Whether the row is held, before.
-    pub fn hold(&mut self, row: usize, held: bool) -> Option<bool> {
-        let inactive = self.inactive.get_mut(row)?;
-        let was = !*inactive;
-        *inactive = !held;
-        Some(was)
-    }
-
-    /// Whether row `row` is held in the steps taken from this mark.
-    pub fn holds(&self, row: usize) -> bool {
-        !self.inactive.get(row).copied().unwrap_or(false)
-    }
-}
-
-impl<V: WireSpace> IslandWork<V> {
-    /// What carries into the next step, as it is now.
-    pub fn mark(&self) -> IslandMark<V> {
-        IslandMark {
-            inactive: self.inactive.clone(),
-            hints: self.hints.clone(),
-            sticks: self.sticks.clone(),
-            level: self.level,
-            calm: self.calm,
-        }
-    }
-
-    /// Back to what `mark` kept, without allocating where the lengths
-    /// agree.
-    pub fn rewind(&mut self, mark: &IslandMark<V>) {
-        self.inactive.clone_from(&mark.inactive);
-        self.hints.clone_from(&mark.hints);
-        self.sticks.clone_from(&mark.sticks);
-        (self.level, self.calm) = (mark.level, mark.calm);
-    }
-
-    /// Takes `states` in as the current positions and velocities
-    /// (`x`, `v`).
-    pub(super) fn load(&mut self, states: &[BeadState<V>]) {
-        self.x.clear();
-        self.x.extend(states.iter().map(|s| s.position));
-        self.v.clear();
-        self.v.extend(states.iter().map(|s| s.velocity));
-    }
-
-    /// What the last successful step reported of each row.
-    pub fn rows(&self) -> &[RowReport] {
-        &self.reports
-    }
-
-    /// The constraint force `Σ λ ∇C` on each bead at the end of the last
-    /// step (λ as [`IslandWork<V>::rows`] reports it).
-    pub fn constraint_forces(&self) -> &[V] {
-        &self.bead_forces
-    }
-
-    /// How many substeps the last step took: 1, or more where it was
-    /// halved (see [`Island::step`]).
-    pub fn substeps(&self) -> u32 {
-        self.substeps
-    }
-
-    /// How many rows the last factorization dropped as redundant.
-    pub fn redundant(&self) -> usize {
-        self.factored.redundant
-    }
-
-    /// Whether row `row` holds its bead: false for a one-sided wire the
-    /// bead has left (see [`Island::set_side`]).
-    pub fn holds(&self, row: usize) -> bool {
-        !self.inactive.get(row).copied().unwrap_or(false)
-    }
-
-    /// Starts wire row `row` of a fresh work held (or set aside) whatever
-    /// the rule of the island's first step would say: what an island
-    /// rebuilt around beads where the last one left them carries over, so
-    /// a bead that had left its one-sided wire and is now behind it (on
-    /// another wire that caught it) stays off it. A work that has stepped
-    /// is not changed.
-    pub fn carry(&mut self, row: usize, held: bool) {
-        if self.carried.len() <= row {
-            self.carried.resize(row + 1, None);
-        }
-        self.carried[row] = Some(held);
-    }
-
-    /// What [`IslandWork::carry`] told row `row` to start as, if anything.
-    pub fn carried(&self, row: usize) -> Option<bool> {
-        self.carried.get(row).copied().flatten()
-    }
-
-    /// The beads that left or landed on a one-sided row in the last step:
-    /// `(row, bead, event)`.
-    pub fn events(&self) -> &[(usize, usize, ContactEvent<V>)] {
-        &self.events
-    }
 }
 
 impl<V: WireSpace> Island<V> {

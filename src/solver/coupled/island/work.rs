@@ -1,0 +1,195 @@
+//! [`IslandWork`], the buffers an island's step works in and what it
+//! reported, and [`IslandMark`], what of them carries from one step into
+//! the next.
+
+use bevy::math::DVec2;
+
+use super::RowReport;
+use crate::geometry::WireSpace;
+use crate::solver::contact::ContactEvent;
+use crate::solver::coupled::normal::{Factored, LuWork};
+use crate::solver::state::BeadState;
+
+/// The buffers one island's step works in, kept between steps so a step
+/// allocates nothing. Also what the last step reported.
+///
+/// A clone carries everything a step reads from the last one (see
+/// [`IslandMark`]) and what the last step reported, with fresh scratch
+/// memory: stepping a clone gives the same numbers, bit for bit, as
+/// stepping the original.
+#[derive(Clone, Default)]
+pub struct IslandWork<V: WireSpace = DVec2> {
+    pub(super) x0: Vec<V>,
+    pub(super) v0: Vec<V>,
+    pub(super) x: Vec<V>,
+    pub(super) v: Vec<V>,
+    pub(super) x_sum: Vec<V>,
+    pub(super) v_sum: Vec<V>,
+    pub(super) force: Vec<V>,
+    pub(super) acceleration: Vec<V>,
+    pub(super) gradient: Vec<V>,
+    pub(super) first_gradient: Vec<V>,
+    pub(super) c: Vec<f64>,
+    pub(super) curvature: Vec<f64>,
+    /// Each row's `−∂C/∂t` (the moving wire's `∇C·w`; zero for the rest):
+    /// `Ċ = J v − bias`.
+    pub(super) bias: Vec<f64>,
+    /// The time the rows are evaluated at.
+    pub(super) time: f64,
+    /// The rows set aside: one-sided wires their beads have left.
+    pub(super) inactive: Vec<bool>,
+    /// Whether each row starts held, where a fresh work is told (see
+    /// [`IslandWork::carry`]).
+    pub(super) carried: Vec<Option<bool>>,
+    /// The contact rows whose beads touched where the step began without
+    /// closing: the step holds them where it would leave them overlapping
+    /// (see [`Island::step_at`](super::Island::step_at)).
+    pub(super) touching: Vec<bool>,
+    /// The rows an island that time-steps holds from the step's start
+    /// before its first pass ([`Island::closing_within`](super::Island::closing_within)): set aside where
+    /// the step began, so its position solve may let them go again.
+    pub(super) stepped_holds: Vec<bool>,
+    /// The one-sided wire rows whose beads, in flight where the step
+    /// began, reach their wires slowly: the step lands them at its end
+    /// instead of at the instant (see [`Island::lands_slowly`](super::Island::lands_slowly)).
+    pub(super) landing_slowly: Vec<bool>,
+    /// Each wire row's curve parameter where its bead was after the last
+    /// step (NaN: unknown), so a self-crossing track keeps it on its branch.
+    pub(super) hints: Vec<f64>,
+    /// Where each stick row holds its bead: the line `axis·x = offset`.
+    pub(super) sticks: Vec<Option<(V, f64)>>,
+    /// What the last step did to one-sided rows: (row, bead, event).
+    pub(super) events: Vec<(usize, usize, ContactEvent<V>)>,
+    pub(super) rhs: Vec<f64>,
+    pub(super) lambda: Vec<f64>,
+    pub(super) lu: LuWork,
+    pub(super) scratch: Vec<V>,
+    /// Each bead's `W Jᵀ μ` in a Gauss–Seidel iteration
+    /// ([`Island::gauss_seidel`](super::Island::gauss_seidel)).
+    pub(super) moved: Vec<V>,
+    pub(super) factored: Factored,
+    pub(super) reports: Vec<RowReport>,
+    pub(super) bead_forces: Vec<V>,
+    pub(super) substeps: u32,
+    /// How many halvings deep the last step's substeps went; the next
+    /// step starts there (see [`Island::step`](super::Island::step)).
+    pub(super) level: u32,
+    /// Steps in a row that went no deeper than they started.
+    pub(super) calm: u32,
+    /// The states at the start of a step, restored if it fails.
+    pub(super) start: Vec<BeadState<V>>,
+}
+
+/// What of an island's [`IslandWork`] carries from one step into the
+/// next: which rows are set aside, where the beads were along their wires,
+/// where friction holds them, how finely the last step was cut. Kept
+/// before a step ([`IslandWork::mark`]) so that a part of the step can be
+/// taken again from its start ([`IslandWork::rewind`]).
+#[derive(Clone, Debug, Default)]
+pub struct IslandMark<V: WireSpace = DVec2> {
+    pub(super) inactive: Vec<bool>,
+    pub(super) hints: Vec<f64>,
+    pub(super) sticks: Vec<Option<(V, f64)>>,
+    pub(super) level: u32,
+    pub(super) calm: u32,
+}
+
+impl<V: WireSpace> IslandMark<V> {
+    /// Holds contact row `row` from here (its beads press), or sets it
+    /// aside (they part), for the steps taken from this mark (see
+    /// [`Island::set_contact`](super::Island::set_contact)). Whether the row is held, before.
+    pub fn hold(&mut self, row: usize, held: bool) -> Option<bool> {
+        let inactive = self.inactive.get_mut(row)?;
+        let was = !*inactive;
+        *inactive = !held;
+        Some(was)
+    }
+
+    /// Whether row `row` is held in the steps taken from this mark.
+    pub fn holds(&self, row: usize) -> bool {
+        !self.inactive.get(row).copied().unwrap_or(false)
+    }
+}
+
+impl<V: WireSpace> IslandWork<V> {
+    /// What carries into the next step, as it is now.
+    pub fn mark(&self) -> IslandMark<V> {
+        IslandMark {
+            inactive: self.inactive.clone(),
+            hints: self.hints.clone(),
+            sticks: self.sticks.clone(),
+            level: self.level,
+            calm: self.calm,
+        }
+    }
+
+    /// Back to what `mark` kept, without allocating where the lengths
+    /// agree.
+    pub fn rewind(&mut self, mark: &IslandMark<V>) {
+        self.inactive.clone_from(&mark.inactive);
+        self.hints.clone_from(&mark.hints);
+        self.sticks.clone_from(&mark.sticks);
+        (self.level, self.calm) = (mark.level, mark.calm);
+    }
+
+    /// Takes `states` in as the current positions and velocities
+    /// (`x`, `v`).
+    pub(super) fn load(&mut self, states: &[BeadState<V>]) {
+        self.x.clear();
+        self.x.extend(states.iter().map(|s| s.position));
+        self.v.clear();
+        self.v.extend(states.iter().map(|s| s.velocity));
+    }
+
+    /// What the last successful step reported of each row.
+    pub fn rows(&self) -> &[RowReport] {
+        &self.reports
+    }
+
+    /// The constraint force `Σ λ ∇C` on each bead at the end of the last
+    /// step (λ as [`IslandWork<V>::rows`] reports it).
+    pub fn constraint_forces(&self) -> &[V] {
+        &self.bead_forces
+    }
+
+    /// How many substeps the last step took: 1, or more where it was
+    /// halved (see [`Island::step`](super::Island::step)).
+    pub fn substeps(&self) -> u32 {
+        self.substeps
+    }
+
+    /// How many rows the last factorization dropped as redundant.
+    pub fn redundant(&self) -> usize {
+        self.factored.redundant
+    }
+
+    /// Whether row `row` holds its bead: false for a one-sided wire the
+    /// bead has left (see [`Island::set_side`](super::Island::set_side)).
+    pub fn holds(&self, row: usize) -> bool {
+        !self.inactive.get(row).copied().unwrap_or(false)
+    }
+
+    /// Starts wire row `row` of a fresh work held (or set aside) whatever
+    /// the rule of the island's first step would say: what an island
+    /// rebuilt around beads where the last one left them carries over, so
+    /// a bead that had left its one-sided wire and is now behind it (on
+    /// another wire that caught it) stays off it. A work that has stepped
+    /// is not changed.
+    pub fn carry(&mut self, row: usize, held: bool) {
+        if self.carried.len() <= row {
+            self.carried.resize(row + 1, None);
+        }
+        self.carried[row] = Some(held);
+    }
+
+    /// What [`IslandWork::carry`] told row `row` to start as, if anything.
+    pub fn carried(&self, row: usize) -> Option<bool> {
+        self.carried.get(row).copied().flatten()
+    }
+
+    /// The beads that left or landed on a one-sided row in the last step:
+    /// `(row, bead, event)`.
+    pub fn events(&self) -> &[(usize, usize, ContactEvent<V>)] {
+        &self.events
+    }
+}
