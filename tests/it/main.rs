@@ -14,6 +14,7 @@ mod fuzz;
 mod ghost;
 mod islands;
 mod layers;
+mod layout;
 mod parallel;
 mod pendulum;
 mod precision;
