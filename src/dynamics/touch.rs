@@ -97,7 +97,7 @@ impl Contacts {
     /// that strike: each strike of impulse `p` opposes the pair's slip
     /// across the line between their centres with an impulse of at most
     /// `μ p`, as much as stops it where that is less (see
-    /// [`rub`](crate::solver::rub)), pairs struck together at `e = 0` as
+    /// `rub`), pairs struck together at `e = 0` as
     /// well as pairs struck one by one. Pairs pressed together rub between
     /// strikes as a bead on a rough wire does: `μ |λ|` against their slip,
     /// and in the plane held still where they stop slipping while `μ |λ|`

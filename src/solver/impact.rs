@@ -98,59 +98,6 @@ pub enum ImpactError {
     },
 }
 
-/// The directions a bead's velocity may change in at a strike: any (a free
-/// bead), along one line (a bead on a curve), or across one direction (a
-/// bead on a surface in space; a bead on a rod from a fixed pin).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Freedom<V = DVec2> {
-    kind: FreedomKind,
-    axis: V,
-}
-
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-enum FreedomKind {
-    #[default]
-    Free,
-    Along,
-    Across,
-}
-
-impl<V: Coordinates> Freedom<V> {
-    /// A free bead: it takes a strike in full.
-    pub fn free() -> Self {
-        Self {
-            kind: FreedomKind::Free,
-            axis: V::ZERO,
-        }
-    }
-
-    /// A bead that moves along `tangent` only (its length does not matter).
-    pub fn along(tangent: V) -> Result<Self, ImpactError> {
-        Ok(Self {
-            kind: FreedomKind::Along,
-            axis: unit(tangent)?,
-        })
-    }
-
-    /// A bead that moves in every direction but `normal`'s (its length
-    /// does not matter).
-    pub fn across(normal: V) -> Result<Self, ImpactError> {
-        Ok(Self {
-            kind: FreedomKind::Across,
-            axis: unit(normal)?,
-        })
-    }
-
-    /// The part of `v` the bead can take: `P v`.
-    pub fn project(&self, v: V) -> V {
-        match self.kind {
-            FreedomKind::Free => v,
-            FreedomKind::Along => self.axis * self.axis.dot(v),
-            FreedomKind::Across => v - self.axis * self.axis.dot(v),
-        }
-    }
-}
-
 /// `v / |v|`, if `v` is finite and not zero.
 fn unit<V: Coordinates>(v: V) -> Result<V, ImpactError> {
     let length = v.dot(v).sqrt();
@@ -159,15 +106,6 @@ fn unit<V: Coordinates>(v: V) -> Result<V, ImpactError> {
     } else {
         Err(ImpactError::NoDirection)
     }
-}
-
-/// A bead as a strike sees it: its inverse mass and its [`Freedom`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ImpactBead<V = DVec2> {
-    /// `1 / m`.
-    pub inverse_mass: f64,
-    /// The directions it may move in.
-    pub freedom: Freedom<V>,
 }
 
 /// Two beads that touch (or overlap): their indices, the unit vector from
@@ -256,19 +194,9 @@ impl<V: Coordinates> Touch<V> {
         }
     }
 
-    /// The two beads.
-    pub fn beads(&self) -> (usize, usize) {
-        (self.a, self.b)
-    }
-
     /// The unit vector from `a`'s centre to `b`'s.
     pub fn normal(&self) -> V {
         self.normal
-    }
-
-    /// The gap between the surfaces: negative where they overlap.
-    pub fn gap(&self) -> f64 {
-        self.gap
     }
 
     /// The rate the gap opens at, `n̂·(v_b − v_a)`: negative while the
@@ -319,36 +247,6 @@ impl<V: Coordinates> Response<V> {
     /// to one along the normal: what friction needs.
     pub fn with_tangents(self, tangents: Vec<Vec<(usize, V)>>) -> Self {
         Self { tangents, ..self }
-    }
-
-    /// The answer of two beads each held by its own rows alone (free, or
-    /// by its [`Freedom`]): `∓P n̂ / m`.
-    pub fn through(touch: &Touch<V>, beads: &[ImpactBead<V>]) -> Result<Self, ImpactError> {
-        let bead = |i: usize| {
-            beads.get(i).ok_or(ImpactError::MissingBead {
-                bead: i,
-                beads: beads.len(),
-            })
-        };
-        let (a, b) = (bead(touch.a)?, bead(touch.b)?);
-        let along = |d: V| {
-            vec![
-                (touch.a, -a.freedom.project(d) * a.inverse_mass),
-                (touch.b, b.freedom.project(d) * b.inverse_mass),
-            ]
-        };
-        let tangents = if touch.friction > 0.0 {
-            touch.tangents().into_iter().map(along).collect()
-        } else {
-            Vec::new()
-        };
-        Ok(Self::new(touch, along(touch.normal)).with_tangents(tangents))
-    }
-
-    /// `w = n̂·(Δv_b − Δv_a)` per unit impulse: zero where neither bead
-    /// can move along the normal.
-    pub fn weight(&self) -> f64 {
-        self.weight
     }
 }
 

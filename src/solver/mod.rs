@@ -14,8 +14,8 @@
 //! | `newton` | Newton's method on `C` and its stopping test, for RATTLE and projection |
 //! | `step` | [`step`]: a whole step of one bead, with the divergence check |
 //! | `contact/` (`wire`, `flight`, `locate`) | [`step_surface`]: one-sided wires, landings and friction, eqs. (16)–(17): on the wire, in flight, where an event falls |
-//! | `impact` | [`resolve_impacts`]: strikes between beads that touch, eq. (18), one pair at a time |
-//! | `touch/` (`group`) | [`settle_touches`]: where within a step beads meet (broad phase, regula falsi), the step cut there |
+//! | `impact` | `resolve_impacts`: strikes between beads that touch, eq. (18), one pair at a time |
+//! | `touch/` (`group`) | `settle_touches`: where within a step beads meet (broad phase, regula falsi), the step cut there |
 //! | `lanes/` (`circle`) | the batched step: eight beads on circles at once, bit for bit [`step`](fn@step), many such batches in one call; the solves on each lane's circle (crate-private) |
 //! | `coupled/` (`island/`, `normal/`, …) | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (12)–(14) |
 //!
@@ -44,14 +44,10 @@ mod wire_normal;
 
 pub use contact::{Contact, ContactEvent, SurfaceStep, free_step, step_surface};
 pub use coupled::{
-    Constraint, Island, IslandError, IslandMark, IslandRow, IslandWork, OPENING, RowKind,
-    RowReport, SpringLink, islands,
+    Constraint, Island, IslandError, IslandMark, IslandRow, IslandWork, RowKind, RowReport,
+    SpringLink, islands,
 };
 pub use euler::{explicit_euler, semi_implicit_euler};
-pub use impact::{
-    Freedom, ImpactBead, ImpactError, MAX_STRIKES_PER_TOUCH, Response, Strike, Touch,
-    resolve_impacts, rub, strike,
-};
 pub(crate) use lanes::{LANES, RoundLanes, RoundSteps, step_on_round_batches};
 pub use method::{Integrator, Method, Stabilization};
 pub use projection::project;
@@ -61,9 +57,9 @@ pub use settings::{Gains, SHORT_PART, StepSettings};
 pub use solve::{SolveError, Solved, lambda, solve};
 pub use state::{Advance, BeadState, LinearForce};
 pub use step::{StepOutput, constraint_state, constraint_state_on, step, step_on};
-pub use touch::{
-    MAX_IMPACTS_PER_STEP, NEAR_MEETING, Pressed, StepSpan, StruckPair, TOUCHING, TouchBead,
-    TouchBody, TouchError, may_touch, overlapping, settle_touches,
+pub(crate) use touch::{
+    Pressed, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody, TouchError, may_touch,
+    overlapping, settle_touches,
 };
 
 /// What the solver's unit tests share.

@@ -5,7 +5,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::headless::{Headless, bead_state, idle, run_steps};
 use wirebead::prelude::*;
-use wirebead::solver::{BeadState, NEAR_MEETING};
+use wirebead::solver::BeadState;
 use wirebead::{
     CatchesBeads, Integrator, Islands, Restitution, SceneEnergy, ScenePreset, SimClock,
     WireContact, preset::PILE_RADIUS,
@@ -185,7 +185,8 @@ fn gliders_meeting_slowly_at_restitution_zero_move_on_together_without_a_strike(
 
 /// Gliders of masses 1 and 3 closing at 2.5 m/s, 20 times faster than
 /// the slow meetings above, whose gap closes 1/32 of a step after a
-/// step's start (half of [`NEAR_MEETING`]): at `e = 0` that step holds
+/// step's start (half of the 1/16 of a step within which a meeting at
+/// `e = 0` counts as near its start, README.md): that step holds
 /// their contact, with no strike to report, and they end where the
 /// impact located at its instant leaves them, at the momentum's velocity
 /// and having lost `½ μ v_rel²`, all to 1e-12 (on a line the two are the
@@ -201,7 +202,7 @@ fn gliders_meeting_near_a_steps_start_at_restitution_zero_are_held_by_that_step(
     let common = (m1 * u1 + m2 * u2) / (m1 + m2);
     let lost = 0.5 * (m1 * m2 / (m1 + m2)) * (u1 - u2) * (u1 - u2);
     let before = 0.5 * m1 * u1 * u1 + 0.5 * m2 * u2 * u2;
-    for (steps_to_meet, struck) in [(10.0 + NEAR_MEETING / 2.0, 0), (10.5, 1)] {
+    for (steps_to_meet, struck) in [(10.0 + 1.0 / 32.0, 0), (10.5, 1)] {
         let (v, x, strikes) = run(steps_to_meet);
         assert_eq!(strikes, struck, "meeting {steps_to_meet} steps in");
         assert!(

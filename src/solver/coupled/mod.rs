@@ -22,10 +22,8 @@ mod tests;
 
 pub use constraint::{Constraint, RowKind, SpringLink};
 pub use group::islands;
-pub use island::{
-    Island, IslandError, IslandMark, IslandRow, IslandWork, NEAR_MEETING, OPENING, RowReport,
-    TOUCHING,
-};
+pub(crate) use island::TOUCHING;
+pub use island::{Island, IslandError, IslandMark, IslandRow, IslandWork, RowReport};
 pub(crate) use island::{
     closes, ends_in_touch, meets_near, meets_slowly, opening_rate, parts, step_speed,
 };

@@ -2,6 +2,98 @@ use bevy::math::{DVec2, DVec3};
 
 use super::*;
 
+// The beads of these tests each held by its own rows alone, free or by a
+// freedom: a strike's answer written out by hand for them, as the island
+// writes it for beads joined by constraints.
+
+/// The directions a bead's velocity may change in at a strike: any (a free
+/// bead), along one line (a bead on a curve), or across one direction (a
+/// bead on a surface in space; a bead on a rod from a fixed pin).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Freedom<V = DVec2> {
+    kind: FreedomKind,
+    axis: V,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+enum FreedomKind {
+    #[default]
+    Free,
+    Along,
+    Across,
+}
+
+impl<V: Coordinates> Freedom<V> {
+    /// A free bead: it takes a strike in full.
+    fn free() -> Self {
+        Self {
+            kind: FreedomKind::Free,
+            axis: V::ZERO,
+        }
+    }
+
+    /// A bead that moves along `tangent` only (its length does not matter).
+    fn along(tangent: V) -> Result<Self, ImpactError> {
+        Ok(Self {
+            kind: FreedomKind::Along,
+            axis: unit(tangent)?,
+        })
+    }
+
+    /// A bead that moves in every direction but `normal`'s (its length
+    /// does not matter).
+    fn across(normal: V) -> Result<Self, ImpactError> {
+        Ok(Self {
+            kind: FreedomKind::Across,
+            axis: unit(normal)?,
+        })
+    }
+
+    /// The part of `v` the bead can take: `P v`.
+    fn project(&self, v: V) -> V {
+        match self.kind {
+            FreedomKind::Free => v,
+            FreedomKind::Along => self.axis * self.axis.dot(v),
+            FreedomKind::Across => v - self.axis * self.axis.dot(v),
+        }
+    }
+}
+
+/// A bead as a strike sees it: its inverse mass and its [`Freedom`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ImpactBead<V = DVec2> {
+    /// `1 / m`.
+    inverse_mass: f64,
+    /// The directions it may move in.
+    freedom: Freedom<V>,
+}
+
+impl<V: Coordinates> Response<V> {
+    /// The answer of two beads each held by its own rows alone (free, or
+    /// by its [`Freedom`]): `∓P n̂ / m`.
+    fn through(touch: &Touch<V>, beads: &[ImpactBead<V>]) -> Result<Self, ImpactError> {
+        let bead = |i: usize| {
+            beads.get(i).ok_or(ImpactError::MissingBead {
+                bead: i,
+                beads: beads.len(),
+            })
+        };
+        let (a, b) = (bead(touch.a)?, bead(touch.b)?);
+        let along = |d: V| {
+            vec![
+                (touch.a, -a.freedom.project(d) * a.inverse_mass),
+                (touch.b, b.freedom.project(d) * b.inverse_mass),
+            ]
+        };
+        let tangents = if touch.friction > 0.0 {
+            touch.tangents().into_iter().map(along).collect()
+        } else {
+            Vec::new()
+        };
+        Ok(Self::new(touch, along(touch.normal)).with_tangents(tangents))
+    }
+}
+
 /// Free beads in a row along x, `spacing` apart, each of radius
 /// `spacing / 2`, so that neighbours touch.
 fn row(masses: &[f64], spacing: f64, e: f64) -> (Vec<ImpactBead>, Vec<Touch>) {

@@ -77,7 +77,7 @@ mod tests;
 
 use group::Group;
 
-pub use super::coupled::{NEAR_MEETING, TOUCHING};
+pub(crate) use super::coupled::TOUCHING;
 
 /// How many instants of impact one group of bodies may be cut at within
 /// one step, per pair of beads it follows (a pile meets many), before

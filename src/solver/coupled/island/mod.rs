@@ -40,10 +40,10 @@ mod step;
 mod work;
 
 pub use build::{IslandError, IslandRow};
+pub(crate) use pairs::TOUCHING;
 pub(crate) use pairs::{
     CONTACT_SLACK, closes, ends_in_touch, meets_near, meets_slowly, opening_rate, parts, step_speed,
 };
-pub use pairs::{NEAR_MEETING, OPENING, TOUCHING};
 pub use work::{IslandMark, IslandWork};
 
 /// How far off a one-sided wire, on the side it pushes toward, a bead must
@@ -225,21 +225,21 @@ impl<V: WireSpace> Island<V> {
     /// Makes rod row `row` a contact between two beads that touch: one
     /// side (`|x_a − x_b| ≥ length`, the two radii), held only while its
     /// beads press. A contact row starts set aside and is set aside at a
-    /// step's start where its beads part ([`OPENING`]); where it pulls is
+    /// step's start where its beads part (`OPENING`); where it pulls is
     /// judged by the step's velocity solve with every contact at once
     /// (RATTLE, or a step that projects: the row is let go there), or by
     /// its λ at the step's start (a step with neither). Where beads apart
     /// meet within a step is the touch settlement's to find
-    /// ([`settle_touches`](crate::solver::settle_touches)), which holds
+    /// (`settle_touches`), which holds
     /// the row ([`IslandMark::hold`]) where a strike leaves the pair in
     /// touch or the step presses a touching pair together; the island's
     /// own step holds a row whose beads touched at its start where the
     /// step would leave them overlapping, and takes it again
     /// ([`Island::step_at`]), so a pile of beads pressing on each other
     /// settles within one step. A held pair does not strike: a strike's
-    /// answer ([`Island::respond`]) keeps the held rows, so that beads
+    /// answer (`Island::respond`) keeps the held rows, so that beads
     /// pressed together answer as one, while pairs apart strike in turn;
-    /// pairs at `e = 0` are struck all at once by [`Island::press`]. Rows
+    /// pairs at `e = 0` are struck all at once by `Island::press`. Rows
     /// of other kinds are left as they are.
     pub fn set_contact(&mut self, row: usize) {
         if let (Some(RowKind::Rod { .. }), Some(slot), Some(contact)) = (

@@ -7,12 +7,12 @@ use crate::geometry::Coordinates;
 use crate::solver::state::BeadState;
 
 /// Two beads whose gap is at most this fraction of their radii touch.
-pub const TOUCHING: f64 = 1e-10;
+pub(crate) const TOUCHING: f64 = 1e-10;
 
 /// A contact row's beads part where their gap opens faster than this
 /// fraction of their reach (the two radii) plus their speeds, per second:
 /// slower is rounding, and the row holds on (see [`Island::set_contact`](super::Island::set_contact)).
-pub const OPENING: f64 = 1e-9;
+pub(crate) const OPENING: f64 = 1e-9;
 
 /// Whether a pair in touch whose gap opens at `rate`, of `reach` (the two
 /// radii) and `speeds` (the sum of its beads' speeds), parts (see
@@ -74,7 +74,7 @@ pub(crate) fn meets_slowly(restitution: f64, closing: f64, moved: f64) -> bool {
 /// pair, `gap` apart and closing at `v`, meets within `gap / v ≤ dt / 16`
 /// of the step's start; its body's step holds its contact row where the
 /// pair would end overlapping (see [`Island::step_at`](super::Island::step_at)).
-pub const NEAR_MEETING: f64 = 1.0 / 16.0;
+pub(crate) const NEAR_MEETING: f64 = 1.0 / 16.0;
 
 /// Whether a pair of restitution `restitution`, `gap` apart and closing
 /// at `closing` (m/s), meets near the start of a step of `dt` (or of a

@@ -79,7 +79,7 @@ impl<V: WireSpace> Island<V> {
     /// apart: it is let go and the kick projected again). A moving wire's own
     /// velocity does not enter: the answer is linear in the impulse, one
     /// velocity change per bead (eq. 18 for a bead joined to others).
-    pub fn respond<'w>(
+    pub(crate) fn respond<'w>(
         &self,
         time: f64,
         states: &[BeadState<V>],
@@ -111,7 +111,7 @@ impl<V: WireSpace> Island<V> {
     /// them at once (Moreau's), each row's impulse (N s, pushing positive)
     /// the second slice; a row not held has none. The rows held are left
     /// as they were.
-    pub fn press<'w>(
+    pub(crate) fn press<'w>(
         &self,
         time: f64,
         states: &[BeadState<V>],

@@ -47,7 +47,7 @@ impl<V: WireSpace> Island<V> {
     /// at which wires on a path (see [`Island::move_wire`]) are placed.
     ///
     /// A contact row set aside whose beads touched at the step's start
-    /// and that the step leaves overlapping by more than [`TOUCHING`] of
+    /// and that the step leaves overlapping by more than `TOUCHING` of
     /// their reach is held and the step taken again from its start, so a
     /// pile pressing on itself settles within the step (RATTLE does the
     /// same within its position solve first, and a post-stabilizing step
@@ -56,7 +56,7 @@ impl<V: WireSpace> Island<V> {
     /// than the island has rows. A step that keeps its rows on their
     /// constraints (RATTLE, or one that projects) holds in the same way
     /// a row whose beads meet slowly at `e = 0`, or within
-    /// [`NEAR_MEETING`](super::NEAR_MEETING) of the step's start
+    /// `NEAR_MEETING` of the step's start
     /// ([`Island::set_contact_restitution`]): they end the step in touch.
     /// A bead in flight that reaches a one-sided wire of restitution 0 no
     /// faster than the step's forces move it lands at the step's end, not
@@ -77,7 +77,7 @@ impl<V: WireSpace> Island<V> {
     /// settlement takes the rest of a step it cut: which pairs meet slowly
     /// (see [`Island::step_at`]) is judged by what the whole step's
     /// forces give them.
-    pub fn step_part(
+    pub(crate) fn step_part(
         &self,
         time: f64,
         states: &mut [BeadState<V>],
@@ -218,7 +218,7 @@ impl<V: WireSpace> Island<V> {
     /// step would), so that what it carries can be kept
     /// ([`IslandWork::mark`]) before that step. A work that has stepped is
     /// left as it is.
-    pub fn begin(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
+    pub(crate) fn begin(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
         if work.inactive.len() != self.rows() {
             self.start_rows(time, states, work);
         }
