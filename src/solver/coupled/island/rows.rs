@@ -14,35 +14,33 @@ impl<V: WireSpace> Island<V> {
     /// Wire row `r` where its bead is in `states` at `time`, whether the
     /// row is held or not (zero for a row of another kind).
     pub(super) fn wire_row(&self, r: usize, states: &[BeadState<V>], time: f64) -> RowAt<V> {
-        let bead = self.entry_bead[self.row_start[r]];
-        states
-            .get(bead)
-            .map_or_else(RowAt::default, |s| self.wire_row_at(r, s.position, time))
+        self.entry_bead
+            .get(self.row_start[r])
+            .and_then(|&bead| states.get(bead))
+            .and_then(|s| self.wire_row_at(r, s.position, time))
+            .unwrap_or_default()
     }
 
-    /// Wire row `r` with its bead at `position` at `time` (zero for a row
-    /// of another kind).
-    fn wire_row_at(&self, r: usize, position: V, time: f64) -> RowAt<V> {
-        let Some((shape, pose, twist)) = self.wire_at(r, time) else {
-            return RowAt::default();
-        };
+    /// Wire row `r` with its bead at `position` at `time`; none for a row
+    /// of another kind.
+    fn wire_row_at(&self, r: usize, position: V, time: f64) -> Option<RowAt<V>> {
+        let (shape, pose, twist) = self.wire_at(r, time)?;
         let g = placed_geometry(&pose, position, |local| {
             V::shape_geometry(shape, local, None)
         });
-        RowAt {
+        Some(RowAt {
             c: g.c,
             normal: g.normal,
             wire: twist.velocity_at(position),
-        }
+        })
     }
 
     /// How far wire row `r`'s bead at `x` is in front of its wire at
     /// `time`: `side · C`, negative behind a one-sided wire (the row's own
     /// units); none for a row of another kind.
     pub(super) fn in_front(&self, r: usize, x: &[V], time: f64) -> Option<f64> {
-        self.wire_at(r, time)?;
-        let at = *x.get(self.entry_bead[self.row_start[r]])?;
-        Some(self.sides[r].0 * self.wire_row_at(r, at, time).c)
+        let at = *x.get(*self.entry_bead.get(self.row_start[r])?)?;
+        Some(self.sides[r].0 * self.wire_row_at(r, at, time)?.c)
     }
 
     /// How far wire row `r`'s bead in `states` is in front of its wire at
@@ -55,9 +53,8 @@ impl<V: WireSpace> Island<V> {
         states: &[BeadState<V>],
         time: f64,
     ) -> Option<(f64, f64)> {
-        self.wire_at(r, time)?;
-        let state = states.get(self.entry_bead[self.row_start[r]])?;
-        let row = self.wire_row_at(r, state.position, time);
+        let state = states.get(*self.entry_bead.get(self.row_start[r])?)?;
+        let row = self.wire_row_at(r, state.position, time)?;
         let length = row.normal.dot(row.normal).sqrt();
         if length.is_nan() || length <= 0.0 {
             return None;
