@@ -16,6 +16,14 @@
 //!   the bowl and those above striking them (`piling`), and from 1 s on,
 //!   the pile jammed and settling (`settling`): ten steps each, each
 //!   timed once.
+//! - `falling`: 10,000 beads of 2 cm in the plane, a hundred rows of a
+//!   hundred 10 cm apart across `x ∈ [−5, 5]`, the rows 8 cm apart,
+//!   falling in a one-sided bowl of radius 20 m (`plane`), and 10,648
+//!   marbles of 2 cm in space, a cube of 22 a side 8 cm apart, falling
+//!   in a one-sided sphere of radius 20 m (`space`), each timed over
+//!   its first steps, before any lands or two come near: what looking
+//!   for beads that may touch costs at that many beads (the broad phase,
+//!   each step, over beads a hundred or 22 × 22 deep).
 
 use std::time::Duration;
 
@@ -29,7 +37,7 @@ use criterion::{
 use wirebead::headless::Headless;
 use wirebead::plugin::{Timeline, TimelinePlugin};
 use wirebead::prelude::*;
-use wirebead::{BeadRadius, Integrator, ScenePreset, SimClock};
+use wirebead::{BeadRadius, Integrator, SceneFile, ScenePreset, SimClock};
 
 /// Rings in the abacus.
 const RINGS: usize = 100;
@@ -164,5 +172,79 @@ fn pile_group(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, abacus_group, pile_group);
+/// Beads falling in the plane.
+const FALLING: usize = 10_000;
+
+/// Marbles to a side of the cube falling in space.
+const CUBE: usize = 22;
+
+/// Beads of 2 cm and 1 kg at rest in a one-sided bowl (a circle in the
+/// plane, a sphere in space) of radius 20 m, RATTLE at 240 Hz: in the
+/// plane [`FALLING`] in rows of a hundred, 10 cm apart across
+/// `x ∈ [−5, 5]`, the rows 8 cm apart upward from `y = −19`; in space a
+/// cube of [`CUBE`] a side, 8 cm apart, its lowest corner at
+/// `(−0.9, −19, −0.9)`.
+fn falling_scene(space: bool) -> SceneFile {
+    let at = |k: usize| {
+        if space {
+            let (i, j, l) = (k % CUBE, (k / CUBE) % CUBE, k / (CUBE * CUBE));
+            let (x, y, z) = (i as f64, j as f64, l as f64);
+            format!(
+                "({}, {}, {})",
+                -0.9 + 0.08 * x,
+                -19.0 + 0.08 * y,
+                -0.9 + 0.08 * z
+            )
+        } else {
+            let (i, j) = (k % 100, k / 100);
+            format!(
+                "({}, {})",
+                -5.0 + 0.1 * (i as f64 + 0.5),
+                -19.0 + 0.08 * j as f64
+            )
+        }
+    };
+    let (beads, dimension, shape) = if space {
+        (CUBE * CUBE * CUBE, 3, "Sphere")
+    } else {
+        (FALLING, 2, "Circle")
+    };
+    let listed: String = (0..beads)
+        .map(|k| {
+            format!(
+                "(name: \"b{k}\", mass: 1.0, radius: 0.02, initial_position: {}),",
+                at(k)
+            )
+        })
+        .collect();
+    SceneFile::from_ron(&format!(
+        "(name: \"falling\", dimension: {dimension}, \
+         params: (timestep: {}, integrator: Rattle), contacts: (restitution: 0.0), \
+         wires: [(shape: {shape}((radius: 20.0)), side: Negative, beads: [{listed}])])",
+        1.0 / 240.0
+    ))
+    .expect("the falling beads")
+}
+
+fn falling_group(c: &mut Criterion) {
+    let mut group = c.benchmark_group("falling");
+    group.sampling_mode(SamplingMode::Flat);
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_millis(1));
+    group.measurement_time(Duration::from_millis(1));
+    for (name, space) in [("plane", false), ("space", true)] {
+        let preset = falling_scene(space);
+        let plugin = WireBeadPlugin::new(preset.params().clone()).expect("valid parameters");
+        let mut app = Headless::new(plugin).build();
+        preset.spawn(&mut app.world_mut().commands());
+        app.world_mut().flush();
+        app.world_mut().run_schedule(FixedUpdate);
+        let beads = if space { CUBE * CUBE * CUBE } else { FALLING };
+        group.throughput(Throughput::Elements(beads as u64));
+        time_steps(&mut group, &mut app, (name, beads));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, abacus_group, pile_group, falling_group);
 criterion_main!(benches);

@@ -5,9 +5,10 @@
 //! The step has been taken as if nothing touched. Then:
 //!
 //! 1. **Broad phase.** Each bead with a radius sweeps a box from where it
-//!    started to where it ended, grown by its radius; sweep and prune on
-//!    the boxes' lowest `x` finds the pairs whose boxes overlap. Beads on
-//!    one wire, on different wires, free or joined: all the same.
+//!    started to where it ended, grown by its radius; a grid of cells
+//!    about two boxes wide finds the pairs whose boxes overlap
+//!    ([`overlapping`]). Beads on one wire, on different wires, free or
+//!    joined: all the same.
 //! 2. The bodies (islands) that such pairs join are settled together, each
 //!    group of them apart from the others.
 //! 3. **Where they meet.** A pair whose gap `|x_b − x_a| − (r_a + r_b)` is
@@ -59,7 +60,8 @@
 //!
 //! | file | what it holds |
 //! |---|---|
-//! | `mod` | [`TouchBody`], [`TouchBead`], [`settle_touches`], the broad phase ([`overlapping`]) and the groups it finds |
+//! | `mod` | [`TouchBody`], [`TouchBead`], [`settle_touches`] and the groups the broad phase finds |
+//! | `broad` | the broad phase ([`overlapping`]): which boxes overlap, by a grid |
 //! | `group` | one group settled: where its pairs meet, the steps to and from each instant, the strikes, the bodies it takes in |
 
 use bevy::math::DVec3;
@@ -71,10 +73,12 @@ use super::solve::SolveError;
 use super::state::BeadState;
 use crate::geometry::Coordinates;
 
+mod broad;
 mod group;
 #[cfg(test)]
 mod tests;
 
+pub(crate) use broad::overlapping;
 use group::Group;
 
 pub(crate) use super::coupled::TOUCHING;
@@ -323,7 +327,7 @@ impl Pool {
 /// velocity takes it in `within` ([`overlapping`]). An island builder
 /// joins such pairs by contact rows before they meet (see
 /// [`Island::set_contact`](crate::solver::Island::set_contact)).
-pub fn may_touch<V: Coordinates>(
+pub(crate) fn may_touch<V: Coordinates>(
     beads: &[(BeadState<V>, f64)],
     within: f64,
     margin: f64,
@@ -337,28 +341,6 @@ pub fn may_touch<V: Coordinates>(
         })
         .collect();
     overlapping(&boxes)
-}
-
-/// The pairs of boxes `(lowest, highest corner)` that overlap, by sweep
-/// and prune along `x`, each as `(i, j)` with `i < j`.
-pub fn overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
-    let mut order: Vec<usize> = (0..boxes.len()).collect();
-    order.sort_by(|&i, &j| boxes[i].0.x.total_cmp(&boxes[j].0.x));
-    let mut open: Vec<usize> = Vec::new();
-    let mut pairs = Vec::new();
-    for &i in &order {
-        let (low, high) = boxes[i];
-        open.retain(|&j| boxes[j].1.x >= low.x);
-        for &j in &open {
-            let (other_low, other_high) = boxes[j];
-            if low.cmple(other_high).all() && other_low.cmple(high).all() {
-                pairs.push((i.min(j), i.max(j)));
-            }
-        }
-        open.push(i);
-    }
-    pairs.sort_unstable();
-    pairs
 }
 
 /// The bodies the pairs join, grouped ([`islands`]'s grouping, the pairs

@@ -214,34 +214,81 @@ fn a_bead_naming_a_missing_body_is_refused_in_words() {
     );
 }
 
+/// Every pair of `boxes` that overlaps, by testing each pair.
+fn every_overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
+    let mut every = Vec::new();
+    for i in 0..boxes.len() {
+        for j in i + 1..boxes.len() {
+            let (a, b) = (boxes[i], boxes[j]);
+            if a.0.cmple(b.1).all() && b.0.cmple(a.1).all() {
+                every.push((i, j));
+            }
+        }
+    }
+    every
+}
+
 proptest::proptest! {
-    /// Sweep and prune finds exactly the overlapping pairs that
-    /// testing every pair finds.
+    /// The grid finds exactly the overlapping pairs that testing every
+    /// pair finds, for boxes of a hair to many cells across, points, and
+    /// boxes that share a face.
     #[test]
-    fn sweep_and_prune_finds_every_overlapping_pair(
+    fn the_broad_phase_finds_every_overlapping_pair(
         boxes in proptest::collection::vec(
-            ((-5.0..5.0f64, -5.0..5.0f64, -5.0..5.0f64), (0.0..2.0f64, 0.0..2.0f64, 0.0..2.0f64)),
-            0..40,
+            (
+                (-5.0..5.0f64, -5.0..5.0f64, -5.0..5.0f64),
+                proptest::prop_oneof![
+                    (0.0..0.3f64, 0.0..0.3f64, 0.0..0.3f64),
+                    (0.0..2.0f64, 0.0..2.0f64, 0.0..2.0f64),
+                    (4.0..12.0f64, 0.0..12.0f64, 0.0..1.0f64),
+                    (0.0..1e-300f64, 0.0..1e-300f64, 0.0..1e-300f64),
+                ],
+            ),
+            0..60,
         ),
     ) {
-        let boxes: Vec<(DVec3, DVec3)> = boxes
+        let mut boxes: Vec<(DVec3, DVec3)> = boxes
             .into_iter()
             .map(|((x, y, z), (w, h, d))| {
                 let low = DVec3::new(x, y, z);
                 (low, low + DVec3::new(w, h, d))
             })
             .collect();
-        let mut every = Vec::new();
-        for i in 0..boxes.len() {
-            for j in i + 1..boxes.len() {
-                let (a, b) = (boxes[i], boxes[j]);
-                if a.0.cmple(b.1).all() && b.0.cmple(a.1).all() {
-                    every.push((i, j));
-                }
-            }
+        // One box that shares a face with the first.
+        if let Some(&(low, high)) = boxes.first() {
+            let width = DVec3::X * (high.x - low.x);
+            boxes.push((low + width, high + width));
         }
-        proptest::prop_assert_eq!(overlapping(&boxes), every);
+        proptest::prop_assert_eq!(overlapping(&boxes), every_overlapping(&boxes));
     }
+}
+
+/// A box with a NaN corner overlaps nothing; an infinite one, or one
+/// far beyond the grid, overlaps every box it meets; boxes a kilometre
+/// across among beads of a centimetre are found as pairs too.
+#[test]
+fn the_broad_phase_takes_nan_infinite_far_and_huge_boxes() {
+    let unit = |x: f64, y: f64| {
+        let low = DVec3::new(x, y, 0.0);
+        (low, low + DVec3::splat(0.01))
+    };
+    let mut boxes: Vec<(DVec3, DVec3)> = (0..200)
+        .map(|k| unit(0.007 * (k % 20) as f64, 0.007 * (k / 20) as f64))
+        .collect();
+    boxes.push((DVec3::NAN, DVec3::ONE));
+    boxes.push((DVec3::splat(f64::NEG_INFINITY), DVec3::splat(f64::INFINITY)));
+    boxes.push((DVec3::splat(-500.0), DVec3::splat(500.0)));
+    boxes.push((DVec3::splat(1e300), DVec3::splat(f64::INFINITY)));
+    boxes.push((DVec3::new(0.05, 0.05, -1.0), DVec3::new(0.05, 0.05, 1.0)));
+    let found = overlapping(&boxes);
+    assert_eq!(found, every_overlapping(&boxes));
+    let nan = 200;
+    assert!(!found.iter().any(|&(i, j)| i == nan || j == nan));
+    // The infinite box meets all but the NaN one.
+    assert_eq!(
+        found.iter().filter(|&&(i, j)| i == 201 || j == 201).count(),
+        203
+    );
 }
 
 /// Two beads of radius 0.1 m, 1 m apart: at rest they may not touch
