@@ -44,6 +44,22 @@ pub enum PresetError {
         /// The fields that item has.
         known: String,
     },
+    /// A pile ([`ScenePreset::pile`](super::ScenePreset::pile)) of more
+    /// beads than its bowl holds in rows of that many: a bead would start
+    /// outside the bowl, where its one-sided wire would pull it in.
+    #[error(
+        "a pile of {beads} beads in rows of {per_row} does not fit in its bowl: row {row} would start outside it; at most {most} fit in rows of {per_row}"
+    )]
+    PileTooLarge {
+        /// The beads asked for.
+        beads: usize,
+        /// Beads to a row.
+        per_row: usize,
+        /// The first row (from 0 at the bottom) with a bead outside.
+        row: usize,
+        /// The most beads the bowl holds in rows of `per_row`.
+        most: usize,
+    },
     /// The file could not be read.
     #[error("cannot read scene file: {0}")]
     Io(#[from] std::io::Error),

@@ -1,6 +1,6 @@
 //! Scene files parsed, refused with their messages, and read back.
 
-use super::ScenePreset;
+use super::{PresetError, ScenePreset};
 use crate::dynamics::{BeadParams, SimParams};
 
 const GOOD: &str = r#"(
@@ -181,6 +181,23 @@ fn a_broken_file_and_bad_tracks_in_a_file_are_refused_in_words() {
 /// [`PILE_RADIUS`](super::PILE_RADIUS), inside the bowl by more than a
 /// radius and no two touching (23 to a row are 2.04 radii apart at the
 /// least, the jitter taken off 2.17); none to a row is taken as one.
+#[test]
+fn a_pile_too_large_for_its_bowl_is_refused_saying_how_many_fit() {
+    let err = ScenePreset::pile(1000, 23).unwrap_err();
+    let PresetError::PileTooLarge { row, most, .. } = err else {
+        panic!("refused for another reason: {err}");
+    };
+    // Rows 2.3 radii apart from y = −0.8: the edge beads of row 36
+    // (y = 0.856) are past 0.98 m from the centre.
+    assert_eq!((row, most), (36, 36 * 23));
+    assert_eq!(
+        err.to_string(),
+        "a pile of 1000 beads in rows of 23 does not fit in its bowl: row 36 would start outside it; at most 828 fit in rows of 23"
+    );
+    let fits = ScenePreset::pile(most, 23).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(fits.all_beads().count(), most);
+}
+
 #[test]
 fn a_pile_has_its_beads_apart_inside_the_bowl() {
     let r = super::PILE_RADIUS;
