@@ -6,15 +6,16 @@ use std::collections::HashMap;
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
+use super::start::{BuildBead, Carried, start_island};
 use super::{CachedIsland, ContactRow, InIsland, IslandReport, Islands, LinkRows, WireRow, touch};
 use crate::dynamics::{
-    Bead, BeadMotion, BeadRadius, CatchesBeads, Contacts, Dimension, DivergenceReason, Joint,
-    OnWire, Pin, Rod, SimParams, SpaceBead, Spring, WirePose, WireRows,
+    Bead, CatchesBeads, Contacts, Dimension, DivergenceReason, Joint, Pin, Rod, SimParams,
+    SpaceBead, Spring, WirePose, WireRows,
 };
 use crate::geometry::{Friction, Side, Surface};
 use crate::plugin::clock::SimClock;
 use crate::plugin::report::Divergences;
-use crate::solver::{self, BeadState, Island, IslandRow, IslandWork, RowKind, SpringLink};
+use crate::solver::{self, BeadState, Island, IslandRow, RowKind, SpringLink};
 
 /// Every link in the world, as the rebuild reads them.
 #[derive(SystemParam)]
@@ -27,20 +28,6 @@ pub(super) struct Links<'w, 's, V: Dimension> {
     /// other dimension is that dimension's, not a link to nothing.
     any_bead: Query<'w, 's, (), Or<(With<Bead>, With<SpaceBead>)>>,
 }
-
-/// What the rebuild reads and writes of each bead: its motion, wire,
-/// marker, and whether it has a radius (and so steps in an island).
-type BuildBead<V> = (
-    Entity,
-    BeadMotion<V>,
-    Option<&'static OnWire>,
-    Has<InIsland>,
-    Option<&'static BeadRadius>,
-);
-
-/// Whether each wire row held its bead (by bead, wire and the wire's
-/// row), and where the bead was, when the last islands were stepped.
-type Carried<V> = HashMap<(Entity, Entity, usize), (bool, BeadState<V>)>;
 
 /// A link while the islands are built: its rows and the beads it names.
 struct Pending<V: Dimension> {
@@ -144,27 +131,12 @@ pub(super) fn prepare_islands<V: Dimension>(
     contacts: Res<Contacts>,
 ) {
     islands.dirty = false;
-    // Whether each bead's wire rows held it, where the islands being
-    // rebuilt left it: a rebuild starts them so where the bead still is.
-    let mut was_held: Carried<V> = HashMap::new();
-    for cached in &islands.cached {
-        for row in &cached.wire_rows {
-            let Some(&bead) = cached.report.beads.get(row.bead) else {
-                continue;
-            };
-            let (held, state) = match cached.states.get(row.bead) {
-                Some(&state) => (cached.work.holds(row.row), state),
-                // Built and not stepped since: what it was told to carry,
-                // where the bead is now.
-                None => match (cached.work.carried(row.row), beads.get(bead)) {
-                    (Some(held), Ok((_, now, ..))) => (held, now.state()),
-                    _ => continue,
-                },
-            };
-            was_held.insert((bead, row.wire, row.part), (held, state));
-        }
-    }
-    islands.cached.clear();
+    // The islands being rebuilt, and where their rows are: a rebuilt
+    // island starts each row as it was where its beads still are.
+    let old = std::mem::take(&mut islands.cached);
+    let was = Carried::from(&old, |bead| {
+        beads.get(bead).ok().map(|(_, now, ..)| now.state())
+    });
     let mut catchers: Vec<Entity> = catching.iter().collect();
     catchers.sort_unstable();
     let is_bead = |e: Entity| beads.contains(e);
@@ -480,8 +452,8 @@ pub(super) fn prepare_islands<V: Dimension>(
                 let work = start_island(
                     &mut island,
                     &entities,
-                    &wire_rows,
-                    &was_held,
+                    (&wire_rows, &pair_rows),
+                    (&old, &was),
                     &wires,
                     &mut beads,
                     &clock,
@@ -525,66 +497,4 @@ pub(super) fn prepare_islands<V: Dimension>(
             _ => {}
         }
     }
-}
-
-/// Starts a fresh island where its beads are: each wire row on its wire's
-/// motion, and the beads' velocities projected onto the island's
-/// constraints ([`Island::project_velocities`]), so that the state a run
-/// starts from is the one simulated. A change is logged in one line.
-fn start_island<V: Dimension>(
-    island: &mut Island<V>,
-    entities: &[Entity],
-    wire_rows: &[WireRow],
-    was_held: &Carried<V>,
-    wires: &Query<(&V::Wire, &WirePose<V>)>,
-    beads: &mut Query<BuildBead<V>>,
-    clock: &SimClock,
-) -> IslandWork<V> {
-    let mut work = IslandWork::default();
-    for wire_row in wire_rows {
-        if let Ok((_, pose)) = wires.get(wire_row.wire)
-            && let Ok(path) = pose.get()
-        {
-            island.move_wire(wire_row.row, None, path);
-        }
-        let bead = entities[wire_row.bead];
-        let key = (bead, wire_row.wire, wire_row.part);
-        if let (Some(&(held, then)), Ok((_, now, ..))) = (was_held.get(&key), beads.get(bead))
-            && then == now.state()
-        {
-            work.carry(wire_row.row, held);
-        }
-    }
-    let mut states: Vec<BeadState<V>> = Vec::with_capacity(entities.len());
-    for &entity in entities {
-        match beads.get(entity) {
-            Ok((_, bead, ..)) if bead.state().is_finite() => states.push(bead.state()),
-            // A bead whose state is not finite: the step reports it.
-            _ => return work,
-        }
-    }
-    let Ok((before, after)) = island.project_velocities(clock.time, &mut states, &mut work) else {
-        // No projection (a singular point): the step meets it and reports.
-        return work;
-    };
-    let mut changed = Vec::new();
-    for (&entity, state) in entities.iter().zip(&states) {
-        if let Ok((_, mut bead, ..)) = beads.get_mut(entity) {
-            let change = state.velocity - bead.velocity.0;
-            let speed = bead.velocity.0.dot(bead.velocity.0).sqrt();
-            if change.dot(change).sqrt() > 1e-9 * speed.max(1.0) {
-                changed.push(entity.to_string());
-            }
-            if bead.velocity.0 != state.velocity {
-                bead.velocity.0 = state.velocity;
-            }
-        }
-    }
-    if !changed.is_empty() {
-        info!(
-            "wirebead: the velocities of beads {} broke their constraints and were projected onto them; their island's kinetic energy went from {before:.6} J to {after:.6} J",
-            changed.join(", ")
-        );
-    }
-    work
 }

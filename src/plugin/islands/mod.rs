@@ -7,10 +7,12 @@
 //! | file | what it holds |
 //! |---|---|
 //! | `build` | rebuilding the islands when the topology changes |
+//! | `start` | how an island built again starts: its rows as the last islands left them |
 //! | `step` | stepping them: gather, solve (in parallel), write back |
 //! | `touch` | beads that touch: the steps cut where they meet, the strikes |
 
 mod build;
+mod start;
 mod step;
 mod touch;
 

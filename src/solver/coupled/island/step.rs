@@ -8,7 +8,8 @@ use super::events::{Cut, Flight};
 use super::integrators::Stage;
 use super::projection::Restore;
 use super::{
-    CALM_STEPS, CONTACT_PASSES, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow, TOUCHING,
+    CALM_STEPS, CONTACT_PASSES, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow,
+    RowReport, TOUCHING,
 };
 use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
 use crate::solver::method::Method;
@@ -229,7 +230,7 @@ impl<V: WireSpace> Island<V> {
     /// a wire that catches it, see [`Island::set_catching`]), or past an
     /// end of its wire, starts in flight (a row told otherwise by
     /// [`IslandWork::carry`] starts as it was told); a
-    /// contact starts set aside;
+    /// contact starts set aside, unless told it is held;
     /// stick rows start set aside (a bead slides until friction stops it),
     /// but a bead at rest on a rough wire starts held by static friction.
     pub(super) fn start_rows(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
@@ -260,9 +261,17 @@ impl<V: WireSpace> Island<V> {
         }
         // What a rebuilt island carries over (see `IslandWork::carry`).
         for (r, carried) in work.carried.iter().enumerate().take(self.rows()) {
-            if let (Some(held), false) = (carried, self.contacts[r]) {
+            if let Some(held) = carried {
                 work.inactive[r] = !held;
             }
+        }
+        if work.carried_force.iter().any(Option::is_some) {
+            // The multipliers to start from, as a last step's report.
+            work.reports.clear();
+            work.reports.extend((0..self.rows()).map(|r| RowReport {
+                lambda: work.carried_force.get(r).copied().flatten().unwrap_or(0.0),
+                ..RowReport::default()
+            }));
         }
         // A bead at rest on a rough wire starts held by static friction.
         for (r, rough) in self.rough.iter().enumerate() {

@@ -41,6 +41,9 @@ pub struct IslandWork<V: WireSpace = DVec2> {
     /// Whether each row starts held, where a fresh work is told (see
     /// [`IslandWork::carry`]).
     pub(super) carried: Vec<Option<bool>>,
+    /// The multiplier each row starts from, where a fresh work is told
+    /// (see [`IslandWork::carry_row`]).
+    pub(super) carried_force: Vec<Option<f64>>,
     /// The contact rows whose beads touched where the step began without
     /// closing: the step holds them where it would leave them overlapping
     /// (see [`Island::step_at`](super::Island::step_at)).
@@ -169,17 +172,44 @@ impl<V: WireSpace> IslandWork<V> {
         !self.inactive.get(row).copied().unwrap_or(false)
     }
 
-    /// Starts wire row `row` of a fresh work held (or set aside) whatever
-    /// the rule of the island's first step would say: what an island
-    /// rebuilt around beads where the last one left them carries over, so
-    /// a bead that had left its one-sided wire and is now behind it (on
-    /// another wire that caught it) stays off it. A work that has stepped
-    /// is not changed.
+    /// Starts row `row` of a fresh work held (or set aside) whatever the
+    /// rule of the island's first step would say: what an island rebuilt
+    /// around beads where the last one left them carries over, so a bead
+    /// that had left its one-sided wire and is now behind it (on another
+    /// wire that caught it) stays off it, and two beads pressed together
+    /// stay pressed. A work that has stepped is not changed.
     pub fn carry(&mut self, row: usize, held: bool) {
         if self.carried.len() <= row {
             self.carried.resize(row + 1, None);
         }
         self.carried[row] = Some(held);
+    }
+
+    /// Starts row `row` of a fresh work as row `from_row` of `from` (the
+    /// work of the island this one's was rebuilt from) ended its last
+    /// step: held or set aside, from its force (a dense island's first
+    /// step predicts the rows it holds warm from it, as from its own last
+    /// step's). `from` not yet stepped passes on what it was told to
+    /// carry. A work that has stepped is not changed.
+    pub fn carry_row(&mut self, row: usize, from: &IslandWork<V>, from_row: usize) {
+        let stepped = !from.inactive.is_empty();
+        let held = if stepped {
+            Some(from.holds(from_row))
+        } else {
+            from.carried(from_row)
+        };
+        let Some(held) = held else { return };
+        self.carry(row, held);
+        let force = match from.reports.get(from_row) {
+            Some(report) if stepped => Some(report.lambda),
+            _ => from.carried_force.get(from_row).copied().flatten(),
+        };
+        if let Some(force) = force {
+            if self.carried_force.len() <= row {
+                self.carried_force.resize(row + 1, None);
+            }
+            self.carried_force[row] = Some(force);
+        }
     }
 
     /// What [`IslandWork::carry`] told row `row` to start as, if anything.

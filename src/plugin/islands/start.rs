@@ -1,0 +1,155 @@
+//! How an island built again starts: each row as the islands it
+//! replaces left it, where its beads have not moved since
+//! ([`Carried`]), and the beads' velocities projected onto its
+//! constraints ([`start_island`]).
+
+use std::collections::HashMap;
+
+use bevy::prelude::*;
+
+use super::{CachedIsland, ContactRow, InIsland, WireRow};
+use crate::dynamics::{BeadMotion, BeadRadius, Dimension, OnWire, WirePose};
+use crate::plugin::clock::SimClock;
+use crate::solver::{BeadState, Island, IslandWork};
+
+/// What the rebuild reads and writes of each bead: its motion, wire,
+/// marker, and whether it has a radius (and so steps in an island).
+pub(super) type BuildBead<V> = (
+    Entity,
+    BeadMotion<V>,
+    Option<&'static OnWire>,
+    Has<InIsland>,
+    Option<&'static BeadRadius>,
+);
+
+/// Where each row of the last islands is (its island and row), and where
+/// its beads were when they were last stepped (or now, for an island
+/// built and not stepped since): what a rebuilt island starts its rows
+/// from. Wire rows by bead, wire and the wire's row; contacts by their
+/// two beads (in order).
+pub(super) struct Carried<V: Dimension> {
+    wire_rows: HashMap<(Entity, Entity, usize), ((usize, usize), BeadState<V>)>,
+    contacts: HashMap<(Entity, Entity), ((usize, usize), [BeadState<V>; 2])>,
+}
+
+impl<V: Dimension> Carried<V> {
+    /// Where the `old` islands' rows are; `now` is where a bead is.
+    pub(super) fn from(
+        old: &[CachedIsland<V>],
+        now: impl Fn(Entity) -> Option<BeadState<V>>,
+    ) -> Self {
+        let mut carried = Self {
+            wire_rows: HashMap::new(),
+            contacts: HashMap::new(),
+        };
+        for (k, cached) in old.iter().enumerate() {
+            let beads = &cached.report.beads;
+            let at = |bead: usize| {
+                cached
+                    .states
+                    .get(bead)
+                    .copied()
+                    .or_else(|| now(beads[bead]))
+            };
+            for row in &cached.wire_rows {
+                if let (Some(&bead), Some(state)) = (beads.get(row.bead), at(row.bead)) {
+                    let key = (bead, row.wire, row.part);
+                    carried.wire_rows.insert(key, ((k, row.row), state));
+                }
+            }
+            for contact in &cached.contacts {
+                let (Some(&a), Some(&b)) = (beads.get(contact.a), beads.get(contact.b)) else {
+                    continue;
+                };
+                let (Some(at_a), Some(at_b)) = (at(contact.a), at(contact.b)) else {
+                    continue;
+                };
+                let ((a, at_a), (b, at_b)) = if a < b {
+                    ((a, at_a), (b, at_b))
+                } else {
+                    ((b, at_b), (a, at_a))
+                };
+                carried
+                    .contacts
+                    .insert((a, b), ((k, contact.row), [at_a, at_b]));
+            }
+        }
+        carried
+    }
+}
+
+/// Starts a fresh island where its beads are: each wire row on its wire's
+/// motion, and the beads' velocities projected onto the island's
+/// constraints ([`Island::project_velocities`]), so that the state a run
+/// starts from is the one simulated. A change is logged in one line.
+pub(super) fn start_island<V: Dimension>(
+    island: &mut Island<V>,
+    entities: &[Entity],
+    (wire_rows, contacts): (&[WireRow], &[ContactRow]),
+    (old, was): (&[CachedIsland<V>], &Carried<V>),
+    wires: &Query<(&V::Wire, &WirePose<V>)>,
+    beads: &mut Query<BuildBead<V>>,
+    clock: &SimClock,
+) -> IslandWork<V> {
+    let mut work = IslandWork::default();
+    for wire_row in wire_rows {
+        if let Ok((_, pose)) = wires.get(wire_row.wire)
+            && let Ok(path) = pose.get()
+        {
+            island.move_wire(wire_row.row, None, path);
+        }
+        let bead = entities[wire_row.bead];
+        let key = (bead, wire_row.wire, wire_row.part);
+        if let (Some(&((k, from), then)), Ok((_, now, ..))) =
+            (was.wire_rows.get(&key), beads.get(bead))
+            && then == now.state()
+        {
+            work.carry_row(wire_row.row, &old[k].work, from);
+        }
+    }
+    // A contact whose beads are where the last island left them starts
+    // as it was: pressed with its force, or set aside.
+    let now = |bead: Entity| beads.get(bead).ok().map(|(_, now, ..)| now.state());
+    for contact in contacts {
+        let (a, b) = (entities[contact.a], entities[contact.b]);
+        let (a, b) = (a.min(b), a.max(b));
+        let Some(&((k, from), [at_a, at_b])) = was.contacts.get(&(a, b)) else {
+            continue;
+        };
+        if now(a) == Some(at_a) && now(b) == Some(at_b) {
+            work.carry_row(contact.row, &old[k].work, from);
+        }
+    }
+    let mut states: Vec<BeadState<V>> = Vec::with_capacity(entities.len());
+    for &entity in entities {
+        match beads.get(entity) {
+            Ok((_, bead, ..)) if bead.state().is_finite() => states.push(bead.state()),
+            // A bead whose state is not finite: the step reports it.
+            _ => return work,
+        }
+    }
+    let Ok((before, after)) = island.project_velocities(clock.time, &mut states, &mut work) else {
+        // No projection (a singular point): the step meets it and reports.
+        return work;
+    };
+    let mut changed = Vec::new();
+    for (&entity, state) in entities.iter().zip(&states) {
+        if let Ok((_, mut bead, ..)) = beads.get_mut(entity) {
+            let change = state.velocity - bead.velocity.0;
+            let speed = bead.velocity.0.dot(bead.velocity.0).sqrt();
+            if change.dot(change).sqrt() > 1e-9 * speed.max(1.0) {
+                changed.push(entity.to_string());
+            }
+            if bead.velocity.0 != state.velocity {
+                bead.velocity.0 = state.velocity;
+            }
+        }
+    }
+    if !changed.is_empty() {
+        info!(
+            "wirebead: the velocities of beads {} broke their constraints and were projected onto them; their island's kinetic energy went from {before:.6} J to {after:.6} J",
+            changed.join(", ")
+        );
+    }
+    work
+}
