@@ -440,6 +440,21 @@ fn a_contact_row_holds_a_pressing_pair_and_lets_a_pulling_one_go() {
     }
 }
 
+/// A bead of mass `m` and a pinned 1 kg bead, both of radius `r`, the
+/// first resting on the second under gravity `g` (their contact row 2):
+/// the island, the states and the forces.
+fn resting_on_a_pin(r: f64, m: f64, g: f64) -> (Island, Vec<BeadState>, Vec<LinearForce>) {
+    let [px, py] = pin(0, DVec2::ZERO);
+    let mut island = Island::new(&[1.0, m], vec![px, py, rod(0, 1, 2.0 * r)], vec![]).unwrap();
+    island.set_contact(2);
+    let states = at_rest(&[DVec2::ZERO, DVec2::new(0.0, 2.0 * r)]);
+    let forces = vec![
+        LinearForce::constant(DVec2::ZERO),
+        LinearForce::constant(DVec2::new(0.0, -m * g)),
+    ];
+    (island, states, forces)
+}
+
 /// A 2 kg bead resting on a pinned one, its contact row set aside: RATTLE's
 /// own step finds the pair touching at its start and pressed into each
 /// other at its end, holds the row and takes the step again, so the bead
@@ -447,14 +462,7 @@ fn a_contact_row_holds_a_pressing_pair_and_lets_a_pulling_one_go() {
 #[test]
 fn rattle_holds_a_touching_pair_its_step_would_press_together() {
     let (r, m, g) = (0.1, 2.0, 9.81);
-    let [px, py] = pin(0, DVec2::ZERO);
-    let mut island = Island::new(&[1.0, m], vec![px, py, rod(0, 1, 2.0 * r)], vec![]).unwrap();
-    island.set_contact(2);
-    let mut states = at_rest(&[DVec2::ZERO, DVec2::new(0.0, 2.0 * r)]);
-    let forces = vec![
-        LinearForce::constant(DVec2::ZERO),
-        LinearForce::constant(DVec2::new(0.0, -m * g)),
-    ];
+    let (island, mut states, forces) = resting_on_a_pin(r, m, g);
     let s = settings(Method::Rattle, 1.0 / 240.0);
     let mut work = IslandWork::default();
     island.begin(0.0, &states, &mut work);
@@ -481,14 +489,7 @@ fn rattle_holds_a_touching_pair_its_step_would_press_together() {
 #[test]
 fn an_island_rebuilt_starts_its_contacts_as_the_last_one_left_them() {
     let (r, m, g) = (0.1, 2.0, 9.81);
-    let [px, py] = pin(0, DVec2::ZERO);
-    let mut island = Island::new(&[1.0, m], vec![px, py, rod(0, 1, 2.0 * r)], vec![]).unwrap();
-    island.set_contact(2);
-    let mut states = at_rest(&[DVec2::ZERO, DVec2::new(0.0, 2.0 * r)]);
-    let forces = vec![
-        LinearForce::constant(DVec2::ZERO),
-        LinearForce::constant(DVec2::new(0.0, -m * g)),
-    ];
+    let (island, mut states, forces) = resting_on_a_pin(r, m, g);
     let s = settings(Method::Rattle, 1.0 / 240.0);
     let mut work = IslandWork::default();
     island
