@@ -49,7 +49,7 @@ impl<V: Dimension> Carried<V> {
                     .states
                     .get(bead)
                     .copied()
-                    .or_else(|| now(beads[bead]))
+                    .or_else(|| beads.get(bead).and_then(|&entity| now(entity)))
             };
             for row in &cached.wire_rows {
                 if let (Some(&bead), Some(state)) = (beads.get(row.bead), at(row.bead)) {
