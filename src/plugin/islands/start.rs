@@ -92,6 +92,7 @@ pub(super) fn start_island<V: Dimension>(
     clock: &SimClock,
 ) -> IslandWork<V> {
     let mut work = IslandWork::default();
+    let now = |bead: Entity| beads.get(bead).ok().map(|(_, now, ..)| now.state());
     for wire_row in wire_rows {
         if let Ok((_, pose)) = wires.get(wire_row.wire)
             && let Ok(path) = pose.get()
@@ -100,16 +101,14 @@ pub(super) fn start_island<V: Dimension>(
         }
         let bead = entities[wire_row.bead];
         let key = (bead, wire_row.wire, wire_row.part);
-        if let (Some(&((k, from), then)), Ok((_, now, ..))) =
-            (was.wire_rows.get(&key), beads.get(bead))
-            && then == now.state()
+        if let Some(&((k, from), then)) = was.wire_rows.get(&key)
+            && now(bead) == Some(then)
         {
             work.carry_row(wire_row.row, &old[k].work, from);
         }
     }
     // A contact whose beads are where the last island left them starts
     // as it was: pressed with its force, or set aside.
-    let now = |bead: Entity| beads.get(bead).ok().map(|(_, now, ..)| now.state());
     for contact in contacts {
         let (a, b) = (entities[contact.a], entities[contact.b]);
         let (a, b) = (a.min(b), a.max(b));

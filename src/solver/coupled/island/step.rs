@@ -261,17 +261,18 @@ impl<V: WireSpace> Island<V> {
         }
         // What a rebuilt island carries over (see `IslandWork::carry`).
         for (r, carried) in work.carried.iter().enumerate().take(self.rows()) {
-            if let Some(held) = carried {
+            if let Some((held, _)) = carried {
                 work.inactive[r] = !held;
             }
         }
-        if work.carried_force.iter().any(Option::is_some) {
+        let force = |r: usize| work.carried.get(r).copied().flatten().and_then(|(_, f)| f);
+        if (0..self.rows()).any(|r| force(r).is_some()) {
             // The multipliers to start from, as a last step's report.
-            work.reports.clear();
-            work.reports.extend((0..self.rows()).map(|r| RowReport {
-                lambda: work.carried_force.get(r).copied().flatten().unwrap_or(0.0),
+            let reports = (0..self.rows()).map(|r| RowReport {
+                lambda: force(r).unwrap_or(0.0),
                 ..RowReport::default()
-            }));
+            });
+            work.reports = reports.collect();
         }
         // A bead at rest on a rough wire starts held by static friction.
         for (r, rough) in self.rough.iter().enumerate() {

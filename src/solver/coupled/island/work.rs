@@ -38,12 +38,10 @@ pub struct IslandWork<V: WireSpace = DVec2> {
     pub(super) time: f64,
     /// The rows set aside: one-sided wires their beads have left.
     pub(super) inactive: Vec<bool>,
-    /// Whether each row starts held, where a fresh work is told (see
-    /// [`IslandWork::carry`]).
-    pub(super) carried: Vec<Option<bool>>,
-    /// The multiplier each row starts from, where a fresh work is told
-    /// (see [`IslandWork::carry_row`]).
-    pub(super) carried_force: Vec<Option<f64>>,
+    /// Whether each row starts held, and the multiplier it starts from,
+    /// where a fresh work is told (see [`IslandWork::carry`] and
+    /// [`IslandWork::carry_row`]).
+    pub(super) carried: Vec<Option<(bool, Option<f64>)>>,
     /// The contact rows whose beads touched where the step began without
     /// closing: the step holds them where it would leave them overlapping
     /// (see [`Island::step_at`](super::Island::step_at)).
@@ -144,7 +142,9 @@ impl<V: WireSpace> IslandWork<V> {
         self.v.extend(states.iter().map(|s| s.velocity));
     }
 
-    /// What the last successful step reported of each row.
+    /// What the last successful step reported of each row; before a
+    /// fresh work's first step, the forces it was told to start from
+    /// ([`IslandWork::carry_row`]).
     pub fn rows(&self) -> &[RowReport] {
         &self.reports
     }
@@ -179,10 +179,7 @@ impl<V: WireSpace> IslandWork<V> {
     /// wire that caught it) stays off it, and two beads pressed together
     /// stay pressed. A work that has stepped is not changed.
     pub fn carry(&mut self, row: usize, held: bool) {
-        if self.carried.len() <= row {
-            self.carried.resize(row + 1, None);
-        }
-        self.carried[row] = Some(held);
+        self.tell(row, held, None);
     }
 
     /// Starts row `row` of a fresh work as row `from_row` of `from` (the
@@ -192,29 +189,35 @@ impl<V: WireSpace> IslandWork<V> {
     /// step's). `from` not yet stepped passes on what it was told to
     /// carry. A work that has stepped is not changed.
     pub fn carry_row(&mut self, row: usize, from: &IslandWork<V>, from_row: usize) {
-        let stepped = !from.inactive.is_empty();
-        let held = if stepped {
-            Some(from.holds(from_row))
-        } else {
-            from.carried(from_row)
-        };
-        let Some(held) = held else { return };
-        self.carry(row, held);
-        let force = match from.reports.get(from_row) {
-            Some(report) if stepped => Some(report.lambda),
-            _ => from.carried_force.get(from_row).copied().flatten(),
-        };
-        if let Some(force) = force {
-            if self.carried_force.len() <= row {
-                self.carried_force.resize(row + 1, None);
+        let told = from.carried.get(from_row).copied().flatten();
+        let (held, force) = if from.inactive.is_empty() {
+            match told {
+                Some(told) => told,
+                None => return,
             }
-            self.carried_force[row] = Some(force);
+        } else {
+            let force = from.reports.get(from_row).map(|report| report.lambda);
+            (from.holds(from_row), force)
+        };
+        self.tell(row, held, force);
+    }
+
+    /// Row `row` of a fresh work starts held (or set aside) and from the
+    /// multiplier `force`, if one is given.
+    fn tell(&mut self, row: usize, held: bool, force: Option<f64>) {
+        if self.carried.len() <= row {
+            self.carried.resize(row + 1, None);
         }
+        self.carried[row] = Some((held, force));
     }
 
     /// What [`IslandWork::carry`] told row `row` to start as, if anything.
     pub fn carried(&self, row: usize) -> Option<bool> {
-        self.carried.get(row).copied().flatten()
+        self.carried
+            .get(row)
+            .copied()
+            .flatten()
+            .map(|(held, _)| held)
     }
 
     /// The beads that left or landed on a one-sided row in the last step:
