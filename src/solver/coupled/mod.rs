@@ -9,13 +9,15 @@
 //! |---|---|
 //! | `constraint` | [`Constraint`], [`RowKind`] (what one row contributes), [`SpringLink`] |
 //! | `group` | [`islands`]: which beads are joined |
+//! | `lcp` | the complementarity problems of dense contact, by projected Newton steps |
 //! | `normal/` (`pattern`, `order`, `band_ldlt`, `band_lu`, `sparse_ldlt`, `sparse_lu`) | `J W Jᵀ`: its patterns, band ordering, and band and sparse (faer) factorizations |
-//! | `island/` (`build`, `rows`, `step`, `integrators`, `newton`, `projection`, `contact`) | [`Island`]: building, row evaluation, each method, projection, contact and friction |
+//! | `island/` (`build`, `rows`, `step`, `integrators`, `newton`, `projection`, `contact`, `dense`, …) | [`Island`]: building, row evaluation, each method, projection, contact and friction |
 //! | `tests/` (`methods`, `rows`, `ropes`, `contact`) | islands against the single-bead solver and physics |
 
 mod constraint;
 mod group;
 mod island;
+mod lcp;
 mod normal;
 #[cfg(test)]
 mod tests;

@@ -153,6 +153,9 @@ impl<V: WireSpace> Island<V> {
         h: f64,
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
+        if self.steps_densely() {
+            return self.rattle_dense(forces, h, work);
+        }
         let n = self.beads();
         let start = work.time;
         let stepped = self.time_steps();
@@ -232,7 +235,13 @@ impl<V: WireSpace> Island<V> {
     /// RATTLE's drift from the step's start at `start`: each bead moved
     /// by its applied forces alone over `h` into `work.x` (velocities
     /// `work.v` the start's), the rows to be met at `start + h`.
-    fn drift(&self, forces: &[LinearForce<V>], h: f64, start: f64, work: &mut IslandWork<V>) {
+    pub(super) fn drift(
+        &self,
+        forces: &[LinearForce<V>],
+        h: f64,
+        start: f64,
+        work: &mut IslandWork<V>,
+    ) {
         self.applied(forces, &work.x0, &work.v0, &mut work.force);
         work.x.clear();
         work.v.clear();
@@ -372,7 +381,7 @@ const BLOCK_CHANCES: usize = 3;
 
 /// A contact row let go whose beads close slower than this fraction of
 /// the fastest bead's speed is not closing: rounding.
-const PUSHING_SLACK: f64 = 1e-12;
+pub(super) const PUSHING_SLACK: f64 = 1e-12;
 
 /// Which state a solve of eq. (12) is at.
 #[derive(Clone, Copy, PartialEq, Eq)]

@@ -9,11 +9,11 @@ use super::{CONTACT_PASSES, CONTACT_SLACK, EXACT_STEPS, Island, IslandWork};
 use crate::geometry::WireSpace;
 
 /// The most chord steps a dense island's RATTLE position solve takes.
-const CHORD_ITERATIONS: u32 = 60;
+pub(super) const CHORD_ITERATIONS: u32 = 60;
 
 /// A chord step that leaves `C` above this fraction of the last is not
 /// converging.
-const CHORD_STALL: f64 = 0.9;
+pub(super) const CHORD_STALL: f64 = 0.9;
 
 use crate::solver::newton::{NEWTON_MAX_ITERATIONS, newton_accepted, newton_within};
 use crate::solver::solve::SolveError;
@@ -181,7 +181,7 @@ impl<V: WireSpace> Island<V> {
 
     /// The largest coordinate of row `r`'s beads at `x`: how far rounding
     /// the coordinates its `C` is computed from reaches.
-    fn reach(&self, r: usize, x: &[V]) -> f64 {
+    pub(super) fn reach(&self, r: usize, x: &[V]) -> f64 {
         (self.row_start[r]..self.row_start[r + 1])
             .map(|e| x[self.entry_bead[e]].reach())
             .fold(0.0, f64::max)
@@ -192,7 +192,7 @@ impl<V: WireSpace> Island<V> {
     /// direction it was moved along (a rod flipped end over end, a bead
     /// carried across its wire's centre). Such a root is refused as no
     /// convergence, so the step is halved.
-    fn same_branch(
+    pub(super) fn same_branch(
         &self,
         work: &IslandWork<V>,
         direction: Direction,

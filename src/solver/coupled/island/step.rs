@@ -87,6 +87,9 @@ impl<V: WireSpace> Island<V> {
         whole: f64,
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
+        if settings.method == Method::Rattle && self.steps_densely() {
+            return self.step_dense(time, states, forces, settings, work);
+        }
         let exact = settings.method.ends_on_constraints();
         work.stepped_holds.clear();
         self.touching(states, forces, settings, whole, work);

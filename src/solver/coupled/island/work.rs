@@ -70,6 +70,9 @@ pub struct IslandWork<V: WireSpace = DVec2> {
     pub(super) moved: Vec<V>,
     pub(super) factored: Factored,
     pub(super) reports: Vec<RowReport>,
+    /// A dense island's last position and velocity forces of each row
+    /// (`2μ/h²`, `2ν/h`), the next step's warm start.
+    pub(super) pressing: Vec<(f64, f64)>,
     pub(super) bead_forces: Vec<V>,
     pub(super) substeps: u32,
     /// How many halvings deep the last step's substeps went; the next

@@ -2,15 +2,23 @@
 //! rows, and its solve.
 
 use super::order::Band;
-use super::{DROPPED_PIVOT, Factored, NormalMatrix, REDUNDANT_PIVOT};
+use super::{DROPPED_PIVOT, Factored, NormalMatrix};
 
 impl NormalMatrix {
     /// `LDLᵀ` of the scaled `A` as a band matrix of half-width `p`, its
     /// rows in the band's order: row `i` at `a[i·(p+1)..]`, `D_ii` first,
-    /// then `L_{i,i−1}` to `L_{i,i−p}`. A pivot at or below [`REDUNDANT_PIVOT`] is replaced by
-    /// [`DROPPED_PIVOT`], as the sparse factorization does. Returns how
-    /// many were.
-    pub(super) fn factor_band(&self, band: &Band, values: &[f64], a: &mut Vec<f64>) -> usize {
+    /// then `L_{i,i−1}` to `L_{i,i−p}`. A pivot at or below `smallest`
+    /// ([`REDUNDANT_PIVOT`](super::REDUNDANT_PIVOT) unless the matrix is
+    /// made compliant) is
+    /// replaced by [`DROPPED_PIVOT`], as the sparse factorization does.
+    /// Returns how many were.
+    pub(super) fn factor_band(
+        &self,
+        band: &Band,
+        values: &[f64],
+        a: &mut Vec<f64>,
+        smallest: f64,
+    ) -> usize {
         let (n, p) = (self.n, band.width);
         let w = p + 1;
         a.clear();
@@ -35,7 +43,7 @@ impl NormalMatrix {
                 let l = a[j * w + j - k];
                 d -= l * l * a[k * w];
             }
-            if d.abs() <= REDUNDANT_PIVOT {
+            if d.abs() <= smallest {
                 d = DROPPED_PIVOT;
                 dropped += 1;
             }

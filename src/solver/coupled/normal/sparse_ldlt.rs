@@ -14,21 +14,23 @@ use crate::geometry::Coordinates;
 
 use super::{DROPPED_PIVOT, Factored, HeldRows, NormalMatrix, REDUNDANT_PIVOT, Scratch};
 
-/// How faer's `LDLᵀ` treats a pivot: at or below [`REDUNDANT_PIVOT`] it
-/// becomes [`DROPPED_PIVOT`].
-fn dropping() -> LdltRegularization<'static, f64> {
+/// How faer's `LDLᵀ` treats a pivot: at or below `smallest` it becomes
+/// [`DROPPED_PIVOT`].
+fn dropping(smallest: f64) -> LdltRegularization<'static, f64> {
     LdltRegularization {
         dynamic_regularization_signs: None,
         dynamic_regularization_delta: DROPPED_PIVOT,
-        dynamic_regularization_epsilon: REDUNDANT_PIVOT,
+        dynamic_regularization_epsilon: smallest,
     }
 }
 
-/// `LDLᵀ` of `a` under `symbolic` into `l_values`, each redundant pivot
-/// dropped ([`dropping`]): how many were.
+/// `LDLᵀ` of `a` under `symbolic` into `l_values`, each pivot at or below
+/// `smallest` dropped ([`dropping`]): how many were (none counted below
+/// [`REDUNDANT_PIVOT`], where the matrix is made compliant).
 fn factor_dropping(
     symbolic: &SymbolicCholesky<usize>,
     a: SparseColMatRef<'_, usize, f64>,
+    smallest: f64,
     memory: &mut MemBuffer,
     l_values: &mut Vec<f64>,
 ) -> Result<usize, usize> {
@@ -39,12 +41,17 @@ fn factor_dropping(
             l_values,
             a,
             Side::Upper,
-            dropping(),
+            dropping(smallest),
             Par::Seq,
             MemStack::new(memory),
             Default::default(),
         )
         .map_err(|_| 0usize)?;
+    // A compliant matrix drops none worth counting (and counting reads
+    // every entry of the factor).
+    if smallest < REDUNDANT_PIVOT {
+        return Ok(0);
+    }
     Ok(l_values.iter().filter(|&&v| v == DROPPED_PIVOT).count())
 }
 
@@ -78,15 +85,17 @@ fn ldlt_solve(
 impl NormalMatrix {
     /// `LDLᵀ` of the scaled `A` (filled into `f.values`) by faer's sparse
     /// Cholesky under `symbolic`'s ordering: a pivot at or below
-    /// [`REDUNDANT_PIVOT`] is replaced by [`DROPPED_PIVOT`], and counted.
+    /// `smallest` ([`REDUNDANT_PIVOT`] unless the matrix is made compliant)
+    /// is replaced by [`DROPPED_PIVOT`], and counted.
     pub(super) fn factor_sparse(
         &self,
         symbolic: &SymbolicCholesky<usize>,
+        smallest: f64,
         f: &mut Factored,
     ) -> Result<(), usize> {
         let memory = self.scratch(symbolic, &mut f.scratch);
         let a = SparseColMatRef::new(self.pattern.as_ref(), &f.values);
-        f.redundant = factor_dropping(symbolic, a, memory, &mut f.l_values)?;
+        f.redundant = factor_dropping(symbolic, a, smallest, memory, &mut f.l_values)?;
         Ok(())
     }
 
@@ -96,13 +105,14 @@ impl NormalMatrix {
     /// meets no other, so its elimination changes nothing in the others',
     /// and it keeps a unit scale. The pattern and its symbolic
     /// factorization are made again only where the rows set aside
-    /// changed.
+    /// changed. A `compliance` is added to the held rows' scaled diagonal
+    /// as [`NormalMatrix::factor_compliant`] does.
     pub(super) fn factor_held<V: Coordinates>(
         &self,
         symbolic: &SymbolicCholesky<usize>,
-        inverse_mass: &[f64],
-        gradient: &[V],
+        (inverse_mass, gradient): (&[f64], &[V]),
         inactive: &[bool],
+        compliance: Option<f64>,
         f: &mut Factored,
     ) -> Result<(), usize> {
         let set_aside = &inactive[..self.n.min(inactive.len())];
@@ -129,15 +139,18 @@ impl NormalMatrix {
             f.scale[r] = self.diagonal_scale(r, self.value(k, inverse_mass, gradient))?;
         }
         values.clear();
+        let added = compliance.unwrap_or(0.0);
         values.extend(source.iter().map(|&(k, row, col)| {
-            self.value(k, inverse_mass, gradient) * (f.scale[row] * f.scale[col])
+            let value = self.value(k, inverse_mass, gradient) * (f.scale[row] * f.scale[col]);
+            if row == col { value + added } else { value }
         }));
         let (Some((pattern, symbolic)), Some(memory)) = (symbolic, memory) else {
             // No row held, or one: solved in closed form.
             return Ok(());
         };
         let a = SparseColMatRef::new(pattern.as_ref(), values);
-        f.redundant = factor_dropping(symbolic, a, memory, &mut f.l_values)?;
+        let smallest = compliance.map_or(REDUNDANT_PIVOT, |c| 1e-3 * c);
+        f.redundant = factor_dropping(symbolic, a, smallest, memory, &mut f.l_values)?;
         Ok(())
     }
 
