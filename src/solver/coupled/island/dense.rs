@@ -63,8 +63,8 @@ fn softness(taken: f64) -> f64 {
 const LCP_STEPS: usize = 16;
 
 /// The buffers of one complementarity solve: the gradients of the rows
-/// held (the others zeroed), which rows the factorization in hand holds,
-/// and `W Jᵀ z`, bead by bead.
+/// held (the others zeroed), which rows the factorization in hand holds
+/// and at what compliance, and `W Jᵀ z`, bead by bead.
 #[derive(Default)]
 struct Linear<V> {
     masked: Vec<V>,
@@ -158,9 +158,11 @@ impl<V: WireSpace> Island<V> {
     /// two-sided row is met (`C + ε μ = 0`) and each one-sided one is met
     /// where it pushes and open where it does not. Each chord step solves
     /// the problem linearized about the last iterate on the factored
-    /// `J₀ W J₀ᵀ + E`, by block principal pivoting from the last rows
-    /// held (the step's first from those held where it begins, and the
-    /// last step's multipliers), and stops by Newton's test row by row.
+    /// `J₀ W J₀ᵀ + E'` (`E'` softer than `E` while the residual is large,
+    /// [`softness`]), by projected Newton steps from the last iterate's
+    /// multipliers (the first chord step's from the last step's forces of
+    /// the rows it held), and the iteration stops by Newton's test row by
+    /// row.
     /// Velocities: `v½ = (x − x₀)/h` and the second half kick, then one
     /// complementarity problem on the rows held and those in touch:
     /// `J v + ε ν = 0` where `ν` pushes, `J v ≥ 0` where it is zero. A row
