@@ -885,7 +885,7 @@ fn a_pile_poured_into_a_bowl_lies_pressed_together_without_overlap() {
 /// and meetings at `e = 0` take energy, nothing gives it. Later, as the
 /// pile jams and its beads roll over one another, the energy never rises
 /// above the lowest it has been by more than 1e-7 of the weight times
-/// the bowl's radius (measured 1.4e-5 J of 4,905 J: RATTLE's own
+/// the bowl's radius (measured 1.2e-5 J of 4,905 J: RATTLE's own
 /// oscillation, and what a contact held from within a step does to
 /// first order). By 2.5 s the pile has settled: frictionless in a round
 /// bowl, it rocks as one body, and its energy changes by no more than

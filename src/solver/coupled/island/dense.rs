@@ -12,11 +12,9 @@ use super::integrators::PUSHING_SLACK;
 use super::newton::{CHORD_ITERATIONS, CHORD_STALL, Direction};
 use super::{Island, IslandWork, OFF_THE_WIRE, RowReport, TOUCHING};
 use crate::geometry::WireSpace;
-use crate::solver::contact::ContactEvent;
 use crate::solver::coupled::lcp::{Bound, LcpError, held, solve_lcp};
 use crate::solver::coupled::normal::Factored;
 use crate::solver::newton::{NEWTON_TOLERANCE, newton_accepted, newton_within};
-use crate::solver::rattle::rattle_half_kick;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::{SolveError, singular};
 use crate::solver::state::{BeadState, LinearForce};
@@ -126,21 +124,7 @@ impl<V: WireSpace> Island<V> {
             }
             let held = !work.inactive[r];
             if was_aside && held {
-                let bead = self.entry_bead[self.row_start[r]];
-                let normal_speed = self
-                    .wire_gap(r, &start, time)
-                    .map_or(0.0, |(_, rate)| rate.abs());
-                let position = states[bead].position;
-                work.events.push((
-                    r,
-                    bead,
-                    ContactEvent::Landed {
-                        time: end,
-                        position,
-                        normal_speed,
-                        bounced: false,
-                    },
-                ));
+                self.report_landed_at_end(r, (time, end), (&start, states), work);
             } else if !was_aside && !held {
                 self.report_left(r, end, states, work);
             }
@@ -238,15 +222,7 @@ impl<V: WireSpace> Island<V> {
         self.solve_positions(&problem, &drift, &mut mu, &mut linear, work)?;
         let active: Vec<bool> = held(&bounds, &mu).collect();
 
-        // v½ and the second half kick, at the new positions.
-        for i in 0..self.beads() {
-            work.v[i] = (work.x[i] - work.x0[i]) / h;
-        }
-        self.applied(forces, &work.x, &work.v, &mut work.force);
-        for i in 0..self.beads() {
-            let m = self.inverse_mass[i].recip();
-            work.v[i] = rattle_half_kick(work.v[i], work.force[i], m, h);
-        }
+        self.half_kick(forces, h, work);
         work.inactive.fill(false);
         self.evaluate_at_new(work);
         let velocity_bounds: Vec<Bound> = (0..rows)
@@ -285,8 +261,6 @@ impl<V: WireSpace> Island<V> {
                 .zip(&nu)
                 .map(|(&m, &n)| (2.0 * m / (h * h), 2.0 * n / h)),
         );
-        work.lambda = mu;
-        work.rhs = nu;
         Ok(())
     }
 
@@ -414,11 +388,11 @@ impl<V: WireSpace> Island<V> {
             if settled {
                 break;
             }
+            // q' = w − (J W Jᵀ + E') ν = q − (E' − E) ν: the problem on
+            // the softer matrix whose solution at ν is where it is now.
             let soft = softness(worst / fastest.max(f64::MIN_POSITIVE));
             for r in 0..rows {
-                shifted[r] = w[r]
-                    - self.along(r, &work.gradient, &linear.moved)
-                    - soft * problem.diagonal[r] * nu[r];
+                shifted[r] = q[r] - (soft - COMPLIANCE) * problem.diagonal[r] * nu[r];
             }
             let x = &work.x;
             self.complementarity(

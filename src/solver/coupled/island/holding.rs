@@ -43,21 +43,35 @@ impl<V: WireSpace> Island<V> {
             if !landed {
                 continue;
             }
-            let bead = self.entry_bead[self.row_start[r]];
-            let normal_speed = self
-                .wire_gap(r, start, time)
-                .map_or(0.0, |(_, rate)| rate.abs());
-            work.events.push((
-                r,
-                bead,
-                ContactEvent::Landed {
-                    time: end,
-                    position: states[bead].position,
-                    normal_speed,
-                    bounced: false,
-                },
-            ));
+            self.report_landed_at_end(r, (time, end), (start, states), work);
         }
+    }
+
+    /// Reports the bead of one-sided wire row `r` landed at the step's
+    /// `end` where it is in `states`, with the speed it closed on its wire
+    /// at the step's `start` (at `time`): a landing the step took rather
+    /// than located.
+    pub(super) fn report_landed_at_end(
+        &self,
+        r: usize,
+        (time, end): (f64, f64),
+        (start, states): (&[BeadState<V>], &[BeadState<V>]),
+        work: &mut IslandWork<V>,
+    ) {
+        let bead = self.entry_bead[self.row_start[r]];
+        let normal_speed = self
+            .wire_gap(r, start, time)
+            .map_or(0.0, |(_, rate)| rate.abs());
+        work.events.push((
+            r,
+            bead,
+            ContactEvent::Landed {
+                time: end,
+                position: states[bead].position,
+                normal_speed,
+                bounced: false,
+            },
+        ));
     }
 
     /// The rows set aside that the step may hold (`work.touching`) and

@@ -156,7 +156,6 @@ impl<V: WireSpace> Island<V> {
         if self.steps_densely() {
             return self.rattle_dense(forces, h, work);
         }
-        let n = self.beads();
         let start = work.time;
         let stepped = self.time_steps();
         // The rows a dense island may let go for pulling once its solve
@@ -214,15 +213,7 @@ impl<V: WireSpace> Island<V> {
             lambda: 0.5 * to_lambda * mu,
             ..RowReport::default()
         }));
-        // v½ and the second half kick, at the new positions.
-        for i in 0..n {
-            work.v[i] = (work.x[i] - work.x0[i]) / h;
-        }
-        self.applied(forces, &work.x, &work.v, &mut work.force);
-        for i in 0..n {
-            let m = self.inverse_mass[i].recip();
-            work.v[i] = rattle_half_kick(work.v[i], work.force[i], m, h);
-        }
+        self.half_kick(forces, h, work);
         self.evaluate_at_new(work);
         self.project_velocity_pushing(work)?;
         let to_mu = 2.0 / h;
@@ -230,6 +221,20 @@ impl<V: WireSpace> Island<V> {
             report.lambda += 0.5 * to_mu * nu;
         }
         Ok(())
+    }
+
+    /// RATTLE's `v½ = (x − x₀)/h` and second half kick at the new
+    /// positions `work.x`, into `work.v`: the velocities its velocity
+    /// solve projects.
+    pub(super) fn half_kick(&self, forces: &[LinearForce<V>], h: f64, work: &mut IslandWork<V>) {
+        for i in 0..self.beads() {
+            work.v[i] = (work.x[i] - work.x0[i]) / h;
+        }
+        self.applied(forces, &work.x, &work.v, &mut work.force);
+        for i in 0..self.beads() {
+            let m = self.inverse_mass[i].recip();
+            work.v[i] = rattle_half_kick(work.v[i], work.force[i], m, h);
+        }
     }
 
     /// RATTLE's drift from the step's start at `start`: each bead moved

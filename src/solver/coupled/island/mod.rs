@@ -14,7 +14,7 @@
 //! | `events` | events located within a step, as a lone bead's are: landings, leaving at an end |
 //! | `integrators` | eq. (12) on an island (λ and the accelerations), RK4, RATTLE: each bead by the lone bead's formulas, the multipliers by matrix solves |
 //! | `complementarity` | the rows a dense island's step holds, predicted by projected Gauss–Seidel on the linearized contact problem, warm from the last step |
-//! | `dense` | a dense island's RATTLE step: positions and velocities each one complementarity problem on slightly compliant rows, solved by block principal pivoting |
+//! | `dense` | a dense island's RATTLE step: positions and velocities each one complementarity problem on slightly compliant rows, solved by chord and projected Newton steps |
 //! | `newton` | the Newton position solve (a matrix solve for the multipliers at each step, stopped by the lone bead's test row by row) and its check that the root continues the start |
 //! | `projection` | post-stabilization, eq. (13), and the velocity projection |
 //! | `contact` | one-sided rows (leaving, landing, bouncing by the lone bead's rule) and friction (sliding, stopping, sticking: the lone bead's friction, with a stick row's multiplier for the pull) |

@@ -224,23 +224,15 @@ impl NormalMatrix {
         natural: bool,
         f: &mut Factored,
     ) -> Result<(), usize> {
-        f.redundant = 0;
-        if inactive.contains(&true)
-            && let Some(symbolic) = &self.symbolic
-            && !(natural && self.band.is_some())
-        {
-            f.layout = Layout::Held;
-            return self.factor_held(symbolic, (inverse_mass, gradient), inactive, None, f);
-        }
-        self.factor_whole(inverse_mass, gradient, inactive, natural, None, f)
+        self.factor_with((inverse_mass, gradient), inactive, natural, None, f)
     }
 
     /// `A + E` on the rows held, `E` the `compliance` times `A`'s diagonal
     /// (a row set aside keeps a unit diagonal, its gradient zero), factored
-    /// as [`NormalMatrix::factor`] factors `A`: as a band where `A` is one,
-    /// else the held rows alone. `A + E` is positive definite however many
-    /// of the rows are redundant: a pivot is dropped only below a
-    /// thousandth of the compliance.
+    /// as [`NormalMatrix::factor`] factors `A` in the rows' own order: as
+    /// a band where `A` is one, else the held rows alone. `A + E` is
+    /// positive definite however many of the rows are redundant: a pivot
+    /// is dropped only below a thousandth of the compliance.
     pub(crate) fn factor_compliant<V: Coordinates>(
         &self,
         inverse_mass: &[f64],
@@ -249,30 +241,34 @@ impl NormalMatrix {
         compliance: f64,
         f: &mut Factored,
     ) -> Result<(), usize> {
-        f.redundant = 0;
-        if inactive.contains(&true)
-            && let Some(symbolic) = &self.symbolic
-            && self.band.is_none()
-        {
-            f.layout = Layout::Held;
-            let a = (inverse_mass, gradient);
-            return self.factor_held(symbolic, a, inactive, Some(compliance), f);
-        }
-        self.factor_whole(inverse_mass, gradient, inactive, true, Some(compliance), f)
+        self.factor_with(
+            (inverse_mass, gradient),
+            inactive,
+            true,
+            Some(compliance),
+            f,
+        )
     }
 
-    /// [`NormalMatrix::factor`] of every row, a row set aside given a unit
-    /// diagonal, `compliance` (if any) added to the scaled diagonal of the
-    /// rows held.
-    fn factor_whole<V: Coordinates>(
+    /// [`NormalMatrix::factor`], `compliance` (if any) added to the scaled
+    /// diagonal of the rows held.
+    fn factor_with<V: Coordinates>(
         &self,
-        inverse_mass: &[f64],
-        gradient: &[V],
+        (inverse_mass, gradient): (&[f64], &[V]),
         inactive: &[bool],
         natural: bool,
         compliance: Option<f64>,
         f: &mut Factored,
     ) -> Result<(), usize> {
+        f.redundant = 0;
+        if inactive.contains(&true)
+            && let Some(symbolic) = &self.symbolic
+            && !(natural && self.band.is_some())
+        {
+            f.layout = Layout::Held;
+            let a = (inverse_mass, gradient);
+            return self.factor_held(symbolic, a, inactive, compliance, f);
+        }
         let nnz = self.term_start.len() - 1;
         f.values.clear();
         f.values
@@ -280,6 +276,9 @@ impl NormalMatrix {
         f.scale.clear();
         for (r, &k) in self.diagonal.iter().enumerate() {
             if inactive.get(r) == Some(&true) {
+                // A row set aside (a one-sided wire the bead has left): its
+                // gradient is zero, so it meets no other row; a unit
+                // diagonal gives it λ = 0.
                 f.values[k] = 1.0;
                 f.scale.push(1.0);
                 continue;
@@ -288,6 +287,7 @@ impl NormalMatrix {
         }
         f.layout = Layout::Sparse;
         let Some(symbolic) = &self.symbolic else {
+            // A single row: solved in closed form.
             if let (Some(c), Some(&k)) = (compliance, self.diagonal.first())
                 && inactive.first() != Some(&true)
             {
