@@ -60,6 +60,19 @@ pub enum PresetError {
         /// The most beads the bowl holds in rows of `per_row`.
         most: usize,
     },
+    /// A pour ([`Pour`](super::Pour)) of more beads than its bowl
+    /// holds on the grid they start on.
+    #[error(
+        "a pour of {beads} beads does not fit in a bowl of radius {bowl} m: at most {most} beads start inside it"
+    )]
+    PourTooLarge {
+        /// The beads asked for.
+        beads: usize,
+        /// The bowl's radius, m.
+        bowl: f64,
+        /// The most beads that start inside it.
+        most: usize,
+    },
     /// The file could not be read.
     #[error("cannot read scene file: {0}")]
     Io(#[from] std::io::Error),

@@ -45,7 +45,7 @@ pub use format::{
     BeadPreset, ConstraintPreset, ContactsPreset, PinPreset, RodPreset, SceneLink, ScenePreset,
     SpringPreset, WirePreset,
 };
-pub use pile::PILE_RADIUS;
+pub use pile::{PILE_RADIUS, Pour};
 pub use plugin::{
     ActivePreset, LoadPreset, ScenePresetLoader, ScenePresetPlugin, apply_loaded_preset,
     load_requested_preset, report_preset_errors,

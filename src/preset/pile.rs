@@ -1,7 +1,7 @@
 //! A pile of beads poured into a bowl: a scene made from a count, for
-//! the tests and benchmarks that pour one.
+//! the tests and benchmarks that pour one, in the plane or in space.
 
-use super::{PresetError, ScenePreset};
+use super::{PresetError, SceneFile, ScenePreset};
 
 /// The radius of each bead of [`ScenePreset::pile`], m.
 pub const PILE_RADIUS: f64 = 0.02;
@@ -55,6 +55,123 @@ impl ScenePreset {
              contacts: (restitution: 0.0), wires: [(shape: Circle((radius: 1.0)), \
              side: Negative, beads: [{listed}])])",
             1.0 / 240.0
+        ))
+    }
+}
+
+/// A pour of beads of 2 cm ([`PILE_RADIUS`]) and 1 kg into a one-sided
+/// bowl at `e = 0`, RATTLE: in the plane a circle, in space a sphere, of
+/// [`Pour::bowl`] that pushes inward. The beads start at rest on a square
+/// (cubic) grid 2.3 radii apart, the lowest points of it that lie inside
+/// the bowl by more than a radius and a half, each moved sideways by up
+/// to 1.5 mm so that no two stack exactly: the bottom of the bowl fills
+/// first, and a pour of 1,000 beads in a bowl of 1 m fills it to about
+/// its middle in the plane.
+///
+/// ```
+/// use wirebead::preset::Pour;
+///
+/// let scene = Pour { beads: 200, space: true, ..Pour::default() }.scene()?;
+/// assert!(scene.in_space());
+/// # Ok::<(), wirebead::preset::PresetError>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pour {
+    /// How many beads.
+    pub beads: usize,
+    /// In space (a sphere) rather than in the plane (a circle).
+    pub space: bool,
+    /// The bowl's radius, m.
+    pub bowl: f64,
+    /// The fixed timestep, s.
+    pub timestep: f64,
+}
+
+impl Default for Pour {
+    /// 1,000 beads in the plane, a bowl of 1 m, 60 Hz.
+    fn default() -> Self {
+        Self {
+            beads: 1000,
+            space: false,
+            bowl: 1.0,
+            timestep: 1.0 / 60.0,
+        }
+    }
+}
+
+impl Pour {
+    /// The beads' starting places, lowest first: `[x, y, z]`, `z` zero in
+    /// the plane. Fewer than [`Pour::beads`] where the bowl holds fewer.
+    fn places(&self) -> Vec<[f64; 3]> {
+        let r = PILE_RADIUS;
+        let spacing = 2.3 * r;
+        let inside = self.bowl - 1.5 * r;
+        if !(inside > 0.0 && inside.is_finite()) {
+            return Vec::new();
+        }
+        let n = (inside / spacing).floor() as i64;
+        let across = -n..=n;
+        let deep = if self.space { across.clone() } else { 0..=0 };
+        let mut places: Vec<[f64; 3]> = Vec::new();
+        for j in -n..=n {
+            for i in across.clone() {
+                for l in deep.clone() {
+                    let k = places.len();
+                    let jitter =
+                        |salt: usize| 0.003 * (((k + salt) * 7919 % 13) as f64 / 13.0 - 0.5);
+                    let x = i as f64 * spacing + jitter(0);
+                    let z = if self.space {
+                        l as f64 * spacing + jitter(5)
+                    } else {
+                        0.0
+                    };
+                    let y = j as f64 * spacing;
+                    if (x * x + y * y + z * z).sqrt() < inside {
+                        places.push([x, y, z]);
+                    }
+                }
+            }
+        }
+        places.truncate(self.beads);
+        places
+    }
+
+    /// The scene, checked as a scene file is ([`SceneFile::from_ron`]). A
+    /// pour of more beads than the bowl holds is refused as
+    /// [`PresetError::PourTooLarge`], which says how many fit; a timestep
+    /// that is not positive and finite as any scene file's is.
+    pub fn scene(&self) -> Result<SceneFile, PresetError> {
+        let places = self.places();
+        if places.len() < self.beads {
+            return Err(PresetError::PourTooLarge {
+                beads: self.beads,
+                bowl: self.bowl,
+                most: places.len(),
+            });
+        }
+        let r = PILE_RADIUS;
+        let listed: String = places
+            .iter()
+            .enumerate()
+            .map(|(k, &[x, y, z])| {
+                let at = if self.space {
+                    format!("({x}, {y}, {z})")
+                } else {
+                    format!("({x}, {y})")
+                };
+                format!("(name: \"b{k}\", mass: 1.0, radius: {r}, initial_position: {at}),")
+            })
+            .collect();
+        let (dimension, shape) = if self.space {
+            ("dimension: 3, ", "Sphere")
+        } else {
+            ("", "Circle")
+        };
+        SceneFile::from_ron(&format!(
+            "(name: \"pour\", {dimension}params: (timestep: {}, integrator: Rattle), \
+             contacts: (restitution: 0.0), wires: [(shape: {shape}((radius: {})), \
+             side: Negative, beads: [{listed}])])",
+            self.timestep, self.bowl
         ))
     }
 }

@@ -216,3 +216,103 @@ fn a_pile_has_its_beads_apart_inside_the_bowl() {
         }
     }
 }
+
+/// Every bead of a pour, in the plane or in space, as `(x, y, z)` with
+/// its radius.
+fn poured(scene: &super::SceneFile) -> Vec<(bevy::math::DVec3, f64)> {
+    match scene {
+        super::SceneFile::Plane(scene) => scene
+            .all_beads()
+            .map(|b| (b.initial_position.extend(0.0), b.radius))
+            .collect(),
+        super::SceneFile::Space(scene) => scene
+            .wires
+            .iter()
+            .flat_map(|w| &w.beads)
+            .map(|b| (b.initial_position, b.radius))
+            .collect(),
+    }
+}
+
+/// A pour of 1,000 beads in a bowl of 1 m, in the plane and in space,
+/// and one of 5,000 in the plane in a bowl of 3 m: as many beads as
+/// asked, each of [`PILE_RADIUS`](super::PILE_RADIUS), inside the bowl
+/// by more than a radius, none touching (2.3 radii apart on the grid,
+/// the jitter of up to 1.5 mm taken off), the lowest first, and the
+/// scene of the dimension asked for.
+#[test]
+fn a_pour_has_its_beads_apart_inside_the_bowl_lowest_first() {
+    let r = super::PILE_RADIUS;
+    for (beads, space, bowl) in [(1000, false, 1.0), (1000, true, 1.0), (5000, false, 3.0)] {
+        let pour = super::Pour {
+            beads,
+            space,
+            bowl,
+            ..super::Pour::default()
+        };
+        let scene = pour.scene().unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(scene.in_space(), space);
+        let at = poured(&scene);
+        assert_eq!(at.len(), beads);
+        for (i, &(a, radius)) in at.iter().enumerate() {
+            assert_eq!(radius, r);
+            assert!(a.length() < bowl - r, "bead {i} at {} m", a.length());
+            if i > 0 {
+                assert!(a.y >= at[i - 1].0.y, "bead {i} below bead {}", i - 1);
+            }
+            for (j, &(b, _)) in at.iter().enumerate().skip(i + 1) {
+                let apart = (a - b).length();
+                assert!(apart > 2.0 * r, "beads {i} and {j}: {apart} m");
+            }
+        }
+    }
+}
+
+/// A pour of more beads than its bowl holds is refused saying how many
+/// fit, and so is a bowl with no room or no radius (zero, negative,
+/// NaN); a timestep that is not positive is refused as any scene file's.
+#[test]
+fn a_pour_too_large_or_malformed_is_refused_in_words() {
+    let pour = super::Pour {
+        beads: 5000,
+        ..super::Pour::default()
+    };
+    let err = pour.scene().unwrap_err();
+    let PresetError::PourTooLarge { most, .. } = err else {
+        panic!("refused for another reason: {err}");
+    };
+    assert!((1000..5000).contains(&most), "{most}");
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "a pour of 5000 beads does not fit in a bowl of radius 1 m: at most {most} beads start inside it"
+        )
+    );
+    let fits = super::Pour {
+        beads: most,
+        ..pour
+    };
+    assert_eq!(
+        poured(&fits.scene().unwrap_or_else(|e| panic!("{e}"))).len(),
+        most
+    );
+    for bowl in [0.0, -1.0, f64::NAN, 0.02] {
+        let err = super::Pour {
+            bowl,
+            ..super::Pour::default()
+        }
+        .scene()
+        .unwrap_err();
+        assert!(
+            matches!(err, PresetError::PourTooLarge { most: 0, .. }),
+            "bowl {bowl}: {err}"
+        );
+    }
+    let err = super::Pour {
+        timestep: 0.0,
+        ..super::Pour::default()
+    }
+    .scene()
+    .unwrap_err();
+    assert!(err.to_string().contains("timestep"), "{err}");
+}
