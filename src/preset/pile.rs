@@ -102,20 +102,42 @@ impl Default for Pour {
 impl Pour {
     /// The beads' starting places, lowest first: `[x, y, z]`, `z` zero in
     /// the plane. Fewer than [`Pour::beads`] where the bowl holds fewer.
+    /// Each row of the grid is walked only across the bowl's width at
+    /// its height, and the walk stops at the last bead, so that a bowl of
+    /// any size costs no more than its beads and its rows below them.
     fn places(&self) -> Vec<[f64; 3]> {
         let r = PILE_RADIUS;
         let spacing = 2.3 * r;
         let inside = self.bowl - 1.5 * r;
-        if !(inside > 0.0 && inside.is_finite()) {
-            return Vec::new();
-        }
-        let n = (inside / spacing).floor() as i64;
-        let across = -n..=n;
-        let deep = if self.space { across.clone() } else { 0..=0 };
         let mut places: Vec<[f64; 3]> = Vec::new();
-        for j in -n..=n {
-            for i in across.clone() {
-                for l in deep.clone() {
+        if !(inside > 0.0 && inside.is_finite()) {
+            return places;
+        }
+        // The grid's points within `half` of the middle along one axis.
+        let across = |half: f64| {
+            let n = (half / spacing).floor() as i64;
+            -n..=n
+        };
+        // The half-width of a slice at `offset` from the middle of a
+        // disc of radius `radius`.
+        let width = |radius: f64, offset: f64| {
+            ((radius - offset.abs()) * (radius + offset.abs()))
+                .max(0.0)
+                .sqrt()
+        };
+        for j in across(inside) {
+            let y = j as f64 * spacing;
+            let row = width(inside, y);
+            for i in across(row) {
+                let depth = if self.space {
+                    width(row, i as f64 * spacing)
+                } else {
+                    0.0
+                };
+                for l in across(depth) {
+                    if places.len() == self.beads {
+                        return places;
+                    }
                     let k = places.len();
                     let jitter =
                         |salt: usize| 0.003 * (((k + salt) * 7919 % 13) as f64 / 13.0 - 0.5);
@@ -125,14 +147,12 @@ impl Pour {
                     } else {
                         0.0
                     };
-                    let y = j as f64 * spacing;
-                    if (x * x + y * y + z * z).sqrt() < inside {
+                    if x.hypot(y).hypot(z) < inside {
                         places.push([x, y, z]);
                     }
                 }
             }
         }
-        places.truncate(self.beads);
         places
     }
 
@@ -155,11 +175,11 @@ impl Pour {
             .enumerate()
             .map(|(k, &[x, y, z])| {
                 let at = if self.space {
-                    format!("({x}, {y}, {z})")
+                    format!("({x:?}, {y:?}, {z:?})")
                 } else {
-                    format!("({x}, {y})")
+                    format!("({x:?}, {y:?})")
                 };
-                format!("(name: \"b{k}\", mass: 1.0, radius: {r}, initial_position: {at}),")
+                format!("(name: \"b{k}\", mass: 1.0, radius: {r:?}, initial_position: {at}),")
             })
             .collect();
         let (dimension, shape) = if self.space {
@@ -168,8 +188,8 @@ impl Pour {
             ("", "Circle")
         };
         SceneFile::from_ron(&format!(
-            "(name: \"pour\", {dimension}params: (timestep: {}, integrator: Rattle), \
-             contacts: (restitution: 0.0), wires: [(shape: {shape}((radius: {})), \
+            "(name: \"pour\", {dimension}params: (timestep: {:?}, integrator: Rattle), \
+             contacts: (restitution: 0.0), wires: [(shape: {shape}((radius: {:?})), \
              side: Negative, beads: [{listed}])])",
             self.timestep, self.bowl
         ))

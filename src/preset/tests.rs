@@ -270,7 +270,9 @@ fn a_pour_has_its_beads_apart_inside_the_bowl_lowest_first() {
 
 /// A pour of more beads than its bowl holds is refused saying how many
 /// fit, and so is a bowl with no room or no radius (zero, negative,
-/// NaN); a timestep that is not positive is refused as any scene file's.
+/// NaN); a bowl of a kilometre takes its ten beads at once, and one of
+/// 1e300 m is refused in words where rounding stacks them;
+/// a timestep that is not positive is refused as any scene file's.
 #[test]
 fn a_pour_too_large_or_malformed_is_refused_in_words() {
     let pour = super::Pour {
@@ -296,6 +298,25 @@ fn a_pour_too_large_or_malformed_is_refused_in_words() {
         poured(&fits.scene().unwrap_or_else(|e| panic!("{e}"))).len(),
         most
     );
+    // A bowl of any size is filled from its bottom in the time its
+    // beads take: a kilometre's ten beads start on its grid; a bowl of
+    // 1e300 m places its beads so far from its centre that rounding puts
+    // them on one another, which the scene's check refuses in words.
+    let far = |bowl: f64| {
+        super::Pour {
+            beads: 10,
+            bowl,
+            space: true,
+            ..super::Pour::default()
+        }
+        .scene()
+    };
+    assert_eq!(
+        poured(&far(1e3).unwrap_or_else(|e| panic!("{e}"))).len(),
+        10
+    );
+    let err = far(1e300).unwrap_err().to_string();
+    assert!(err.contains("overlap"), "{err}");
     for bowl in [0.0, -1.0, f64::NAN, 0.02] {
         let err = super::Pour {
             bowl,
