@@ -883,6 +883,87 @@ fn a_pile_poured_into_a_bowl_lies_pressed_together_without_overlap() {
     eprintln!("{n} beads: overlap {worst:e}, energy change {worst_change:e}");
 }
 
+/// What [`pour_watched`] saw: the worst overlap of any step (a share of
+/// a radius), the most the scene's energy rose in one step while the
+/// beads poured, the most it rose above the lowest it had been, and its
+/// value after each step.
+struct Poured {
+    worst: f64,
+    rise: f64,
+    above: f64,
+    energies: Vec<f64>,
+}
+
+/// Runs a pour of `spawned` beads (of [`PILE_RADIUS`], into a bowl of
+/// radius 1 m, in the plane `V = DVec2` or in space `DVec3`) for `steps`
+/// steps, asserting at each that no two beads overlap by more than 1e-9
+/// of a radius; the energy's rises are measured over the first `pouring`
+/// steps. Asserts that no bead stopped and that every bead came down onto
+/// the bowl or onto another bead within the first `landing` steps.
+fn pour_watched<V: Coordinates>(
+    app: &mut App,
+    spawned: &[Entity],
+    (pouring, landing, steps): (usize, usize, usize),
+) -> Poured {
+    let r = PILE_RADIUS;
+    let length = |v: V| v.dot(v).sqrt();
+    let mut landed = vec![false; spawned.len()];
+    let (mut worst, mut rise, mut above, mut lowest) = (f64::MIN, 0.0f64, 0.0f64, f64::INFINITY);
+    let mut energies: Vec<f64> = Vec::with_capacity(steps);
+    for step in 1..=steps {
+        run_steps(app, 1);
+        let overlap = worst_overlap_of::<V>(app);
+        assert!(
+            overlap <= 1e-9,
+            "step {step}: beads overlap by {overlap:e} of a radius"
+        );
+        worst = worst.max(overlap);
+        let e = app.world().resource::<SceneEnergy>().total;
+        if let (Some(&before), true) = (energies.last(), step <= pouring) {
+            rise = rise.max(e - before);
+        }
+        energies.push(e);
+        lowest = lowest.min(e);
+        above = above.max(e - lowest);
+        if step > landing {
+            continue;
+        }
+        let world = app.world_mut();
+        let at: Vec<V> = spawned
+            .iter()
+            .map(|&b| world.get::<BeadPosition<V>>(b).expect("a bead").0)
+            .collect();
+        for (k, &x) in at.iter().enumerate() {
+            let on_bowl = (length(x) - 1.0).abs() <= 1e-6 * r;
+            landed[k] |= on_bowl
+                || at
+                    .iter()
+                    .enumerate()
+                    .any(|(j, &y)| j != k && length(y - x) <= 2.0 * r * (1.0 + 1e-6));
+        }
+    }
+    let world = app.world_mut();
+    let stopped: Vec<String> = world
+        .query::<&Diverged>()
+        .iter(world)
+        .map(|d| format!("at {} s: {}", d.time, d.reason))
+        .collect();
+    assert!(
+        stopped.is_empty(),
+        "{} beads stopped, the first {:?}",
+        stopped.len(),
+        stopped.first()
+    );
+    let aloft = landed.iter().filter(|&&l| !l).count();
+    assert_eq!(aloft, 0, "beads that never came down");
+    Poured {
+        worst,
+        rise,
+        above,
+        energies,
+    }
+}
+
 /// Five hundred beads of 2 cm and 1 kg at `e = 0` poured in rows of 23
 /// into a one-sided bowl of radius 1 m ([`ScenePreset::pile`]), RATTLE at
 /// 240 Hz for 3 s, one dense island whose step solves its contacts as
@@ -910,63 +991,20 @@ fn a_pile_of_500_beads_poured_into_a_bowl_never_overlaps_nor_gains_energy() {
     let preset = ScenePreset::pile(500, 23).unwrap_or_else(|e| panic!("{e}"));
     let (mut app, spawned) = spawned_from(&preset);
     app.init_resource::<SceneEnergy>();
-    let mut landed = vec![false; spawned.len()];
-    let mut worst = f64::MIN;
     let r = PILE_RADIUS;
     let weight = 500.0 * 9.81;
     let (pouring, settled, steps) = (108, 600, 720);
-    let mut energy = None;
-    let (mut rise, mut above, mut lowest) = (0.0f64, 0.0f64, f64::INFINITY);
-    let mut settled_range = (f64::INFINITY, f64::NEG_INFINITY);
-    for step in 1..=steps {
-        run_steps(&mut app, 1);
-        let overlap = worst_overlap(&mut app);
-        assert!(
-            overlap <= 1e-9,
-            "step {step}: beads overlap by {overlap:e} of a radius"
-        );
-        worst = worst.max(overlap);
-        let e = app.world().resource::<SceneEnergy>().total;
-        if let (Some(before), true) = (energy, step <= pouring) {
-            rise = rise.max(e - before);
-        }
-        energy = Some(e);
-        lowest = lowest.min(e);
-        above = above.max(e - lowest);
-        if step >= settled {
-            settled_range = (settled_range.0.min(e), settled_range.1.max(e));
-        }
-        if step > pouring {
-            continue;
-        }
-        // Down: on the bowl, or touching another bead.
-        let at: Vec<DVec2> = spawned
-            .iter()
-            .map(|&b| bead_state(app.world(), b).expect("a bead").position)
-            .collect();
-        for (k, &x) in at.iter().enumerate() {
-            let on_bowl = (x.length() - 1.0).abs() <= 1e-6 * r;
-            landed[k] |= on_bowl
-                || at
-                    .iter()
-                    .enumerate()
-                    .any(|(j, &y)| j != k && (y - x).length() <= 2.0 * r * (1.0 + 1e-6));
-        }
-    }
-    let world = app.world_mut();
-    let stopped: Vec<String> = world
-        .query::<&Diverged>()
-        .iter(world)
-        .map(|d| format!("at {} s: {}", d.time, d.reason))
-        .collect();
-    assert!(
-        stopped.is_empty(),
-        "{} beads stopped, the first {:?}",
-        stopped.len(),
-        stopped.first()
-    );
-    let aloft = landed.iter().filter(|&&l| !l).count();
-    assert_eq!(aloft, 0, "beads that never came down");
+    let Poured {
+        worst,
+        rise,
+        above,
+        energies,
+    } = pour_watched::<DVec2>(&mut app, &spawned, (pouring, pouring, steps));
+    let settled_range = energies[settled - 1..]
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &e| {
+            (lo.min(e), hi.max(e))
+        });
     let swing = settled_range.1 - settled_range.0;
     eprintln!(
         "500 beads poured: overlap {worst:e}, energy rose by at most {rise:e} J in a step \
@@ -1020,47 +1058,9 @@ fn a_pile_of_marbles_poured_into_a_sphere_never_overlaps_nor_gains_energy() {
     app.world_mut().flush();
     let r = PILE_RADIUS;
     let weight = n as f64 * 9.81;
-    let (pouring, landing, steps) = (30, 60, 120);
-    let mut landed = vec![false; n];
-    let (mut worst, mut energy) = (f64::MIN, None);
-    let (mut rise, mut above, mut lowest) = (0.0f64, 0.0f64, f64::INFINITY);
-    for step in 1..=steps {
-        run_steps(&mut app, 1);
-        let overlap = worst_overlap_of::<DVec3>(&mut app);
-        assert!(
-            overlap <= 1e-9,
-            "step {step}: marbles overlap by {overlap:e} of a radius"
-        );
-        worst = worst.max(overlap);
-        let e = app.world().resource::<SceneEnergy>().total;
-        if let (Some(before), true) = (energy, step <= pouring) {
-            rise = rise.max(e - before);
-        }
-        energy = Some(e);
-        lowest = lowest.min(e);
-        above = above.max(e - lowest);
-        if step > landing {
-            continue;
-        }
-        let world = app.world_mut();
-        let at: Vec<DVec3> = spawned
-            .iter()
-            .map(|&b| world.get::<BeadPosition<DVec3>>(b).expect("a marble").0)
-            .collect();
-        for (k, &x) in at.iter().enumerate() {
-            let on_sphere = (x.length() - 1.0).abs() <= 1e-6 * r;
-            landed[k] |= on_sphere
-                || at
-                    .iter()
-                    .enumerate()
-                    .any(|(j, &y)| j != k && (y - x).length() <= 2.0 * r * (1.0 + 1e-6));
-        }
-    }
-    let world = app.world_mut();
-    let stopped = world.query::<&Diverged>().iter(world).count();
-    assert_eq!(stopped, 0, "marbles stopped");
-    let aloft = landed.iter().filter(|&&l| !l).count();
-    assert_eq!(aloft, 0, "marbles that never came down");
+    let Poured {
+        worst, rise, above, ..
+    } = pour_watched::<DVec3>(&mut app, &spawned, (30, 60, 120));
     eprintln!(
         "{n} marbles poured: overlap {worst:e}, energy rose by at most {rise:e} J in a step \
          while pouring, {above:e} J above its lowest"
