@@ -73,6 +73,15 @@ pub enum PresetError {
         /// The most beads that start inside it.
         most: usize,
     },
+    /// An hourglass ([`Hourglass`](super::Hourglass)) of more grains
+    /// than it is made for.
+    #[error("an hourglass of {beads} grains is more than the {most} it is made for")]
+    HourglassTooLarge {
+        /// The grains asked for.
+        beads: usize,
+        /// The most it is made for.
+        most: usize,
+    },
     /// The file could not be read.
     #[error("cannot read scene file: {0}")]
     Io(#[from] std::io::Error),

@@ -28,6 +28,7 @@
 mod error;
 mod export;
 mod format;
+mod hourglass;
 mod pile;
 mod plugin;
 mod space;
@@ -45,6 +46,7 @@ pub use format::{
     BeadPreset, ConstraintPreset, ContactsPreset, PinPreset, RodPreset, SceneLink, ScenePreset,
     SpringPreset, WirePreset,
 };
+pub use hourglass::{GRAIN_RADIUS, Hourglass};
 pub use pile::{PILE_RADIUS, Pour};
 pub use plugin::{
     ActivePreset, LoadPreset, ScenePresetLoader, ScenePresetPlugin, apply_loaded_preset,

@@ -337,3 +337,87 @@ fn a_pour_too_large_or_malformed_is_refused_in_words() {
     .unwrap_err();
     assert!(err.to_string().contains("timestep"), "{err}");
 }
+
+/// The hourglass of 2,000 grains, and ones of 1 and 300: as many grains
+/// as asked, each of [`GRAIN_RADIUS`](super::GRAIN_RADIUS), in the upper
+/// bulb (above the neck) and inside the glass by more than a radius and
+/// a half, none touching, the lowest first; the glass a closed one-sided
+/// wire, the same on both sides of the middle and of the neck, whose
+/// neck lets the grains' centres through 3.5 radii either side of the
+/// middle.
+#[test]
+fn an_hourglass_has_its_grains_apart_in_the_upper_bulb_lowest_first() {
+    use crate::geometry::{ImplicitCurve, WireShape};
+    use bevy::math::DVec2;
+    let r = super::GRAIN_RADIUS;
+    for beads in [2000, 300, 1] {
+        let scene = super::Hourglass {
+            beads,
+            ..super::Hourglass::default()
+        }
+        .scene()
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(scene.wires.len(), 1);
+        let wire = &scene.wires[0];
+        let WireShape::Spline(glass) = &wire.shape else {
+            panic!("the glass is a {:?}", wire.shape);
+        };
+        assert!(glass.spec().closed && !glass.has_ends());
+        for p in [
+            DVec2::new(0.2, 0.3),
+            DVec2::new(0.05, 0.9),
+            DVec2::new(0.01, 0.02),
+        ] {
+            let mirrored = [DVec2::new(-p.x, p.y), DVec2::new(p.x, -p.y), -p];
+            for q in mirrored {
+                assert!(
+                    (glass.value(q) - glass.value(p)).abs() <= 1e-9,
+                    "{p} and {q}"
+                );
+            }
+        }
+        assert!((glass.value(DVec2::ZERO) - 3.5 * r).abs() <= 0.05 * r);
+        let grains: Vec<_> = scene.all_beads().collect();
+        assert_eq!(grains.len(), beads);
+        for (i, a) in grains.iter().enumerate() {
+            let at = a.initial_position;
+            assert_eq!(a.radius, r);
+            assert!(at.y > 2.0 * r, "{} at {at}", a.name);
+            assert!(glass.value(at) > 1.5 * r, "{} at {at}", a.name);
+            if i > 0 {
+                assert!(at.y >= grains[i - 1].initial_position.y, "{} lower", a.name);
+            }
+            for b in &grains[i + 1..] {
+                let apart = (at - b.initial_position).length();
+                assert!(apart > 2.0 * r, "{} and {}: {apart} m", a.name, b.name);
+            }
+        }
+    }
+}
+
+/// An hourglass of more grains than it is made for is refused in words,
+/// and a timestep that is not positive as any scene file's.
+#[test]
+fn an_hourglass_too_large_or_malformed_is_refused_in_words() {
+    let most = super::Hourglass::MOST;
+    let err = super::Hourglass {
+        beads: most + 1,
+        ..super::Hourglass::default()
+    }
+    .scene()
+    .unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "an hourglass of {} grains is more than the {most} it is made for",
+            most + 1
+        )
+    );
+    let err = super::Hourglass {
+        timestep: -1.0,
+        ..super::Hourglass::default()
+    }
+    .scene()
+    .unwrap_err();
+    assert!(err.to_string().contains("timestep"), "{err}");
+}
