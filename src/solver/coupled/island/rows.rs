@@ -14,19 +14,31 @@ impl<V: WireSpace> Island<V> {
     /// Wire row `r` where its bead is in `states` at `time`, whether the
     /// row is held or not (zero for a row of another kind).
     pub(super) fn wire_row(&self, r: usize, states: &[BeadState<V>], time: f64) -> RowAt<V> {
+        self.wire_row_near(r, states, time, f64::NAN)
+    }
+
+    /// [`Island::wire_row`], the bead's nearest point on its wire searched
+    /// near the curve parameter `hint` (anywhere where it is NaN).
+    pub(super) fn wire_row_near(
+        &self,
+        r: usize,
+        states: &[BeadState<V>],
+        time: f64,
+        hint: f64,
+    ) -> RowAt<V> {
         self.entry_bead
             .get(self.row_start[r])
             .and_then(|&bead| states.get(bead))
-            .and_then(|s| self.wire_row_at(r, s.position, time))
+            .and_then(|s| self.wire_row_at(r, s.position, time, hint))
             .unwrap_or_default()
     }
 
-    /// Wire row `r` with its bead at `position` at `time`; none for a row
-    /// of another kind.
-    fn wire_row_at(&self, r: usize, position: V, time: f64) -> Option<RowAt<V>> {
+    /// Wire row `r` with its bead at `position` at `time`, searched near
+    /// `hint`; none for a row of another kind.
+    fn wire_row_at(&self, r: usize, position: V, time: f64, hint: f64) -> Option<RowAt<V>> {
         let (shape, pose, twist) = self.wire_at(r, time)?;
         let g = placed_geometry(&pose, position, |local| {
-            V::shape_geometry(shape, local, None)
+            V::shape_geometry(shape, local, Some(hint))
         });
         Some(RowAt {
             c: g.c,
@@ -40,7 +52,7 @@ impl<V: WireSpace> Island<V> {
     /// units); none for a row of another kind.
     pub(super) fn in_front(&self, r: usize, x: &[V], time: f64) -> Option<f64> {
         let at = *x.get(*self.entry_bead.get(self.row_start[r])?)?;
-        Some(self.sides[r].0 * self.wire_row_at(r, at, time)?.c)
+        Some(self.sides[r].0 * self.wire_row_at(r, at, time, f64::NAN)?.c)
     }
 
     /// How far wire row `r`'s bead in `states` is in front of its wire at
@@ -54,7 +66,7 @@ impl<V: WireSpace> Island<V> {
         time: f64,
     ) -> Option<(f64, f64)> {
         let state = states.get(*self.entry_bead.get(self.row_start[r])?)?;
-        let row = self.wire_row_at(r, state.position, time)?;
+        let row = self.wire_row_at(r, state.position, time, f64::NAN)?;
         let length = row.normal.dot(row.normal).sqrt();
         if length.is_nan() || length <= 0.0 {
             return None;
@@ -155,6 +167,27 @@ impl<V: WireSpace> Island<V> {
         Some((shape, pose, twist))
     }
 
+    /// Finds the curve parameter of each wire row whose bead's place along
+    /// its wire is unknown (an island's first step), by one search of the
+    /// whole wire where the bead is at `time`: the step's evaluations then
+    /// search only near it, and keep the branch it is on.
+    pub(super) fn find_unknown(
+        &self,
+        time: f64,
+        states: &[BeadState<V>],
+        work: &mut IslandWork<V>,
+    ) {
+        work.hints.resize(self.rows(), f64::NAN);
+        for r in 0..self.rows() {
+            if work.hints[r].is_nan()
+                && let Some((shape, pose, _, state)) = self.wire_and_bead(r, states, time)
+            {
+                let local = Placement::to_local(&pose, state.position);
+                work.hints[r] = V::shape_parameter(shape, local, f64::NAN);
+            }
+        }
+    }
+
     /// Keeps each wire row's curve parameter where its bead is now (at
     /// `time`), and reports each set-aside row's own `C` and `Ċ`.
     pub(super) fn follow(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
@@ -164,11 +197,12 @@ impl<V: WireSpace> Island<V> {
                 continue;
             };
             let local = Placement::to_local(&pose, state.position);
-            work.hints[r] = V::shape_parameter(shape, local, work.hints[r]);
+            let hint = V::shape_parameter(shape, local, work.hints[r]);
+            work.hints[r] = hint;
             if work.inactive.get(r) == Some(&true)
                 && let Some(report) = work.reports.get_mut(r)
             {
-                let row = self.wire_row(r, states, time);
+                let row = self.wire_row_near(r, states, time, hint);
                 report.c = row.c;
                 report.c_dot = row.normal.dot(state.velocity - row.wire);
             }

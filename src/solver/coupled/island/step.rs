@@ -220,9 +220,11 @@ impl<V: WireSpace> Island<V> {
 
     /// Sets the rows a fresh `work` starts with at `states` (as its first
     /// step would), so that what it carries can be kept
-    /// ([`IslandWork::mark`]) before that step. A work that has stepped is
-    /// left as it is.
+    /// ([`IslandWork::mark`]) before that step, and finds where along its
+    /// wire each bead is that it does not know yet. A work that has
+    /// stepped keeps its rows.
     pub(crate) fn begin(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
+        self.find_unknown(time, states, work);
         if work.inactive.len() != self.rows() {
             self.start_rows(time, states, work);
         }

@@ -189,7 +189,8 @@ impl<V: WireSpace> IslandWork<V> {
     /// work of the island this one's was rebuilt from) ended its last
     /// step: held or set aside, from its force (a dense island's first
     /// step predicts the rows it holds warm from it, as from its own last
-    /// step's). `from` not yet stepped passes on what it was told to
+    /// step's), a wire row's bead where it was along its wire. `from` not
+    /// yet stepped passes on what it was told to
     /// carry. A work that has stepped is not changed.
     pub fn carry_row(&mut self, row: usize, from: &IslandWork<V>, from_row: usize) {
         let told = from.carried.get(from_row).copied().flatten();
@@ -203,6 +204,13 @@ impl<V: WireSpace> IslandWork<V> {
             (from.holds(from_row), force)
         };
         self.tell(row, held, force);
+        // A wire row's bead is where it was along its wire.
+        if let Some(&hint) = from.hints.get(from_row) {
+            if self.hints.len() <= row {
+                self.hints.resize(row + 1, f64::NAN);
+            }
+            self.hints[row] = hint;
+        }
     }
 
     /// Row `row` of a fresh work starts held (or set aside) and from the
