@@ -7,6 +7,7 @@
 //! cargo run --release -p wirebead-vs-avian -- carts [--steps 600] [--sizes 1000,10000] [--substeps 50] [--rail prismatic|locked]
 //! cargo run --release -p wirebead-vs-avian -- spheres [--steps 600] [--sizes 1,10000]
 //! cargo run --release -p wirebead-vs-avian -- touch [--dt 0.016667] [--steps 120] [--substeps 50]
+//! cargo run --release -p wirebead-vs-avian -- pile [--beads 1000] [--steps 180] [--piles plane|space|both] [--budget 300]
 //! ```
 //!
 //! - `circle` (the default, also without a subcommand): a bead on a circle
@@ -34,6 +35,11 @@
 //!   [`touch`]). Prints how many balls the cradle sends out and how high,
 //!   the momentum and energy across the strikes, the gliders' velocities
 //!   against the formulas, and ns per step.
+//! - `pile`: beads poured into a bowl at `e = 0`, in the plane and in
+//!   space, our plugin against avian2d's and avian3d's colliders (see
+//!   [`pile`]). Prints ms per step as the pile falls, lands and settles,
+//!   the worst overlap of two beads and into the bowl, and how the energy
+//!   rose.
 //!
 //! Every job uses Bevy's process-wide task pools with a compute thread per
 //! core, on both sides.
@@ -42,6 +48,7 @@
 
 mod avian_side;
 mod carts;
+mod pile;
 mod rope;
 mod spheres;
 mod touch;
@@ -90,6 +97,8 @@ enum Job {
     Spheres(spheres::SpheresArgs),
     /// Newton's cradle and the air track, against avian2d's colliders.
     Touch(touch::TouchArgs),
+    /// Beads poured into a bowl, against avian2d's and avian3d's colliders.
+    Pile(pile::PileArgs),
 }
 
 /// Options of the circle job.
@@ -203,6 +212,7 @@ fn main() {
         Some(Job::Carts(args)) => carts::run(&args),
         Some(Job::Spheres(args)) => spheres::run(&args),
         Some(Job::Touch(args)) => touch::run(&args),
+        Some(Job::Pile(args)) => pile::run(&args),
     }
 }
 
