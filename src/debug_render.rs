@@ -65,6 +65,10 @@ pub struct DebugRenderStyle {
     pub hatch_length: f64,
     /// Arrow length for a force equal to the bead's weight.
     pub force_scale: f32,
+    /// The most beads a scene may have for their constraint forces to be
+    /// drawn: a pile's, one arrow of its weight on every bead, would cover
+    /// it.
+    pub force_arrows_up_to: usize,
     /// The world rectangle `(min, max)` an open wire is drawn across and a
     /// game's own curve traced in.
     pub bounds: (DVec2, DVec2),
@@ -86,6 +90,7 @@ impl Default for DebugRenderStyle {
             bead_radius: 0.05,
             hatch_length: 0.04,
             force_scale: 0.15,
+            force_arrows_up_to: 64,
             bounds: (DVec2::splat(-5.0), DVec2::splat(5.0)),
         }
     }
@@ -188,7 +193,8 @@ pub fn draw_links(
 
 /// Draws the constraint force on each bead on a wire (on a bead hanging
 /// from rods it lies along them and would hide them), in units of the
-/// bead's weight, and the drag spring.
+/// bead's weight, where the scene has at most
+/// [`DebugRenderStyle::force_arrows_up_to`] beads, and the drag spring.
 pub fn draw_forces(
     beads: Query<(
         &BeadPosition,
@@ -206,12 +212,13 @@ pub fn draw_forces(
         .filter_map(|(_, _, d, _, on_wire)| d.filter(|_| on_wire))
         .map(|d| d.constraint_force.length())
         .fold(0.0, f64::max);
+    let arrows = beads.iter().len() <= style.force_arrows_up_to;
     for (bead, mass, diagnostics, drag, on_wire) in &beads {
         let per_newton =
             style.force_scale * force_unit(params.gravity.length(), mass.get(), largest);
         let at = bead.as_vec2();
         let force = diagnostics
-            .filter(|_| on_wire)
+            .filter(|_| on_wire && arrows)
             .map_or(Vec2::ZERO, |d| d.constraint_force.as_vec2())
             * per_newton;
         if force.is_finite() && force.length() > 1e-3 * style.force_scale {

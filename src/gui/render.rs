@@ -224,6 +224,7 @@ fn style_debug_render(
         hatch_length: hatch_length(&view),
         force_scale: style.force_scale * view.size.y,
         bounds: (center - size, center + size),
+        ..DebugRenderStyle::default()
     };
 }
 

@@ -32,8 +32,8 @@ fn drawn(app: &App) -> Vec<Vec2> {
         .collect()
 }
 
-#[test]
-fn the_debug_renderer_draws_wires_rods_and_beads_where_they_are() {
+/// A headless app with the debug renderer, beads drawn 0.1 across.
+fn debug_app() -> App {
     let mut app = App::new();
     app.add_plugins((
         // The process's task pools as every other test app asks for them.
@@ -52,6 +52,12 @@ fn the_debug_renderer_draws_wires_rods_and_beads_where_they_are() {
         bead_radius: 0.1,
         ..default()
     });
+    app
+}
+
+#[test]
+fn the_debug_renderer_draws_wires_rods_and_beads_where_they_are() {
+    let mut app = debug_app();
     let world = app.world_mut();
     let centre = Vec2::new(2.0, 1.0);
     let wire = world
@@ -89,5 +95,32 @@ fn the_debug_renderer_draws_wires_rods_and_beads_where_they_are() {
             .filter(|p| ((**p - at).length() - 0.1).abs() < 1e-5)
             .count();
         assert!(ring >= 16, "{ring} points on the bead at {at}");
+    }
+}
+
+/// A bead resting at the bottom of a circle gets its constraint force
+/// drawn, an arrow of the style's length for its weight straight up; in a
+/// scene of more beads than `force_arrows_up_to` (a pile) no arrow is.
+#[test]
+fn force_arrows_are_drawn_up_to_the_styles_count_of_beads() {
+    for (others, drawn_arrow) in [(0, true), (64, false)] {
+        let mut app = debug_app();
+        let world = app.world_mut();
+        let wire = world
+            .spawn((Wire::circle(1.5).unwrap(), Transform::default()))
+            .id();
+        world.spawn((
+            Bead::at_rest(1.0, DVec2::new(0.0, -1.5)).unwrap(),
+            OnWire(wire),
+        ));
+        for k in 0..others {
+            world.spawn(Bead::at_rest(1.0, DVec2::new(10.0 + k as f64, 0.0)).unwrap());
+        }
+        // The first update takes no step.
+        run_steps(&mut app, 0);
+        run_steps(&mut app, 1);
+        let tip = Vec2::new(0.0, -1.5 + DebugRenderStyle::default().force_scale);
+        let near = drawn(&app).iter().any(|p| (*p - tip).length() < 1e-2);
+        assert_eq!(near, drawn_arrow, "{} beads", others + 1);
     }
 }

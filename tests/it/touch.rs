@@ -6,10 +6,10 @@ use bevy::prelude::*;
 use wirebead::geometry::Coordinates;
 use wirebead::headless::{Headless, bead_state, idle, run_steps};
 use wirebead::prelude::*;
-use wirebead::preset::{GRAIN_RADIUS, Hourglass, Pour};
+use wirebead::preset::{GRAIN_RADIUS, Hourglass, Pour, scene_ron};
 use wirebead::solver::BeadState;
 use wirebead::{
-    CatchesBeads, Integrator, Islands, Restitution, SceneEnergy, ScenePreset, SimClock,
+    CatchesBeads, Integrator, Islands, Restitution, SceneEnergy, SceneFile, ScenePreset, SimClock,
     WireContact, preset::PILE_RADIUS,
 };
 
@@ -1073,6 +1073,24 @@ fn a_pile_of_marbles_poured_into_a_sphere_never_overlaps_nor_gains_energy() {
         above <= 1e-5 * weight,
         "the scene's energy rose {above:e} J above the lowest it had been"
     );
+}
+
+/// The shipped `hourglass.scene.ron` is the hourglass preset of 300
+/// grains ([`Hourglass`]): read back, it writes the same scene file, to
+/// the digit.
+#[test]
+fn the_shipped_hourglass_is_the_preset_of_300_grains() {
+    let path = crate::presets::shipped_dir().join("hourglass.scene.ron");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{e}"));
+    let shipped = ScenePreset::from_ron(&text).unwrap_or_else(|e| panic!("{e}"));
+    let made = Hourglass {
+        beads: 300,
+        ..Hourglass::default()
+    }
+    .scene()
+    .unwrap_or_else(|e| panic!("{e}"));
+    let written = |scene: ScenePreset| scene_ron(&SceneFile::Plane(scene)).expect("written");
+    assert_eq!(written(shipped), written(made));
 }
 
 /// Two hundred grains of 1 cm and 10 g at `e = 0` in an hourglass

@@ -69,6 +69,7 @@ impl Default for PresetCatalog {
                 ("Air track, sticky", "scenes/air_track_sticky.scene.ron"),
                 ("Abacus", "scenes/abacus.scene.ron"),
                 ("Train on a closed track", "scenes/train.scene.ron"),
+                ("Hourglass of 300 grains", "scenes/hourglass.scene.ron"),
                 (
                     "In space: bead on a rotating hoop",
                     "scenes/rotating_hoop.scene.ron",
