@@ -26,7 +26,7 @@
 //! the energy at the end less the lowest it has been. A run that passes
 //! `--budget` seconds of stepping stops there, and the table says where.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use bevy::app::App;
 use bevy::math::{DVec2, DVec3};
@@ -36,7 +36,7 @@ use wirebead::headless::{Headless, bead_state, space_bead_state};
 use wirebead::prelude::*;
 use wirebead::preset::{PILE_RADIUS, Pour};
 
-use crate::avian_side;
+use crate::{avian_side, touch};
 
 /// Magnitude of gravity, m/s², along −y (the scene files' default).
 const GRAVITY: f64 = 9.81;
@@ -153,19 +153,6 @@ fn theirs_space(app: &App, beads: &[Entity]) -> States {
         .collect()
 }
 
-/// Steps our app once.
-fn our_step(app: &mut App, _: usize) -> f64 {
-    let start = Instant::now();
-    app.update();
-    start.elapsed().as_secs_f64()
-}
-
-/// Steps an avian2d app once.
-fn plane_step(app: &mut App, k: usize) -> f64 {
-    let step = app.world().resource::<Time<Fixed>>().timestep();
-    avian_side::timed_step(app, step, k)
-}
-
 /// Steps an avian3d app once.
 fn space_step(app: &mut App, k: usize) -> f64 {
     let step = app.world().resource::<Time<Fixed>>().timestep();
@@ -208,7 +195,7 @@ fn our_pile(args: &PileArgs, space: bool) -> Pile {
         app,
         beads,
         read: if space { ours_space } else { ours_plane },
-        step: our_step,
+        step: touch::our_step,
     }
 }
 
@@ -261,7 +248,7 @@ fn their_plane_pile(args: &PileArgs) -> Pile {
         app,
         beads,
         read: theirs_plane,
-        step: plane_step,
+        step: touch::their_step,
     }
 }
 

@@ -124,14 +124,14 @@ impl Scene {
 }
 
 /// Steps our app once.
-fn our_step(app: &mut App, _: usize) -> f64 {
+pub(crate) fn our_step(app: &mut App, _: usize) -> f64 {
     let start = Instant::now();
     app.update();
     start.elapsed().as_secs_f64()
 }
 
-/// Steps an avian app once.
-fn their_step(app: &mut App, k: usize) -> f64 {
+/// Steps an avian2d app once.
+pub(crate) fn their_step(app: &mut App, k: usize) -> f64 {
     let step = app.world().resource::<Time<Fixed>>().timestep();
     avian_side::timed_step(app, step, k)
 }
