@@ -96,6 +96,14 @@ impl Default for DebugRenderStyle {
     }
 }
 
+impl DebugRenderStyle {
+    /// Whether a scene of `beads` beads has its constraint forces drawn:
+    /// at most [`DebugRenderStyle::force_arrows_up_to`].
+    pub fn draws_force_arrows(&self, beads: usize) -> bool {
+        beads <= self.force_arrows_up_to
+    }
+}
+
 /// Where a wire's `Transform` puts it (the identity for a pose that is not
 /// in the plane).
 pub fn wire_pose(transform: &Transform) -> Pose {
@@ -212,7 +220,7 @@ pub fn draw_forces(
         .filter_map(|(_, _, d, _, on_wire)| d.filter(|_| on_wire))
         .map(|d| d.constraint_force.length())
         .fold(0.0, f64::max);
-    let arrows = beads.iter().len() <= style.force_arrows_up_to;
+    let arrows = style.draws_force_arrows(beads.iter().len());
     for (bead, mass, diagnostics, drag, on_wire) in &beads {
         let per_newton =
             style.force_scale * force_unit(params.gravity.length(), mass.get(), largest);

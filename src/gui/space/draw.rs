@@ -13,7 +13,7 @@ use bevy::render::render_resource::Face;
 use super::shapes::{curve_points, fitted_surface_mesh};
 use super::{Orbit, SPACE_LAYER, SpaceGizmos};
 use crate::controls::Presentation;
-use crate::debug_render::force_unit;
+use crate::debug_render::{DebugRenderStyle, force_unit};
 use crate::geometry::{Side, SpaceShape};
 use crate::gui::render::{BeadSizes, SceneStyle, Trail};
 use crate::{
@@ -286,7 +286,8 @@ pub fn draw_wires(
 
 /// Draws rods as lines, pins as small crosses, springs as thin lines,
 /// the constraint force on each bead on a wire as an arrow (in units of
-/// its weight) and the drag spring.
+/// its weight) where the scene has few enough beads
+/// ([`DebugRenderStyle::draws_force_arrows`]), and the drag spring.
 pub fn draw_links(
     beads: Query<(
         &BeadPosition<DVec3>,
@@ -301,7 +302,7 @@ pub fn draw_links(
     transforms: Query<&Transform>,
     params: Res<SimParams>,
     orbit: Res<Orbit>,
-    style: Res<SceneStyle>,
+    (style, debug): (Res<SceneStyle>, Res<DebugRenderStyle>),
     mut gizmos: Gizmos<SpaceGizmos>,
 ) {
     let at = |e: Entity| beads.get(e).ok().map(|b| b.0.0.as_vec3());
@@ -329,10 +330,11 @@ pub fn draw_links(
         .filter_map(|(_, _, d, _, on_wire)| d.filter(|_| on_wire))
         .map(|d| d.constraint_force.length())
         .fold(0.0, f64::max);
+    let arrows = debug.draws_force_arrows(beads.iter().len());
     for (bead, mass, diagnostics, drag, on_wire) in &beads {
         let p = bead.0.as_vec3();
         let force = diagnostics
-            .filter(|_| on_wire)
+            .filter(|_| on_wire && arrows)
             .map_or(Vec3::ZERO, |d| d.constraint_force.as_vec3())
             * (scale * force_unit(g, mass.get(), largest));
         if force.is_finite() && force.length() > 1e-3 * scale {

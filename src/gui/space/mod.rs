@@ -92,6 +92,7 @@ pub struct SpaceViewPlugin;
 impl Plugin for SpaceViewPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<Orbit>()
+            .init_resource::<crate::debug_render::DebugRenderStyle>()
             .init_gizmo_group::<SpaceGizmos>()
             .add_systems(Startup, (spawn_space_camera, style_space_gizmos))
             .add_systems(
