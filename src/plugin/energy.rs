@@ -7,6 +7,7 @@ use bevy::prelude::*;
 use super::clock::SimClock;
 use super::islands::{InIsland, Islands};
 use crate::dynamics::{BeadMass, BeadPosition, BeadVelocity, SimParams};
+use crate::geometry::Coordinates;
 use crate::solver::BeadState;
 
 /// The scene's energy after the last step: the kinetic and gravitational
@@ -40,14 +41,18 @@ pub struct SceneEnergy {
 }
 
 /// Measures [`SceneEnergy`]: each island's energy (its beads' and its
-/// springs'), and each bead stepped alone on its wire.
+/// springs'), and each bead stepped alone on its wire, in the plane and
+/// in space.
 pub(super) fn measure_scene_energy(
     mut energy: ResMut<SceneEnergy>,
     params: Res<SimParams>,
     clock: Res<SimClock>,
-    islands: Res<Islands>,
-    space_islands: Res<Islands<DVec3>>,
+    (islands, space_islands): (Res<Islands>, Res<Islands<DVec3>>),
     alone: Query<(&BeadPosition, &BeadVelocity, &BeadMass), Without<InIsland>>,
+    alone_in_space: Query<
+        (&BeadPosition<DVec3>, &BeadVelocity<DVec3>, &BeadMass),
+        Without<InIsland>,
+    >,
 ) {
     let joined: f64 = islands
         .iter()
@@ -56,17 +61,22 @@ pub(super) fn measure_scene_energy(
         .sum();
     let lone: f64 = alone
         .iter()
-        .map(|(x, v, m)| {
-            let state = BeadState {
-                position: x.0,
-                velocity: v.0,
-            };
-            let (kinetic, potential) = state.energy(m.get(), params.gravity);
-            kinetic + potential
-        })
+        .map(|(x, v, m)| bead_energy(x.0, v.0, m.get(), params.gravity))
+        .chain(
+            alone_in_space
+                .iter()
+                .map(|(x, v, m)| bead_energy(x.0, v.0, m.get(), params.gravity_in_space())),
+        )
         .sum();
     *energy = SceneEnergy {
         total: joined + lone,
         time: clock.time,
     };
+}
+
+/// A bead's kinetic and gravitational energy, of `mass` at `position`
+/// moving at `velocity` under `gravity`.
+fn bead_energy<V: Coordinates>(position: V, velocity: V, mass: f64, gravity: V) -> f64 {
+    let (kinetic, potential) = BeadState { position, velocity }.energy(mass, gravity);
+    kinetic + potential
 }

@@ -8,7 +8,9 @@ use bevy::prelude::*;
 use wirebead::geometry::{Circle, Helix, OnPlane, Pose3, SpaceMotion, SpacePath, Sphere};
 use wirebead::headless::{Headless, run_for, space_bead_state};
 use wirebead::prelude::*;
-use wirebead::{BeadMass, ConstraintDiagnostics, Islands, NextBeadParams, SpaceBead, SpaceWire};
+use wirebead::{
+    BeadMass, ConstraintDiagnostics, Islands, NextBeadParams, SceneEnergy, SpaceBead, SpaceWire,
+};
 
 use crate::space::conical_start;
 
@@ -740,4 +742,40 @@ fn a_bead_rides_a_plane_oscillating_in_space() {
             .max((p.z - across.z).abs());
     });
     assert!(worst <= 1e-9, "off the plane's motion by {worst:e}");
+}
+
+/// The scene's energy ([`SceneEnergy`], which the panel plots) counts a
+/// bead in space stepped alone on its surface, in no island: a conical
+/// pendulum in a sphere, RATTLE at 1 ms for a second, has the scene's
+/// energy its own `½ m |v|² + m g y` to 1e-12 at every tenth of a second,
+/// and keeps it within 1e-6 J of its start.
+#[test]
+fn the_scene_energy_counts_a_bead_alone_on_a_surface() {
+    let (r, alpha) = (1.2, 40f64.to_radians());
+    let mut app = app(1e-3);
+    app.init_resource::<SceneEnergy>();
+    let wire = app
+        .world_mut()
+        .spawn(SpaceWire::surface_of(Sphere { radius: r }))
+        .id();
+    let (start, _) = conical_start(r, alpha);
+    let bead = spawn(&mut app, Some(wire), start.position, start.velocity);
+    let own = |app: &App| {
+        let s = space_bead_state(app.world(), bead).expect("a bead in space");
+        0.5 * s.velocity.length_squared() + G * s.position.y
+    };
+    let first = own(&app);
+    for _ in 0..10 {
+        run_for(&mut app, 0.1);
+        let scene = app.world().resource::<SceneEnergy>().total;
+        assert!(
+            (scene - own(&app)).abs() <= 1e-12,
+            "{scene} against {}",
+            own(&app)
+        );
+        assert!(
+            (scene - first).abs() <= 1e-6,
+            "{scene} against {first} at the start"
+        );
+    }
 }
