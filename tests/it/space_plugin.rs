@@ -44,6 +44,22 @@ fn spawn(app: &mut App, wire: Option<Entity>, position: DVec3, velocity: DVec3) 
     bead.id()
 }
 
+/// A conical pendulum inside a sphere of radius 1.2 m, 40° from the
+/// downward vertical: the bead, the radius and the bead's start.
+fn conical_in_sphere(app: &mut App) -> (Entity, f64, wirebead::solver::BeadState<DVec3>) {
+    let (r, alpha) = (1.2, 40f64.to_radians());
+    let wire = app
+        .world_mut()
+        .spawn(SpaceWire::surface_of(Sphere { radius: r }))
+        .id();
+    let (start, _) = conical_start(r, alpha);
+    (
+        spawn(app, Some(wire), start.position, start.velocity),
+        r,
+        start,
+    )
+}
+
 /// The conical pendulum inside a sphere of radius 1.2 m, 40° from the
 /// downward vertical, through the plugin (RATTLE at 1 ms, 3 s): its height
 /// stays within 1e-5 r, it stays on the sphere to 1e-12, its `Transform`
@@ -51,14 +67,8 @@ fn spawn(app: &mut App, wire: Option<Entity>, position: DVec3, velocity: DVec3) 
 /// its own, in no island.
 #[test]
 fn a_conical_pendulum_on_a_sphere_steps_through_the_plugin() {
-    let (r, alpha) = (1.2, 40f64.to_radians());
     let mut app = app(1e-3);
-    let wire = app
-        .world_mut()
-        .spawn(SpaceWire::surface_of(Sphere { radius: r }))
-        .id();
-    let (start, _) = conical_start(r, alpha);
-    let bead = spawn(&mut app, Some(wire), start.position, start.velocity);
+    let (bead, r, start) = conical_in_sphere(&mut app);
     let mut worst = (0.0f64, 0.0f64);
     for _ in 0..30 {
         run_for(&mut app, 0.1);
@@ -751,15 +761,9 @@ fn a_bead_rides_a_plane_oscillating_in_space() {
 /// and keeps it within 1e-6 J of its start.
 #[test]
 fn the_scene_energy_counts_a_bead_alone_on_a_surface() {
-    let (r, alpha) = (1.2, 40f64.to_radians());
     let mut app = app(1e-3);
     app.init_resource::<SceneEnergy>();
-    let wire = app
-        .world_mut()
-        .spawn(SpaceWire::surface_of(Sphere { radius: r }))
-        .id();
-    let (start, _) = conical_start(r, alpha);
-    let bead = spawn(&mut app, Some(wire), start.position, start.velocity);
+    let (bead, ..) = conical_in_sphere(&mut app);
     let own = |app: &App| {
         let s = space_bead_state(app.world(), bead).expect("a bead in space");
         0.5 * s.velocity.length_squared() + G * s.position.y
