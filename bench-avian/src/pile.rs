@@ -125,32 +125,35 @@ fn ours_space(app: &App, beads: &[Entity]) -> States {
         .collect()
 }
 
-/// avian2d's balls' states.
-fn theirs_plane(app: &App, beads: &[Entity]) -> States {
-    use avian2d::prelude::{LinearVelocity, Position};
+/// An avian side's balls' states: their `P`osition and `L`inear
+/// velocity components, lifted into space by `lift`.
+fn theirs<P, L, V>(app: &App, beads: &[Entity], lift: fn(V) -> DVec3) -> States
+where
+    P: Component + std::ops::Deref<Target = V>,
+    L: Component + std::ops::Deref<Target = V>,
+    V: Copy,
+{
     let world = app.world();
     beads
         .iter()
         .map(|&b| {
-            let x = world.get::<Position>(b).expect("a position").0;
-            let v = world.get::<LinearVelocity>(b).expect("a velocity").0;
-            (x.extend(0.0), v.extend(0.0))
+            let x = **world.get::<P>(b).expect("a position");
+            let v = **world.get::<L>(b).expect("a velocity");
+            (lift(x), lift(v))
         })
         .collect()
+}
+
+/// avian2d's balls' states.
+fn theirs_plane(app: &App, beads: &[Entity]) -> States {
+    use avian2d::prelude::{LinearVelocity, Position};
+    theirs::<Position, LinearVelocity, DVec2>(app, beads, |v| v.extend(0.0))
 }
 
 /// avian3d's balls' states.
 fn theirs_space(app: &App, beads: &[Entity]) -> States {
     use avian3d::prelude::{LinearVelocity, Position};
-    let world = app.world();
-    beads
-        .iter()
-        .map(|&b| {
-            let x = world.get::<Position>(b).expect("a position").0;
-            let v = world.get::<LinearVelocity>(b).expect("a velocity").0;
-            (x, v)
-        })
-        .collect()
+    theirs::<Position, LinearVelocity, DVec3>(app, beads, |v| v)
 }
 
 /// Steps an avian3d app once.

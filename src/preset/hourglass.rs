@@ -4,6 +4,7 @@ use std::f64::consts::{FRAC_1_SQRT_2, PI};
 
 use bevy::math::DVec2;
 
+use super::pile::{CLEAR, GRID, jitter};
 use super::{PresetError, ScenePreset};
 use crate::geometry::{ImplicitCurve, Spline, SplineKind, SplineSpec};
 
@@ -14,13 +15,6 @@ pub const GRAIN_RADIUS: f64 = 0.01;
 /// in grain radii: the beads' centres pass through an opening of twice
 /// this, some four and a half grains across.
 const NECK: f64 = 3.5;
-
-/// The grid the grains start on, in grain radii between centres.
-const SPACING: f64 = 2.3;
-
-/// How far inside the glass a grain starts, in grain radii: the wire is
-/// the line of the grains' centres, so a grain starts clear of it.
-const CLEAR: f64 = 1.5;
 
 /// An hourglass turned over: [`Hourglass::beads`] grains of 1 cm
 /// ([`GRAIN_RADIUS`]) and 10 g at rest in the upper bulb, lowest first,
@@ -62,12 +56,12 @@ impl Hourglass {
     /// 100,000).
     pub const MOST: usize = 100_000;
 
-    /// The bulbs' radius for `beads` grains: a square grid of `SPACING`
+    /// The bulbs' radius for `beads` grains: a square grid of `GRID`
     /// filling nine tenths of a disc holds them with a tenth to spare,
     /// and never less than the neck's funnels need.
     fn bulb(beads: usize) -> f64 {
         let r = GRAIN_RADIUS;
-        let area = beads as f64 * (SPACING * r).powi(2) / 0.9;
+        let area = beads as f64 * (GRID * r).powi(2) / 0.9;
         ((area / PI).sqrt() + CLEAR * r).max(20.0 * r)
     }
 
@@ -109,7 +103,7 @@ impl Hourglass {
     /// radii and above the neck; at most [`Hourglass::beads`].
     fn places(&self, glass: &Spline, (bulb, top): (f64, f64)) -> Vec<DVec2> {
         let r = GRAIN_RADIUS;
-        let spacing = SPACING * r;
+        let spacing = GRID * r;
         let mut places = Vec::new();
         let rows = (top / spacing).ceil() as usize;
         let across = (bulb / spacing).ceil() as i64;
@@ -120,8 +114,7 @@ impl Hourglass {
                     return places;
                 }
                 let k = places.len();
-                let jitter = 0.0015 * ((k * 7919 % 13) as f64 / 13.0 - 0.5);
-                let at = DVec2::new(i as f64 * spacing + jitter, y);
+                let at = DVec2::new(i as f64 * spacing + jitter(k, 0.0015), y);
                 if glass.value(at) > CLEAR * r {
                     places.push(at);
                 }

@@ -6,6 +6,19 @@ use super::{PresetError, SceneFile, ScenePreset};
 /// The radius of each bead of [`ScenePreset::pile`], m.
 pub const PILE_RADIUS: f64 = 0.02;
 
+/// The grid a preset's beads start on, in radii between centres.
+pub(super) const GRID: f64 = 2.3;
+
+/// How far inside its wire a preset's bead starts, in radii: the wire is
+/// the line of the beads' centres, so a bead starts clear of it.
+pub(super) const CLEAR: f64 = 1.5;
+
+/// How far bead `k` of a preset's grid is moved sideways, within half of
+/// `width` either way, so that no two stack exactly.
+pub(super) fn jitter(k: usize, width: f64) -> f64 {
+    width * ((k * 7919 % 13) as f64 / 13.0 - 0.5)
+}
+
 impl ScenePreset {
     /// `beads` beads of 2 cm ([`PILE_RADIUS`]) and 1 kg poured into a
     /// one-sided bowl (a circle of radius 1 m that pushes inward) at
@@ -22,9 +35,8 @@ impl ScenePreset {
         let per_row = per_row.max(1);
         let at = |k: usize| {
             let (i, j) = (k % per_row, k / per_row);
-            let jitter = 0.003 * ((k * 7919 % 13) as f64 / 13.0 - 0.5);
-            let x = -0.5 + (i as f64 + 0.5) / per_row as f64 + jitter;
-            (x, -0.8 + 2.3 * r * j as f64)
+            let x = -0.5 + (i as f64 + 0.5) / per_row as f64 + jitter(k, 0.003);
+            (x, -0.8 + GRID * r * j as f64)
         };
         // Inside the bowl by more than a radius, or the wire would pull
         // the bead in from behind it.
@@ -107,8 +119,8 @@ impl Pour {
     /// any size costs no more than its beads and its rows below them.
     fn places(&self) -> Vec<[f64; 3]> {
         let r = PILE_RADIUS;
-        let spacing = 2.3 * r;
-        let inside = self.bowl - 1.5 * r;
+        let spacing = GRID * r;
+        let inside = self.bowl - CLEAR * r;
         let mut places: Vec<[f64; 3]> = Vec::new();
         if !(inside > 0.0 && inside.is_finite()) {
             return places;
@@ -139,11 +151,9 @@ impl Pour {
                         return places;
                     }
                     let k = places.len();
-                    let jitter =
-                        |salt: usize| 0.003 * (((k + salt) * 7919 % 13) as f64 / 13.0 - 0.5);
-                    let x = i as f64 * spacing + jitter(0);
+                    let x = i as f64 * spacing + jitter(k, 0.003);
                     let z = if self.space {
-                        l as f64 * spacing + jitter(5)
+                        l as f64 * spacing + jitter(k + 5, 0.003)
                     } else {
                         0.0
                     };

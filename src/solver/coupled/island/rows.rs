@@ -167,6 +167,21 @@ impl<V: WireSpace> Island<V> {
         Some((shape, pose, twist))
     }
 
+    /// Wire row `r`'s bead's curve parameter in `states` at `time`,
+    /// searched near `hint` (anywhere where it is NaN), with the bead;
+    /// none for a row of another kind.
+    fn along_wire<'a>(
+        &'a self,
+        r: usize,
+        states: &'a [BeadState<V>],
+        time: f64,
+        hint: f64,
+    ) -> Option<(f64, &'a BeadState<V>)> {
+        let (shape, pose, _, state) = self.wire_and_bead(r, states, time)?;
+        let local = Placement::to_local(&pose, state.position);
+        Some((V::shape_parameter(shape, local, hint), state))
+    }
+
     /// Finds the curve parameter of each wire row whose bead's place along
     /// its wire is unknown (an island's first step), by one search of the
     /// whole wire where the bead is at `time`: the step's evaluations then
@@ -180,10 +195,9 @@ impl<V: WireSpace> Island<V> {
         work.hints.resize(self.rows(), f64::NAN);
         for r in 0..self.rows() {
             if work.hints[r].is_nan()
-                && let Some((shape, pose, _, state)) = self.wire_and_bead(r, states, time)
+                && let Some((hint, _)) = self.along_wire(r, states, time, f64::NAN)
             {
-                let local = Placement::to_local(&pose, state.position);
-                work.hints[r] = V::shape_parameter(shape, local, f64::NAN);
+                work.hints[r] = hint;
             }
         }
     }
@@ -193,11 +207,9 @@ impl<V: WireSpace> Island<V> {
     pub(super) fn follow(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
         work.hints.resize(self.rows(), f64::NAN);
         for r in 0..self.rows() {
-            let Some((shape, pose, _, state)) = self.wire_and_bead(r, states, time) else {
+            let Some((hint, state)) = self.along_wire(r, states, time, work.hints[r]) else {
                 continue;
             };
-            let local = Placement::to_local(&pose, state.position);
-            let hint = V::shape_parameter(shape, local, work.hints[r]);
             work.hints[r] = hint;
             if work.inactive.get(r) == Some(&true)
                 && let Some(report) = work.reports.get_mut(r)
