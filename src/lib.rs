@@ -98,11 +98,12 @@ mod validate;
 pub use controls::KeyboardControlsPlugin;
 pub use dynamics::{
     Bead, BeadBundle, BeadDiagnostics, BeadDiverged, BeadForce, BeadForces, BeadForcesItem,
-    BeadMass, BeadParams, BeadPosition, BeadRadius, BeadVelocity, BeadsStruck, CatchesBeads,
-    ConstraintDiagnostics, ContactChanged, Contacts, Dimension, Diverged, DivergenceReason, Joint,
-    MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams, NextParams, NextWireShape, OnWire, Pin,
-    PrescribedMotion, RailOrientation, Restitution, Rod, SimParams, SpaceBead, SpaceBeadBundle,
-    SpaceParams, SpaceWire, Spring, SpringAnchor, Wire, WireBeads, WireContact, WireRows, pose_of,
+    BeadMass, BeadParams, BeadPosition, BeadRadius, BeadSentBack, BeadVelocity, BeadsStruck,
+    CatchesBeads, ConstraintDiagnostics, ContactChanged, Contacts, Dimension, Diverged,
+    DivergenceReason, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams, NextParams, NextWireShape,
+    OnWire, Pin, PrescribedMotion, RailOrientation, Restitution, Rod, SendsBeadsBack, SimParams,
+    SpaceBead, SpaceBeadBundle, SpaceParams, SpaceWire, Spring, SpringAnchor, Wire, WireBeads,
+    WireContact, WireRows, pose_of,
 };
 pub use geometry::{
     Friction, ImplicitCurve, Oscillate, Side, Spin, Surface, WireKind, WireMotion, WireShape,

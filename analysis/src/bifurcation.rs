@@ -107,6 +107,8 @@ impl HoopSweep {
                 friction: Friction::NONE,
                 damping: self.damping,
                 rail: None,
+                catches: false,
+                sends_back: None,
                 beads: vec![BeadPreset {
                     name: "b".to_owned(),
                     mass: 1.0,

@@ -23,7 +23,9 @@ pub use dimension::{Dimension, WireRows};
 pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
 pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, NextParams, SimParams, SpaceParams};
 pub use rail::RailOrientation;
-pub use touch::{BeadRadius, BeadsStruck, CatchesBeads, Contacts, Restitution};
+pub use touch::{
+    BeadRadius, BeadSentBack, BeadsStruck, CatchesBeads, Contacts, Restitution, SendsBeadsBack,
+};
 pub(crate) use wire::WirePose;
 pub use wire::{
     ContactChanged, NextWireShape, OnWire, PrescribedMotion, SpaceWire, Wire, WireBeads,

@@ -1,10 +1,13 @@
 //! Beads that touch: a bead's [`BeadRadius`] and [`Restitution`], the
-//! scene-wide [`Contacts`], the [`BeadsStruck`] message, and the wires
-//! that catch beads with radii ([`CatchesBeads`]).
+//! scene-wide [`Contacts`], the [`BeadsStruck`] message, the wires that
+//! catch beads with radii ([`CatchesBeads`]) and those that take their
+//! beads back to the start ([`SendsBeadsBack`]).
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::validate::{ParamError, non_negative, restitution};
+use crate::geometry::Coordinates;
+use crate::validate::{ParamError, finite_vector, non_negative, positive, restitution};
 
 /// A bead's radius in metres: beads with radii touch when their centres
 /// are the sum of their radii apart, and may not come closer. The centre
@@ -43,6 +46,53 @@ impl BeadRadius {
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
 #[reflect(Component)]
 pub struct CatchesBeads;
+
+/// Sends each bead on the wire back to a point of it, at rest and held on
+/// the wire again, once the bead has left the wire (past an end, or where
+/// a one-sided wire would have to pull) and settled: slower than `speed`
+/// for `after` seconds. A bead waits while another bead with a radius is
+/// within reach of the point (the sum of their radii and one radius
+/// more), so that none is put on another. A marble run that runs for
+/// ever: each marble that comes to rest in the bowl goes back to the top
+/// of its rail.
+///
+/// The point is where the bead is put: on the wire, or the step pulls it
+/// there. A bead sent back is a bead moved by the game: its island is
+/// built again, its rows start afresh.
+#[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Component)]
+pub struct SendsBeadsBack<V: Coordinates + Reflect + TypePath = DVec2> {
+    to: V,
+    speed: f64,
+    after: f64,
+}
+
+impl<V: Coordinates + Reflect + TypePath> SendsBeadsBack<V> {
+    /// Sends settled beads back to `to`, if it is finite, `speed` positive
+    /// and `after` zero or more (both finite).
+    pub fn new(to: V, speed: f64, after: f64) -> Result<Self, ParamError> {
+        Ok(Self {
+            to: finite_vector("point beads are sent back to", to)?,
+            speed: positive("speed below which a bead has settled", speed)?,
+            after: non_negative("time a bead takes to settle", after)?,
+        })
+    }
+
+    /// Where a settled bead is put.
+    pub fn to(&self) -> V {
+        self.to
+    }
+
+    /// The speed below which a bead is settling, m/s.
+    pub fn speed(&self) -> f64 {
+        self.speed
+    }
+
+    /// How long a bead must stay below that speed, s.
+    pub fn after(&self) -> f64 {
+        self.after
+    }
+}
 
 /// A bead's own restitution, for the pairs it strikes in: the pair takes
 /// the smaller of its two beads' (a bead without one takes
@@ -116,6 +166,17 @@ impl Contacts {
     pub fn friction(&self) -> f64 {
         self.friction
     }
+}
+
+/// Sent when a wire with [`SendsBeadsBack`] sends one of its beads back:
+/// the bead jumped there between two steps (a trail drawn through the
+/// jump would cross the scene).
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct BeadSentBack {
+    /// The bead.
+    pub bead: Entity,
+    /// The time it was sent back at (before the next step), s.
+    pub time: f64,
 }
 
 /// Sent when two beads strike (also logged, one line).

@@ -45,9 +45,13 @@ pub trait WireSpace: Coordinates {
     fn shape_geometry(shape: &Self::Shape, p: Self, hint: Option<f64>) -> Geometry<Self>;
     /// `shape`'s characteristic length.
     fn shape_scale(shape: &Self::Shape) -> f64;
-    /// Whether `shape` ends (an open curve in the plane; see
-    /// [`ImplicitCurve::has_ends`](super::ImplicitCurve::has_ends)).
+    /// Whether `shape` ends (an open curve; see
+    /// [`ImplicitCurve::has_ends`](super::ImplicitCurve::has_ends) and
+    /// [`SpaceCurve::has_ends`](super::SpaceCurve::has_ends)).
     fn shape_has_ends(shape: &Self::Shape) -> bool;
+    /// Whether `shape` is the second row of a curve in space, which its
+    /// first row speaks for (a bead leaves both at once).
+    fn shape_second_row(shape: &Self::Shape) -> bool;
     /// How far past an end of `shape` the point nearest the local point
     /// `p` lies, looked for near the parameter `hint` (see
     /// [`ImplicitCurve::past_end`](super::ImplicitCurve::past_end)):
@@ -195,6 +199,9 @@ impl WireSpace for DVec2 {
     fn shape_has_ends(shape: &WireShape) -> bool {
         shape.curve().has_ends()
     }
+    fn shape_second_row(_shape: &WireShape) -> bool {
+        false
+    }
     fn shape_past_end(shape: &WireShape, p: Self, hint: f64) -> f64 {
         shape.curve().past_end_near(p, hint)
     }
@@ -248,11 +255,20 @@ impl WireSpace for DVec3 {
             SpaceRow::Curve { curve, .. } => curve.scale(),
         }
     }
-    fn shape_has_ends(_shape: &SpaceRow) -> bool {
-        false
+    fn shape_has_ends(shape: &SpaceRow) -> bool {
+        match shape {
+            SpaceRow::Surface(_) => false,
+            SpaceRow::Curve { curve, .. } => curve.has_ends(),
+        }
     }
-    fn shape_past_end(_shape: &SpaceRow, _p: Self, _hint: f64) -> f64 {
-        f64::NEG_INFINITY
+    fn shape_past_end(shape: &SpaceRow, p: Self, hint: f64) -> f64 {
+        match shape {
+            SpaceRow::Surface(_) => f64::NEG_INFINITY,
+            SpaceRow::Curve { curve, .. } => curve.past_end(p, hint),
+        }
+    }
+    fn shape_second_row(shape: &SpaceRow) -> bool {
+        matches!(shape, SpaceRow::Curve { row: 1, .. })
     }
     fn shape_parameter(shape: &SpaceRow, p: Self, hint: f64) -> f64 {
         match shape {

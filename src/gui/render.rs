@@ -16,8 +16,8 @@ use crate::debug_render::{
 };
 use crate::geometry::{Pose, WireShape};
 use crate::{
-    Bead, BeadParams, BeadPosition, BeadRadius, OnWire, Restart, Rod, Wire, WireBeadSystems,
-    WireContact,
+    Bead, BeadParams, BeadPosition, BeadRadius, BeadSentBack, OnWire, Restart, Rod, Wire,
+    WireBeadSystems, WireContact,
 };
 
 /// Colours and sizes of the scene.
@@ -189,7 +189,7 @@ impl Plugin for SceneRenderPlugin {
                 Update,
                 (
                     add_bead_visuals,
-                    clear_trails_on_restart::<Vec2>,
+                    clear_trails::<Vec2>,
                     frame_camera,
                     size_and_colour_beads,
                     style_debug_render,
@@ -283,13 +283,20 @@ pub fn record_trails(
     }
 }
 
-/// Empties every trail (in the plane or in space) when the run restarts.
-pub(crate) fn clear_trails_on_restart<P: Send + Sync + 'static>(
+/// Empties every trail (in the plane or in space) when the run restarts,
+/// and the trail of each bead sent back to its wire (which jumped there).
+pub(crate) fn clear_trails<P: Send + Sync + 'static>(
     mut restarts: MessageReader<Restart>,
+    mut sent: MessageReader<BeadSentBack>,
     mut trails: Query<&mut Trail<P>>,
 ) {
     if restarts.read().count() > 0 {
         for mut trail in &mut trails {
+            trail.0.clear();
+        }
+    }
+    for back in sent.read() {
+        if let Ok(mut trail) = trails.get_mut(back.bead) {
             trail.0.clear();
         }
     }

@@ -82,6 +82,15 @@ pub enum PresetError {
         /// The most it is made for.
         most: usize,
     },
+    /// A marble run ([`MarbleRun`](super::MarbleRun)) of more marbles
+    /// than it is made for.
+    #[error("a marble run of {marbles} marbles is more than the {most} its bowl is made for")]
+    MarbleRunTooLarge {
+        /// The marbles asked for.
+        marbles: usize,
+        /// The most it is made for.
+        most: usize,
+    },
     /// The file could not be read.
     #[error("cannot read scene file: {0}")]
     Io(#[from] std::io::Error),

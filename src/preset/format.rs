@@ -6,7 +6,7 @@ use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::error::PresetError;
-use crate::dynamics::{BeadParams, BeadRadius, Contacts, SimParams};
+use crate::dynamics::{BeadParams, BeadRadius, Contacts, SendsBeadsBack, SimParams};
 use crate::geometry::{Coordinates, Friction, Side, Surface, WireMotion, WireShape};
 use crate::solver::{TOUCHING, overlapping};
 use crate::validate::{ParamError, finite, finite_vector, non_negative, positive};
@@ -202,13 +202,81 @@ pub struct WirePreset {
     /// by default, and only on a one-sided wire.
     #[serde(default, skip_serializing_if = "is_false")]
     pub catches: bool,
+    /// Whether it sends its beads back to a point of it once they have
+    /// left it and settled (see [`SendsBeadsBack`](crate::SendsBeadsBack)):
+    /// `sends_back: (to: (x, y), speed: v, after: t)`; not by default.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "written_some",
+        deserialize_with = "given_some"
+    )]
+    pub sends_back: Option<SendBackPreset<DVec2>>,
     /// The beads on it.
     #[serde(default)]
     pub beads: Vec<BeadPreset>,
 }
 
+/// Where a wire sends its settled beads back to: `(to: point, speed: v,
+/// after: t)`, a bead off the wire slower than `v` m/s for `t` s put at
+/// rest at `to` (see [`SendsBeadsBack`](crate::SendsBeadsBack)).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SendBackPreset<V> {
+    /// The point of the wire a bead is put at.
+    pub to: V,
+    /// The speed below which a bead is settling, m/s.
+    pub speed: f64,
+    /// How long it must stay below it, s.
+    pub after: f64,
+}
+
+impl<V: crate::dynamics::Dimension> SendBackPreset<V> {
+    /// The component, if the numbers are valid.
+    pub fn component(&self) -> Result<SendsBeadsBack<V>, ParamError> {
+        SendsBeadsBack::new(self.to, self.speed, self.after)
+    }
+}
+
+/// Checks what a wire does with beads that are not on it, in either
+/// dimension: one that catches them is one-sided, and the numbers it
+/// sends its beads back by are valid.
+pub(super) fn catching_and_sending<V: crate::dynamics::Dimension>(
+    (catches, side): (bool, Side),
+    sends_back: Option<&SendBackPreset<V>>,
+) -> Result<(), ParamError> {
+    if let Some(back) = sends_back {
+        back.component()?;
+    }
+    if catches && side == Side::Both {
+        return Err(ParamError::Incompatible(
+            "a wire that catches beads must be one-sided (side: Positive or Negative)",
+        ));
+    }
+    Ok(())
+}
+
+/// An optional section as a file writes it: `field: (…)`, not
+/// `Some((…))`.
+pub(super) fn written_some<T: Serialize, S: serde::Serializer>(
+    value: &Option<T>,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    match value {
+        Some(value) => value.serialize(serializer),
+        None => serializer.serialize_none(),
+    }
+}
+
+/// An optional section as a file gives it: present, or left out.
+pub(super) fn given_some<'de, T: Deserialize<'de>, D: serde::Deserializer<'de>>(
+    deserializer: D,
+) -> Result<Option<T>, D::Error> {
+    T::deserialize(deserializer).map(Some)
+}
+
 /// Whether a flag is off (and goes unwritten).
-fn is_false(flag: &bool) -> bool {
+pub(super) fn is_false(flag: &bool) -> bool {
     !flag
 }
 
@@ -286,12 +354,8 @@ impl ScenePreset {
                 .and_then(|_| wire.motion.validate())
                 .and_then(|_| wire.surface().validate())
                 .map_err(|source| PresetError::Wire { index, source })?;
-            if wire.catches && wire.side == Side::Both {
-                let source = ParamError::Incompatible(
-                    "a wire that catches beads must be one-sided (side: Positive or Negative)",
-                );
-                return Err(PresetError::Wire { index, source });
-            }
+            catching_and_sending((wire.catches, wire.side), wire.sends_back.as_ref())
+                .map_err(|source| PresetError::Wire { index, source })?;
         }
         let wires: Vec<&[BeadPreset]> = self.wires.iter().map(|w| w.beads.as_slice()).collect();
         check_beads_and_links(&wires, &self.beads, &self.constraints, &self.springs).map(drop)

@@ -29,6 +29,7 @@ mod error;
 mod export;
 mod format;
 mod hourglass;
+mod marble_run;
 mod pile;
 mod plugin;
 mod space;
@@ -44,9 +45,10 @@ pub(crate) use export::{BeadEdits, WireEdits, edited_scene};
 pub use export::{ExportDir, ExportPlugin, LastExport, scene_ron, scene_stem, with_edits};
 pub use format::{
     BeadPreset, ConstraintPreset, ContactsPreset, PinPreset, RodPreset, SceneLink, ScenePreset,
-    SpringPreset, WirePreset,
+    SendBackPreset, SpringPreset, WirePreset,
 };
 pub use hourglass::{GRAIN_RADIUS, Hourglass};
+pub use marble_run::{MARBLE_BOWL, MarbleRun};
 pub use pile::{PILE_RADIUS, Pour};
 pub use plugin::{
     ActivePreset, LoadPreset, ScenePresetLoader, ScenePresetPlugin, apply_loaded_preset,

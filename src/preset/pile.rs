@@ -117,7 +117,7 @@ impl Pour {
     /// Each row of the grid is walked only across the bowl's width at
     /// its height, and the walk stops at the last bead, so that a bowl of
     /// any size costs no more than its beads and its rows below them.
-    fn places(&self) -> Vec<[f64; 3]> {
+    pub(super) fn places(&self) -> Vec<[f64; 3]> {
         let r = PILE_RADIUS;
         let spacing = GRID * r;
         let inside = self.bowl - CLEAR * r;

@@ -8,11 +8,11 @@ use serde::{Deserialize, Serialize};
 
 use super::error::PresetError;
 use super::format::{
-    BeadPreset, ConstraintPreset, ContactsPreset, SceneLink, SpringPreset, check_beads_and_links,
-    names_of,
+    BeadPreset, ConstraintPreset, ContactsPreset, SceneLink, SendBackPreset, SpringPreset,
+    catching_and_sending, check_beads_and_links, given_some, is_false, names_of, written_some,
 };
 use super::spawn::{FromPreset, spawn_beads_and_links};
-use crate::dynamics::{PrescribedMotion, RailOrientation, SpaceParams, SpaceWire};
+use crate::dynamics::{CatchesBeads, PrescribedMotion, RailOrientation, SpaceParams, SpaceWire};
 use crate::geometry::{
     Circle, Cone, Cycloid, Cylinder, Ellipse, Friction, Helix, Line, OnPlane, Oscillate, Parabola,
     Plane, Pose3, Side, Sine, SpaceMotion, SpaceShape, Sphere, Spline, Surface, Torus, WireShape,
@@ -244,31 +244,29 @@ pub struct SpaceWirePreset {
     #[serde(
         default,
         skip_serializing_if = "Option::is_none",
-        serialize_with = "written_rail",
-        deserialize_with = "given_rail"
+        serialize_with = "written_some",
+        deserialize_with = "given_some"
     )]
     pub rail: Option<RailPreset>,
+    /// Whether it catches every bead with a radius that flies onto it, not
+    /// only its own (a marble run's bowl; see [`CatchesBeads`]): `false`
+    /// by default, and only on a one-sided surface.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub catches: bool,
+    /// Whether it sends its beads back to a point of it once they have
+    /// left it and settled: `sends_back: (to: (x, y, z), speed: v,
+    /// after: t)` (see [`SendsBeadsBack`](crate::SendsBeadsBack)); not by
+    /// default.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "written_some",
+        deserialize_with = "given_some"
+    )]
+    pub sends_back: Option<SendBackPreset<DVec3>>,
     /// The beads on it.
     #[serde(default)]
     pub beads: Vec<BeadPreset<DVec3>>,
-}
-
-/// A rail as a file writes it: `rail: (up: …)`, not `Some((up: …))`.
-fn written_rail<S: serde::Serializer>(
-    rail: &Option<RailPreset>,
-    serializer: S,
-) -> Result<S::Ok, S::Error> {
-    match rail {
-        Some(rail) => rail.serialize(serializer),
-        None => serializer.serialize_none(),
-    }
-}
-
-/// A rail as a file gives it: present, or left out.
-fn given_rail<'de, D: serde::Deserializer<'de>>(
-    deserializer: D,
-) -> Result<Option<RailPreset>, D::Error> {
-    RailPreset::deserialize(deserializer).map(Some)
 }
 
 /// A wire's rail: `rail: (up: (0.0, 1.0, 0.0))`.
@@ -299,7 +297,8 @@ impl SpaceWirePreset {
         })
     }
 
-    /// Checks its shape, pose, motion, surface and rail.
+    /// Checks its shape, pose, motion, surface, rail and what it does with
+    /// beads not on it.
     fn validate(&self) -> Result<(), ParamError> {
         self.shape.validate()?;
         self.pose()?;
@@ -312,6 +311,7 @@ impl SpaceWirePreset {
             }
             RailOrientation::new(rail.up)?;
         }
+        catching_and_sending((self.catches, self.side), self.sends_back.as_ref())?;
         self.surface().validate()
     }
 }
@@ -398,6 +398,12 @@ impl SpaceScene {
                     && motion != SpaceMotion::Fixed
                 {
                     entity.insert(prescribed);
+                }
+                if wire.catches {
+                    entity.insert(CatchesBeads);
+                }
+                if let Some(Ok(back)) = wire.sends_back.map(|b| b.component()) {
+                    entity.insert(back);
                 }
                 entity.id()
             });

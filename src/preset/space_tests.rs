@@ -53,6 +53,30 @@ fn the_rotating_hoop_scene_parses() {
     // A rail: its beads turn with the track.
     let rail = space(&HOOP.replace("beads:", "rail: (up: (0.0, 1.0, 0.0)), beads:"));
     assert_eq!(rail.wires[0].rail, Some(super::RailPreset { up: DVec3::Y }));
+    // A bowl that catches, a wire that sends its beads back: written as
+    // read, left out where not given.
+    assert!(!scene.wires[0].catches && scene.wires[0].sends_back.is_none());
+    let back = "sends_back: (to: (1.0, 0.0, 0.0), speed: 0.1, after: 0.5), beads:";
+    let bowl = space(
+        &HOOP
+            .replace("Circle((radius: 1.0))", "Sphere((radius: 1.0))")
+            .replace("beads:", &format!("side: Negative, catches: true, {back}")),
+    );
+    let wire = &bowl.wires[0];
+    assert!(wire.catches);
+    let sent = wire
+        .sends_back
+        .expect("sends back")
+        .component()
+        .expect("valid");
+    assert_eq!(
+        (sent.to(), sent.speed(), sent.after()),
+        (DVec3::X, 0.1, 0.5)
+    );
+    let written = crate::preset::scene_ron(&SceneFile::Space(bowl.clone())).expect("written");
+    assert!(written.contains("catches: true") && written.contains("sends_back: ("));
+    let plain = crate::preset::scene_ron(&SceneFile::Space(scene.clone())).expect("written");
+    assert!(!plain.contains("sends_back") && !plain.contains("catches"));
     // A spin with no axis turns about z, as in the plane.
     let default_axis = space(&HOOP.replace(", axis: (0.0, 1.0, 0.0)))", "))"));
     assert_eq!(
@@ -117,6 +141,31 @@ fn bad_scenes_in_space_are_refused_in_one_line_naming_the_item() {
             HOOP.replace("Circle((radius: 1.0))", "Sphere((radius: 1.0))")
                 .replace("beads:", "rail: (up: (0.0, 1.0, 0.0)), beads:"),
             "wire 0: a rail is a curve: a surface has no track to turn with",
+        ),
+        (
+            HOOP.replace("beads:", "catches: true, beads:"),
+            "wire 0: a wire that catches beads must be one-sided",
+        ),
+        (
+            HOOP.replace(
+                "beads:",
+                "sends_back: (to: (1.0, 0.0, 0.0), speed: 0.0, after: 0.5), beads:",
+            ),
+            "wire 0: speed below which a bead has settled must be positive and finite, got 0",
+        ),
+        (
+            HOOP.replace(
+                "beads:",
+                "sends_back: (to: (1.0, NaN, 0.0), speed: 0.1, after: 0.5), beads:",
+            ),
+            "wire 0: point beads are sent back to must be finite",
+        ),
+        (
+            HOOP.replace(
+                "beads:",
+                "sends_back: (to: (1.0, 0.0, 0.0), speed: 0.1, after: -1.0), beads:",
+            ),
+            "wire 0: time a bead takes to settle",
         ),
         (
             HOOP.replace("mass: 1.0", "mass: NaN"),

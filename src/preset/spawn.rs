@@ -36,6 +36,9 @@ impl ScenePreset {
                 if wire.catches {
                     entity.insert(CatchesBeads);
                 }
+                if let Some(Ok(back)) = wire.sends_back.map(|b| b.component()) {
+                    entity.insert(back);
+                }
                 entity.id()
             });
             let base = Pose::new(wire.position, wire.angle_degrees.to_radians());

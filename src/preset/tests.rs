@@ -421,3 +421,70 @@ fn an_hourglass_too_large_or_malformed_is_refused_in_words() {
     .unwrap_err();
     assert!(err.to_string().contains("timestep"), "{err}");
 }
+
+/// A marble run: its marbles apart, the first twelve on the rail at its
+/// spiral's points (the spline passes through them) and the rest off it inside the
+/// bowl below the rail's end; the bowl catches, the rail sends marbles
+/// back to its top.
+#[test]
+fn a_marble_run_has_its_marbles_apart_on_the_rail_and_in_the_bowl() {
+    use bevy::math::DVec3;
+
+    use crate::geometry::SpaceCurve;
+    let scene = super::MarbleRun::default().scene().expect("a marble run");
+    let [bowl, rail] = &scene.wires[..] else {
+        panic!("a bowl and a rail: {} wires", scene.wires.len());
+    };
+    assert!(bowl.catches && bowl.sends_back.is_none());
+    let points = super::MarbleRun::rail();
+    let back = rail.sends_back.expect("the rail sends back");
+    assert_eq!(back.to, points[0]);
+    let super::SpaceShapePreset::Spline(curve) = &rail.shape else {
+        panic!("the rail is a spline");
+    };
+    assert!(curve.has_ends());
+    let at: Vec<DVec3> = rail.beads.iter().map(|b| b.initial_position).collect();
+    assert_eq!(at.len(), 200);
+    let r = super::PILE_RADIUS;
+    let off = |p: DVec3| {
+        let [a, b] = curve.rows(p, f64::NAN);
+        a.c.hypot(b.c)
+    };
+    for (k, &p) in at.iter().enumerate() {
+        // The spiral's points but its last, then the bowl.
+        if k < points.len() - 3 {
+            assert_eq!(p, points[k]);
+            assert!(off(p) <= 1e-12, "marble {k} is {} off the rail", off(p));
+        } else {
+            assert!(off(p) > 2.0 * r, "marble {k} starts on the rail");
+            assert!(
+                p.length() < super::MARBLE_BOWL - r,
+                "marble {k} outside the bowl"
+            );
+            assert!(
+                p.y < points[points.len() - 1].y - 2.0 * r,
+                "marble {k} above the rail's end"
+            );
+        }
+        for (j, &q) in at[..k].iter().enumerate() {
+            assert!((p - q).length() > 2.0 * r, "marbles {j} and {k} overlap");
+        }
+    }
+    let err = super::MarbleRun {
+        marbles: super::MarbleRun::MOST + 1,
+        ..super::MarbleRun::default()
+    }
+    .scene()
+    .unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "a marble run of 1001 marbles is more than the 1000 its bowl is made for"
+    );
+    let none = super::MarbleRun {
+        timestep: 0.0,
+        ..super::MarbleRun::default()
+    }
+    .scene()
+    .unwrap_err();
+    assert!(none.to_string().contains("timestep"), "{none}");
+}

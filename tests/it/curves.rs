@@ -176,3 +176,65 @@ fn a_planar_spline_in_space_steps_as_in_the_plane() {
     let worst = curve_against_plane(&plane, space, plane.point(0.5), 3000);
     assert!(worst <= 1e-10, "{worst:e} from the plane's trajectory");
 }
+
+/// A bead that slides down an open spline in space leaves it at its end,
+/// as on an open curve in the plane: the instant it passes the end is
+/// found within the step, the island reports it once (for the curve's two
+/// rows), and the bead flies on from there. On a straight track (three
+/// points in a line) RATTLE slides and flies exactly under gravity, so
+/// the bead leaves where the track ends at `√(2 g sinθ L)` along it and
+/// then follows the parabola from there: to 1e-9 m over half a second.
+#[test]
+fn a_bead_leaves_an_open_spline_in_space_at_its_end() {
+    let (top, end) = (DVec3::new(0.0, 1.0, 0.0), DVec3::new(1.6, 0.0, 1.2));
+    let spline = Spline::<DVec3>::new(SplineSpec {
+        kind: SplineKind::CatmullRom,
+        points: vec![top, (top + end) / 2.0, end],
+        closed: false,
+    })
+    .expect("a straight track");
+    assert!(spline.has_ends(), "an open spline ends");
+    let s = common::params(Method::Rattle, 1.0 / 240.0).step_settings();
+    let island = Island::new(&[1.0], curve_rows(spline.clone()).to_vec(), vec![])
+        .expect("a bead on a spline");
+    let mut work = IslandWork::default();
+    let mut states = [BeadState {
+        position: top,
+        velocity: DVec3::ZERO,
+    }];
+    let g = DVec3::new(0.0, -G, 0.0);
+    let gravity = [LinearForce::constant(g)];
+    let length = (end - top).length();
+    let tangent = (end - top) / length;
+    let along = g.dot(tangent);
+    let leaves = (2.0 * length / along).sqrt();
+    let leaving = tangent * along * leaves;
+    let mut left = Vec::new();
+    let steps = ((leaves + 0.5) / s.dt).round() as usize;
+    for k in 0..steps {
+        island
+            .step_at(k as f64 * s.dt, &mut states, &gravity, &s, &mut work)
+            .expect("a step");
+        left.extend(work.events().iter().map(|&(_, _, event)| event));
+    }
+    let [wirebead::solver::ContactEvent::Left { time, position }] = left[..] else {
+        panic!("the bead left once: {left:?}");
+    };
+    assert!(
+        (time - leaves).abs() <= 1e-9,
+        "left at {time}, not {leaves}"
+    );
+    assert!(
+        (position - end).length() <= 1e-9,
+        "left at {position}, not {end}"
+    );
+    let t = steps as f64 * s.dt - leaves;
+    let flown = end + leaving * t + 0.5 * g * t * t;
+    let off = (states[0].position - flown).length();
+    assert!(
+        off <= 1e-9,
+        "{off:e} m from the parabola from the track's end"
+    );
+    let fast = (states[0].velocity - (leaving + g * t)).length();
+    assert!(fast <= 1e-9, "{fast:e} m/s from the parabola's velocity");
+}

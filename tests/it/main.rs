@@ -15,6 +15,7 @@ mod ghost;
 mod islands;
 mod layers;
 mod layout;
+mod marble_run;
 mod parallel;
 mod pendulum;
 mod precision;

@@ -75,6 +75,17 @@ pub trait SpaceCurve {
             normal,
         }
     }
+    /// Whether the curve ends (an open spline): a bead that passes an end
+    /// leaves it there, as on an open curve in the plane.
+    fn has_ends(&self) -> bool {
+        false
+    }
+    /// How far past an end along its tangent line the point nearest `p`
+    /// lies, looked for near the parameter `hint`: zero or less on the
+    /// curve, −∞ for a curve with no end.
+    fn past_end(&self, _p: DVec3, _hint: f64) -> f64 {
+        f64::NEG_INFINITY
+    }
 }
 
 /// A curve's tangent and first normal at a point, both unit (zero at a
@@ -201,6 +212,12 @@ impl<P: Parametric<DVec3>> SpaceCurve for Traced<P, DVec3> {
             normal: self.normal_at(nearest.s, tangent),
         }
     }
+    fn has_ends(&self) -> bool {
+        !self.path().closed()
+    }
+    fn past_end(&self, p: DVec3, hint: f64) -> f64 {
+        self.nearest(p, hint).past
+    }
 }
 
 impl SpaceCurve for Spline<DVec3> {
@@ -215,6 +232,12 @@ impl SpaceCurve for Spline<DVec3> {
     }
     fn frame(&self, p: DVec3, hint: f64) -> CurveFrame {
         self.traced().frame(p, hint)
+    }
+    fn has_ends(&self) -> bool {
+        SpaceCurve::has_ends(self.traced())
+    }
+    fn past_end(&self, p: DVec3, hint: f64) -> f64 {
+        SpaceCurve::past_end(self.traced(), p, hint)
     }
 }
 

@@ -89,6 +89,10 @@ impl Default for PresetCatalog {
                     "scenes/rope_in_space.scene.ron",
                 ),
                 ("In space: bead in a bowl", "scenes/bowl.scene.ron"),
+                (
+                    "In space: marble run of 200",
+                    "scenes/marble_run_in_space.scene.ron",
+                ),
             ]
             .into_iter()
             .map(|(a, b)| (a.to_owned(), b.to_owned()))

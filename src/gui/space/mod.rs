@@ -24,7 +24,7 @@ use bevy::prelude::*;
 use bevy_egui::input::EguiWantsInput;
 
 use super::drag::Grabbed;
-use super::render::{SceneCamera, SceneStyle, clear_trails_on_restart};
+use super::render::{SceneCamera, SceneStyle, clear_trails};
 use crate::{SpaceBead, SpaceWire, SpringAnchor};
 pub use draw::WireDrawing;
 
@@ -103,7 +103,7 @@ impl Plugin for SpaceViewPlugin {
                 Update,
                 (
                     show_view,
-                    clear_trails_on_restart::<Vec3>,
+                    clear_trails::<Vec3>,
                     draw::add_wire_drawings,
                     draw::add_bead_visuals,
                     draw::frame_scene,

@@ -33,14 +33,16 @@ fn onto(curve: &dyn SpaceCurve, mut p: DVec3, hint: f64) -> Option<DVec3> {
 }
 
 /// Points along `curve` in its local frame, for drawing: from the first
-/// of `starts` that projects onto it, walked both ways in steps of about
-/// `reach / 300` until the curve closes on itself or leaves the ball of
-/// radius `reach` about the origin. A closed curve's last point is its
+/// of `starts` that projects onto it (not onto its continuation past an
+/// end), walked both ways in steps of about `reach / 300` until the curve
+/// closes on itself, passes an end (an open spline's), or leaves the ball
+/// of radius `reach` about the origin. A closed curve's last point is its
 /// first. Empty if no start projects onto it.
 pub fn curve_points(curve: &dyn SpaceCurve, starts: &[DVec3], reach: f64) -> Vec<DVec3> {
+    let on_it = |p: &DVec3| p.is_finite() && curve.past_end(*p, f64::NAN) <= 0.0;
     let Some(first) = starts
         .iter()
-        .find_map(|&s| onto(curve, s, f64::NAN).filter(|p| p.is_finite()))
+        .find_map(|&s| onto(curve, s, f64::NAN).filter(on_it))
     else {
         return Vec::new();
     };
@@ -60,6 +62,9 @@ pub fn curve_points(curve: &dyn SpaceCurve, starts: &[DVec3], reach: f64) -> Vec
             let Some(next) = onto(curve, p + tangent * ds, hint) else {
                 break;
             };
+            if curve.past_end(next, hint) > 0.0 {
+                break;
+            }
             if points.len() > 4 && next.distance(first) < 0.75 * ds {
                 points.push(first);
                 return (points, true);
@@ -217,6 +222,34 @@ mod tests {
         for w in points.windows(2) {
             assert!((w[0].distance(w[1]) - ds).abs() < 0.05 * ds);
         }
+    }
+
+    /// An open spline is traced from end to end and no farther: every
+    /// point on it, the first and last within a step of its ends.
+    #[test]
+    fn an_open_spline_is_traced_to_its_ends_and_no_farther() {
+        use crate::geometry::{Spline, SplineKind, SplineSpec};
+        let points = vec![
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(1.0, 0.5, 0.5),
+            DVec3::new(2.0, 0.0, 0.0),
+        ];
+        let spline = Spline::<DVec3>::new(SplineSpec {
+            kind: SplineKind::CatmullRom,
+            points: points.clone(),
+            closed: false,
+        })
+        .expect("a spline");
+        let reach = 30.0;
+        let traced = curve_points(&spline, &[points[1]], reach);
+        let ds = reach / 300.0;
+        for p in &traced {
+            assert!(spline.past_end(*p, f64::NAN) <= 0.0, "{p} past an end");
+        }
+        let ends = [traced[0], traced[traced.len() - 1]];
+        assert!(ends[0].distance(points[0]).min(ends[0].distance(points[2])) <= ds);
+        assert!(ends[1].distance(points[0]).min(ends[1].distance(points[2])) <= ds);
+        assert!(ends[0].distance(ends[1]) > 2.0, "both ways");
     }
 
     #[test]

@@ -449,7 +449,7 @@ pub(super) fn prepare_islands<V: Dimension>(
         });
         match built {
             Ok(mut island) => {
-                let work = start_island(
+                let (work, states) = start_island(
                     &mut island,
                     &entities,
                     (&wire_rows, &pair_rows),
@@ -466,7 +466,7 @@ pub(super) fn prepare_islands<V: Dimension>(
                     },
                     island,
                     work,
-                    states: Vec::with_capacity(group.len()),
+                    states,
                     forces: Vec::with_capacity(group.len()),
                     masses: masses.clone(),
                     links: link_rows,

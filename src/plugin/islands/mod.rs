@@ -10,11 +10,15 @@
 //! | `start` | how an island built again starts: its rows as the last islands left them |
 //! | `step` | stepping them: gather, solve (in parallel), write back |
 //! | `touch` | beads that touch: the steps cut where they meet, the strikes |
+//! | `send_back` | beads that settled off a wire sent back to its start ([`SendsBeadsBack`]) |
 
 mod build;
+mod send_back;
 mod start;
 mod step;
 mod touch;
+
+use std::collections::HashMap;
 
 use bevy::ecs::lifecycle::{Add, Insert, Remove};
 use bevy::math::{DVec2, DVec3};
@@ -24,7 +28,8 @@ use super::clock::advance_clock;
 use super::schedule::WireBeadSystems;
 use super::wires::place_wires;
 use crate::dynamics::{
-    BeadRadius, CatchesBeads, ConstraintDiagnostics, Dimension, Joint, OnWire, Pin, Rod, Spring,
+    BeadRadius, BeadSentBack, CatchesBeads, ConstraintDiagnostics, Dimension, Joint, OnWire, Pin,
+    Rod, SendsBeadsBack, Spring,
 };
 use crate::solver::{BeadState, Island, IslandMark, IslandWork, LinearForce, SolveError};
 
@@ -42,6 +47,9 @@ impl Plugin for IslandPlugin {
             .register_type::<Pin<DVec3>>()
             .register_type::<Spring>()
             .register_type::<CatchesBeads>()
+            .add_message::<BeadSentBack>()
+            .register_type::<SendsBeadsBack>()
+            .register_type::<SendsBeadsBack<DVec3>>()
             .register_type::<ConstraintDiagnostics>();
         add_islands::<DVec2>(app);
         add_islands::<DVec3>(app);
@@ -87,6 +95,12 @@ fn add_islands<V: Dimension>(app: &mut App) {
                 step::step_islands::<V>
                     .run_if(any_island::<V>)
                     .in_set(WireBeadSystems::Step),
+                // Before the islands are built for the step: a bead sent
+                // back is in the one it joins for this step.
+                send_back::send_back::<V>
+                    .run_if(any_with_component::<SendsBeadsBack<V>>)
+                    .before(build::prepare_islands::<V>)
+                    .in_set(WireBeadSystems::Prepare),
             ),
         );
 }
@@ -207,6 +221,10 @@ struct CachedIsland<V: Dimension> {
 pub struct Islands<V: Dimension = DVec2> {
     cached: Vec<CachedIsland<V>>,
     dirty: bool,
+    /// Since when each bead off a wire that sends beads back has been
+    /// slower than the wire's settling speed ([`SendsBeadsBack`]), s:
+    /// kept here so that a clone steps on as the original would.
+    settling: HashMap<Entity, f64>,
 }
 
 impl<V: Dimension> Default for Islands<V> {
@@ -214,6 +232,7 @@ impl<V: Dimension> Default for Islands<V> {
         Self {
             cached: Vec::new(),
             dirty: false,
+            settling: HashMap::new(),
         }
     }
 }
@@ -239,7 +258,8 @@ impl<V: Dimension> Islands<V> {
                 20 * (c.states.len() * size_of::<V>() + c.report.rows * size_of::<f64>())
                     + size_of::<CachedIsland<V>>()
             })
-            .sum()
+            .sum::<usize>()
+            + self.settling.len() * size_of::<(Entity, f64)>()
     }
 
     /// Asks for a rebuild before the next step.

@@ -23,9 +23,8 @@ pub(super) type BuildBead<V> = (
 );
 
 /// Where each row of the last islands is (its island and row), and where
-/// its beads were when they were last stepped (or now, for an island
-/// built and not stepped since): what a rebuilt island starts its rows
-/// from. Wire rows by bead, wire and the wire's row; contacts by their
+/// its beads were when they were last stepped (or built, for an island
+/// not stepped since): what a rebuilt island starts its rows from. Wire rows by bead, wire and the wire's row; contacts by their
 /// two beads (in order).
 pub(super) struct Carried<V: Dimension> {
     wire_rows: HashMap<(Entity, Entity, usize), ((usize, usize), BeadState<V>)>,
@@ -82,6 +81,9 @@ impl<V: Dimension> Carried<V> {
 /// motion, and the beads' velocities projected onto the island's
 /// constraints ([`Island::project_velocities`]), so that the state a run
 /// starts from is the one simulated. A change is logged in one line.
+/// Returns the work and the beads' states it starts from (none where one
+/// is not finite): what a rebuild before its first step compares the
+/// beads with, so that a bead moved since starts its rows afresh.
 pub(super) fn start_island<V: Dimension>(
     island: &mut Island<V>,
     entities: &[Entity],
@@ -90,7 +92,7 @@ pub(super) fn start_island<V: Dimension>(
     wires: &Query<(&V::Wire, &WirePose<V>)>,
     beads: &mut Query<BuildBead<V>>,
     clock: &SimClock,
-) -> IslandWork<V> {
+) -> (IslandWork<V>, Vec<BeadState<V>>) {
     let mut work = IslandWork::default();
     let now = |bead: Entity| beads.get(bead).ok().map(|(_, now, ..)| now.state());
     for wire_row in wire_rows {
@@ -124,12 +126,12 @@ pub(super) fn start_island<V: Dimension>(
         match beads.get(entity) {
             Ok((_, bead, ..)) if bead.state().is_finite() => states.push(bead.state()),
             // A bead whose state is not finite: the step reports it.
-            _ => return work,
+            _ => return (work, Vec::new()),
         }
     }
     let Ok((before, after)) = island.project_velocities(clock.time, &mut states, &mut work) else {
         // No projection (a singular point): the step meets it and reports.
-        return work;
+        return (work, states);
     };
     let mut changed = Vec::new();
     for (&entity, state) in entities.iter().zip(&states) {
@@ -150,5 +152,5 @@ pub(super) fn start_island<V: Dimension>(
             changed.join(", ")
         );
     }
-    work
+    (work, states)
 }

@@ -318,7 +318,7 @@ impl<V: WireSpace> Island<V> {
     }
 
     /// Records that wire row `r`'s bead left its wire at `time`, where it
-    /// is in `states`.
+    /// is in `states` (once for a curve in space, by its first row).
     pub(super) fn report_left(
         &self,
         r: usize,
@@ -326,6 +326,9 @@ impl<V: WireSpace> Island<V> {
         states: &[BeadState<V>],
         work: &mut IslandWork<V>,
     ) {
+        if self.second_row(r) {
+            return; // the curve's first row reported it
+        }
         let bead = self.entry_bead[self.row_start[r]];
         let position = states[bead].position;
         work.events

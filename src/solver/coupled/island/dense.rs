@@ -81,16 +81,18 @@ struct Problem<'a> {
 }
 
 impl<V: WireSpace> Island<V> {
-    /// Whether the island's RATTLE steps are dense ([`Island::step_dense`]):
-    /// it time-steps ([`Island::time_steps`]), has no friction, no wire
-    /// that ends and none that catches its bead, and every one-sided wire
-    /// row lands at `e = 0` (contacts that strike with `e > 0` are the
-    /// touch settlement's).
-    pub(crate) fn steps_densely(&self) -> bool {
+    /// Whether the island's RATTLE steps are dense ([`Island::step_dense`])
+    /// with its rows as `work` has them: it time-steps
+    /// ([`Island::time_steps`]), has no friction, every one-sided wire row
+    /// lands at `e = 0` (contacts that strike with `e > 0` are the touch
+    /// settlement's), and every bead on a wire that ends has left it (a
+    /// marble off the end of its rail; the instant a bead passes an end is
+    /// located, which a dense step does not do).
+    pub(crate) fn steps_densely(&self, work: &IslandWork<V>) -> bool {
         self.time_steps()
             && !self.is_rough()
-            && !self.has_ends()
-            && !self.catching.contains(&true)
+            && (!self.has_ends()
+                || (0..self.rows()).all(|r| !self.ends(r) || work.inactive.get(r) == Some(&true)))
             && self
                 .sides
                 .iter()
@@ -179,10 +181,19 @@ impl<V: WireSpace> Island<V> {
         let start = work.time;
         work.inactive.clear();
         work.inactive.resize(rows, false);
+        // A bead behind a wire that catches it (a marble under another
+        // track, or outside the bowl) does not land on it from there.
+        let behind = |r: usize| {
+            self.catching[r]
+                && self
+                    .in_front(r, &work.x0, start)
+                    .is_some_and(|c| c < -OFF_THE_WIRE * self.rows[r].scale())
+        };
         let bounds: Vec<Bound> = (0..rows)
             .map(|r| match self.sides[r] {
                 (0.0, _) if set_aside[r] => Bound::Out,
                 (0.0, _) => Bound::Equal,
+                (_, _) if set_aside[r] && behind(r) => Bound::Out,
                 (side, e) if e == 0.0 || !set_aside[r] => Bound::Side(side),
                 _ => Bound::Out,
             })

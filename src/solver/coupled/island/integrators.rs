@@ -153,7 +153,7 @@ impl<V: WireSpace> Island<V> {
         h: f64,
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
-        if self.steps_densely() {
+        if self.steps_densely(work) {
             return self.rattle_dense(forces, h, work);
         }
         let start = work.time;

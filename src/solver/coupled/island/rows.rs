@@ -82,6 +82,27 @@ impl<V: WireSpace> Island<V> {
         matches!(&self.rows[r], RowKind::Wire { shape, .. } if V::shape_has_ends(shape))
     }
 
+    /// Whether row `r` is the second row of a curve in space (the row
+    /// before it the same bead's first), which its first row speaks for:
+    /// past an end, a bead leaves both.
+    pub(super) fn second_row(&self, r: usize) -> bool {
+        r > 0 && matches!(&self.rows[r], RowKind::Wire { shape, .. } if V::shape_second_row(shape))
+    }
+
+    /// How far wire row `r`'s bead in `states` is from its wire at
+    /// `time`, in the row's units: `|C|`, or for a curve in space the
+    /// length of its two rows' offsets.
+    pub(super) fn off_wire(&self, r: usize, states: &[BeadState<V>], time: f64) -> f64 {
+        let first = if self.second_row(r) { r - 1 } else { r };
+        let c = |r: usize| self.wire_row(r, states, time).c;
+        let off = c(first).abs();
+        if first + 1 < self.rows() && self.second_row(first + 1) {
+            off.hypot(c(first + 1))
+        } else {
+            off
+        }
+    }
+
     /// Whether any row is a wire's that ends.
     pub(super) fn has_ends(&self) -> bool {
         self.ended > 0
@@ -98,6 +119,8 @@ impl<V: WireSpace> Island<V> {
         time: f64,
         hints: &[f64],
     ) -> f64 {
+        // A curve's two rows end as one, where its first row says.
+        let r = if self.second_row(r) { r - 1 } else { r };
         let Some((shape, pose, _, state)) = self.wire_and_bead(r, states, time) else {
             return f64::NEG_INFINITY;
         };

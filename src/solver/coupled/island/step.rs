@@ -87,7 +87,12 @@ impl<V: WireSpace> Island<V> {
         whole: f64,
         work: &mut IslandWork<V>,
     ) -> Result<(), SolveError> {
-        if settings.method == Method::Rattle && self.steps_densely() {
+        let rattle = settings.method == Method::Rattle;
+        if rattle && self.time_steps() && self.has_ends() {
+            // Which beads have left a wire that ends decides.
+            self.begin(time, states, work);
+        }
+        if rattle && self.steps_densely(work) {
             return self.step_dense(time, states, forces, settings, work);
         }
         let exact = settings.method.ends_on_constraints();
@@ -233,7 +238,7 @@ impl<V: WireSpace> Island<V> {
     /// Which rows a fresh island starts with: a bead that starts off a
     /// one-sided wire, on the side it pushes toward (or on either side of
     /// a wire that catches it, see [`Island::set_catching`]), or past an
-    /// end of its wire, starts in flight (a row told otherwise by
+    /// end of its wire or away from a wire that ends, starts in flight (a row told otherwise by
     /// [`IslandWork::carry`] starts as it was told); a
     /// contact starts set aside, unless told it is held;
     /// stick rows start set aside (a bead slides until friction stops it),
@@ -259,8 +264,13 @@ impl<V: WireSpace> Island<V> {
             let off = OFF_THE_WIRE * self.rows[r].scale();
             let apart = side != 0.0
                 && (self.contacts[r] || side * c() > off || (self.catching[r] && c().abs() > off));
-            if apart || (ends && self.ends(r) && self.past_end(r, states, time, &work.hints) > 0.0)
-            {
+            // A bead past an end of its wire, or away from a wire that
+            // ends, has left it.
+            let left = || {
+                self.past_end(r, states, time, &work.hints) > 0.0
+                    || self.off_wire(r, states, time) > off
+            };
+            if apart || (ends && self.ends(r) && left()) {
                 work.inactive[r] = true;
             }
         }
