@@ -242,7 +242,7 @@ pub(super) fn prepare_islands<V: Dimension>(
     // Beads with radii that may meet soon, joined by contact rows.
     let with_radius: Vec<(Entity, BeadState<V>, f64)> = beads
         .iter()
-        .filter_map(|(entity, bead, _, _, radius)| {
+        .filter_map(|(entity, bead, _, _, radius, _)| {
             let r = radius?.get();
             (r > 0.0).then(|| (entity, bead.state(), r))
         })
@@ -295,7 +295,7 @@ pub(super) fn prepare_islands<V: Dimension>(
             join(b, &mut members);
         }
     }
-    for (entity, _, on_wire, _, radius) in &beads {
+    for (entity, _, on_wire, _, radius, _) in &beads {
         let lone = on_wire.is_some_and(|on| wires.get(on.0).map_or(true, |(w, _)| w.lone()));
         if !lone || radius.is_some() {
             join(entity, &mut members);
@@ -345,7 +345,7 @@ pub(super) fn prepare_islands<V: Dimension>(
         let mut wired = WiredRows::default();
         let mut invalid = None;
         for (local, &entity) in entities.iter().enumerate() {
-            let Ok((_, bead, on_wire, _, radius)) = beads.get(entity) else {
+            let Ok((_, bead, on_wire, _, radius, _)) = beads.get(entity) else {
                 invalid = Some(format!("entity {entity} is no longer a bead"));
                 break;
             };
@@ -486,7 +486,7 @@ pub(super) fn prepare_islands<V: Dimension>(
             }
         }
     }
-    for (entity, _, _, marked, _) in &beads {
+    for (entity, _, _, marked, ..) in &beads {
         match (index.contains_key(&entity), marked) {
             (true, false) => {
                 commands.entity(entity).try_insert(InIsland);

@@ -8,18 +8,20 @@ use std::collections::HashMap;
 use bevy::prelude::*;
 
 use super::{CachedIsland, ContactRow, InIsland, WireRow};
-use crate::dynamics::{BeadMotion, BeadRadius, Dimension, OnWire, WirePose};
+use crate::dynamics::{BeadMotion, BeadRadius, Dimension, OnWire, WireContact, WirePose};
 use crate::plugin::clock::SimClock;
-use crate::solver::{BeadState, Island, IslandWork};
+use crate::solver::{BeadState, Contact, Island, IslandWork};
 
 /// What the rebuild reads and writes of each bead: its motion, wire,
-/// marker, and whether it has a radius (and so steps in an island).
+/// marker, whether it has a radius (and so steps in an island), and
+/// whether it is held on its wire.
 pub(super) type BuildBead<V> = (
     Entity,
     BeadMotion<V>,
     Option<&'static OnWire>,
     Has<InIsland>,
     Option<&'static BeadRadius>,
+    Option<&'static mut WireContact>,
 );
 
 /// Where each row of the last islands is (its island and row), and where
@@ -127,6 +129,17 @@ pub(super) fn start_island<V: Dimension>(
             Ok((_, bead, ..)) if bead.state().is_finite() => states.push(bead.state()),
             // A bead whose state is not finite: the step reports it.
             _ => return (work, Vec::new()),
+        }
+    }
+    // A bead an island starts off its own wire (one that starts away from
+    // a wire that ends has left it) is in flight from the start; one the
+    // last islands carried is as they left it.
+    for wire_row in wire_rows.iter().filter(|w| w.own && !work.carries(w.row)) {
+        if island.starts_aside(wire_row.row, clock.time, &states, &[])
+            && let Ok((.., Some(mut contact))) = beads.get_mut(entities[wire_row.bead])
+            && contact.contact != Contact::InFlight
+        {
+            contact.contact = Contact::InFlight;
         }
     }
     let Ok((before, after)) = island.project_velocities(clock.time, &mut states, &mut work) else {

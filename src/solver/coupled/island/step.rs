@@ -223,6 +223,34 @@ impl<V: WireSpace> Island<V> {
         Ok(())
     }
 
+    /// Whether row `r` starts set aside at `states` (every bead's) at
+    /// `time`, by the rule of [`Island::start_rows`] before what a rebuilt
+    /// island carries: a contact (held only once its beads press, see
+    /// [`Island::set_contact`]); a one-sided wire's bead off it on the side
+    /// it pushes toward, or on either side of a wire that catches it; a
+    /// bead past an end of its wire, or away from a wire that ends (it has
+    /// left it). `hints`: the rows' curve parameters, where known.
+    pub(crate) fn starts_aside(
+        &self,
+        r: usize,
+        time: f64,
+        states: &[BeadState<V>],
+        hints: &[f64],
+    ) -> bool {
+        let side = self.sides[r].0;
+        let ends = self.ends(r);
+        if states.len() != self.beads() || (side == 0.0 && !ends) {
+            return false;
+        }
+        let c = || self.wire_row(r, states, time).c;
+        let off = OFF_THE_WIRE * self.rows[r].scale();
+        let apart = side != 0.0
+            && (self.contacts[r] || side * c() > off || (self.catching[r] && c().abs() > off));
+        let left =
+            || self.past_end(r, states, time, hints) > 0.0 || self.off_wire(r, states, time) > off;
+        apart || (ends && left())
+    }
+
     /// Sets the rows a fresh `work` starts with at `states` (as its first
     /// step would), so that what it carries can be kept
     /// ([`IslandWork::mark`]) before that step, and finds where along its
@@ -252,26 +280,11 @@ impl<V: WireSpace> Island<V> {
                 work.inactive[s] = true;
             }
         }
-        let ends = self.has_ends();
-        for r in 0..self.rows() {
-            let (side, _) = self.sides[r];
-            if !whole || (side == 0.0 && !ends) {
-                continue;
-            }
-            // A contact is held only once its beads press (see
-            // `Island::set_contact`).
-            let c = || self.wire_row(r, states, time).c;
-            let off = OFF_THE_WIRE * self.rows[r].scale();
-            let apart = side != 0.0
-                && (self.contacts[r] || side * c() > off || (self.catching[r] && c().abs() > off));
-            // A bead past an end of its wire, or away from a wire that
-            // ends, has left it.
-            let left = || {
-                self.past_end(r, states, time, &work.hints) > 0.0
-                    || self.off_wire(r, states, time) > off
-            };
-            if apart || (ends && self.ends(r) && left()) {
-                work.inactive[r] = true;
+        if whole {
+            for r in 0..self.rows() {
+                if self.starts_aside(r, time, states, &work.hints) {
+                    work.inactive[r] = true;
+                }
             }
         }
         // What a rebuilt island carries over (see `IslandWork::carry`).

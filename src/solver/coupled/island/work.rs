@@ -175,6 +175,12 @@ impl<V: WireSpace> IslandWork<V> {
         !self.inactive.get(row).copied().unwrap_or(false)
     }
 
+    /// Whether row `row` starts as a rebuilt island carried it over
+    /// ([`IslandWork::carry_row`]), not by the first step's rule.
+    pub(crate) fn carries(&self, row: usize) -> bool {
+        self.carried.get(row).is_some_and(Option::is_some)
+    }
+
     /// Starts row `row` of a fresh work held (or set aside) whatever the
     /// rule of the island's first step would say: what an island rebuilt
     /// around beads where the last one left them carries over, so a bead
