@@ -16,6 +16,10 @@
 //!   the bowl and those above striking them (`piling`), and from 1 s on,
 //!   the pile jammed and settling (`settling`): ten steps each, each
 //!   timed once.
+//! - `resting`: 10,000 beads of 2 cm in the plane stacked at rest on a
+//!   floor in a hundred columns of a hundred, and 10,648 marbles in space
+//!   in 22 × 22 columns of 22, every contact pressed or touching: what a
+//!   pile at rest costs a step.
 //! - `falling`: 10,000 beads of 2 cm in the plane, a hundred rows of a
 //!   hundred 10 cm apart across `x ∈ [−5, 5]`, the rows 8 cm apart,
 //!   falling in a one-sided bowl of radius 20 m (`plane`), and 10,648
@@ -246,5 +250,96 @@ fn falling_group(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, abacus_group, pile_group, falling_group);
+/// Columns of the resting pile in the plane, and its beads to a column.
+const RESTING: usize = 100;
+
+/// Columns to a side of the resting pile in space, and its marbles to a
+/// column.
+const RESTING_CUBE: usize = 22;
+
+/// A pile at rest on a floor (a one-sided line in the plane, a one-sided
+/// plane in space, its positive side up): beads of 2 cm and 1 kg stacked
+/// in columns, each touching the ones beside it and pressing on the one
+/// below (2r apart, to a millionth of a nanometre's gap), [`RESTING`]
+/// columns of [`RESTING`] in the plane, [`RESTING_CUBE`] × [`RESTING_CUBE`]
+/// columns of [`RESTING_CUBE`] in space, at `e = 0`, RATTLE at 240 Hz.
+/// Every bead is the floor's; those above its first layer start off it.
+fn resting_scene(space: bool) -> SceneFile {
+    let r = 0.02;
+    let spacing = 2.0 * r * (1.0 + 1e-12);
+    let (n, side) = if space {
+        (RESTING_CUBE.pow(3), RESTING_CUBE)
+    } else {
+        (RESTING * RESTING, RESTING)
+    };
+    let at = |k: usize| {
+        let (i, up) = (k % side, k / side);
+        // The floor is the line of the lowest beads' centres.
+        let y = spacing * (up % side) as f64;
+        if space {
+            let l = up / side;
+            format!("({}, {y}, {})", spacing * i as f64, spacing * l as f64)
+        } else {
+            format!("({}, {y})", spacing * i as f64)
+        }
+    };
+    let listed: String = (0..n)
+        .map(|k| {
+            format!(
+                "(name: \"b{k}\", mass: 1.0, radius: {r}, initial_position: {}),",
+                at(k)
+            )
+        })
+        .collect();
+    let (dimension, floor) = if space {
+        (3, "Plane(())")
+    } else {
+        (2, "Line(())")
+    };
+    SceneFile::from_ron(&format!(
+        "(name: \"resting\", dimension: {dimension}, \
+         params: (timestep: {}, integrator: Rattle), contacts: (restitution: 0.0), \
+         wires: [(shape: {floor}, side: Positive, beads: [{listed}])])",
+        1.0 / 240.0
+    ))
+    .expect("the resting pile")
+}
+
+/// Steps a resting pile takes before it is timed: its gaps of a
+/// millionth of a nanometre closed, every contact pressed.
+const SETTLED: usize = 5;
+
+fn resting_group(c: &mut Criterion) {
+    let mut group = c.benchmark_group("resting");
+    group.sampling_mode(SamplingMode::Flat);
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_millis(1));
+    group.measurement_time(Duration::from_millis(1));
+    for (name, space) in [("plane", false), ("space", true)] {
+        let preset = resting_scene(space);
+        let plugin = WireBeadPlugin::new(preset.params().clone()).expect("valid parameters");
+        let mut app = Headless::new(plugin).build();
+        preset.spawn(&mut app.world_mut().commands());
+        app.world_mut().flush();
+        for _ in 0..SETTLED {
+            app.world_mut().run_schedule(FixedUpdate);
+        }
+        let beads = if space {
+            RESTING_CUBE.pow(3)
+        } else {
+            RESTING * RESTING
+        };
+        group.throughput(Throughput::Elements(beads as u64));
+        time_steps(&mut group, &mut app, (name, beads));
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    abacus_group,
+    pile_group,
+    falling_group,
+    resting_group
+);
 criterion_main!(benches);
