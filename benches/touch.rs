@@ -149,19 +149,9 @@ const SETTLING: usize = 240;
 
 fn pile_group(c: &mut Criterion) {
     let preset = ScenePreset::pile(PILE, 23).expect("the pile");
-    let plugin = WireBeadPlugin::new(preset.params.clone()).expect("valid parameters");
-    let mut app = Headless::new(plugin).build();
-    preset.spawn(&mut app.world_mut().commands());
-    app.world_mut().flush();
-    for _ in 0..POURED {
-        app.world_mut().run_schedule(FixedUpdate);
-    }
-    let mut group = c.benchmark_group("pile");
+    let mut app = stepped(&SceneFile::Plane(preset), POURED);
+    let mut group = step_by_step(c, "pile");
     group.throughput(Throughput::Elements(PILE as u64));
-    group.sampling_mode(SamplingMode::Flat);
-    group.sample_size(10);
-    group.warm_up_time(Duration::from_millis(1));
-    group.measurement_time(Duration::from_millis(1));
     time_steps(&mut group, &mut app, ("pouring", PILE));
     let taken = app.world().resource::<SimClock>().steps as usize;
     for _ in taken..PILED {
@@ -230,19 +220,33 @@ fn falling_scene(space: bool) -> SceneFile {
     .expect("the falling beads")
 }
 
-fn falling_group(c: &mut Criterion) {
-    let mut group = c.benchmark_group("falling");
+/// A group that times steps of many beads one at a time: ten samples of
+/// one step each, flat.
+fn step_by_step<'a>(c: &'a mut Criterion, name: &str) -> BenchmarkGroup<'a, WallTime> {
+    let mut group = c.benchmark_group(name);
     group.sampling_mode(SamplingMode::Flat);
     group.sample_size(10);
     group.warm_up_time(Duration::from_millis(1));
     group.measurement_time(Duration::from_millis(1));
-    for (name, space) in [("plane", false), ("space", true)] {
-        let preset = falling_scene(space);
-        let plugin = WireBeadPlugin::new(preset.params().clone()).expect("valid parameters");
-        let mut app = Headless::new(plugin).build();
-        preset.spawn(&mut app.world_mut().commands());
-        app.world_mut().flush();
+    group
+}
+
+/// `scene` spawned headless, after `steps` steps.
+fn stepped(scene: &SceneFile, steps: usize) -> App {
+    let plugin = WireBeadPlugin::new(scene.params().clone()).expect("valid parameters");
+    let mut app = Headless::new(plugin).build();
+    scene.spawn(&mut app.world_mut().commands());
+    app.world_mut().flush();
+    for _ in 0..steps {
         app.world_mut().run_schedule(FixedUpdate);
+    }
+    app
+}
+
+fn falling_group(c: &mut Criterion) {
+    let mut group = step_by_step(c, "falling");
+    for (name, space) in [("plane", false), ("space", true)] {
+        let mut app = stepped(&falling_scene(space), 1);
         let beads = if space { CUBE * CUBE * CUBE } else { FALLING };
         group.throughput(Throughput::Elements(beads as u64));
         time_steps(&mut group, &mut app, (name, beads));
@@ -310,20 +314,9 @@ fn resting_scene(space: bool) -> SceneFile {
 const SETTLED: usize = 5;
 
 fn resting_group(c: &mut Criterion) {
-    let mut group = c.benchmark_group("resting");
-    group.sampling_mode(SamplingMode::Flat);
-    group.sample_size(10);
-    group.warm_up_time(Duration::from_millis(1));
-    group.measurement_time(Duration::from_millis(1));
+    let mut group = step_by_step(c, "resting");
     for (name, space) in [("plane", false), ("space", true)] {
-        let preset = resting_scene(space);
-        let plugin = WireBeadPlugin::new(preset.params().clone()).expect("valid parameters");
-        let mut app = Headless::new(plugin).build();
-        preset.spawn(&mut app.world_mut().commands());
-        app.world_mut().flush();
-        for _ in 0..SETTLED {
-            app.world_mut().run_schedule(FixedUpdate);
-        }
+        let mut app = stepped(&resting_scene(space), SETTLED);
         let beads = if space {
             RESTING_CUBE.pow(3)
         } else {
