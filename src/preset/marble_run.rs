@@ -2,7 +2,7 @@
 //! drop off its end into a bowl, and each, once it settles, is sent back
 //! to the top.
 
-use std::f64::consts::PI;
+use std::f64::consts::{PI, TAU};
 
 use bevy::math::DVec3;
 
@@ -15,8 +15,11 @@ pub const MARBLE_BOWL: f64 = 0.6;
 /// How far the rail's spiral is from the bowl's vertical axis, m.
 const SPIRAL: f64 = 0.4;
 
-/// The rail's spiral: a point every eighth of a turn, a turn and a half
-/// down from `y = 0.3` to `y = −0.15`.
+/// The turns of the rail's spiral.
+const TURNS: f64 = 1.5;
+
+/// The rail's spiral: a point every eighth of a turn, [`TURNS`] down from
+/// `y = 0.3` to `y = −0.15`.
 const SPIRAL_POINTS: usize = 13;
 
 /// How the rail turns in from its spiral toward the bowl's axis at its
@@ -38,9 +41,10 @@ const ON_THE_RAIL: usize = SPIRAL_POINTS - 1;
 /// rail, one at each point of its spiral but the last; the rest start on
 /// a grid at the bottom of the bowl, off the rail. Each marble rolls down
 /// the rail, flies off its end, drops into the bowl, and once it has lain
-/// slower than 25 cm/s for 0.2 s the rail sends it back to its top ([`SendsBeadsBack`](crate::SendsBeadsBack)),
-/// as soon as no marble is there: the run goes on for ever. Everything
-/// meets at `e = 0`, without friction; RATTLE.
+/// slower than 25 cm/s for 0.2 s the rail sends it back to its top
+/// ([`SendsBeadsBack`](crate::SendsBeadsBack)), as soon as no marble is
+/// there: the run goes on for ever. Everything meets at `e = 0`, without
+/// friction; RATTLE.
 ///
 /// ```
 /// use wirebead::preset::MarbleRun;
@@ -82,11 +86,11 @@ impl MarbleRun {
         (0..SPIRAL_POINTS)
             .map(|k| {
                 let turned = k as f64 / (SPIRAL_POINTS - 1) as f64;
-                let (sin, cos) = (1.5 * 2.0 * PI * turned).sin_cos();
+                let (sin, cos) = (TURNS * TAU * turned).sin_cos();
                 DVec3::new(SPIRAL * cos, 0.3 - 0.45 * turned, SPIRAL * sin)
             })
             .chain(TURN_IN.map(|(from_axis, y)| {
-                let (sin, cos) = (3.0 * PI + PI / 6.0).sin_cos();
+                let (sin, cos) = (TURNS * TAU + PI / 6.0).sin_cos();
                 DVec3::new(from_axis * cos, y, from_axis * sin)
             }))
             .collect()

@@ -6,7 +6,7 @@ use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 use wirebead::headless::{Headless, run_steps};
 use wirebead::prelude::*;
-use wirebead::preset::{MARBLE_BOWL, MarbleRun, PILE_RADIUS, scene_ron};
+use wirebead::preset::{MARBLE_BOWL, MarbleRun, PILE_RADIUS};
 use wirebead::solver::Contact;
 use wirebead::{SceneEnergy, SceneFile, ScenePreset, SendsBeadsBack, WireContact};
 
@@ -178,14 +178,10 @@ fn a_marble_run_in_space_sends_its_marbles_round_and_round() {
 /// file, to the digit.
 #[test]
 fn the_shipped_marble_run_is_the_preset_of_200_marbles() {
-    let path = crate::presets::shipped_dir().join("marble_run_in_space.scene.ron");
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{e}"));
-    let shipped = SceneFile::from_ron(&text).unwrap_or_else(|e| panic!("{e}"));
     let made = MarbleRun::default()
         .scene()
         .unwrap_or_else(|e| panic!("{e}"));
-    let written = |scene: SceneFile| scene_ron(&scene).expect("written");
-    assert_eq!(written(shipped), written(SceneFile::Space(made)));
+    crate::presets::assert_shipped_is("marble_run_in_space.scene.ron", SceneFile::Space(made));
 }
 
 /// In the plane as in space: a marble of 2 cm rides an open ramp (a

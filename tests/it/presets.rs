@@ -57,6 +57,16 @@ pub(crate) fn shipped_dir() -> PathBuf {
         .join("assets/scenes")
 }
 
+/// Asserts that the shipped scene file `name` is the scene `made`: read
+/// back, it writes the same scene file, to the digit.
+pub(crate) fn assert_shipped_is(name: &str, made: wirebead::SceneFile) {
+    let text =
+        std::fs::read_to_string(shipped_dir().join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let shipped = wirebead::SceneFile::from_ron(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let written = |scene| wirebead::preset::scene_ron(&scene).expect("written");
+    assert_eq!(written(shipped), written(made), "{name}");
+}
+
 #[test]
 fn shipped_presets_are_valid_and_put_beads_on_their_wires() {
     let dir = shipped_dir();

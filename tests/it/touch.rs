@@ -6,7 +6,7 @@ use bevy::prelude::*;
 use wirebead::geometry::Coordinates;
 use wirebead::headless::{Headless, bead_state, idle, run_steps};
 use wirebead::prelude::*;
-use wirebead::preset::{GRAIN_RADIUS, Hourglass, Pour, scene_ron};
+use wirebead::preset::{GRAIN_RADIUS, Hourglass, Pour};
 use wirebead::solver::BeadState;
 use wirebead::{
     CatchesBeads, Integrator, Islands, Restitution, SceneEnergy, SceneFile, ScenePreset, SimClock,
@@ -1083,17 +1083,13 @@ fn a_pile_of_marbles_poured_into_a_sphere_never_overlaps_nor_gains_energy() {
 /// the digit.
 #[test]
 fn the_shipped_hourglass_is_the_preset_of_300_grains() {
-    let path = crate::presets::shipped_dir().join("hourglass.scene.ron");
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{e}"));
-    let shipped = ScenePreset::from_ron(&text).unwrap_or_else(|e| panic!("{e}"));
     let made = Hourglass {
         beads: 300,
         ..Hourglass::default()
     }
     .scene()
     .unwrap_or_else(|e| panic!("{e}"));
-    let written = |scene: ScenePreset| scene_ron(&SceneFile::Plane(scene)).expect("written");
-    assert_eq!(written(shipped), written(made));
+    crate::presets::assert_shipped_is("hourglass.scene.ron", SceneFile::Plane(made));
 }
 
 /// Two hundred grains of 1 cm and 10 g at `e = 0` in an hourglass

@@ -26,8 +26,9 @@ pub(super) type BuildBead<V> = (
 
 /// Where each row of the last islands is (its island and row), and where
 /// its beads were when they were last stepped (or built, for an island
-/// not stepped since): what a rebuilt island starts its rows from. Wire rows by bead, wire and the wire's row; contacts by their
-/// two beads (in order).
+/// not stepped since): what a rebuilt island starts its rows from. Wire
+/// rows by bead, wire and the wire's row; contacts by their two beads
+/// (in order).
 pub(super) struct Carried<V: Dimension> {
     wire_rows: HashMap<(Entity, Entity, usize), ((usize, usize), BeadState<V>)>,
     contacts: HashMap<(Entity, Entity), ((usize, usize), [BeadState<V>; 2])>,

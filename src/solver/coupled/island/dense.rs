@@ -184,10 +184,8 @@ impl<V: WireSpace> Island<V> {
         // A bead behind a wire that catches it (a marble under another
         // track, or outside the bowl) does not land on it from there.
         let behind = |r: usize| {
-            self.catching[r]
-                && self
-                    .in_front(r, &work.x0, start)
-                    .is_some_and(|c| c < -OFF_THE_WIRE * self.rows[r].scale())
+            let at = work.x0[self.entry_bead[self.row_start[r]]];
+            self.catching[r] && self.behind_at(r, at, start)
         };
         let bounds: Vec<Bound> = (0..rows)
             .map(|r| match self.sides[r] {

@@ -4,7 +4,7 @@
 
 use crate::geometry::WireSpace;
 
-use super::{Island, IslandWork, OFF_THE_WIRE};
+use super::{Island, IslandWork};
 use crate::solver::contact::locate;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::SolveError;
@@ -53,10 +53,8 @@ impl<V: WireSpace> Island<V> {
         (0..self.rows())
             .filter(|&r| self.sides[r].0 != 0.0 && work.inactive[r] && !self.contacts[r])
             .filter(|&r| {
-                let behind = || {
-                    self.sides[r].0 * self.wire_row(r, states, time).c
-                        < -OFF_THE_WIRE * self.rows[r].scale()
-                };
+                let at = states[self.entry_bead[self.row_start[r]]].position;
+                let behind = || self.behind_at(r, at, time);
                 let strict = self.catching[r] || self.ends(r);
                 !(strict && behind()) && self.past_end(r, states, time, &work.hints) <= 0.0
             })

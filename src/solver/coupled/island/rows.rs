@@ -4,7 +4,7 @@
 
 use bevy::math::DVec2;
 
-use super::{Island, IslandWork, opening_rate, parts};
+use super::{Island, IslandWork, OFF_THE_WIRE, opening_rate, parts};
 use crate::geometry::{Placement, Twist, WireSpace, placed_geometry};
 use crate::solver::coupled::constraint::RowKind;
 use crate::solver::state::{BeadState, LinearForce};
@@ -45,6 +45,14 @@ impl<V: WireSpace> Island<V> {
             normal: g.normal,
             wire: twist.velocity_at(position),
         })
+    }
+
+    /// Whether wire row `r`'s bead, at `at`, is behind its one-sided wire
+    /// at `time` by more than rounding ([`OFF_THE_WIRE`] of its scale):
+    /// one that catches beads does not land it from there.
+    pub(super) fn behind_at(&self, r: usize, at: V, time: f64) -> bool {
+        self.wire_row_at(r, at, time, f64::NAN)
+            .is_some_and(|row| self.sides[r].0 * row.c < -OFF_THE_WIRE * self.rows[r].scale())
     }
 
     /// How far wire row `r`'s bead at `x` is in front of its wire at

@@ -263,14 +263,15 @@ impl<V: WireSpace> Island<V> {
         }
     }
 
-    /// Which rows a fresh island starts with: a bead that starts off a
-    /// one-sided wire, on the side it pushes toward (or on either side of
-    /// a wire that catches it, see [`Island::set_catching`]), or past an
-    /// end of its wire or away from a wire that ends, starts in flight (a row told otherwise by
-    /// [`IslandWork::carry`] starts as it was told); a
-    /// contact starts set aside, unless told it is held;
-    /// stick rows start set aside (a bead slides until friction stops it),
-    /// but a bead at rest on a rough wire starts held by static friction.
+    /// Which rows a fresh island starts with: those
+    /// [`Island::starts_aside`] sets aside (a contact, unless told it is
+    /// held; a bead off a one-sided wire on the side it pushes toward, or
+    /// on either side of a wire that catches it, see
+    /// [`Island::set_catching`]; a bead past an end of its wire or away
+    /// from a wire that ends, in flight), a row told otherwise by
+    /// [`IslandWork::carry`] as it was told; stick rows start set aside (a
+    /// bead slides until friction stops it), but a bead at rest on a rough
+    /// wire starts held by static friction.
     pub(super) fn start_rows(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
         let whole = states.len() == self.beads();
         work.inactive.clear();
