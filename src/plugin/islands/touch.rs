@@ -116,6 +116,14 @@ impl<V: Dimension> TouchBody<V> for IslandBody<'_, V> {
         self.settings.method.ends_on_constraints() && self.cached.island.time_steps()
     }
 
+    fn ends_held(&self, a: usize, b: usize) -> bool {
+        self.time_steps()
+            && self
+                .cached
+                .contact_row(a, b)
+                .is_some_and(|row| self.cached.work.holds(row))
+    }
+
     fn hold(&mut self, a: usize, b: usize, held: bool) {
         if let Some(row) = self.cached.contact_row(a, b) {
             self.cached.mark.hold(row, held);

@@ -251,7 +251,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
                         || (self.pressable(bodies, pair)
                             && (meets_near(0.0, g0, speed, self.span.dt)
                                 || bodies[self.bodies[self.slot(pair.0)]].time_steps()));
-                    if !(within && ends_in_touch(end, r)) {
+                    if !(within && (ends_in_touch(end, r) || self.ends_held(bodies, pair))) {
                         return Ok(Some((0.0, pair)));
                     }
                     continue;
@@ -267,6 +267,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
             // overlapping, and left alone where it ends apart.
             if h <= 0.0
                 || ends_in_touch(end, r)
+                || self.ends_held(bodies, pair)
                 || (end > 0.0 && self.meets_slowly(bodies, pair, (a0, b0)))
             {
                 continue;

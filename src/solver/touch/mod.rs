@@ -149,6 +149,16 @@ pub trait TouchBody<V: Coordinates> {
     fn time_steps(&self) -> bool {
         false
     }
+    /// Whether the body's step, as taken so far, ends holding a contact
+    /// row between its beads `a` and `b` that it time-steps
+    /// ([`TouchBody::time_steps`]): the pair ends pressed together as the
+    /// step's complementarity problem left it (overlapping by no more than
+    /// the row's compliance lets a push), which is that step's meeting,
+    /// not one to locate.
+    fn ends_held(&self, a: usize, b: usize) -> bool {
+        let _ = (a, b);
+        false
+    }
     /// Holds the contact between beads `a` and `b` in the steps from the
     /// last [`TouchBody::keep`] (a strike left them in touch), or sets it
     /// aside (they bounced or part). A body without the row ignores it.

@@ -22,10 +22,11 @@ use crate::solver::state::{BeadState, LinearForce};
 /// The compliance of a dense island's rows, as a fraction of each row's
 /// diagonal of `J W Jᵀ`: a held row meets `C + ε μ = 0`, `ε` this times
 /// the diagonal. A row pressing with `μ` overlaps by this fraction of how
-/// far `μ` alone would move its beads (some 1e-12 m at the foot of a pile
-/// of 2 cm beads twenty deep at 60 Hz), and `J W Jᵀ + E` is positive
-/// definite however many rows are redundant.
-pub(super) const COMPLIANCE: f64 = 1e-10;
+/// far `μ` alone would move its beads (some 1e-13 m at the foot of a pile
+/// of 2 cm beads twenty deep at 60 Hz, some 1e-12 m where a landing
+/// presses), within the touch settlement's tolerance for touching, and
+/// `J W Jᵀ + E` is positive definite however many rows are redundant.
+pub(super) const COMPLIANCE: f64 = 1e-11;
 
 /// How many times Newton's tolerance (at the position level) and the
 /// slack of a contact's closing speed (at the velocity level) a row set

@@ -293,6 +293,14 @@ impl<V: Coordinates> Group<'_, V> {
         meets_slowly(0.0, -opening_rate(&a, &b).0, moved)
     }
 
+    /// Whether pair `(i, j)`'s body ends its step holding the pair's
+    /// contact row, time-stepped ([`TouchBody::ends_held`]).
+    pub(super) fn ends_held<B: TouchBody<V>>(&self, bodies: &[B], (i, j): (usize, usize)) -> bool {
+        let slot = self.slot(i);
+        slot == self.slot(j)
+            && bodies[self.bodies[slot]].ends_held(self.beads[i].bead, self.beads[j].bead)
+    }
+
     /// Whether a contact row holds pair `(i, j)` now: pressed together,
     /// the two answer a strike as one and do not strike each other.
     pub(super) fn held<B: TouchBody<V>>(&self, bodies: &[B], (i, j): (usize, usize)) -> bool {
