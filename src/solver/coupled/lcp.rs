@@ -146,7 +146,33 @@ pub(crate) fn solve_lcp<E>(
         newton(&free, w, &mut d).map_err(LcpError::Solve)?;
         let mut alpha = 1.0;
         let mut taken = false;
-        for _ in 0..=HALVINGS {
+        // The longest part of the step along `d` that keeps every row
+        // within its bound, and the row that meets its bound there.
+        let (mut feasible, mut meets) = (1.0f64, None);
+        for r in 0..rows {
+            if let Bound::Side(side) = bounds[r]
+                && side * (z[r] + d[r]) < 0.0
+            {
+                let part = (side * z[r]) / (-side * d[r]);
+                if part < feasible {
+                    (feasible, meets) = (part.max(0.0), Some(r));
+                }
+            }
+        }
+        for trial_step in 0..=HALVINGS + 1 {
+            // The whole step projected onto the bounds; where that does not
+            // descend enough, the part of it that keeps every row within
+            // its bound, that row put on its bound (a descent whatever the
+            // conditioning: `d` is the least of the objective along itself
+            // at 1, with the other rows where they are); where that part
+            // is nothing, halvings along the projection arc.
+            let to_bound = trial_step == 1 && feasible > 0.0;
+            match trial_step {
+                0 => {}
+                1 if to_bound => alpha = feasible,
+                1 => continue,
+                k => alpha = 0.5f64.powi(i32::try_from(k - 1).unwrap_or(i32::MAX)),
+            }
             let mut cut = false;
             trial.clear();
             trial.extend((0..rows).map(|r| {
@@ -155,6 +181,10 @@ pub(crate) fn solve_lcp<E>(
                 cut |= projected != moved;
                 projected
             }));
+            if let (true, Some(r)) = (to_bound, meets) {
+                trial[r] = 0.0;
+                cut = true;
+            }
             apply(&trial, &mut w_trial);
             // f(trial) − f(z) = Δᵀ (w + w_trial) / 2, Δ = trial − z
             // (exact for a quadratic).
@@ -165,12 +195,11 @@ pub(crate) fn solve_lcp<E>(
                 change += 0.5 * delta * (w[r] + w_trial[r]);
                 first += delta * w[r];
             }
-            if change <= SUFFICIENT * first || first == 0.0 {
+            if change <= SUFFICIENT * first || first == 0.0 || (to_bound && change <= 0.0) {
                 exact = alpha == 1.0 && !cut;
                 taken = true;
                 break;
             }
-            alpha *= 0.5;
         }
         if !taken {
             let violation = violation(bounds, z, w);

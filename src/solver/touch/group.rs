@@ -269,6 +269,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
                 || ends_in_touch(end, r)
                 || self.ends_held(bodies, pair)
                 || (end > 0.0 && self.meets_slowly(bodies, pair, (a0, b0)))
+                || (end > 0.0 && self.stepped_past(bodies, pair, [a0, b0, a1, b1], g0))
             {
                 continue;
             }

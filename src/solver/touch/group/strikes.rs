@@ -301,6 +301,37 @@ impl<V: Coordinates> Group<'_, V> {
             && bodies[self.bodies[slot]].ends_held(self.beads[i].bead, self.beads[j].bead)
     }
 
+    /// Whether pair `(i, j)`, apart where the step began (gap `g0`) and
+    /// where it ends, at `[a0, b0, a1, b1]`, is its body's step to have
+    /// kept apart: a contact row of a body that time-steps joins it, and
+    /// it came no nearer along its line of centres where the step began
+    /// than its gap and half its reach. Such a body's step meets the row
+    /// where it ends, so a pair that only turned about each other (whose
+    /// straight paths from start to end cut a corner between them) has
+    /// met nothing to strike; one that came so much nearer may have
+    /// passed through the other within the step, and its instant is
+    /// located.
+    pub(super) fn stepped_past<B: TouchBody<V>>(
+        &self,
+        bodies: &[B],
+        (i, j): (usize, usize),
+        [a0, b0, a1, b1]: [BeadState<V>; 4],
+        g0: f64,
+    ) -> bool {
+        let slot = self.slot(i);
+        if !(self.pressable(bodies, (i, j)) && bodies[self.bodies[slot]].time_steps()) {
+            return false;
+        }
+        let d0 = b0.position - a0.position;
+        let length = d0.dot(d0).sqrt();
+        if length.is_nan() || length <= 0.0 {
+            return false;
+        }
+        let approach = -(d0 / length).dot((b1.position - a1.position) - d0);
+        let reach = self.beads[i].radius + self.beads[j].radius;
+        approach <= g0 + 0.5 * reach
+    }
+
     /// Whether a contact row holds pair `(i, j)` now: pressed together,
     /// the two answer a strike as one and do not strike each other.
     pub(super) fn held<B: TouchBody<V>>(&self, bodies: &[B], (i, j): (usize, usize)) -> bool {
