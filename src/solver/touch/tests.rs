@@ -202,46 +202,47 @@ fn a_closing_pair_in_touch_strikes_at_once_and_pairs_that_never_meet_are_left() 
 
 /// Two beads of unit mass in one body that time-steps its contacts at
 /// `e = 0`, joined by a contact row set aside: the first at rest at the
-/// origin, the second either turning about it at `orbit` (radius, radians
-/// over the step) or coasting; `held` whether the row holds.
-struct Joined {
+/// origin, the second turning about it on a circle of `radius` by `angle`
+/// over the step of `dt`.
+struct Turning {
     start: Vec<BeadState>,
     end: Vec<BeadState>,
     steps: usize,
-    orbit: Option<(f64, f64)>,
+    radius: f64,
+    angle: f64,
     dt: f64,
-    held: bool,
 }
 
-impl Joined {
-    /// The second bead on its orbit `s` of the way through the step.
-    fn on_orbit(radius: f64, angle: f64, dt: f64, s: f64) -> BeadState {
-        let (sin, cos) = (angle * s).sin_cos();
+impl Turning {
+    /// The second bead `s` of the way through the step.
+    fn at(&self, s: f64) -> BeadState {
+        let (sin, cos) = (self.angle * s).sin_cos();
         BeadState {
-            position: DVec2::new(cos, sin) * radius,
-            velocity: DVec2::new(-sin, cos) * radius * angle / dt,
+            position: DVec2::new(cos, sin) * self.radius,
+            velocity: DVec2::new(-sin, cos) * self.radius * self.angle / self.dt,
         }
     }
 
-    fn new(second: BeadState, orbit: Option<(f64, f64)>, dt: f64) -> Self {
-        let start = vec![BeadState::default(), second];
-        let mut end = start.clone();
-        match orbit {
-            Some((radius, angle)) => end[1] = Self::on_orbit(radius, angle, dt, 1.0),
-            None => end[1].position += second.velocity * dt,
-        }
-        Self {
-            start,
-            end,
+    /// The pair, the second bead also closing on the first at `closing`
+    /// where the step begins.
+    fn new(radius: f64, angle: f64, dt: f64, closing: f64) -> Self {
+        let mut turning = Self {
+            start: Vec::new(),
+            end: Vec::new(),
             steps: 0,
-            orbit,
+            radius,
+            angle,
             dt,
-            held: false,
-        }
+        };
+        let mut second = turning.at(0.0);
+        second.velocity -= second.position.normalize() * closing;
+        turning.start = vec![BeadState::default(), second];
+        turning.end = vec![BeadState::default(), turning.at(1.0)];
+        turning
     }
 }
 
-impl TouchBody<DVec2> for Joined {
+impl TouchBody<DVec2> for Turning {
     fn start(&self) -> &[BeadState] {
         &self.start
     }
@@ -250,16 +251,7 @@ impl TouchBody<DVec2> for Joined {
     }
     fn advance(&mut self, time: f64, h: f64, states: &mut [BeadState]) -> Result<(), SolveError> {
         self.steps += 1;
-        match self.orbit {
-            Some((radius, angle)) => {
-                states[1] = Self::on_orbit(radius, angle, self.dt, (time + h) / self.dt);
-            }
-            None => {
-                for s in states {
-                    s.position += s.velocity * h;
-                }
-            }
-        }
+        states[1] = self.at((time + h) / self.dt);
         Ok(())
     }
     fn keep(&mut self) {}
@@ -279,13 +271,10 @@ impl TouchBody<DVec2> for Joined {
         self.end = states.to_vec();
     }
     fn contact(&self, _: usize, _: usize) -> Option<bool> {
-        Some(self.held)
+        Some(false)
     }
     fn time_steps(&self) -> bool {
         true
-    }
-    fn hold(&mut self, _: usize, _: usize, held: bool) {
-        self.held = held;
     }
 }
 
@@ -309,12 +298,9 @@ fn a_time_stepping_body_keeps_a_pair_that_turns_about_itself_within_a_step() {
     ];
     beads[1].bead = 1;
     let span = StepSpan { time: 0.0, dt };
-    let (radius, angle) = (2.0 * r * 1.01, 50f64.to_radians());
     // Closing at 1 m/s where the step begins: not a meeting its step
     // takes by being slow.
-    let mut second = Joined::on_orbit(radius, angle, dt, 0.0);
-    second.velocity -= second.position.normalize();
-    let mut turning = vec![Joined::new(second, Some((radius, angle)), dt)];
+    let mut turning = vec![Turning::new(2.0 * r * 1.01, 50f64.to_radians(), dt, 1.0)];
     let mut struck = Vec::new();
     settle_touches(span, &mut turning, &beads, &mut struck).expect("settles");
     assert!(struck.is_empty(), "{struck:?}");
