@@ -422,9 +422,15 @@ fn spawned(text: &str) -> (App, Vec<Entity>, ScenePreset) {
 
 /// [`spawned`] for a scene already made.
 fn spawned_from(preset: &ScenePreset) -> (App, Vec<Entity>) {
-    let plugin = WireBeadPlugin::new(preset.params.clone()).expect("valid params");
+    spawned_from_file(&SceneFile::Plane(preset.clone()))
+}
+
+/// A single-threaded headless app with `scene` spawned, in the plane or
+/// in space, and its beads.
+fn spawned_from_file(scene: &SceneFile) -> (App, Vec<Entity>) {
+    let plugin = WireBeadPlugin::new(scene.params().clone()).expect("valid params");
     let mut app = Headless::new(plugin).single_threaded().build();
-    let beads = preset.spawn(&mut app.world_mut().commands());
+    let beads = scene.spawn(&mut app.world_mut().commands());
     app.world_mut().flush();
     (app, beads)
 }
@@ -1054,11 +1060,8 @@ fn a_pile_of_marbles_poured_into_a_sphere_never_overlaps_nor_gains_energy() {
     }
     .scene()
     .unwrap_or_else(|e| panic!("{e}"));
-    let plugin = WireBeadPlugin::new(scene.params().clone()).expect("valid params");
-    let mut app = Headless::new(plugin).single_threaded().build();
+    let (mut app, spawned) = spawned_from_file(&scene);
     app.init_resource::<SceneEnergy>();
-    let spawned = scene.spawn(&mut app.world_mut().commands());
-    app.world_mut().flush();
     let r = PILE_RADIUS;
     let weight = n as f64 * 9.81;
     let Poured {
@@ -1094,10 +1097,7 @@ fn a_pile_poured_at_60_hz_takes_every_meeting_in_its_dense_step() {
     }
     .scene()
     .unwrap_or_else(|e| panic!("{e}"));
-    let plugin = WireBeadPlugin::new(scene.params().clone()).expect("valid params");
-    let mut app = Headless::new(plugin).single_threaded().build();
-    scene.spawn(&mut app.world_mut().commands());
-    app.world_mut().flush();
+    let (mut app, _) = spawned_from_file(&scene);
     let mut struck = 0;
     let mut worst = f64::MIN;
     for _ in 0..30 {

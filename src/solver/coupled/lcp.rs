@@ -147,31 +147,34 @@ pub(crate) fn solve_lcp<E>(
         let mut alpha = 1.0;
         let mut taken = false;
         // The longest part of the step along `d` that keeps every row
-        // within its bound, and the row that meets its bound there.
-        let (mut feasible, mut meets) = (1.0f64, None);
+        // within its bound, and the row that meets its bound there (none
+        // where the whole step keeps them all).
+        let mut meets: Option<(f64, usize)> = None;
         for r in 0..rows {
             if let Bound::Side(side) = bounds[r]
                 && side * (z[r] + d[r]) < 0.0
             {
-                let part = (side * z[r]) / (-side * d[r]);
-                if part < feasible {
-                    (feasible, meets) = (part.max(0.0), Some(r));
+                let part = ((side * z[r]) / (-side * d[r])).max(0.0);
+                if meets.is_none_or(|(least, _)| part < least) {
+                    meets = Some((part, r));
                 }
             }
         }
+        let to_bound = meets.filter(|&(part, _)| part > 0.0);
         for trial_step in 0..=HALVINGS + 1 {
             // The whole step projected onto the bounds; where that does not
             // descend enough, the part of it that keeps every row within
             // its bound, that row put on its bound (a descent whatever the
             // conditioning: `d` is the least of the objective along itself
-            // at 1, with the other rows where they are); where that part
-            // is nothing, halvings along the projection arc.
-            let to_bound = trial_step == 1 && feasible > 0.0;
-            match trial_step {
-                0 => {}
-                1 if to_bound => alpha = feasible,
-                1 => continue,
-                k => alpha = 0.5f64.powi(i32::try_from(k - 1).unwrap_or(i32::MAX)),
+            // at 1, with the other rows where they are); where no row
+            // meets its bound or that part is nothing, halvings along the
+            // projection arc.
+            let bounded = if trial_step == 1 { to_bound } else { None };
+            match (trial_step, bounded) {
+                (0, _) => {}
+                (1, Some((part, _))) => alpha = part,
+                (1, None) => continue,
+                (k, _) => alpha = 0.5f64.powi(i32::try_from(k - 1).unwrap_or(i32::MAX)),
             }
             let mut cut = false;
             trial.clear();
@@ -181,7 +184,7 @@ pub(crate) fn solve_lcp<E>(
                 cut |= projected != moved;
                 projected
             }));
-            if let (true, Some(r)) = (to_bound, meets) {
+            if let Some((_, r)) = bounded {
                 trial[r] = 0.0;
                 cut = true;
             }
@@ -195,7 +198,8 @@ pub(crate) fn solve_lcp<E>(
                 change += 0.5 * delta * (w[r] + w_trial[r]);
                 first += delta * w[r];
             }
-            if change <= SUFFICIENT * first || first == 0.0 || (to_bound && change <= 0.0) {
+            if change <= SUFFICIENT * first || first == 0.0 || (bounded.is_some() && change <= 0.0)
+            {
                 exact = alpha == 1.0 && !cut;
                 taken = true;
                 break;
