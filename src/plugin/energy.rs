@@ -54,11 +54,7 @@ pub(super) fn measure_scene_energy(
         Without<InIsland>,
     >,
 ) {
-    let joined: f64 = islands
-        .iter()
-        .map(|i| i.energy)
-        .chain(space_islands.iter().map(|i| i.energy))
-        .sum();
+    let joined = islands.energy() + space_islands.energy();
     let lone: f64 = alone
         .iter()
         .map(|(x, v, m)| bead_energy(x.0, v.0, m.get(), params.gravity))

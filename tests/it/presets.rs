@@ -9,7 +9,7 @@ use wirebead::SceneLink;
 use wirebead::headless::{Headless, idle, run_steps};
 use wirebead::prelude::*;
 use wirebead::preset::{ActivePreset, FromPreset};
-use wirebead::{ConstraintDiagnostics, Islands, LoadPreset, ScenePreset};
+use wirebead::{ConstraintDiagnostics, LoadPreset, SceneEnergy, ScenePreset};
 
 use crate::common::{BeadNow, bead};
 
@@ -108,16 +108,11 @@ fn coupled_presets_run_ten_seconds_on_their_constraints() {
         let preset = ScenePreset::from_ron(&text).unwrap();
         let plugin = WireBeadPlugin::new(preset.params.clone()).unwrap();
         let mut app = Headless::new(plugin).single_threaded().build();
+        app.init_resource::<SceneEnergy>();
         preset.spawn(&mut app.world_mut().commands());
         app.world_mut().flush();
         run_steps(&mut app, 1);
-        let energy = |app: &App| {
-            app.world()
-                .resource::<Islands>()
-                .iter()
-                .map(|i| i.energy)
-                .sum::<f64>()
-        };
+        let energy = |app: &App| app.world().resource::<SceneEnergy>().total;
         let e0 = energy(&app);
         let mut worst = 0.0f64;
         let mut drift = 0.0f64;

@@ -6,16 +6,19 @@ use std::collections::HashMap;
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
+use super::lone::LoneTouch;
 use super::start::{BuildBead, Carried, start_island};
+use super::touch::Rider;
 use super::{CachedIsland, ContactRow, InIsland, IslandReport, Islands, LinkRows, WireRow, touch};
 use crate::dynamics::{
-    Bead, CatchesBeads, Contacts, Dimension, DivergenceReason, Joint, Pin, Rod, SimParams,
-    SpaceBead, Spring, WirePose, WireRows,
+    Bead, CatchesBeads, Contacts, Dimension, DivergenceReason, Joint, OnWire, Pin, Restitution,
+    Rod, SimParams, SpaceBead, Spring, WirePose, WireRows,
 };
 use crate::geometry::{Friction, Side, Surface};
 use crate::plugin::clock::SimClock;
 use crate::plugin::report::Divergences;
-use crate::solver::{self, BeadState, Island, IslandRow, RowKind, SpringLink};
+use crate::plugin::step::LoneStep;
+use crate::solver::{self, Island, IslandRow, RowKind, SpringLink};
 
 /// Every link in the world, as the rebuild reads them.
 #[derive(SystemParam)]
@@ -117,12 +120,13 @@ fn pin_rows<V: Dimension>(at: V) -> Vec<IslandRow<V>> {
 
 /// Rebuilds [`Islands`] after the topology changed, and keeps the
 /// [`InIsland`] marker on exactly the beads in one.
-pub(super) fn prepare_islands<V: Dimension>(
+pub(super) fn prepare_islands<V: LoneStep>(
     mut islands: ResMut<Islands<V>>,
     links: Links<V>,
     mut beads: Query<BuildBead<V>>,
     wires: Query<(&V::Wire, &WirePose<V>)>,
     catching: Query<Entity, (With<CatchesBeads>, With<V::Wire>)>,
+    restitutions: Query<&Restitution>,
     transforms: Query<&Transform>,
     mut commands: Commands,
     mut divergences: Divergences,
@@ -134,6 +138,7 @@ pub(super) fn prepare_islands<V: Dimension>(
     // The islands being rebuilt, and where their rows are: a rebuilt
     // island starts each row as it was where its beads still are.
     let old = std::mem::take(&mut islands.cached);
+    islands.lone.clear();
     let was = Carried::from(&old, |bead| {
         beads.get(bead).ok().map(|(_, now, ..)| now.state())
     });
@@ -239,20 +244,56 @@ pub(super) fn prepare_islands<V: Dimension>(
             None => springs.push((entity, *spring)),
         }
     }
-    // Beads with radii that may meet soon, joined by contact rows.
-    let with_radius: Vec<(Entity, BeadState<V>, f64)> = beads
+    // The beads a link names: none of them rides its wire alone.
+    let mut linked: Vec<Entity> = named
         .iter()
-        .filter_map(|(entity, bead, _, _, radius, _)| {
-            let r = radius?.get();
-            (r > 0.0).then(|| (entity, bead.state(), r))
+        .flat_map(|(_, b)| b.iter().copied())
+        .chain(springs.iter().flat_map(|(_, s)| s.beads()))
+        .collect();
+    linked.sort_unstable();
+    // A bead with a radius on a plain wire of one row (not traced),
+    // joined to nothing and caught by no other wire, rides it alone.
+    let rides_alone = |entity: Entity, on_wire: Option<&OnWire>| {
+        let Some(wire) = on_wire.and_then(|on| wires.get(on.0).ok()) else {
+            return false;
+        };
+        let plain = wire.0.lone()
+            && wire.0.surface().is_plain()
+            && V::lone_shape(wire.0).is_some_and(|shape| !V::traced(&shape));
+        plain
+            && linked.binary_search(&entity).is_err()
+            && catchers
+                .iter()
+                .all(|&w| on_wire.is_some_and(|on| on.0 == w))
+    };
+    // Beads with radii that may meet soon, joined by contact rows, and
+    // whether each rides its wire alone.
+    let with_radius: Vec<(Entity, Rider<V>)> = beads
+        .iter()
+        .filter_map(|(entity, bead, on_wire, _, radius, _)| {
+            let radius = radius?.get();
+            let restitution = restitutions
+                .get(entity)
+                .map_or(contacts.restitution(), Restitution::get);
+            (radius > 0.0).then(|| {
+                let rider = Rider {
+                    state: bead.state(),
+                    radius,
+                    restitution,
+                    alone: rides_alone(entity, on_wire),
+                };
+                (entity, rider)
+            })
         })
         .collect();
+    let riders: Vec<Rider<V>> = with_radius.iter().map(|b| b.1).collect();
     // A pair with friction in the plane gets a second row, to hold it
     // while static friction can (set aside while it slips); in space a
     // pair has no one direction to be held in.
     let sticks = contacts.friction() > 0.0 && V::stick_axis(V::AXES[0]).is_some();
-    for (i, j) in touch::near(&with_radius, params.timestep) {
-        let ((a, _, ra), (b, _, rb)) = (with_radius[i], with_radius[j]);
+    for (i, j) in touch::near(&riders, params.timestep) {
+        let ((a, rider_a), (b, rider_b)) = (with_radius[i], with_radius[j]);
+        let (ra, rb) = (rider_a.radius, rider_b.radius);
         let row = IslandRow {
             kind: RowKind::Rod { length: ra + rb },
             beads: vec![0, 1],
@@ -275,8 +316,8 @@ pub(super) fn prepare_islands<V: Dimension>(
     }
     // The beads in islands: every bead a link names, every bead on no
     // wire, every bead on a wire without a step of its own (a curve in
-    // space), and every bead with a radius (its step may be cut where it
-    // meets another).
+    // space), and every bead with a radius that does not ride its wire
+    // alone (its step may be cut where it meets another).
     let mut index: HashMap<Entity, usize> = HashMap::new();
     let mut members: Vec<Entity> = Vec::new();
     let mut join = |bead: Entity, members: &mut Vec<Entity>| {
@@ -295,9 +336,16 @@ pub(super) fn prepare_islands<V: Dimension>(
             join(b, &mut members);
         }
     }
+    let mut alone: Vec<Entity> = with_radius
+        .iter()
+        .filter(|b| b.1.alone)
+        .map(|b| b.0)
+        .collect();
+    alone.sort_unstable();
     for (entity, _, on_wire, _, radius, _) in &beads {
         let lone = on_wire.is_some_and(|on| wires.get(on.0).map_or(true, |(w, _)| w.lone()));
-        if !lone || radius.is_some() {
+        let touches = radius.is_some() && alone.binary_search(&entity).is_err();
+        if !lone || touches {
             join(entity, &mut members);
         }
     }
@@ -449,6 +497,10 @@ pub(super) fn prepare_islands<V: Dimension>(
         });
         match built {
             Ok(mut island) => {
+                let riding = entities
+                    .iter()
+                    .map(|e| alone.binary_search(e).is_ok())
+                    .collect();
                 let (work, states) = start_island(
                     &mut island,
                     &entities,
@@ -475,8 +527,10 @@ pub(super) fn prepare_islands<V: Dimension>(
                     contacts: pair_rows,
                     outcome: None,
                     touching: Vec::new(),
+                    alone: riding,
                     start: Vec::new(),
                     mark: default(),
+                    begin: default(),
                 });
             }
             Err(reason) => {
@@ -486,8 +540,23 @@ pub(super) fn prepare_islands<V: Dimension>(
             }
         }
     }
+    // The beads with a radius that ride their wire alone and no contact
+    // row joins: each a body of its own.
+    for &entity in &alone {
+        if index.contains_key(&entity) {
+            continue;
+        }
+        let Ok((_, bead, Some(on_wire), ..)) = beads.get(entity) else {
+            continue;
+        };
+        islands
+            .lone
+            .push(LoneTouch::new(entity, on_wire.0, bead.mass(), bead.state()));
+    }
+    let stepped =
+        |entity: Entity| index.contains_key(&entity) || alone.binary_search(&entity).is_ok();
     for (entity, _, _, marked, ..) in &beads {
-        match (index.contains_key(&entity), marked) {
+        match (stepped(entity), marked) {
             (true, false) => {
                 commands.entity(entity).try_insert(InIsland);
             }

@@ -2,17 +2,21 @@
 //! [`Pin`]s, [`Joint`]s and [`Spring`]s, and free beads (on no wire), are
 //! grouped and cached in [`Islands`] until the topology changes, and
 //! stepped each step by [`Island`]. A bead on a wire and joined to
-//! nothing keeps the per-bead step (and its batched fast path).
+//! nothing keeps the per-bead step (and its batched fast path); one with
+//! a radius steps alone here, so that its meetings are settled with the
+//! islands' (`lone`).
 //!
 //! | file | what it holds |
 //! |---|---|
 //! | `build` | rebuilding the islands when the topology changes |
 //! | `start` | how an island built again starts: its rows as the last islands left them |
 //! | `step` | stepping them: gather, solve (in parallel), write back |
+//! | `lone` | beads with a radius that ride a plain wire alone, each a body of its own in the settlement |
 //! | `touch` | beads that touch: the steps cut where they meet, the strikes |
 //! | `send_back` | beads that settled off a wire sent back to its start ([`SendsBeadsBack`]) |
 
 mod build;
+mod lone;
 mod send_back;
 mod start;
 mod step;
@@ -26,6 +30,7 @@ use bevy::prelude::*;
 
 use super::clock::advance_clock;
 use super::schedule::WireBeadSystems;
+use super::step::LoneStep;
 use super::wires::place_wires;
 use crate::dynamics::{
     BeadRadius, BeadSentBack, CatchesBeads, ConstraintDiagnostics, Dimension, Joint, OnWire, Pin,
@@ -58,7 +63,7 @@ impl Plugin for IslandPlugin {
 
 /// The islands of one dimension: their resource, the lifecycle observers
 /// that mark them for a rebuild, the rebuild and the step.
-fn add_islands<V: Dimension>(app: &mut App) {
+fn add_islands<V: LoneStep>(app: &mut App) {
     app.init_resource::<Islands<V>>()
         .add_observer(topology_changed::<Add, V::Bead, V>)
         .add_observer(topology_changed::<Remove, V::Bead, V>)
@@ -105,8 +110,10 @@ fn add_islands<V: Dimension>(app: &mut App) {
         );
 }
 
-/// Marks a bead stepped in an island (joined to another bead or a point,
-/// or on no wire); the per-bead step leaves it alone. Kept by the plugin.
+/// Marks a bead the island plugin steps: in an island (joined to another
+/// bead or a point, or on no wire), or with a radius riding a wire alone
+/// (its meetings settled with the islands'); the per-bead step leaves it
+/// alone. Kept by the plugin.
 #[derive(Component, Clone, Copy, Debug, Default)]
 pub(crate) struct InIsland;
 
@@ -204,10 +211,16 @@ struct CachedIsland<V: Dimension> {
     outcome: Option<Result<(), SolveError>>,
     /// Its beads with a radius, gathered each step (see `touch`).
     touching: touch::Touching,
+    /// Whether each of its beads would ride its wire alone but for the
+    /// contact rows that join it (see `touch::near`).
+    alone: Vec<bool>,
     /// Where the step started and what its work carried into it, kept
     /// while it has beads that touch.
     start: Vec<BeadState<V>>,
     mark: IslandMark<V>,
+    /// What its work carried into the step, kept while it has beads that
+    /// touch (for a settlement taken again from the step's start).
+    begin: IslandMark<V>,
 }
 
 /// The islands of the current topology: beads joined by constraints and
@@ -220,6 +233,9 @@ struct CachedIsland<V: Dimension> {
 #[derive(Resource, Clone)]
 pub struct Islands<V: Dimension = DVec2> {
     cached: Vec<CachedIsland<V>>,
+    /// The beads with a radius on a plain wire, joined to nothing: each
+    /// steps alone, and settles touches as a body of its own.
+    lone: Vec<lone::LoneTouch<V>>,
     dirty: bool,
     /// Since when each bead off a wire that sends beads back has been
     /// slower than the wire's settling speed ([`SendsBeadsBack`]), s:
@@ -231,6 +247,7 @@ impl<V: Dimension> Default for Islands<V> {
     fn default() -> Self {
         Self {
             cached: Vec::new(),
+            lone: Vec::new(),
             dirty: false,
             settling: HashMap::new(),
         }
@@ -248,6 +265,14 @@ impl<V: Dimension> Islands<V> {
         self.iter().find(|r| r.beads.contains(&bead))
     }
 
+    /// The kinetic and gravitational energy of every bead the islands
+    /// step, and the energy in their springs, after the last step: each
+    /// island's, and each bead with a radius that rides a wire alone.
+    pub(crate) fn energy(&self) -> f64 {
+        let joined: f64 = self.iter().map(|r| r.energy).sum();
+        joined + self.lone.iter().map(|l| l.energy).sum::<f64>()
+    }
+
     /// Roughly how much memory a clone of the islands takes, in bytes:
     /// the step's buffers hold about twenty numbers per bead coordinate
     /// and per row.
@@ -259,6 +284,7 @@ impl<V: Dimension> Islands<V> {
                     + size_of::<CachedIsland<V>>()
             })
             .sum::<usize>()
+            + self.lone.len() * size_of::<lone::LoneTouch<V>>()
             + self.settling.len() * size_of::<(Entity, f64)>()
     }
 
@@ -284,8 +310,8 @@ fn islands_changed<V: Dimension>(islands: Res<Islands<V>>) -> bool {
     islands.dirty
 }
 
-/// Whether there is an island to step: the run condition of
+/// Whether there is an island or a bead alone to step: the run condition of
 /// [`step::step_islands`].
 fn any_island<V: Dimension>(islands: Res<Islands<V>>) -> bool {
-    !islands.cached.is_empty()
+    !islands.cached.is_empty() || !islands.lone.is_empty()
 }

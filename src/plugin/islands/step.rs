@@ -4,6 +4,7 @@
 
 use bevy::prelude::*;
 
+use super::lone::LoneTouch;
 use super::{CachedIsland, InIsland, Islands, LinkRows, PressedPair, touch};
 use crate::dynamics::{
     BeadDiagnostics, BeadForce, BeadMotion, BeadPosition, BeadRadius, BeadVelocity, BeadsStruck,
@@ -13,11 +14,22 @@ use crate::dynamics::{
 use crate::plugin::clock::SimClock;
 use crate::plugin::parallel::{ParallelStep, StepSplit};
 use crate::plugin::report::{ContactReports, Divergences};
+use crate::plugin::step::LoneStep;
 use crate::solver::{BeadState, Contact, RowReport, StepSettings};
 
-/// The beads [`step_islands`] steps: those in an island that have not
-/// stopped.
+/// The beads [`step_islands`] steps: those in an island (or riding a
+/// wire alone with a radius) that have not stopped.
 type Stepped = (With<InIsland>, Without<Diverged>);
+
+/// What a step gathers of each bead: its state, the force on it, its
+/// radius and restitution.
+type Gathered<V> = (
+    &'static BeadPosition<V>,
+    &'static BeadVelocity<V>,
+    &'static BeadForce<V>,
+    Option<&'static BeadRadius>,
+    Option<&'static Restitution>,
+);
 
 /// Steps every island whose beads have not diverged: gathers their states
 /// and forces, calls [`Island::step`] (the islands split over the compute
@@ -27,23 +39,14 @@ type Stepped = (With<InIsland>, Without<Diverged>);
 /// Between the step and the write-back, the steps of islands whose beads
 /// met are cut where they met and the strikes made (`touch`).
 #[allow(clippy::too_many_arguments)]
-pub(super) fn step_islands<V: Dimension>(
+pub(super) fn step_islands<V: LoneStep>(
     params: Res<SimParams>,
     contacts: Res<Contacts>,
     clock: Res<SimClock>,
     parallel: Res<ParallelStep>,
     mut islands: ResMut<Islands<V>>,
     mut beads: ParamSet<(
-        Query<
-            (
-                &BeadPosition<V>,
-                &BeadVelocity<V>,
-                &BeadForce<V>,
-                Option<&BeadRadius>,
-                Option<&Restitution>,
-            ),
-            Stepped,
-        >,
+        Query<Gathered<V>, Stepped>,
         Query<
             (
                 BeadMotion<V>,
@@ -157,15 +160,50 @@ pub(super) fn step_islands<V: Dimension>(
             }
         }
     }
+    // The beads that ride their wires alone, each stepped by itself.
+    let Islands { cached, lone, .. } = &mut *islands;
+    let motion = beads.p0();
+    let shapes: Vec<Option<V::Lone>> = lone
+        .iter_mut()
+        .map(|lone| {
+            let shape = gather_lone(lone, &motion, &wires, (&contacts, gravity))?;
+            lone.step(&shape, time, &settings);
+            Some(shape)
+        })
+        .collect();
     touch::settle(
-        &mut islands.cached,
+        cached,
+        (lone, &shapes),
         time,
         &settings,
         &mut struck,
         &mut divergences,
     );
-    if touch::regroup(&islands.cached, settings.dt) {
+    if touch::regroup(cached, lone, settings.dt) {
         islands.mark_dirty();
+    }
+    let mut written = beads.p1();
+    for lone in &mut islands.lone {
+        match &lone.outcome {
+            None => continue,
+            Some(Err(reason)) => {
+                divergences.report(lone.entity, reason.clone(), clock.time);
+                continue;
+            }
+            Some(Ok(())) => {}
+        }
+        let Ok((mut bead, bead_diagnostics, transform, _)) = written.get_mut(lone.entity) else {
+            continue;
+        };
+        bead.advance_to(lone.state);
+        if let Some(mut transform) = transform {
+            V::place(&mut transform, lone.state.position);
+        }
+        let diagnosed = lone.diagnostics(gravity);
+        lone.energy = diagnosed.energy();
+        if let Some(mut d) = bead_diagnostics {
+            *d = diagnosed;
+        }
     }
     for cached in &mut islands.cached {
         match cached.outcome {
@@ -251,6 +289,44 @@ pub(super) fn step_islands<V: Dimension>(
     }
 }
 
+/// Gathers bead `lone`'s state, force, radius and restitution for its
+/// step, and its wire's path, under `contacts` and `gravity`; the wire's
+/// shape, if the bead and its wire are there (else its outcome says why
+/// it did not step, or it stopped).
+fn gather_lone<V: LoneStep>(
+    lone: &mut LoneTouch<V>,
+    motion: &Query<Gathered<V>, Stepped>,
+    wires: &Query<(Ref<V::Wire>, &WirePose<V>)>,
+    (contacts, gravity): (&Contacts, V),
+) -> Option<V::Lone> {
+    lone.outcome = None;
+    lone.output = None;
+    let (position, velocity, force, radius, restitution) = motion.get(lone.entity).ok()?;
+    lone.state = BeadState {
+        position: position.0,
+        velocity: velocity.0,
+    };
+    lone.radius = radius.map_or(0.0, BeadRadius::get);
+    lone.restitution = restitution.map_or(contacts.restitution(), Restitution::get);
+    lone.friction = contacts.friction();
+    lone.force = force.linear(lone.mass, gravity, lone.state.position);
+    let found = match wires.get(lone.wire) {
+        Ok((wire, pose)) => pose.get().map_err(|e| e.to_string()).and_then(|path| {
+            lone.path = path;
+            V::lone_shape(&wire)
+                .ok_or_else(|| format!("wire {} has no shape a bead rides alone", lone.wire))
+        }),
+        Err(_) => Err(format!("entity {} has no Wire", lone.wire)),
+    };
+    match found {
+        Ok(shape) => Some(shape),
+        Err(why) => {
+            lone.outcome = Some(Err(DivergenceReason::InvalidWire(why)));
+            None
+        }
+    }
+}
+
 /// A pin's rows reported together: the bead's distance from its point,
 /// that distance's rate, and the length of the pin's force.
 fn pin_report(rows: &[RowReport]) -> ConstraintDiagnostics {
@@ -274,6 +350,7 @@ fn step_island<V: Dimension>(cached: &mut CachedIsland<V>, time: f64, settings: 
         cached.island.begin(time, &cached.states, &mut cached.work);
         cached.start.clone_from(&cached.states);
         cached.mark = cached.work.mark();
+        cached.begin.clone_from(&cached.mark);
     }
     cached.outcome = Some(cached.island.step_at(
         time,

@@ -7,8 +7,10 @@
 use bevy::prelude::*;
 
 use super::CachedIsland;
+use super::lone::{LoneBody, LoneTouch};
 use crate::dynamics::{BeadsStruck, Dimension, DivergenceReason};
 use crate::plugin::report::Divergences;
+use crate::plugin::step::LoneStep;
 use crate::solver::{
     self, BeadState, Pressed, SolveError, StepSettings, StepSpan, StruckPair, TouchBead, TouchBody,
     TouchError,
@@ -129,6 +131,14 @@ impl<V: Dimension> TouchBody<V> for IslandBody<'_, V> {
             self.cached.mark.hold(row, held);
         }
     }
+
+    fn restart(&mut self, time: f64, dt: f64) -> Result<(), SolveError> {
+        self.cached.mark.clone_from(&self.cached.begin);
+        let mut states = self.cached.start.clone();
+        self.advance(time, dt, &mut states)?;
+        self.finish(&states);
+        Ok(())
+    }
 }
 
 impl<V: Dimension> CachedIsland<V> {
@@ -151,31 +161,69 @@ const NEAR_STEPS: f64 = 2.0;
 /// islands are built, so that a pair joined stays joined a while.
 const NEAR_MARGIN: f64 = 0.25;
 
-/// The pairs of beads `(entity, state, radius)` that may meet within
-/// [`NEAR_STEPS`] steps of `dt`, with [`NEAR_MARGIN`] to spare: the island
-/// builder joins them by contact rows.
-pub(super) fn near<V: Dimension>(
-    beads: &[(Entity, BeadState<V>, f64)],
-    dt: f64,
-) -> Vec<(usize, usize)> {
-    let states: Vec<(BeadState<V>, f64)> = beads.iter().map(|&(_, s, r)| (s, r)).collect();
-    solver::may_touch(&states, NEAR_STEPS * dt, NEAR_MARGIN)
+/// A bead with a radius as the islands are built and regrouped: where it
+/// is, its radius and restitution, and whether it rides its wire alone
+/// where no contact row joins it ([`LoneTouch`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Rider<V> {
+    pub(super) state: BeadState<V>,
+    pub(super) radius: f64,
+    pub(super) restitution: f64,
+    pub(super) alone: bool,
+}
+
+impl<V: Dimension> Rider<V> {
+    /// Whether this bead and `other`, which may meet soon, are joined by
+    /// a contact row: always, but for two beads that ride their wires
+    /// alone and bounce (the lesser restitution above zero), which are
+    /// joined only where they rest in touch
+    /// ([`solver::rests_in_touch`]). Beads that bounce settle their
+    /// meetings as two bodies, each stepped alone; beads at `e = 0` are
+    /// held by their row in their island's step (see
+    /// [`solver::settle_touches`]).
+    fn joins(&self, other: &Self) -> bool {
+        let bounce = self.restitution.min(other.restitution) > 0.0;
+        !(self.alone && other.alone && bounce)
+            || solver::rests_in_touch(&self.state, &other.state, self.radius + other.radius)
+    }
+}
+
+/// The pairs of `beads` that the island builder joins by contact rows:
+/// those that may meet within [`NEAR_STEPS`] steps of `dt`, with
+/// [`NEAR_MARGIN`] to spare, that [`Rider::joins`].
+pub(super) fn near<V: Dimension>(beads: &[Rider<V>], dt: f64) -> Vec<(usize, usize)> {
+    let states: Vec<(BeadState<V>, f64)> = beads.iter().map(|b| (b.state, b.radius)).collect();
+    let mut pairs = solver::may_touch(&states, NEAR_STEPS * dt, NEAR_MARGIN);
+    pairs.retain(|&(i, j)| beads[i].joins(&beads[j]));
+    pairs
 }
 
 /// Whether the islands should be built again before the next step: two
 /// beads that may meet within it are not joined by a contact row (in
-/// different islands, or not yet near at the last build), or two joined
-/// by one have gone far apart (their islands may part).
-pub(super) fn regroup<V: Dimension>(cached: &[CachedIsland<V>], dt: f64) -> bool {
+/// different islands, or not yet near at the last build; of two beads
+/// that ride their wires alone, only where they rest in touch, see
+/// [`near`]), or two joined by one have gone far apart (their islands may
+/// part).
+pub(super) fn regroup<V: Dimension>(
+    cached: &[CachedIsland<V>],
+    lone: &[LoneTouch<V>],
+    dt: f64,
+) -> bool {
     let mut beads = Vec::new();
+    // Each bead's island (none for one alone) and index there.
     let mut place = Vec::new();
     for (k, island) in cached.iter().enumerate() {
         if island.outcome != Some(Ok(())) {
             continue;
         }
-        for &(bead, radius, ..) in &island.touching {
-            beads.push((island.states[bead], radius));
-            place.push((k, bead));
+        for &(bead, radius, restitution, _) in &island.touching {
+            beads.push(Rider {
+                state: island.states[bead],
+                radius,
+                restitution,
+                alone: island.alone[bead],
+            });
+            place.push((Some(k), bead));
         }
         for contact in &island.contacts {
             let (a, b) = (island.states.get(contact.a), island.states.get(contact.b));
@@ -188,11 +236,24 @@ pub(super) fn regroup<V: Dimension>(cached: &[CachedIsland<V>], dt: f64) -> bool
             }
         }
     }
-    solver::may_touch(&beads, dt, 0.0)
+    for (k, lone) in lone.iter().enumerate() {
+        if matches!(lone.outcome, Some(Ok(()))) {
+            beads.push(Rider {
+                state: lone.state,
+                radius: lone.radius,
+                restitution: lone.restitution,
+                alone: true,
+            });
+            place.push((None, k));
+        }
+    }
+    let states: Vec<(BeadState<V>, f64)> = beads.iter().map(|b| (b.state, b.radius)).collect();
+    solver::may_touch(&states, dt, 0.0)
         .into_iter()
         .any(|(i, j)| {
             let ((ki, a), (kj, b)) = (place[i], place[j]);
-            ki != kj || cached[ki].contact_row(a, b).is_none()
+            let joined = ki.is_some_and(|k| ki == kj && cached[k].contact_row(a, b).is_some());
+            !joined && beads[i].joins(&beads[j])
         })
 }
 
@@ -200,8 +261,9 @@ pub(super) fn regroup<V: Dimension>(cached: &[CachedIsland<V>], dt: f64) -> bool
 /// [`solver::settle_touches`]): the islands that stepped and have beads
 /// with radii take part; each strike is sent as [`BeadsStruck`] and
 /// logged, and a failure stops the touching beads, reported in words.
-pub(super) fn settle<V: Dimension>(
+pub(super) fn settle<V: LoneStep>(
     cached: &mut [CachedIsland<V>],
+    (lone, shapes): (&mut [LoneTouch<V>], &[Option<V::Lone>]),
     time: f64,
     settings: &StepSettings,
     struck: &mut MessageWriter<BeadsStruck>,
@@ -209,6 +271,29 @@ pub(super) fn settle<V: Dimension>(
 ) {
     let mut beads = Vec::new();
     let mut entities = Vec::new();
+    // The beads alone that stepped, each a body after the islands.
+    let mut lone_bodies: Vec<LoneBody<V>> = lone
+        .iter_mut()
+        .zip(shapes)
+        .filter(|(lone, _)| matches!(lone.outcome, Some(Ok(()))))
+        .filter_map(|(lone, shape)| {
+            Some(LoneBody {
+                lone,
+                shape: shape.as_ref()?,
+                settings: *settings,
+            })
+        })
+        .collect();
+    for (k, body) in lone_bodies.iter().enumerate() {
+        beads.push(TouchBead {
+            body: cached.len() + k,
+            bead: 0,
+            radius: body.lone.radius,
+            restitution: body.lone.restitution,
+            friction: body.lone.friction,
+        });
+        entities.push(body.lone.entity);
+    }
     for (body, island) in cached.iter().enumerate() {
         if island.outcome != Some(Ok(())) {
             continue;
@@ -227,12 +312,17 @@ pub(super) fn settle<V: Dimension>(
     if beads.len() < 2 {
         return;
     }
-    let mut bodies: Vec<IslandBody<V>> = cached
+    let mut island_bodies: Vec<IslandBody<V>> = cached
         .iter_mut()
         .map(|cached| IslandBody {
             cached,
             settings: *settings,
         })
+        .collect();
+    let mut bodies: Vec<&mut dyn TouchBody<V>> = island_bodies
+        .iter_mut()
+        .map(|b| b as &mut dyn TouchBody<V>)
+        .chain(lone_bodies.iter_mut().map(|b| b as &mut dyn TouchBody<V>))
         .collect();
     let span = StepSpan {
         time,

@@ -46,6 +46,15 @@ pub(crate) trait LoneStep: Dimension + LaneSpace {
     /// Runs `f` on the shape along `path`, its nearest point looked for
     /// near the parameter `hint` where it has one.
     fn near<R>(shape: &Self::Lone, path: &Self::Path, hint: f64, f: impl OnTrack<Self, R>) -> R;
+    /// Runs `f` on the shape along `path`: resting where the path does
+    /// not move, moving otherwise.
+    #[inline(always)]
+    fn on_path<R>(shape: &Self::Lone, path: &Self::Path, f: impl OnTrack<Self, R>) -> R {
+        match Self::path_fixed(path) {
+            Some(pose) => Self::fixed(shape, pose, f),
+            None => Self::moving(shape, path, f),
+        }
+    }
 }
 
 /// Runs `$body` with `$curve` bound to the shape's concrete curve, so the
@@ -142,9 +151,6 @@ impl LoneStep for DVec3 {
         f.run(&MovingSurface { surface, path })
     }
     fn near<R>(surface: &SharedSurface, path: &SpacePath, _: f64, f: impl OnTrack<Self, R>) -> R {
-        match path.fixed() {
-            Some(pose) => Self::fixed(surface, pose, f),
-            None => Self::moving(surface, path, f),
-        }
+        Self::on_path(surface, path, f)
     }
 }

@@ -28,7 +28,7 @@ use crate::dynamics::{
     Bead, BeadDiagnostics, BeadForce, BeadMass, BeadPosition, BeadVelocity, Diverged, OnWire,
     SimParams, SpaceBead, WireContact, WirePose,
 };
-pub(crate) use lone::LoneStep;
+pub(crate) use lone::{LoneStep, OnTrack};
 use run::{StepContext, split_table};
 use table::WireTable;
 

@@ -15,6 +15,9 @@ const MOST_CELLS: i64 = 64;
 /// other. Each coordinate so fits in 21 bits of a cell's key.
 const FARTHEST_CELL: i64 = (1 << 20) - 1;
 
+/// Up to this many boxes are tested pair by pair, without a grid.
+const FEW: usize = 16;
+
 /// The grid's cells are this many times the median box's largest side:
 /// a box covers one or two of them along each axis.
 const CELL_BOXES: f64 = 2.0;
@@ -31,6 +34,22 @@ const CELL_BOXES: f64 = 2.0;
 /// A box covering more than [`MOST_CELLS`] cells (or an infinite one) is
 /// tested against every box instead.
 pub(crate) fn overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
+    let overlap = |i: usize, j: usize| {
+        let ((a_low, a_high), (b_low, b_high)) = (boxes[i], boxes[j]);
+        a_low.cmple(b_high).all() && b_low.cmple(a_high).all()
+    };
+    // A few boxes: every pair, already in order.
+    if boxes.len() <= FEW {
+        let mut pairs = Vec::new();
+        for i in 0..boxes.len() {
+            for j in i + 1..boxes.len() {
+                if overlap(i, j) {
+                    pairs.push((i, j));
+                }
+            }
+        }
+        return pairs;
+    }
     let side = CELL_BOXES * cell_side(boxes);
     // The grid starts at the lowest corner, so that boxes all alike
     // along an axis (beads in the plane along z) share one cell on it.
@@ -69,10 +88,6 @@ pub(crate) fn overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
         }
     }
     entries.sort_unstable();
-    let overlap = |i: usize, j: usize| {
-        let ((a_low, a_high), (b_low, b_high)) = (boxes[i], boxes[j]);
-        a_low.cmple(b_high).all() && b_low.cmple(a_high).all()
-    };
     let mut pairs = Vec::new();
     for run in entries.chunk_by(|a, b| a.0 == b.0) {
         let here = run[0].0;

@@ -4,8 +4,9 @@
 
 use bevy::math::DVec3;
 
+use super::pool::{Met, Pool, Settled};
 use super::{
-    MAX_IMPACTS_PER_STEP, Pool, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody, TouchError,
+    MAX_IMPACTS_PER_STEP, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody, TouchError,
     overlapping, swept,
 };
 use crate::geometry::Coordinates;
@@ -25,8 +26,11 @@ pub(super) struct Group<'a, V: Coordinates> {
     span: StepSpan,
     beads: &'a [TouchBead],
     bodies: Vec<usize>,
-    /// The beads (indices into `beads`) of the group's bodies.
+    /// The beads (indices into `beads`) of the group's bodies, and the box
+    /// each has swept so far this step (from its start through each
+    /// instant the group was cut at).
     members: Vec<usize>,
+    paths: Vec<(DVec3, DVec3)>,
     pairs: Vec<(usize, usize)>,
     /// When the group is now.
     time: f64,
@@ -56,18 +60,23 @@ impl<'a, V: Coordinates> Group<'a, V> {
         all: &[B],
         beads: &'a [TouchBead],
         bodies: Vec<usize>,
+        pool: &Pool,
     ) -> Self {
         let now = bodies.iter().map(|&b| all[b].start().to_vec()).collect();
         let end = bodies.iter().map(|&b| all[b].end().to_vec()).collect();
         let tried = vec![false; bodies.len()];
-        let members = (0..beads.len())
-            .filter(|&i| bodies.contains(&beads[i].body))
+        let mut members: Vec<usize> = bodies
+            .iter()
+            .flat_map(|&b| pool.beads_of(b))
+            .copied()
             .collect();
+        members.sort_unstable();
         let mut group = Self {
             span,
             beads,
             bodies,
             members,
+            paths: Vec::new(),
             pairs: Vec::new(),
             time: span.time,
             now,
@@ -78,7 +87,20 @@ impl<'a, V: Coordinates> Group<'a, V> {
             last_trial: None,
         };
         group.pairs = group.find_pairs(&[]).0;
+        group.paths = group.members.iter().map(|&i| group.swept(i)).collect();
         group
+    }
+
+    /// Grows each member's path to take in where it is now, or at the
+    /// step's end.
+    fn trace(&mut self, at_end: bool) {
+        for k in 0..self.members.len() {
+            let i = self.members[k];
+            let p = self.state(i, at_end).position;
+            let (low, high) = swept(&self.beads[i], p, p);
+            let path = &mut self.paths[k];
+            *path = (path.0.min(low), path.1.max(high));
+        }
     }
 
     /// The pairs of the group's beads whose boxes from now to the end
@@ -101,57 +123,45 @@ impl<'a, V: Coordinates> Group<'a, V> {
         (pairs, met)
     }
 
-    /// Takes into the group the bodies not yet settled whose beads' boxes
-    /// meet its beads' boxes from now on (with the rest of the group the
-    /// broad phase first put them in), each stepped to now; then finds
-    /// the group's pairs again.
-    fn absorb<B: TouchBody<V>>(
-        &mut self,
-        bodies: &mut [B],
-        pool: &mut Pool,
-    ) -> Result<(), SolveError> {
+    /// The bodies outside the group whose beads' boxes meet its beads'
+    /// boxes from now on: those not yet settled (each with the rest of the
+    /// group the broad phase first put it in), taken from the pool, and
+    /// those settled with another group. The group is then settled again
+    /// from the step's start with them, so that what they met before now
+    /// is settled too.
+    fn meets_outside(&self, pool: &mut Pool) -> Option<Met> {
         // Only the beads whose boxes meet the box about the whole group's.
         let (low, high) = self.members.iter().map(|&i| self.swept(i)).fold(
             (DVec3::INFINITY, DVec3::NEG_INFINITY),
             |(low, high), (a, b)| (low.min(a), high.max(b)),
         );
-        let outside: Vec<Boxed> = (0..self.beads.len())
-            .filter(|&j| pool.free[self.beads[j].body])
-            .map(|j| (j, pool.boxes[j]))
-            .filter(|(_, (a, b))| a.cmple(high).all() && low.cmple(*b).all())
+        let outside: Vec<Boxed> = pool
+            .near((low, high))
+            .into_iter()
+            .filter(|(j, _)| !self.bodies.contains(&self.beads[*j].body))
             .collect();
         let (_, met) = self.find_pairs(&outside);
+        if met.is_empty() {
+            return None;
+        }
+        let mut found = Met::default();
         for j in met {
             let body = self.beads[j].body;
             if !pool.free[body] {
+                if !found.free.contains(&body) && !found.settled.contains(&body) {
+                    found.settled.push(body);
+                }
                 continue;
             }
-            let taken = match pool.group_of[body] {
+            match pool.group_of[body] {
                 usize::MAX => {
                     pool.free[body] = false;
-                    vec![body]
+                    found.free.push(body);
                 }
-                g => pool.take(g),
-            };
-            for body in taken {
-                let mut now = bodies[body].start().to_vec();
-                let since = self.time - self.span.time;
-                if since > 0.0 {
-                    bodies[body].advance(self.span.time, since, &mut now)?;
-                    bodies[body].keep();
-                }
-                let mut end = now.clone();
-                bodies[body].advance(self.time, self.left(), &mut end)?;
-                self.bodies.push(body);
-                self.now.push(now);
-                self.end.push(end);
-                self.tried.push(false);
-                self.members
-                    .extend((0..self.beads.len()).filter(|&i| self.beads[i].body == body));
+                g => found.free.extend(pool.take(g)),
             }
         }
-        self.pairs = self.find_pairs(&[]).0;
-        Ok(())
+        Some(found)
     }
 
     /// The place of bead `i`'s body in the group.
@@ -195,20 +205,26 @@ impl<'a, V: Coordinates> Group<'a, V> {
         bodies: &mut [B],
         pool: &mut Pool,
         struck: &mut Vec<StruckPair>,
-    ) -> Result<(), TouchError> {
+    ) -> Result<Settled, TouchError> {
         let mut last = (0, 0);
         let mut instants = 0;
         while instants < MAX_IMPACTS_PER_STEP * self.pairs.len().max(1) {
             instants += 1;
             let Some((tau, pair)) = self.first_meeting(bodies)? else {
-                return self.finish(bodies);
+                self.finish(bodies, pool)?;
+                return Ok(Settled::Done(self.bodies));
             };
             last = pair;
             self.cut = true;
             self.step_all(bodies, tau, true)?;
+            self.trace(false);
             self.strike(bodies, struck)?;
             self.step_all(bodies, self.left(), false)?;
-            self.absorb(bodies, pool)?;
+            self.trace(true);
+            if let Some(met) = self.meets_outside(pool) {
+                return Ok(Settled::Met(self.bodies, met));
+            }
+            self.pairs = self.find_pairs(&[]).0;
         }
         Err(TouchError::TooManyImpacts {
             a: last.0,
@@ -519,7 +535,11 @@ impl<'a, V: Coordinates> Group<'a, V> {
     /// Hands each body its new end, if the group was cut; a body whose
     /// last step was a trial is stepped to its end once more, so that what
     /// it reports is its end's.
-    fn finish<B: TouchBody<V>>(mut self, bodies: &mut [B]) -> Result<(), TouchError> {
+    fn finish<B: TouchBody<V>>(
+        &mut self,
+        bodies: &mut [B],
+        pool: &mut Pool,
+    ) -> Result<(), TouchError> {
         if !self.cut && !self.tried.iter().any(|&t| t) {
             return Ok(());
         }
@@ -528,6 +548,11 @@ impl<'a, V: Coordinates> Group<'a, V> {
         }
         for (slot, &body) in self.bodies.iter().enumerate() {
             bodies[body].finish(&self.end[slot]);
+        }
+        // The paths the cuts gave, for the groups settled after it.
+        self.trace(true);
+        for (&i, &path) in self.members.iter().zip(&self.paths) {
+            pool.grow(i, path);
         }
         Ok(())
     }

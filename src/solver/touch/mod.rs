@@ -22,6 +22,12 @@
 //!    each bead answering through its body (a
 //!    [`Response`](crate::solver::Response)); the rest of the step is taken
 //!    again from the struck state, and 3 repeats.
+//! 5. Where a strike sends a bead of the group to meet beads of bodies
+//!    outside it (not yet settled, or settled with another group), the
+//!    group and those bodies (with the groups they were settled with) are
+//!    settled again as one from the step's start
+//!    ([`TouchBody::restart`]), so that what those bodies met before the
+//!    instant is settled too.
 //!
 //! A pair already touching that does not close (beads hanging side by
 //! side, or moving on together after a strike at `e = 0`) is left in
@@ -62,24 +68,28 @@
 //! |---|---|
 //! | `mod` | [`TouchBody`], [`TouchBead`], [`settle_touches`] and the groups the broad phase finds |
 //! | `broad` | the broad phase ([`overlapping`]): which boxes overlap, by a grid |
-//! | `group` | one group settled: where its pairs meet, the steps to and from each instant, the strikes, the bodies it takes in |
+//! | `group` | one group settled: where its pairs meet, the steps to and from each instant, the strikes, the bodies it meets |
+//! | `pool` | the bodies of a step's settlement: which are settled, each bead's box, how a group's settlement ended |
 
 use bevy::math::DVec3;
 use thiserror::Error;
 
-use super::coupled::islands;
+use super::coupled::{islands, opening_rate, parts};
 use super::impact::{ImpactError, Strike};
-use super::solve::SolveError;
+use super::solve::{SolveError, singular};
 use super::state::BeadState;
+use super::wire_normal::{along, usable};
 use crate::geometry::Coordinates;
 
 mod broad;
 mod group;
+mod pool;
 #[cfg(test)]
 mod tests;
 
 pub(crate) use broad::overlapping;
 use group::Group;
+use pool::{Pool, Settled};
 
 pub(crate) use super::coupled::TOUCHING;
 
@@ -164,6 +174,76 @@ pub trait TouchBody<V: Coordinates> {
     /// aside (they bounced or part). A body without the row ignores it.
     fn hold(&mut self, a: usize, b: usize, held: bool) {
         let _ = (a, b, held);
+    }
+    /// Takes the body back to where the step `[time, time + dt]` began,
+    /// its end to the step from there as if nothing touched: its beads
+    /// are settled again with a group whose bead came to meet them. The
+    /// default steps from [`TouchBody::start`], for a body that keeps
+    /// nothing between its steps.
+    fn restart(&mut self, time: f64, dt: f64) -> Result<(), SolveError> {
+        let mut states = self.start().to_vec();
+        self.advance(time, dt, &mut states)?;
+        self.finish(&states);
+        Ok(())
+    }
+}
+
+/// A body borrowed: bodies of different kinds settle together as
+/// `&mut dyn TouchBody<V>`.
+impl<V: Coordinates, T: TouchBody<V> + ?Sized> TouchBody<V> for &mut T {
+    fn start(&self) -> &[BeadState<V>] {
+        (**self).start()
+    }
+    fn end(&self) -> &[BeadState<V>] {
+        (**self).end()
+    }
+    fn advance(
+        &mut self,
+        time: f64,
+        h: f64,
+        states: &mut [BeadState<V>],
+    ) -> Result<(), SolveError> {
+        (**self).advance(time, h, states)
+    }
+    fn keep(&mut self) {
+        (**self).keep();
+    }
+    fn respond(
+        &mut self,
+        time: f64,
+        states: &[BeadState<V>],
+        bead: usize,
+        impulse: V,
+    ) -> Result<Vec<V>, SolveError> {
+        (**self).respond(time, states, bead, impulse)
+    }
+    fn push(&self, bead: usize) -> V {
+        (**self).push(bead)
+    }
+    fn finish(&mut self, states: &[BeadState<V>]) {
+        (**self).finish(states);
+    }
+    fn contact(&self, a: usize, b: usize) -> Option<bool> {
+        (**self).contact(a, b)
+    }
+    fn press(
+        &mut self,
+        time: f64,
+        states: &[BeadState<V>],
+    ) -> Result<Option<Pressed<V>>, SolveError> {
+        (**self).press(time, states)
+    }
+    fn time_steps(&self) -> bool {
+        (**self).time_steps()
+    }
+    fn ends_held(&self, a: usize, b: usize) -> bool {
+        (**self).ends_held(a, b)
+    }
+    fn hold(&mut self, a: usize, b: usize, held: bool) {
+        (**self).hold(a, b, held);
+    }
+    fn restart(&mut self, time: f64, dt: f64) -> Result<(), SolveError> {
+        (**self).restart(time, dt)
     }
 }
 
@@ -274,17 +354,11 @@ pub fn settle_touches<V: Coordinates, B: TouchBody<V>>(
         .collect();
     let pairs = overlapping(&boxes);
     let found = groups(beads, bodies.len(), &pairs);
-    let mut pool = Pool {
-        boxes,
-        group_of: vec![usize::MAX; bodies.len()],
-        free: vec![true; bodies.len()],
-        groups: found,
-    };
-    for (g, group) in pool.groups.iter().enumerate() {
-        for &body in group {
-            pool.group_of[body] = g;
-        }
-    }
+    let mut pool = Pool::new(boxes, beads, bodies.len(), found);
+    // Which settlement each body was settled in, and each settlement's
+    // bodies.
+    let mut settled_in = vec![usize::MAX; bodies.len()];
+    let mut settlements: Vec<Vec<usize>> = Vec::new();
     for g in 0..pool.groups.len() {
         let Some(first) = pool.groups[g].first() else {
             continue;
@@ -292,8 +366,38 @@ pub fn settle_touches<V: Coordinates, B: TouchBody<V>>(
         if !pool.free[*first] {
             continue; // taken in by a group settled before it
         }
-        let group = pool.take(g);
-        Group::new(span, bodies, beads, group).settle(bodies, &mut pool, struck)?;
+        let mut group = pool.take(g);
+        loop {
+            let group_now = Group::new(span, bodies, beads, group, &pool);
+            match group_now.settle(bodies, &mut pool, struck)? {
+                Settled::Done(done) => {
+                    for &body in &done {
+                        settled_in[body] = settlements.len();
+                    }
+                    settlements.push(done);
+                    break;
+                }
+                // A bead of the group came to meet bodies outside it: all
+                // are settled again as one, from the step's start (those
+                // settled before with their groups).
+                Settled::Met(mine, met) => {
+                    let mut again = mine;
+                    for body in met.settled {
+                        if !again.contains(&body) {
+                            again.append(&mut settlements[settled_in[body]]);
+                        }
+                    }
+                    for &body in &again {
+                        bodies[body].restart(span.time, span.dt)?;
+                    }
+                    struck.retain(|p| {
+                        !again.contains(&beads[p.a].body) && !again.contains(&beads[p.b].body)
+                    });
+                    again.extend(met.free);
+                    group = again;
+                }
+            }
+        }
     }
     Ok(())
 }
@@ -304,31 +408,6 @@ fn swept<V: Coordinates>(t: &TouchBead, from: V, to: V) -> (DVec3, DVec3) {
     let (a, b) = (from.xyz(), to.xyz());
     let grown = t.radius * (1.0 + 4.0 * TOUCHING);
     (a.min(b) - grown, a.max(b) + grown)
-}
-
-/// The bodies not yet settled this step, in the groups the broad phase
-/// first put them in, and each bead's box from the step's start to its
-/// end.
-struct Pool {
-    boxes: Vec<(DVec3, DVec3)>,
-    group_of: Vec<usize>,
-    free: Vec<bool>,
-    groups: Vec<Vec<usize>>,
-}
-
-impl Pool {
-    /// Takes the free bodies of group `g`.
-    fn take(&mut self, g: usize) -> Vec<usize> {
-        let bodies: Vec<usize> = self.groups[g]
-            .iter()
-            .copied()
-            .filter(|&b| self.free[b])
-            .collect();
-        for &b in &bodies {
-            self.free[b] = false;
-        }
-        bodies
-    }
 }
 
 /// The pairs of beads, each `(state, radius)`, that may come to touch
@@ -351,6 +430,40 @@ pub(crate) fn may_touch<V: Coordinates>(
         })
         .collect();
     overlapping(&boxes)
+}
+
+/// Whether beads `a` and `b`, of `reach` (their two radii), rest in
+/// touch: touching (their gap within [`TOUCHING`] of the reach) and not
+/// parting. Two beads that ride their wires alone and rest in touch are
+/// joined by a contact row, so that what presses them together is held
+/// rather than struck step after step; apart, or parting as after an
+/// elastic strike, they settle their meetings as two bodies.
+pub(crate) fn rests_in_touch<V: Coordinates>(
+    a: &BeadState<V>,
+    b: &BeadState<V>,
+    reach: f64,
+) -> bool {
+    let d = b.position - a.position;
+    let gap = d.dot(d).sqrt() - reach;
+    let (rate, speeds) = opening_rate(a, b);
+    gap <= TOUCHING * reach && !parts(rate, reach, speeds)
+}
+
+/// The velocity change of a bead of `mass` held at `position` on a wire
+/// whose normal there is `normal`, per `impulse` on it: the impulse's
+/// part along the wire over the mass (the row's `J W Jᵀ` answer for a
+/// body of one bead). An error in words at a singular point of the wire.
+pub(crate) fn wire_response<V: Coordinates>(
+    position: V,
+    normal: V,
+    mass: f64,
+    impulse: V,
+) -> Result<V, SolveError> {
+    let nn = normal.dot(normal);
+    if !usable(nn) {
+        return Err(singular(position));
+    }
+    Ok(along(normal, nn, impulse) / mass)
 }
 
 /// The bodies the pairs join, grouped ([`islands`]'s grouping, the pairs
