@@ -161,7 +161,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
                 g => found.free.extend(pool.take(g)),
             }
         }
-        Some(found)
+        (!found.free.is_empty() || !found.settled.is_empty()).then_some(found)
     }
 
     /// The place of bead `i`'s body in the group.

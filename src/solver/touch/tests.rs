@@ -5,12 +5,14 @@ use bevy::math::{DVec2, DVec3};
 
 use super::*;
 
-/// Free beads of unit mass coasting at constant velocity: exact, so
-/// that where they meet is known in closed form.
+/// Free beads coasting at constant velocity (of unit mass unless
+/// [`Coasting::of_mass`] says otherwise): exact, so that where they meet
+/// is known in closed form.
 struct Coasting {
     start: Vec<BeadState>,
     end: Vec<BeadState>,
     steps: usize,
+    mass: f64,
 }
 
 impl Coasting {
@@ -30,7 +32,13 @@ impl Coasting {
             start,
             end,
             steps: 0,
+            mass: 1.0,
         }
+    }
+
+    /// The same beads, each of `mass`.
+    fn of_mass(self, mass: f64) -> Self {
+        Self { mass, ..self }
     }
 }
 
@@ -56,7 +64,7 @@ impl TouchBody<DVec2> for Coasting {
         bead: usize,
         impulse: DVec2,
     ) -> Result<Vec<DVec2>, SolveError> {
-        Ok(unit_answer(states.len(), bead, impulse))
+        Ok(unit_answer(states.len(), bead, impulse / self.mass))
     }
     fn push(&self, _: usize) -> DVec2 {
         DVec2::ZERO
@@ -424,4 +432,64 @@ fn beads_may_touch_only_where_their_motion_can_bring_them_together() {
         vec![(0, 1)]
     );
     assert!(may_touch(&[bead(0.0, 0.0, 5.0), bead(0.5, 0.3, -5.0)], 1.0, 0.0).is_empty());
+}
+
+/// Four beads of radius 0.1 on a line, each a body, in two groups the
+/// broad phase finds apart: W at rest with X drifting towards it, settled
+/// first; then Z, of 10 kg, strikes Y halfway through the step and sends
+/// it back into X, after X's group was settled. Y's group is settled
+/// again with X's from the step's start: no pair ends overlapping, Y and
+/// X strike, and momentum and energy are kept to 1e-12.
+#[test]
+fn a_strike_that_sends_a_bead_into_a_group_settled_before_settles_both_again() {
+    let dt = 1.0;
+    let masses = [1.0, 1.0, 1.0, 10.0];
+    let starts = [(0.015, 0.0), (0.25, -0.04), (0.5, 0.0), (0.8, -0.2)];
+    let mut bodies: Vec<Coasting> = starts
+        .iter()
+        .zip(masses)
+        .map(|(&start, m)| Coasting::new(&[start], dt).of_mass(m))
+        .collect();
+    let beads = beads(4, 0.1);
+    let sums = |states: &[(f64, f64)]| {
+        let momentum: f64 = states.iter().zip(masses).map(|((_, v), m)| m * v).sum();
+        let energy: f64 = states
+            .iter()
+            .zip(masses)
+            .map(|((_, v), m)| 0.5 * m * v * v)
+            .sum();
+        (momentum, energy)
+    };
+    // Apart, the broad phase sees two groups: W and X, then Y and Z.
+    let boxes: Vec<(DVec3, DVec3)> = bodies
+        .iter()
+        .zip(&beads)
+        .map(|(b, t)| swept(t, b.start[0].position, b.end[0].position))
+        .collect();
+    assert_eq!(overlapping(&boxes), vec![(0, 1), (2, 3)]);
+    let mut struck = Vec::new();
+    let span = StepSpan { time: 0.0, dt };
+    settle_touches(span, &mut bodies, &beads, &mut struck).expect("settles");
+    let ends: Vec<(f64, f64)> = bodies
+        .iter()
+        .map(|b| (b.end[0].position.x, b.end[0].velocity.x))
+        .collect();
+    for i in 0..4 {
+        for j in i + 1..4 {
+            let gap = (ends[j].0 - ends[i].0).abs() - 0.2;
+            assert!(
+                gap >= -1e-12,
+                "beads {i} and {j} end {gap:e} apart: {ends:?}"
+            );
+        }
+    }
+    let ((p0, e0), (p1, e1)) = (sums(&starts), sums(&ends));
+    assert!((p1 - p0).abs() <= 1e-12, "momentum {p0} to {p1}");
+    assert!((e1 - e0).abs() <= 1e-12, "energy {e0} to {e1}");
+    assert!(
+        struck
+            .iter()
+            .any(|s| (s.a.min(s.b), s.a.max(s.b)) == (1, 2)),
+        "{struck:?}"
+    );
 }
