@@ -1389,6 +1389,12 @@ fn a_marble_under_its_own_track_stays_off_it_through_rebuilds() {
 /// top bead from the top (rad), its angular speed about the bottom bead
 /// (rad/s), and whether the two still press.
 fn resting_on_a_bead(degrees: f64, mu: f64, steps: u32) -> (f64, f64, bool) {
+    resting_on_a_bead_rebuilt(degrees, mu, steps, 0)
+}
+
+/// [`resting_on_a_bead`], the islands built again `rebuilds` times
+/// through its steps (a bead spawned far away each time).
+fn resting_on_a_bead_rebuilt(degrees: f64, mu: f64, steps: u32, rebuilds: u32) -> (f64, f64, bool) {
     let (x, y) = (
         0.2 * degrees.to_radians().sin(),
         0.2 * degrees.to_radians().cos(),
@@ -1402,7 +1408,18 @@ fn resting_on_a_bead(degrees: f64, mu: f64, steps: u32) -> (f64, f64, bool) {
         1.0 / 240.0
     );
     let (mut app, spawned, _) = spawned(&text);
-    run_steps(&mut app, steps);
+    let parts = rebuilds + 1;
+    for part in 0..parts {
+        if part > 0 {
+            let far = BeadParams {
+                mass: 1.0,
+                initial_position: DVec2::new(100.0 * f64::from(part), 100.0),
+                initial_velocity: DVec2::ZERO,
+            };
+            app.world_mut().spawn(Bead::new(far).expect("a bead"));
+        }
+        run_steps(&mut app, steps / parts);
+    }
     let world = app.world_mut();
     assert_eq!(world.query::<&Diverged>().iter(world).count(), 0);
     let base = bead_state(app.world(), spawned[0]).expect("the base");
@@ -1430,6 +1447,19 @@ fn a_bead_at_rest_on_another_is_held_by_static_friction() {
         angle > 21f64.to_radians(),
         "without friction it did not slide: {angle}"
     );
+}
+
+/// Static friction across rebuilds: the bead of
+/// [`a_bead_at_rest_on_another_is_held_by_static_friction`], the islands
+/// built again ten times in its 2 s (a bead spawned far away each time),
+/// stays where it was laid to 1e-9 rad: each rebuilt island starts the
+/// pair's stick row held at the line it held on.
+#[test]
+fn a_bead_held_by_static_friction_stays_held_when_its_island_is_built_again() {
+    let (angle, speed, pressing) = resting_on_a_bead_rebuilt(20.0, 0.5, 480, 10);
+    let moved = (angle - 20f64.to_radians()).abs();
+    assert!(moved <= 1e-9, "moved by {moved:e} rad, at {speed:e} rad/s");
+    assert!(pressing, "the pair no longer presses");
 }
 
 /// The bead of [`resting_on_a_bead`] in space (the pair in the plane
@@ -1613,4 +1643,76 @@ fn an_abacus_of_beads_riding_alone_keeps_each_rings_energy_and_never_overlaps() 
     assert!(drift <= 1e-9, "a ring's energy moved by {drift:e} of it");
     let world = app.world_mut();
     assert_eq!(world.query::<&Diverged>().iter(world).count(), 0);
+}
+
+/// Islands merge and split without building the rest again: a pile of
+/// 30 beads poured into a bowl at 60 Hz ([`Pour`]) for 1 s, beside two
+/// beads far off that close on each other and meet at `e = 0` after
+/// 0.78 s (their pair joins an island of its own, and the islands are
+/// regrouped for it at a step where the pile's are not): the pile's
+/// island is kept whole, counting its steps on as in the same pour run
+/// alone ([`IslandReport::steps`](wirebead::IslandReport)), and every
+/// bead of the pile is, after every step, where it is in that run, to
+/// the bit.
+#[test]
+fn a_pile_steps_on_unchanged_while_a_pair_far_off_meets_and_joins() {
+    let scene = Pour {
+        beads: 30,
+        ..Pour::default()
+    }
+    .scene()
+    .unwrap_or_else(|e| panic!("{e}"));
+    let (mut alone, pile) = spawned_from_file(&scene);
+    let (mut beside, same) = spawned_from_file(&scene);
+    let mut pair = Vec::new();
+    for (x, v) in [(5.0, 1.0), (6.6, -1.0)] {
+        let params = BeadParams {
+            mass: 1.0,
+            initial_position: DVec2::new(x, 0.0),
+            initial_velocity: DVec2::new(v, 0.0),
+        };
+        let bead = (
+            Bead::new(params).expect("a bead"),
+            BeadRadius::new(PILE_RADIUS).expect("a radius"),
+        );
+        pair.push(beside.world_mut().spawn(bead).id());
+    }
+    let (mut pressed, mut kept, mut apart) = (0, 0, 0);
+    for step in 1..=60 {
+        run_steps(&mut alone, 1);
+        run_steps(&mut beside, 1);
+        for (&a, &b) in pile.iter().zip(&same) {
+            let (a, b) = (bead_state(alone.world(), a), bead_state(beside.world(), b));
+            assert_eq!(a, b, "step {step}: a bead of the pile went elsewhere");
+        }
+        let islands = beside.world().resource::<Islands>();
+        let joined = islands
+            .of(pair[0])
+            .is_some_and(|i| i.beads.contains(&pair[1]));
+        pressed += usize::from(joined);
+        let lived = |app: &App, bead| app.world().resource::<Islands>().of(bead).map(|i| i.steps);
+        let (then, now) = (lived(&alone, pile[0]), lived(&beside, same[0]));
+        kept += usize::from(then.is_some() && then == now);
+        // The pair's island built anew where the pile's was not.
+        apart += usize::from(joined && lived(&beside, pair[0]) == Some(1) && then > Some(1));
+        assert!(
+            now >= then,
+            "step {step}: the pile's island was built again after {now:?} steps, alone after {then:?}"
+        );
+    }
+    assert!(pressed > 0, "the pair far off never met");
+    assert!(
+        apart > 0,
+        "the pair joined only where the pile was built again"
+    );
+    assert_eq!(kept, 60, "the pile's island was built again for the pair");
+    let (a, b) = (
+        bead_state(beside.world(), pair[0]).expect("a bead"),
+        bead_state(beside.world(), pair[1]).expect("a bead"),
+    );
+    let gap = (b.position - a.position).length() - 2.0 * PILE_RADIUS;
+    assert!(
+        gap.abs() <= 1e-9 * PILE_RADIUS && (b.velocity - a.velocity).length() <= 1e-9,
+        "the pair far off did not meet at e = 0: gap {gap:e} m"
+    );
 }

@@ -7,7 +7,7 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use super::lone::LoneTouch;
-use super::start::{BuildBead, Carried, start_island};
+use super::start::{BuildBead, Carried, by_least_bead, kept, start_island};
 use super::touch::Rider;
 use super::{CachedIsland, ContactRow, InIsland, IslandReport, Islands, LinkRows, WireRow, touch};
 use crate::dynamics::{
@@ -134,10 +134,22 @@ pub(super) fn prepare_islands<V: LoneStep>(
     params: Res<SimParams>,
     contacts: Res<Contacts>,
 ) {
-    islands.dirty = false;
+    // Where only the pairs that may touch changed, an island none of them
+    // concerns whose beads are as they were is kept whole.
+    let regrouped = !islands.dirty;
+    (islands.dirty, islands.regrouped) = (false, false);
+    let wanting = std::mem::take(&mut islands.wanting);
     // The islands being rebuilt, and where their rows are: a rebuilt
     // island starts each row as it was where its beads still are.
-    let old = std::mem::take(&mut islands.cached);
+    let mut old: Vec<Option<CachedIsland<V>>> = std::mem::take(&mut islands.cached)
+        .into_iter()
+        .map(Some)
+        .collect();
+    let by_least = if regrouped {
+        by_least_bead(&old, &wanting)
+    } else {
+        HashMap::new()
+    };
     islands.lone.clear();
     let was = Carried::from(&old, |bead| {
         beads.get(bead).ok().map(|(_, now, ..)| now.state())
@@ -388,6 +400,11 @@ pub(super) fn prepare_islands<V: LoneStep>(
     }
     for ((group, links), springs) in groups.iter().zip(group_links).zip(group_springs) {
         let entities: Vec<Entity> = group.iter().map(|&m| members[m]).collect();
+        let mass = |e: Entity| beads.get(e).ok().map(|(_, bead, ..)| bead.mass());
+        if let Some(island) = kept(&mut old, &by_least, &entities, mass) {
+            islands.cached.push(island);
+            continue;
+        }
         let mut masses = Vec::with_capacity(group.len());
         let mut rows = Vec::new();
         let mut wired = WiredRows::default();

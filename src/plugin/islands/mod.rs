@@ -8,8 +8,8 @@
 //!
 //! | file | what it holds |
 //! |---|---|
-//! | `build` | rebuilding the islands when the topology changes |
-//! | `start` | how an island built again starts: its rows as the last islands left them |
+//! | `build` | rebuilding the islands when the topology changes, or the pairs that may touch |
+//! | `start` | how an island built again starts: its rows as the last islands left them; which islands a regrouping keeps whole |
 //! | `step` | stepping them: gather, solve (in parallel), write back |
 //! | `lone` | beads with a radius that ride a plain wire alone, each a body of its own in the settlement |
 //! | `touch` | beads that touch: the steps cut where they meet, the strikes |
@@ -139,6 +139,10 @@ pub struct IslandReport {
     /// The pairs of its beads pressed together at the end of the last
     /// step, each with the force they press with.
     pub pressed: Vec<PressedPair>,
+    /// How many steps it has written back since it was built. Islands
+    /// that merge or split as pairs of beads meet and part are built
+    /// anew; the others are kept, and count on.
+    pub steps: u64,
 }
 
 /// Two beads that touch, pressed together at the end of a step: the
@@ -225,8 +229,9 @@ struct CachedIsland<V: Dimension> {
 
 /// The islands of the current topology: beads joined by constraints and
 /// springs, each solved as one system. Rebuilt when a link, a bead or a
-/// wire is added, changed or removed, or the run restarts. `Islands` are
-/// the plane's, `Islands<DVec3>` space's.
+/// wire is added, changed or removed, or the run restarts; as beads with
+/// radii come near or part, only the islands they join or leave are
+/// built again. `Islands` are the plane's, `Islands<DVec3>` space's.
 ///
 /// A clone (as the [`Timeline`](crate::plugin::Timeline) keeps one each
 /// step) steps on exactly as the original would.
@@ -237,6 +242,14 @@ pub struct Islands<V: Dimension = DVec2> {
     /// steps alone, and settles touches as a body of its own.
     lone: Vec<lone::LoneTouch<V>>,
     dirty: bool,
+    /// Whether the pairs of beads that may touch changed since the
+    /// islands were built, and nothing else did: the rebuild keeps each
+    /// island that does not want it (`wanting`) whose beads are as they
+    /// were.
+    regrouped: bool,
+    /// Which islands a pair of beads that may touch wants built again
+    /// (see `touch::regroup`).
+    wanting: Vec<bool>,
     /// Since when each bead off a wire that sends beads back has been
     /// slower than the wire's settling speed ([`SendsBeadsBack`]), s:
     /// kept here so that a clone steps on as the original would.
@@ -249,6 +262,8 @@ impl<V: Dimension> Default for Islands<V> {
             cached: Vec::new(),
             lone: Vec::new(),
             dirty: false,
+            regrouped: false,
+            wanting: Vec::new(),
             settling: HashMap::new(),
         }
     }
@@ -292,6 +307,14 @@ impl<V: Dimension> Islands<V> {
     pub(crate) fn mark_dirty(&mut self) {
         self.dirty = true;
     }
+
+    /// Asks for the islands that `wanting` names (a pair of beads that
+    /// may touch is not joined, or one joined has parted) to be built
+    /// again before the next step, the others kept as they are.
+    fn mark_regrouped(&mut self, wanting: Vec<bool>) {
+        self.regrouped = true;
+        self.wanting = wanting;
+    }
 }
 
 /// Marks the islands for a rebuild: observed on the lifecycle events that
@@ -307,7 +330,7 @@ fn topology_changed<E: EntityEvent, B: Bundle, V: Dimension>(
 /// [`build::prepare_islands`], so a step with nothing changed costs the executor
 /// no task.
 fn islands_changed<V: Dimension>(islands: Res<Islands<V>>) -> bool {
-    islands.dirty
+    islands.dirty || islands.regrouped
 }
 
 /// Whether there is an island or a bead alone to step: the run condition of

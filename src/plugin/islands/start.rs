@@ -37,7 +37,7 @@ pub(super) struct Carried<V: Dimension> {
 impl<V: Dimension> Carried<V> {
     /// Where the `old` islands' rows are; `now` is where a bead is.
     pub(super) fn from(
-        old: &[CachedIsland<V>],
+        old: &[Option<CachedIsland<V>>],
         now: impl Fn(Entity) -> Option<BeadState<V>>,
     ) -> Self {
         let mut carried = Self {
@@ -45,6 +45,7 @@ impl<V: Dimension> Carried<V> {
             contacts: HashMap::new(),
         };
         for (k, cached) in old.iter().enumerate() {
+            let Some(cached) = cached else { continue };
             let beads = &cached.report.beads;
             let at = |bead: usize| {
                 cached
@@ -91,7 +92,7 @@ pub(super) fn start_island<V: Dimension>(
     island: &mut Island<V>,
     entities: &[Entity],
     (wire_rows, contacts): (&[WireRow], &[ContactRow]),
-    (old, was): (&[CachedIsland<V>], &Carried<V>),
+    (old, was): (&[Option<CachedIsland<V>>], &Carried<V>),
     wires: &Query<(&V::Wire, &WirePose<V>)>,
     beads: &mut Query<BuildBead<V>>,
     clock: &SimClock,
@@ -108,20 +109,27 @@ pub(super) fn start_island<V: Dimension>(
         let key = (bead, wire_row.wire, wire_row.part);
         if let Some(&((k, from), then)) = was.wire_rows.get(&key)
             && now(bead) == Some(then)
+            && let Some(Some(then)) = old.get(k)
         {
-            work.carry_row(wire_row.row, &old[k].work, from);
+            let row = (wire_row.row, island.stick_row(wire_row.row));
+            work.carry_held(row, &then.work, (from, then.island.stick_row(from)));
         }
     }
     // A contact whose beads are where the last island left them starts
-    // as it was: pressed with its force, or set aside.
+    // as it was: pressed with its force, or set aside, and held by static
+    // friction where it was, at the same line.
     for contact in contacts {
         let (a, b) = (entities[contact.a], entities[contact.b]);
         let (a, b) = (a.min(b), a.max(b));
         let Some(&((k, from), [at_a, at_b])) = was.contacts.get(&(a, b)) else {
             continue;
         };
-        if now(a) == Some(at_a) && now(b) == Some(at_b) {
-            work.carry_row(contact.row, &old[k].work, from);
+        if now(a) == Some(at_a)
+            && now(b) == Some(at_b)
+            && let Some(Some(then)) = old.get(k)
+        {
+            let row = (contact.row, island.stick_row(contact.row));
+            work.carry_held(row, &then.work, (from, then.island.stick_row(from)));
         }
     }
     let mut states: Vec<BeadState<V>> = Vec::with_capacity(entities.len());
@@ -167,4 +175,55 @@ pub(super) fn start_island<V: Dimension>(
         );
     }
     (work, states)
+}
+
+/// The old islands a rebuild that only regroups may keep whole, by the
+/// least of their beads: those that stepped and that no pair of beads
+/// that may touch wants built again (`wanting`, see `touch::regroup`).
+pub(super) fn by_least_bead<V: Dimension>(
+    old: &[Option<CachedIsland<V>>],
+    wanting: &[bool],
+) -> HashMap<Entity, usize> {
+    old.iter()
+        .enumerate()
+        .filter_map(|(k, cached)| {
+            let cached = cached.as_ref()?;
+            let least = cached.report.beads.iter().min()?;
+            let keeps = cached.outcome == Some(Ok(())) && wanting.get(k) == Some(&false);
+            keeps.then_some((*least, k))
+        })
+        .collect()
+}
+
+/// Takes out of `old` the island a rebuild that only regroups keeps for
+/// the beads `entities` (see [`by_least_bead`]): one of the same beads,
+/// each of the mass it was built with. It steps on as though no rebuild
+/// had been: its contact rows (every pair of its beads that may meet
+/// within the step has one), their forces, stick lines and its halvings
+/// as they were.
+pub(super) fn kept<V: Dimension>(
+    old: &mut [Option<CachedIsland<V>>],
+    by_least: &HashMap<Entity, usize>,
+    entities: &[Entity],
+    mass: impl Fn(Entity) -> Option<f64>,
+) -> Option<CachedIsland<V>> {
+    let k = *by_least.get(entities.iter().min()?)?;
+    let cached = old.get(k)?.as_ref()?;
+    let was = &cached.report.beads;
+    let sorted = |beads: &[Entity]| {
+        let mut beads = beads.to_vec();
+        beads.sort_unstable();
+        beads
+    };
+    if was.len() != entities.len() || sorted(was) != sorted(entities) {
+        return None;
+    }
+    if was
+        .iter()
+        .zip(&cached.masses)
+        .any(|(&e, &m)| mass(e) != Some(m))
+    {
+        return None;
+    }
+    old.get_mut(k)?.take()
 }

@@ -179,8 +179,8 @@ pub(super) fn step_islands<V: LoneStep>(
         &mut struck,
         &mut divergences,
     );
-    if touch::regroup(cached, lone, settings.dt) {
-        islands.mark_dirty();
+    if let Some(wanting) = touch::regroup(cached, lone, settings.dt) {
+        islands.mark_regrouped(wanting);
     }
     let mut written = beads.p1();
     for lone in &mut islands.lone {
@@ -286,6 +286,7 @@ pub(super) fn step_islands<V: LoneStep>(
         cached.report.energy = cached.island.energy(&cached.states, gravity);
         cached.report.redundant = cached.work.redundant();
         cached.report.substeps = cached.work.substeps();
+        cached.report.steps += 1;
     }
 }
 

@@ -198,20 +198,22 @@ pub(super) fn near<V: Dimension>(beads: &[Rider<V>], dt: f64) -> Vec<(usize, usi
     pairs
 }
 
-/// Whether the islands should be built again before the next step: two
-/// beads that may meet within it are not joined by a contact row (in
-/// different islands, or not yet near at the last build; of two beads
-/// that ride their wires alone, only where they rest in touch, see
-/// [`near`]), or two joined by one have gone far apart (their islands may
-/// part).
+/// Whether the islands should be built again before the next step, and
+/// which want it: two beads that may meet within it are not joined by a
+/// contact row (in different islands, or not yet near at the last build;
+/// of two beads that ride their wires alone, only where they rest in
+/// touch, see [`near`]), or two joined by one have gone far apart (their
+/// islands may part). None where nothing wants it; else whether each of
+/// `cached` does (the others may be kept whole).
 pub(super) fn regroup<V: Dimension>(
     cached: &[CachedIsland<V>],
     lone: &[LoneTouch<V>],
     dt: f64,
-) -> bool {
+) -> Option<Vec<bool>> {
     let mut beads = Vec::new();
     // Each bead's island (none for one alone) and index there.
     let mut place = Vec::new();
+    let mut wanting = vec![false; cached.len()];
     for (k, island) in cached.iter().enumerate() {
         if island.outcome != Some(Ok(())) {
             continue;
@@ -225,16 +227,16 @@ pub(super) fn regroup<V: Dimension>(
             });
             place.push((Some(k), bead));
         }
-        for contact in &island.contacts {
+        wanting[k] = island.contacts.iter().any(|contact| {
             let (a, b) = (island.states.get(contact.a), island.states.get(contact.b));
-            let (Some(a), Some(b)) = (a, b) else { continue };
+            let (Some(a), Some(b)) = (a, b) else {
+                return false;
+            };
             let reach = contact.reach;
             let d = a.position - b.position;
             let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
-            if d.dot(d).sqrt() - reach > 4.0 * reach + 4.0 * NEAR_STEPS * dt * speeds {
-                return true;
-            }
-        }
+            d.dot(d).sqrt() - reach > 4.0 * reach + 4.0 * NEAR_STEPS * dt * speeds
+        });
     }
     for (k, lone) in lone.iter().enumerate() {
         if matches!(lone.outcome, Some(Ok(()))) {
@@ -248,13 +250,18 @@ pub(super) fn regroup<V: Dimension>(
         }
     }
     let states: Vec<(BeadState<V>, f64)> = beads.iter().map(|b| (b.state, b.radius)).collect();
-    solver::may_touch(&states, dt, 0.0)
-        .into_iter()
-        .any(|(i, j)| {
-            let ((ki, a), (kj, b)) = (place[i], place[j]);
-            let joined = ki.is_some_and(|k| ki == kj && cached[k].contact_row(a, b).is_some());
-            !joined && beads[i].joins(&beads[j])
-        })
+    let mut any = wanting.contains(&true);
+    for (i, j) in solver::may_touch(&states, dt, 0.0) {
+        let ((ki, a), (kj, b)) = (place[i], place[j]);
+        let joined = ki.is_some_and(|k| ki == kj && cached[k].contact_row(a, b).is_some());
+        if !joined && beads[i].joins(&beads[j]) {
+            any = true;
+            for k in [ki, kj].into_iter().flatten() {
+                wanting[k] = true;
+            }
+        }
+    }
+    any.then_some(wanting)
 }
 
 /// Settles the touches of the step that started at `time` (see

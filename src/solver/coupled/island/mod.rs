@@ -324,6 +324,13 @@ impl<V: WireSpace> Island<V> {
         self.contacts.get(row).copied().unwrap_or(false)
     }
 
+    /// The row that holds row `row`'s bead (or pair) still while static
+    /// friction can ([`Island::set_rough`], [`Island::set_contact_friction`]),
+    /// if it has one.
+    pub(crate) fn stick_row(&self, row: usize) -> Option<usize> {
+        self.rough.get(row)?.as_ref()?.stick
+    }
+
     /// Gives the wire of row `row` Coulomb friction and viscous damping
     /// along it, eq. (17). `stick` names an axis row of the same bead
     /// (`RowKind::Axis`, any axis) the island uses to hold the bead still

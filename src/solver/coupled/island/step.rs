@@ -271,7 +271,8 @@ impl<V: WireSpace> Island<V> {
     /// from a wire that ends, in flight), a row told otherwise by
     /// [`IslandWork::carry`] as it was told; stick rows start set aside (a
     /// bead slides until friction stops it), but a bead at rest on a rough
-    /// wire starts held by static friction.
+    /// wire starts held by static friction, and a stick row carried over
+    /// as it was carried ([`IslandWork::carry_held`]).
     pub(super) fn start_rows(&self, time: f64, states: &[BeadState<V>], work: &mut IslandWork<V>) {
         let whole = states.len() == self.beads();
         work.inactive.clear();
@@ -309,7 +310,9 @@ impl<V: WireSpace> Island<V> {
                 continue;
             };
             let bead = self.entry_bead[self.row_start[r]];
-            if work.inactive[r] || self.paths[r].is_some() || !whole || self.contacts[r] {
+            let carried = work.carries(*s);
+            if work.inactive[r] || self.paths[r].is_some() || !whole || self.contacts[r] || carried
+            {
                 continue;
             }
             let row = self.wire_row(r, states, time);
@@ -328,7 +331,12 @@ impl<V: WireSpace> Island<V> {
         work.x.clear();
         work.x.extend(states.iter().map(|s| s.position));
         for (r, rough) in self.rough.iter().enumerate() {
-            let Some(rough) = rough else { continue };
+            // A stick row a rebuilt island carried is as it was.
+            let Some(rough) =
+                (*rough).filter(|rough| !rough.stick.is_some_and(|s| work.carries(s)))
+            else {
+                continue;
+            };
             let touches = self
                 .contact_gap(r, &work.x)
                 .is_some_and(|(gap, reach)| gap.abs() <= TOUCHING * reach);

@@ -219,6 +219,40 @@ impl<V: WireSpace> IslandWork<V> {
         }
     }
 
+    /// [`IslandWork::carry_row`] for row `row` and its stick row (the row
+    /// that holds its bead or pair still while static friction can, if
+    /// it has one) from `from_row` and its own: a stick row that held
+    /// starts held, at the line it held on, with its multiplier; one that
+    /// was set aside, or has no line, starts set aside.
+    pub(crate) fn carry_held(
+        &mut self,
+        (row, stick): (usize, Option<usize>),
+        from: &IslandWork<V>,
+        (from_row, from_stick): (usize, Option<usize>),
+    ) {
+        self.carry_row(row, from, from_row);
+        let (Some(stick), Some(from_stick)) = (stick, from_stick) else {
+            return;
+        };
+        let line = from.sticks.get(from_stick).copied().flatten();
+        let held = if from.inactive.is_empty() {
+            from.carried(from_stick)
+        } else {
+            Some(from.holds(from_stick))
+        };
+        match (held, line) {
+            (Some(true), Some(line)) => {
+                self.carry_row(stick, from, from_stick);
+                if self.sticks.len() <= stick {
+                    self.sticks.resize(stick + 1, None);
+                }
+                self.sticks[stick] = Some(line);
+            }
+            (Some(_), _) => self.tell(stick, false, None),
+            (None, _) => {}
+        }
+    }
+
     /// Row `row` of a fresh work starts held (or set aside) and from the
     /// multiplier `force`, if one is given.
     fn tell(&mut self, row: usize, held: bool, force: Option<f64>) {
