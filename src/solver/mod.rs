@@ -59,7 +59,7 @@ pub use state::{Advance, BeadState, LinearForce};
 pub use step::{StepOutput, constraint_state, constraint_state_on, step, step_on};
 pub(crate) use touch::{
     Pressed, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody, TouchError, may_touch,
-    overlapping, rests_in_touch, settle_touches, wire_response,
+    may_touch_near, overlapping, rests_in_touch, settle_touches, wire_response,
 };
 
 /// What the solver's unit tests share.

@@ -7,7 +7,9 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use super::lone::LoneTouch;
-use super::start::{BuildBead, Carried, by_least_bead, kept, start_island};
+use super::start::{
+    BuildBead, Carried, by_least_bead, contact_starts, kept, own_rows, start_island,
+};
 use super::touch::Rider;
 use super::{CachedIsland, ContactRow, InIsland, IslandReport, Islands, LinkRows, WireRow, touch};
 use crate::dynamics::{
@@ -539,8 +541,10 @@ pub(super) fn prepare_islands<V: LoneStep>(
                     forces: Vec::with_capacity(group.len()),
                     masses: masses.clone(),
                     links: link_rows,
+                    own_rows: own_rows(&wire_rows, group.len()),
                     wire_rows,
                     anchored,
+                    contact_starts: contact_starts(&pair_rows, group.len()),
                     contacts: pair_rows,
                     outcome: None,
                     touching: Vec::new(),

@@ -206,10 +206,15 @@ struct CachedIsland<V: Dimension> {
     links: Vec<LinkRows>,
     /// The wire rows of the beads on a wire.
     wire_rows: Vec<WireRow>,
+    /// Each bead's row on its own wire, if it is on one.
+    own_rows: Vec<Option<usize>>,
     /// The first row of each pin fixed to another entity, and the pin.
     anchored: Vec<(usize, Entity)>,
     /// The contact rows between its beads that may touch, by `(a, b)`.
     contacts: Vec<ContactRow>,
+    /// Where each bead's contacts with the beads after it start in
+    /// `contacts` (one more than it has beads).
+    contact_starts: Vec<usize>,
     /// What this step did: not stepped (a bead of it has stopped), or the
     /// step's result.
     outcome: Option<Result<(), SolveError>>,

@@ -1,7 +1,9 @@
 //! How an island built again starts: each row as the islands it
 //! replaces left it, where its beads have not moved since
 //! ([`Carried`]), and the beads' velocities projected onto its
-//! constraints ([`start_island`]).
+//! constraints ([`start_island`]); which islands a regrouping keeps whole
+//! ([`kept`]); and the lookups a built island keeps, each bead's row on
+//! its own wire and each bead's contacts.
 
 use std::collections::HashMap;
 
@@ -226,4 +228,24 @@ pub(super) fn kept<V: Dimension>(
         return None;
     }
     old.get_mut(k)?.take()
+}
+
+/// Each of `beads` beads' row on its own wire among `wire_rows`, if it is
+/// on one.
+pub(super) fn own_rows(wire_rows: &[WireRow], beads: usize) -> Vec<Option<usize>> {
+    let mut own = vec![None; beads];
+    for wire_row in wire_rows.iter().filter(|w| w.own) {
+        if let Some(slot) = own.get_mut(wire_row.bead) {
+            slot.get_or_insert(wire_row.row);
+        }
+    }
+    own
+}
+
+/// Where each of `beads` beads' contacts with the beads after it start in
+/// `contacts` (sorted by their beads), and where the last ends.
+pub(super) fn contact_starts(contacts: &[ContactRow], beads: usize) -> Vec<usize> {
+    (0..=beads)
+        .map(|a| contacts.partition_point(|c| c.a < a))
+        .collect()
 }

@@ -234,11 +234,7 @@ pub(super) fn step_islands<V: LoneStep>(
             if let Some(mut transform) = transform {
                 V::place(&mut transform, state.position);
             }
-            let wire_row = cached
-                .wire_rows
-                .iter()
-                .find(|w| w.bead == i && w.own)
-                .map(|w| w.row);
+            let wire_row = cached.own_rows.get(i).copied().flatten();
             if let (Some(mut contact), Some(row)) = (contact, wire_row) {
                 let held = if cached.work.holds(row) {
                     Contact::OnWire

@@ -145,11 +145,10 @@ impl<V: Dimension> CachedIsland<V> {
     /// The contact row between beads `a` and `b` of the island, if it has
     /// one.
     fn contact_row(&self, a: usize, b: usize) -> Option<usize> {
-        let key = (a.min(b), a.max(b));
-        self.contacts
-            .binary_search_by_key(&key, |c| (c.a, c.b))
-            .ok()
-            .map(|k| self.contacts[k].row)
+        let (a, b) = (a.min(b), a.max(b));
+        let (&from, &to) = (self.contact_starts.get(a)?, self.contact_starts.get(a + 1)?);
+        let contacts = self.contacts.get(from..to)?;
+        contacts.iter().find(|c| c.b == b).map(|c| c.row)
     }
 }
 
@@ -190,10 +189,11 @@ impl<V: Dimension> Rider<V> {
 
 /// The pairs of `beads` that the island builder joins by contact rows:
 /// those that may meet within [`NEAR_STEPS`] steps of `dt`, with
-/// [`NEAR_MARGIN`] to spare, that [`Rider::joins`].
+/// [`NEAR_MARGIN`] to spare, and those [`regroup`] would look for, that
+/// [`Rider::joins`].
 pub(super) fn near<V: Dimension>(beads: &[Rider<V>], dt: f64) -> Vec<(usize, usize)> {
     let states: Vec<(BeadState<V>, f64)> = beads.iter().map(|b| (b.state, b.radius)).collect();
-    let mut pairs = solver::may_touch(&states, NEAR_STEPS * dt, NEAR_MARGIN);
+    let mut pairs = solver::may_touch_near(&states, (NEAR_STEPS * dt, NEAR_MARGIN), dt);
     pairs.retain(|&(i, j)| beads[i].joins(&beads[j]));
     pairs
 }

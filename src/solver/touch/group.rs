@@ -55,12 +55,14 @@ pub(super) struct Group<'a, V: Coordinates> {
 type Trial<V> = Vec<Option<Vec<BeadState<V>>>>;
 
 impl<'a, V: Coordinates> Group<'a, V> {
+    /// The group of `bodies` of `all`, from where each starts the step;
+    /// `found` where they stand as the broad phase found them (its pairs
+    /// are the group's).
     pub(super) fn new<B: TouchBody<V>>(
         span: StepSpan,
-        all: &[B],
-        beads: &'a [TouchBead],
+        (all, beads): (&[B], &'a [TouchBead]),
         bodies: Vec<usize>,
-        pool: &Pool,
+        (pool, found): (&Pool, bool),
     ) -> Self {
         let now = bodies.iter().map(|&b| all[b].start().to_vec()).collect();
         let end = bodies.iter().map(|&b| all[b].end().to_vec()).collect();
@@ -86,7 +88,11 @@ impl<'a, V: Coordinates> Group<'a, V> {
             pressed: Vec::new(),
             last_trial: None,
         };
-        group.pairs = group.find_pairs(&[]).0;
+        group.pairs = if found {
+            pool.pairs_within(&group.members)
+        } else {
+            group.find_pairs(&[]).0
+        };
         group.paths = group.members.iter().map(|&i| group.swept(i)).collect();
         group
     }

@@ -354,7 +354,7 @@ pub fn settle_touches<V: Coordinates, B: TouchBody<V>>(
         .collect();
     let pairs = overlapping(&boxes);
     let found = groups(beads, bodies.len(), &pairs);
-    let mut pool = Pool::new(boxes, beads, bodies.len(), found);
+    let mut pool = Pool::new(boxes, beads, bodies.len(), (pairs, found));
     // Which settlement each body was settled in, and each settlement's
     // bodies.
     let mut settled_in = vec![usize::MAX; bodies.len()];
@@ -367,8 +367,11 @@ pub fn settle_touches<V: Coordinates, B: TouchBody<V>>(
             continue; // taken in by a group settled before it
         }
         let mut group = pool.take(g);
+        // Its bodies stand where the broad phase found them until a strike
+        // sends them to be settled again.
+        let mut found_here = true;
         loop {
-            let group_now = Group::new(span, bodies, beads, group, &pool);
+            let group_now = Group::new(span, (bodies, beads), group, (&pool, found_here));
             match group_now.settle(bodies, &mut pool, struck)? {
                 Settled::Done(done) => {
                     for &body in &done {
@@ -395,6 +398,7 @@ pub fn settle_touches<V: Coordinates, B: TouchBody<V>>(
                     });
                     again.extend(met.free);
                     group = again;
+                    found_here = false;
                 }
             }
         }
@@ -423,13 +427,47 @@ pub(crate) fn may_touch<V: Coordinates>(
 ) -> Vec<(usize, usize)> {
     let boxes: Vec<(DVec3, DVec3)> = beads
         .iter()
-        .map(|(state, radius)| {
-            let p = state.position.xyz();
-            let grown = radius * (1.0 + margin) + 2.0 * within * state.velocity.xyz().abs();
-            (p - grown, p + grown)
-        })
+        .map(|&(state, radius)| grown(state, radius, within, margin))
         .collect();
     overlapping(&boxes)
+}
+
+/// The pairs of [`may_touch`] within `within` and `margin` whose gap is
+/// also within that margin of their radii and twice the way their speeds
+/// take them in `within` (two beads side by side along a diagonal, whose
+/// boxes overlap, are not), or that [`may_touch`] within `soon` and no
+/// margin (those a regrouping looks for, which so are always among
+/// these).
+pub(crate) fn may_touch_near<V: Coordinates>(
+    beads: &[(BeadState<V>, f64)],
+    (within, margin): (f64, f64),
+    soon: f64,
+) -> Vec<(usize, usize)> {
+    let mut pairs = may_touch(beads, within, margin);
+    pairs.retain(|&(i, j)| {
+        let ((a, ra), (b, rb)) = (beads[i], beads[j]);
+        let d = b.position - a.position;
+        let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
+        let gap = d.dot(d).sqrt() - (ra + rb);
+        let near = gap <= margin * (ra + rb) + 2.0 * within * speeds;
+        let (box_a, box_b) = (grown(a, ra, soon, 0.0), grown(b, rb, soon, 0.0));
+        near || gap.is_nan() || (box_a.0.cmple(box_b.1).all() && box_b.0.cmple(box_a.1).all())
+    });
+    pairs
+}
+
+/// The box of a bead at `state` of `radius`, grown by its radius, a
+/// `margin` fraction more, and along each axis twice the way its velocity
+/// takes it in `within`.
+fn grown<V: Coordinates>(
+    state: BeadState<V>,
+    radius: f64,
+    within: f64,
+    margin: f64,
+) -> (DVec3, DVec3) {
+    let p = state.position.xyz();
+    let grown = radius * (1.0 + margin) + 2.0 * within * state.velocity.xyz().abs();
+    (p - grown, p + grown)
 }
 
 /// Whether beads `a` and `b`, of `reach` (their two radii), rest in

@@ -24,17 +24,25 @@ pub(super) struct Pool {
     key: Vec<f64>,
     above: f64,
     below: f64,
+    /// The pairs of beads whose boxes overlapped where the step began
+    /// (each `(i, j)`, `i < j`, in order), those of bead `i` from
+    /// `pairs_from[i]` on.
+    pairs: Vec<(usize, usize)>,
+    pairs_from: Vec<usize>,
 }
 
 impl Pool {
     /// The pool of `bodies` bodies before any is settled, the broad phase
-    /// having found `groups`.
+    /// having found `pairs` and the `groups` they join.
     pub(super) fn new(
         boxes: Vec<(DVec3, DVec3)>,
         beads: &[TouchBead],
         bodies: usize,
-        groups: Vec<Vec<usize>>,
+        (pairs, groups): (Vec<(usize, usize)>, Vec<Vec<usize>>),
     ) -> Self {
+        let pairs_from = (0..=beads.len())
+            .map(|i| pairs.partition_point(|&(a, _)| a < i))
+            .collect();
         let mut first = vec![0; bodies + 1];
         for bead in beads {
             first[bead.body + 1] += 1;
@@ -67,6 +75,8 @@ impl Pool {
             key,
             above,
             below: 0.0,
+            pairs,
+            pairs_from,
         };
         for (g, group) in pool.groups.iter().enumerate() {
             for &body in group {
@@ -93,6 +103,25 @@ impl Pool {
             .map(|&j| (j, self.boxes[j]))
             .filter(|(_, (a, b))| a.cmple(high).all() && low.cmple(*b).all())
             .collect()
+    }
+
+    /// The pairs of `members` (in order) whose boxes overlapped where the
+    /// step began, in order: those of a group whose bodies stand where the
+    /// broad phase found them.
+    pub(super) fn pairs_within(&self, members: &[usize]) -> Vec<(usize, usize)> {
+        let mut within = Vec::new();
+        for &i in members {
+            let (Some(&from), Some(&to)) = (self.pairs_from.get(i), self.pairs_from.get(i + 1))
+            else {
+                continue;
+            };
+            within.extend(
+                self.pairs[from..to]
+                    .iter()
+                    .filter(|(_, j)| members.binary_search(j).is_ok()),
+            );
+        }
+        within
     }
 
     /// Grows bead `j`'s box to take in `path`, the box of the path its

@@ -493,3 +493,57 @@ fn a_strike_that_sends_a_bead_into_a_group_settled_before_settles_both_again() {
         "{struck:?}"
     );
 }
+
+/// The pairs an island builder joins: in a cube of 27 marbles of 2 cm at
+/// rest, 2r apart along the axes, the 54 pairs side by side along an
+/// axis, not the 104 more whose boxes meet along the diagonals of a
+/// cell (0.83 and 1.46 of a radius apart).
+#[test]
+fn beads_are_near_where_their_gap_may_close_not_where_their_boxes_meet() {
+    let (r, dt) = (0.02, 1.0 / 240.0);
+    let spacing = 2.0 * r * (1.0 + 1e-12);
+    let beads: Vec<(BeadState<DVec3>, f64)> = (0..27)
+        .map(|k| {
+            let at = DVec3::new((k % 3) as f64, ((k / 3) % 3) as f64, (k / 9) as f64);
+            let state = BeadState {
+                position: at * spacing,
+                velocity: DVec3::ZERO,
+            };
+            (state, r)
+        })
+        .collect();
+    let boxes = may_touch(&beads, 2.0 * dt, 0.25);
+    let near = may_touch_near(&beads, (2.0 * dt, 0.25), dt);
+    assert_eq!((boxes.len(), near.len()), (158, 54));
+    for (i, j) in near {
+        let d = beads[j].0.position - beads[i].0.position;
+        assert!((d.length() - spacing).abs() <= 1e-15, "{i} and {j} are {d}");
+    }
+}
+
+proptest::proptest! {
+    /// Every pair a regrouping looks for ([`may_touch`] within a step,
+    /// no margin) is among those an island builder joins
+    /// ([`may_touch_near`] within two steps, a quarter of the radii to
+    /// spare), so that a rebuild joins every pair that asked for it.
+    #[test]
+    fn the_pairs_a_regrouping_looks_for_are_near(
+        beads in proptest::collection::vec(
+            ((-0.2..0.2f64, -0.2..0.2f64, -0.2..0.2f64), (-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64), 0.005..0.03f64),
+            0..60,
+        ),
+    ) {
+        let beads: Vec<(BeadState<DVec3>, f64)> = beads
+            .into_iter()
+            .map(|((x, y, z), (u, v, w), r)| {
+                let state = BeadState { position: DVec3::new(x, y, z), velocity: DVec3::new(u, v, w) };
+                (state, r)
+            })
+            .collect();
+        let dt = 1.0 / 60.0;
+        let near = may_touch_near(&beads, (2.0 * dt, 0.25), dt);
+        for pair in may_touch(&beads, dt, 0.0) {
+            proptest::prop_assert!(near.binary_search(&pair).is_ok(), "{:?} is not near", pair);
+        }
+    }
+}

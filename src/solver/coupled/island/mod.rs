@@ -145,18 +145,13 @@ impl<V: WireSpace> Island<V> {
     /// steps), and gives it `shape` where one is given (a wire edited in
     /// place); rows of other kinds are left as they are.
     pub fn place_wire(&mut self, row: usize, shape: Option<V::Shape>, pose: V::Pose) {
-        if let Some(RowKind::Wire {
-            shape: placed_shape,
-            pose: placed,
-        }) = self.rows.get_mut(row)
-        {
+        if let Some(RowKind::Wire { pose: placed, .. }) = self.rows.get_mut(row) {
             *placed = pose;
             if self.paths[row].take().is_some() {
                 self.moving -= 1;
             }
             if let Some(shape) = shape {
-                *placed_shape = shape;
-                self.count_ends();
+                self.reshape(row, shape);
             }
         }
     }
@@ -169,24 +164,38 @@ impl<V: WireSpace> Island<V> {
         if let Some(pose) = V::path_fixed(&path) {
             return self.place_wire(row, shape, pose);
         }
+        if let Some(RowKind::Wire { .. }) = self.rows.get(row) {
+            if self.paths[row].replace(path).is_none() {
+                self.moving += 1;
+            }
+            if let Some(shape) = shape {
+                self.reshape(row, shape);
+            }
+        }
+    }
+
+    /// Counts the rows of wires that end (an island built).
+    fn count_ends(&mut self) {
+        self.ended = (0..self.rows()).filter(|&r| self.ends(r)).count();
+    }
+
+    /// Gives the wire of row `row` `shape` and counts the row again among
+    /// the rows of wires that end, without looking at the others: a wire
+    /// edited in place under ten thousand beads costs a look at each.
+    fn reshape(&mut self, row: usize, shape: V::Shape) {
+        let was = self.ends(row);
         if let Some(RowKind::Wire {
             shape: placed_shape,
             ..
         }) = self.rows.get_mut(row)
         {
-            if self.paths[row].replace(path).is_none() {
-                self.moving += 1;
-            }
-            if let Some(shape) = shape {
-                *placed_shape = shape;
-                self.count_ends();
-            }
+            *placed_shape = shape;
         }
-    }
-
-    /// Counts the rows of wires that end again (a wire's shape changed).
-    fn count_ends(&mut self) {
-        self.ended = (0..self.rows()).filter(|&r| self.ends(r)).count();
+        match (was, self.ends(row)) {
+            (false, true) => self.ended += 1,
+            (true, false) => self.ended -= 1,
+            _ => {}
+        }
     }
 
     /// Makes the wire of row `row` one-sided (see
