@@ -47,6 +47,7 @@ pub use coupled::{
     Constraint, Island, IslandError, IslandMark, IslandRow, IslandWork, RowKind, RowReport,
     SpringLink, islands,
 };
+pub(crate) use coupled::{pair_gap, pair_speeds};
 pub use euler::{explicit_euler, semi_implicit_euler};
 pub(crate) use lanes::{LANES, RoundLanes, RoundSteps, step_on_round_batches};
 pub use method::{Integrator, Method, Stabilization};

@@ -63,6 +63,17 @@ pub fn app(params: SimParams) -> App {
     app
 }
 
+/// Has the islands built again before the next step: spawns a free bead
+/// far from everything (the `k`-th such, apart from the others).
+pub fn build_islands_again(app: &mut App, k: u32) {
+    let far = BeadParams {
+        mass: 1.0,
+        initial_position: DVec2::new(100.0 * f64::from(k), 100.0),
+        initial_velocity: DVec2::ZERO,
+    };
+    app.world_mut().spawn(Bead::new(far).expect("a bead"));
+}
+
 pub fn spawn_wire(app: &mut App, wire: Wire, transform: Transform) -> Entity {
     app.world_mut().spawn((wire, transform)).id()
 }

@@ -1411,12 +1411,7 @@ fn resting_on_a_bead_rebuilt(degrees: f64, mu: f64, steps: u32, rebuilds: u32) -
     let parts = rebuilds + 1;
     for part in 0..parts {
         if part > 0 {
-            let far = BeadParams {
-                mass: 1.0,
-                initial_position: DVec2::new(100.0 * f64::from(part), 100.0),
-                initial_velocity: DVec2::ZERO,
-            };
-            app.world_mut().spawn(Bead::new(far).expect("a bead"));
+            crate::common::build_islands_again(&mut app, part);
         }
         run_steps(&mut app, steps / parts);
     }

@@ -602,12 +602,7 @@ fn a_cart_held_by_static_friction_stays_held_when_its_island_is_built_again() {
     app.world_mut().flush();
     for rebuild in 0..=10 {
         if rebuild > 0 {
-            let far = BeadParams {
-                mass: 1.0,
-                initial_position: DVec2::new(100.0 * f64::from(rebuild), 100.0),
-                initial_velocity: DVec2::ZERO,
-            };
-            app.world_mut().spawn(Bead::new(far).expect("a bead"));
+            crate::common::build_islands_again(&mut app, rebuild);
         }
         run_for(&mut app, 2.0 / 11.0);
     }

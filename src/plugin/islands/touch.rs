@@ -233,9 +233,8 @@ pub(super) fn regroup<V: Dimension>(
                 return false;
             };
             let reach = contact.reach;
-            let d = a.position - b.position;
-            let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
-            d.dot(d).sqrt() - reach > 4.0 * reach + 4.0 * NEAR_STEPS * dt * speeds
+            let gap = solver::pair_gap(a.position, b.position, reach);
+            gap > 4.0 * reach + 4.0 * NEAR_STEPS * dt * solver::pair_speeds(a, b)
         });
     }
     for (k, lone) in lone.iter().enumerate() {

@@ -27,5 +27,6 @@ pub use group::islands;
 pub(crate) use island::TOUCHING;
 pub use island::{Island, IslandError, IslandMark, IslandRow, IslandWork, RowReport};
 pub(crate) use island::{
-    closes, ends_in_touch, meets_near, meets_slowly, opening_rate, parts, step_speed,
+    closes, ends_in_touch, meets_near, meets_slowly, opening_rate, pair_gap, pair_speeds, parts,
+    step_speed,
 };

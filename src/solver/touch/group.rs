@@ -11,7 +11,7 @@ use super::{
 };
 use crate::geometry::Coordinates;
 use crate::solver::contact::locate_between;
-use crate::solver::coupled::{closes, ends_in_touch, meets_near, opening_rate};
+use crate::solver::coupled::{closes, ends_in_touch, meets_near, opening_rate, pair_gap};
 use crate::solver::solve::SolveError;
 use crate::solver::state::BeadState;
 
@@ -195,8 +195,7 @@ impl<'a, V: Coordinates> Group<'a, V> {
 
     /// The gap of pair `(i, j)` between the positions `xa` and `xb`.
     fn gap(&self, (i, j): (usize, usize), xa: V, xb: V) -> f64 {
-        let d = xb - xa;
-        d.dot(d).sqrt() - (self.beads[i].radius + self.beads[j].radius)
+        pair_gap(xa, xb, self.beads[i].radius + self.beads[j].radius)
     }
 
     /// How far the group's end is from now.

@@ -74,7 +74,7 @@
 use bevy::math::DVec3;
 use thiserror::Error;
 
-use super::coupled::{islands, opening_rate, parts};
+use super::coupled::{islands, opening_rate, pair_gap, pair_speeds, parts};
 use super::impact::{ImpactError, Strike};
 use super::solve::{SolveError, singular};
 use super::state::BeadState;
@@ -446,10 +446,8 @@ pub(crate) fn may_touch_near<V: Coordinates>(
     let mut pairs = may_touch(beads, within, margin);
     pairs.retain(|&(i, j)| {
         let ((a, ra), (b, rb)) = (beads[i], beads[j]);
-        let d = b.position - a.position;
-        let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
-        let gap = d.dot(d).sqrt() - (ra + rb);
-        let near = gap <= margin * (ra + rb) + 2.0 * within * speeds;
+        let gap = pair_gap(a.position, b.position, ra + rb);
+        let near = gap <= margin * (ra + rb) + 2.0 * within * pair_speeds(&a, &b);
         let (box_a, box_b) = (grown(a, ra, soon, 0.0), grown(b, rb, soon, 0.0));
         near || gap.is_nan() || (box_a.0.cmple(box_b.1).all() && box_b.0.cmple(box_a.1).all())
     });
@@ -481,8 +479,7 @@ pub(crate) fn rests_in_touch<V: Coordinates>(
     b: &BeadState<V>,
     reach: f64,
 ) -> bool {
-    let d = b.position - a.position;
-    let gap = d.dot(d).sqrt() - reach;
+    let gap = pair_gap(a.position, b.position, reach);
     let (rate, speeds) = opening_rate(a, b);
     gap <= TOUCHING * reach && !parts(rate, reach, speeds)
 }

@@ -44,7 +44,8 @@ mod work;
 pub use build::{IslandError, IslandRow};
 pub(crate) use pairs::TOUCHING;
 pub(crate) use pairs::{
-    CONTACT_SLACK, closes, ends_in_touch, meets_near, meets_slowly, opening_rate, parts, step_speed,
+    CONTACT_SLACK, closes, ends_in_touch, meets_near, meets_slowly, opening_rate, pair_gap,
+    pair_speeds, parts, step_speed,
 };
 pub use work::{IslandMark, IslandWork};
 
@@ -164,7 +165,7 @@ impl<V: WireSpace> Island<V> {
         if let Some(pose) = V::path_fixed(&path) {
             return self.place_wire(row, shape, pose);
         }
-        if let Some(RowKind::Wire { .. }) = self.rows.get(row) {
+        if matches!(self.rows.get(row), Some(RowKind::Wire { .. })) {
             if self.paths[row].replace(path).is_none() {
                 self.moving += 1;
             }

@@ -26,8 +26,19 @@ pub(crate) fn parts(rate: f64, reach: f64, speeds: f64) -> bool {
 pub(crate) fn opening_rate<V: Coordinates>(a: &BeadState<V>, b: &BeadState<V>) -> (f64, f64) {
     let d = b.position - a.position;
     let rate = d.dot(b.velocity - a.velocity) / d.dot(d).sqrt();
-    let speeds = a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt();
-    (rate, speeds)
+    (rate, pair_speeds(a, b))
+}
+
+/// The sum of beads `a` and `b`'s speeds.
+pub(crate) fn pair_speeds<V: Coordinates>(a: &BeadState<V>, b: &BeadState<V>) -> f64 {
+    a.velocity.dot(a.velocity).sqrt() + b.velocity.dot(b.velocity).sqrt()
+}
+
+/// The gap between beads at `a` and `b` whose radii sum to `reach`: how
+/// far apart their surfaces are (negative where they overlap).
+pub(crate) fn pair_gap<V: Coordinates>(a: V, b: V, reach: f64) -> f64 {
+    let d = b - a;
+    d.dot(d).sqrt() - reach
 }
 
 /// A pair in touch closes (and strikes at once) where it closes faster

@@ -4,7 +4,7 @@
 
 use bevy::math::DVec2;
 
-use super::{Island, IslandWork, OFF_THE_WIRE, opening_rate, parts};
+use super::{Island, IslandWork, OFF_THE_WIRE, opening_rate, pair_gap, parts};
 use crate::geometry::{Placement, Twist, WireSpace, placed_geometry};
 use crate::solver::coupled::constraint::RowKind;
 use crate::solver::state::{BeadState, LinearForce};
@@ -151,8 +151,7 @@ impl<V: WireSpace> Island<V> {
     /// kind.
     pub(super) fn contact_gap(&self, r: usize, x: &[V]) -> Option<(f64, f64)> {
         let (a, b, reach) = self.contact_pair(r)?;
-        let d = *x.get(a)? - *x.get(b)?;
-        Some((d.dot(d).sqrt() - reach, reach))
+        Some((pair_gap(*x.get(a)?, *x.get(b)?, reach), reach))
     }
 
     /// Whether the beads of contact row `r` part where they are in

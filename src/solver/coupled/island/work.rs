@@ -234,15 +234,10 @@ impl<V: WireSpace> IslandWork<V> {
         let (Some(stick), Some(from_stick)) = (stick, from_stick) else {
             return;
         };
+        self.carry_row(stick, from, from_stick);
         let line = from.sticks.get(from_stick).copied().flatten();
-        let held = if from.inactive.is_empty() {
-            from.carried(from_stick)
-        } else {
-            Some(from.holds(from_stick))
-        };
-        match (held, line) {
+        match (self.carried(stick), line) {
             (Some(true), Some(line)) => {
-                self.carry_row(stick, from, from_stick);
                 if self.sticks.len() <= stick {
                     self.sticks.resize(stick + 1, None);
                 }
