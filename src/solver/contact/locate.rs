@@ -46,19 +46,37 @@ pub(crate) fn locate(
 /// (where it is not), each with its value of `g`, to a width of 1e-13 of
 /// `h`: the end `b` of the last bracket.
 pub(crate) fn locate_between(
+    a: (f64, f64),
+    b: (f64, f64),
+    h: f64,
+    g: impl FnMut(f64) -> Result<f64, SolveError>,
+) -> Result<f64, SolveError> {
+    bracket_root(a, b, 1e-13 * h, g)
+}
+
+/// Regula falsi with the Illinois modification within the bracket from
+/// `a` (where `g` is positive) to `b` (where it is not), each with its
+/// value of `g`, until the bracket is at most `width` wide (none: until
+/// no number lies between its ends), at most 100 trials: the end `b` of
+/// the last bracket. Where the line through the ends falls outside the
+/// bracket, its middle is tried.
+pub(crate) fn bracket_root<E>(
     (mut a, mut ga): (f64, f64),
     (mut b, mut gb): (f64, f64),
-    h: f64,
-    mut g: impl FnMut(f64) -> Result<f64, SolveError>,
-) -> Result<f64, SolveError> {
+    width: f64,
+    mut g: impl FnMut(f64) -> Result<f64, E>,
+) -> Result<f64, E> {
     let mut last = 0;
     for _ in 0..100 {
-        if b - a <= 1e-13 * h || gb == 0.0 {
+        if b - a <= width || gb == 0.0 {
             break;
         }
         let mut m = b - gb * (b - a) / (gb - ga);
         if !(m > a && m < b) {
             m = 0.5 * (a + b);
+            if !(m > a && m < b) {
+                break; // a and b are neighbours: to the last bit
+            }
         }
         let gm = g(m)?;
         if gm > 0.0 {

@@ -31,7 +31,7 @@ mod tests;
 mod wire;
 
 pub use flight::free_step;
-pub(crate) use locate::{locate, locate_between};
+pub(crate) use locate::{bracket_root, locate, locate_between};
 
 /// Whether a bead is on its wire or flying off it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -59,7 +59,11 @@ pub(crate) fn overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
         .filter(|low| low.is_finite())
         .reduce(DVec3::min)
         .unwrap_or(DVec3::ZERO);
-    let cell = |p: DVec3| ((p - origin) / side).floor();
+    // Where `p` is in cells from the origin: at or above it for every
+    // box entered in the grid, so that each coordinate's cell is its
+    // whole part (a conversion, not a call to `floor`).
+    let inverse = side.recip();
+    let scaled = |p: DVec3| (p - origin) * inverse;
     // A cell's coordinates, each within FARTHEST_CELL, packed in one key.
     let key = |c: I64Vec3| {
         let c = (c + FARTHEST_CELL + 1).as_u64vec3();
@@ -71,14 +75,14 @@ pub(crate) fn overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
         if low.is_nan() || high.is_nan() {
             continue;
         }
-        let (from, to) = (cell(low), cell(high));
-        let near = from.abs().max(to.abs()).max_element() <= FARTHEST_CELL as f64;
-        let span = (to - from + 1.0).max(DVec3::ONE);
-        if !near || span.x * span.y * span.z > MOST_CELLS as f64 {
+        let (from, to) = (scaled(low), scaled(high));
+        let near = from.min_element() >= 0.0 && to.max_element() <= FARTHEST_CELL as f64;
+        let (from, to) = (from.as_i64vec3(), to.as_i64vec3());
+        let span = (to - from + 1).max(I64Vec3::ONE);
+        if !near || span.x * span.y * span.z > MOST_CELLS {
             large.push(i);
             continue;
         }
-        let (from, to) = (from.as_i64vec3(), to.as_i64vec3());
         for x in from.x..=to.x {
             for y in from.y..=to.y {
                 for z in from.z..=to.z {
@@ -87,19 +91,17 @@ pub(crate) fn overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
             }
         }
     }
-    entries.sort_unstable();
     let mut pairs = Vec::new();
-    for run in entries.chunk_by(|a, b| a.0 == b.0) {
-        let here = run[0].0;
-        for (k, &(_, i)) in run.iter().enumerate() {
-            for &(_, j) in &run[k + 1..] {
+    for bucket in bucketed(&entries).chunk_by(|a, b| a.0 == b.0) {
+        for (k, &(_, here, i)) in bucket.iter().enumerate() {
+            for &(_, there, j) in &bucket[k + 1..] {
                 let (i, j) = (i as usize, j as usize);
-                if !overlap(i, j) {
+                if here != there || !overlap(i, j) {
                     continue;
                 }
                 // Reported from the cell of the intersection's lowest
                 // corner, which both boxes cover, and from no other.
-                let corner = cell(boxes[i].0.max(boxes[j].0)).as_i64vec3();
+                let corner = scaled(boxes[i].0.max(boxes[j].0)).as_i64vec3();
                 if key(corner) == here {
                     pairs.push((i.min(j), i.max(j)));
                 }
@@ -117,6 +119,31 @@ pub(crate) fn overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
     }
     pairs.sort_unstable();
     pairs
+}
+
+/// The grid's entries `(cell key, box)` gathered by a hash of their key,
+/// each as `(hash, key, box)`, those of one hash together (a counting
+/// sort, in time linear in the entries): the boxes sharing a cell share a
+/// hash, and a hash's few entries of other cells are told apart by key.
+fn bucketed(entries: &[(u64, u32)]) -> Vec<(u32, u64, u32)> {
+    let bits = entries.len().max(2).next_power_of_two().trailing_zeros();
+    // Fibonacci hashing: the top `bits` bits of the key times 2⁶⁴/φ.
+    let hash = |key: u64| (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - bits)) as u32;
+    let mut starts = vec![0u32; (1usize << bits) + 1];
+    for &(key, _) in entries {
+        starts[hash(key) as usize + 1] += 1;
+    }
+    for b in 1..starts.len() {
+        starts[b] += starts[b - 1];
+    }
+    let mut gathered = vec![(0u32, 0u64, 0u32); entries.len()];
+    for &(key, i) in entries {
+        let h = hash(key);
+        let slot = &mut starts[h as usize];
+        gathered[*slot as usize] = (h, key, i);
+        *slot += 1;
+    }
+    gathered
 }
 
 /// The side of the grid's cells: the median of the finite boxes' largest

@@ -10,7 +10,7 @@ use super::{
     overlapping, swept,
 };
 use crate::geometry::Coordinates;
-use crate::solver::contact::locate_between;
+use crate::solver::contact::{bracket_root, locate_between};
 use crate::solver::coupled::{closes, ends_in_touch, meets_near, opening_rate, pair_gap};
 use crate::solver::solve::SolveError;
 use crate::solver::state::BeadState;
@@ -439,26 +439,24 @@ impl<'a, V: Coordinates> Group<'a, V> {
             self.gap(pair, at(a0, a1), at(b0, b1))
         };
         // The first of 32 samples at which the gap has closed brackets
-        // the meeting; bisection on the cubic, which costs no step, finds
-        // it to the last bit (regula falsi's 1e-13 of the step would be
-        // looser than what Newton's first trial is to meet).
+        // the meeting; regula falsi on the cubic, which costs no step,
+        // finds it to the last bit (to 1e-13 of the step would be looser
+        // than what Newton's first trial is to meet).
         let samples = 32;
-        let mut before = 0.0;
+        let mut before = (0.0, gap(0.0));
+        if before.1.is_nan() || before.1 <= 0.0 {
+            return Some(0.0); // in touch already
+        }
         for k in 1..=samples {
             let tau = by * k as f64 / samples as f64;
-            if gap(tau) <= 0.0 {
-                let (mut lo, mut hi) = (before, tau);
-                for _ in 0..60 {
-                    let mid = 0.5 * (lo + hi);
-                    if gap(mid) > 0.0 {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                return Some(hi);
+            let here = gap(tau);
+            if here <= 0.0 {
+                let found = bracket_root(before, (tau, here), 0.0, |tau| {
+                    Ok::<_, std::convert::Infallible>(gap(tau))
+                });
+                return found.ok();
             }
-            before = tau;
+            before = (tau, here);
         }
         None
     }

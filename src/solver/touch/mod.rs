@@ -505,16 +505,30 @@ pub(crate) fn wire_response<V: Coordinates>(
 /// as links), each group that a pair names, in the order of its first
 /// body.
 fn groups(beads: &[TouchBead], bodies: usize, pairs: &[(usize, usize)]) -> Vec<Vec<usize>> {
+    // Only the bodies a pair names, numbered in order (so that the groups
+    // come in the order of their first bodies): a step whose beads are
+    // mostly apart makes no group of each lone body.
+    let mut slot = vec![usize::MAX; bodies];
+    for &(i, j) in pairs {
+        slot[beads[i].body] = 0;
+        slot[beads[j].body] = 0;
+    }
+    let mut named = Vec::new();
+    for (body, slot) in slot.iter_mut().enumerate() {
+        if *slot == 0 {
+            *slot = named.len();
+            named.push(body);
+        }
+    }
     let links: Vec<[usize; 2]> = pairs
         .iter()
-        .map(|&(i, j)| [beads[i].body, beads[j].body])
+        .map(|&(i, j)| [slot[beads[i].body], slot[beads[j].body]])
         .collect();
-    let mut named = vec![false; bodies];
-    for &body in links.iter().flatten() {
-        named[body] = true;
+    let mut found = islands(named.len(), links.iter().map(|l| l.as_slice()));
+    for group in &mut found {
+        for body in group.iter_mut() {
+            *body = named[*body];
+        }
     }
-    islands(bodies, links.iter().map(|l| l.as_slice()))
-        .into_iter()
-        .filter(|group| named[group[0]])
-        .collect()
+    found
 }
