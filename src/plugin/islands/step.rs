@@ -171,6 +171,7 @@ pub(super) fn step_islands<V: LoneStep>(
             Some(shape)
         })
         .collect();
+    let mut near_alone = Vec::new();
     touch::settle(
         cached,
         (lone, &shapes),
@@ -178,8 +179,9 @@ pub(super) fn step_islands<V: LoneStep>(
         &settings,
         &mut struck,
         &mut divergences,
+        &mut near_alone,
     );
-    if let Some(wanting) = touch::regroup(cached, lone, settings.dt) {
+    if let Some(wanting) = touch::regroup(cached, (lone, &near_alone), settings.dt) {
         islands.mark_regrouped(wanting);
     }
     let mut written = beads.p1();

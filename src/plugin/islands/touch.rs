@@ -207,9 +207,25 @@ pub(super) fn near<V: Dimension>(beads: &[Rider<V>], dt: f64) -> Vec<(usize, usi
 /// `cached` does (the others may be kept whole).
 pub(super) fn regroup<V: Dimension>(
     cached: &[CachedIsland<V>],
-    lone: &[LoneTouch<V>],
+    (lone, near_alone): (&[LoneTouch<V>], &[(usize, usize)]),
     dt: f64,
 ) -> Option<Vec<bool>> {
+    let stepped = |k: usize| lone.get(k).filter(|l| matches!(l.outcome, Some(Ok(()))));
+    let islands_touch = cached
+        .iter()
+        .any(|island| island.outcome == Some(Ok(())) && !island.touching.is_empty());
+    if !islands_touch && lone.iter().all(|l| l.restitution > 0.0) {
+        // Every bead with a radius rides alone and bounces: a pair is
+        // joined only where it rests in touch, and the settlement named
+        // every pair that ends the step in touch.
+        let rests = near_alone.iter().any(|&(a, b)| {
+            let (Some(a), Some(b)) = (stepped(a), stepped(b)) else {
+                return false;
+            };
+            solver::rests_in_touch(&a.state, &b.state, a.radius + b.radius)
+        });
+        return rests.then(|| vec![false; cached.len()]);
+    }
     let mut beads = Vec::new();
     // Each bead's island (none for one alone) and index there.
     let mut place = Vec::new();
@@ -267,6 +283,9 @@ pub(super) fn regroup<V: Dimension>(
 /// [`solver::settle_touches`]): the islands that stepped and have beads
 /// with radii take part; each strike is sent as [`BeadsStruck`] and
 /// logged, and a failure stops the touching beads, reported in words.
+/// `near_alone` is set to the pairs of beads in `lone` whose paths
+/// through the step, as settled, came near (see
+/// [`solver::settle_touches`]): every pair of them that ends in touch.
 pub(super) fn settle<V: LoneStep>(
     cached: &mut [CachedIsland<V>],
     (lone, shapes): (&mut [LoneTouch<V>], &[Option<V::Lone>]),
@@ -274,18 +293,25 @@ pub(super) fn settle<V: LoneStep>(
     settings: &StepSettings,
     struck: &mut MessageWriter<BeadsStruck>,
     divergences: &mut Divergences,
+    near_alone: &mut Vec<(usize, usize)>,
 ) {
+    near_alone.clear();
     let mut beads = Vec::new();
     let mut entities = Vec::new();
-    // The beads alone that stepped, each a body after the islands.
+    // The beads alone that stepped, each a body after the islands, and
+    // each one's place in `lone`.
+    let mut alone = Vec::new();
     let mut lone_bodies: Vec<LoneBody<V>> = lone
         .iter_mut()
         .zip(shapes)
-        .filter(|(lone, _)| matches!(lone.outcome, Some(Ok(()))))
-        .filter_map(|(lone, shape)| {
+        .enumerate()
+        .filter(|(_, (lone, _))| matches!(lone.outcome, Some(Ok(()))))
+        .filter_map(|(k, (lone, shape))| {
+            let shape = shape.as_ref()?;
+            alone.push(k);
             Some(LoneBody {
                 lone,
-                shape: shape.as_ref()?,
+                shape,
                 settings: *settings,
             })
         })
@@ -334,8 +360,13 @@ pub(super) fn settle<V: LoneStep>(
         time,
         dt: settings.dt,
     };
-    let mut pairs = Vec::new();
-    let settled = solver::settle_touches(span, &mut bodies, &beads, &mut pairs);
+    let (mut pairs, mut near) = (Vec::new(), Vec::new());
+    let settled = solver::settle_touches(span, &mut bodies, &beads, (&mut pairs, &mut near));
+    // The pairs of beads alone that came near, by their places in `lone`.
+    near_alone.extend(
+        near.iter()
+            .filter_map(|&(i, j)| Some((*alone.get(i)?, *alone.get(j)?))),
+    );
     for pair in &pairs {
         report(pair, &entities, struck);
     }

@@ -326,13 +326,18 @@ pub struct StepSpan {
 /// `bodies` were stepped over `span` as if nothing touched; where beads in
 /// `beads` met within it, the step is cut and the strikes made, and each
 /// body that took part is [`finish`](TouchBody::finish)ed at its new end.
-/// Each strike is appended to `struck`.
+/// Each strike is appended to `struck`. `near` is set to the pairs of
+/// `beads` (each `(i, j)`, `i < j`, in order) whose boxes as the
+/// settlement leaves them overlap: each box takes in its bead's path
+/// through the step, as settled, grown by its radius, so that every pair
+/// whose beads end the step in touch is among them.
 pub fn settle_touches<V: Coordinates, B: TouchBody<V>>(
     span: StepSpan,
     bodies: &mut [B],
     beads: &[TouchBead],
-    struck: &mut Vec<StruckPair>,
+    (struck, near): (&mut Vec<StruckPair>, &mut Vec<(usize, usize)>),
 ) -> Result<(), TouchError> {
+    near.clear();
     for (i, bead) in beads.iter().enumerate() {
         let known = bodies
             .get(bead.body)
@@ -403,6 +408,7 @@ pub fn settle_touches<V: Coordinates, B: TouchBody<V>>(
             }
         }
     }
+    pool.overlapping_now(near);
     Ok(())
 }
 

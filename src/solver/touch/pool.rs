@@ -29,6 +29,8 @@ pub(super) struct Pool {
     /// `pairs_from[i]` on.
     pairs: Vec<(usize, usize)>,
     pairs_from: Vec<usize>,
+    /// The beads whose boxes have grown since the broad phase.
+    grown: Vec<usize>,
 }
 
 impl Pool {
@@ -77,6 +79,7 @@ impl Pool {
             below: 0.0,
             pairs,
             pairs_from,
+            grown: Vec::new(),
         };
         for (g, group) in pool.groups.iter().enumerate() {
             for &body in group {
@@ -128,10 +131,34 @@ impl Pool {
     /// settlement gave it.
     pub(super) fn grow(&mut self, j: usize, path: (DVec3, DVec3)) {
         let b = &mut self.boxes[j];
+        let was = *b;
         *b = (b.0.min(path.0), b.1.max(path.1));
+        if *b != was {
+            self.grown.push(j);
+        }
         if !self.key[j].is_nan() {
             self.above = self.above.max(b.1.x - self.key[j]);
             self.below = self.below.max(self.key[j] - b.0.x);
+        }
+    }
+
+    /// The pairs of beads whose boxes overlap now, each `(i, j)`, `i < j`,
+    /// in order, into `out`: those the broad phase found, and those that
+    /// a box grown since meets.
+    pub(super) fn overlapping_now(&self, out: &mut Vec<(usize, usize)>) {
+        out.clear();
+        out.extend_from_slice(&self.pairs);
+        for &j in &self.grown {
+            out.extend(
+                self.near(self.boxes[j])
+                    .into_iter()
+                    .filter(|&(i, _)| i != j)
+                    .map(|(i, _)| (i.min(j), i.max(j))),
+            );
+        }
+        if !self.grown.is_empty() {
+            out.sort_unstable();
+            out.dedup();
         }
     }
 
