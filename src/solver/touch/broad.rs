@@ -59,9 +59,9 @@ pub(crate) fn overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
         .filter(|low| low.is_finite())
         .reduce(DVec3::min)
         .unwrap_or(DVec3::ZERO);
-    // Where `p` is in cells from the origin: at or above it for every
-    // box entered in the grid, so that each coordinate's cell is its
-    // whole part (a conversion, not a call to `floor`).
+    // Where `p` is in cells from the origin: a box entered in the grid
+    // lies at or above it, so that each coordinate's cell is its whole
+    // part (a conversion, not a call to `floor`).
     let inverse = side.recip();
     let scaled = |p: DVec3| (p - origin) * inverse;
     // A cell's coordinates, each within FARTHEST_CELL, packed in one key.
@@ -76,13 +76,16 @@ pub(crate) fn overlapping(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
             continue;
         }
         let (from, to) = (scaled(low), scaled(high));
-        let near = from.min_element() >= 0.0 && to.max_element() <= FARTHEST_CELL as f64;
-        let (from, to) = (from.as_i64vec3(), to.as_i64vec3());
-        let span = (to - from + 1).max(I64Vec3::ONE);
-        if !near || span.x * span.y * span.z > MOST_CELLS {
+        let within = |c: DVec3| c.min_element() >= 0.0 && c.max_element() <= FARTHEST_CELL as f64;
+        // Within the grid, each coordinate's cell is its whole part.
+        let cells = (within(from) && within(to)).then(|| (from.as_i64vec3(), to.as_i64vec3()));
+        let Some((from, to)) = cells.filter(|(from, to)| {
+            let span = (*to - *from + 1).max(I64Vec3::ONE);
+            span.x * span.y * span.z <= MOST_CELLS
+        }) else {
             large.push(i);
             continue;
-        }
+        };
         for x in from.x..=to.x {
             for y in from.y..=to.y {
                 for z in from.z..=to.z {
