@@ -514,17 +514,15 @@ fn groups(beads: &[TouchBead], bodies: usize, pairs: &[(usize, usize)]) -> Vec<V
     // Only the bodies a pair names, numbered in order (so that the groups
     // come in the order of their first bodies): a step whose beads are
     // mostly apart makes no group of each lone body.
-    let mut slot = vec![usize::MAX; bodies];
+    let mut is_named = vec![false; bodies];
     for &(i, j) in pairs {
-        slot[beads[i].body] = 0;
-        slot[beads[j].body] = 0;
+        is_named[beads[i].body] = true;
+        is_named[beads[j].body] = true;
     }
-    let mut named = Vec::new();
-    for (body, slot) in slot.iter_mut().enumerate() {
-        if *slot == 0 {
-            *slot = named.len();
-            named.push(body);
-        }
+    let named: Vec<usize> = (0..bodies).filter(|&b| is_named[b]).collect();
+    let mut slot = vec![usize::MAX; bodies];
+    for (k, &body) in named.iter().enumerate() {
+        slot[body] = k;
     }
     let links: Vec<[usize; 2]> = pairs
         .iter()
