@@ -8,6 +8,8 @@
 //! unique, every contact pushing only, and no pass holds rows one layer
 //! of a pile at a time.
 
+use bordered::{Bordered, MOST_DIFFERING};
+
 use super::integrators::PUSHING_SLACK;
 use super::newton::{CHORD_ITERATIONS, CHORD_STALL, Direction};
 use super::{Island, IslandWork, OFF_THE_WIRE, RowReport, TOUCHING};
@@ -61,14 +63,18 @@ fn softness(taken: f64) -> f64 {
 /// take.
 const LCP_STEPS: usize = 16;
 
+mod bordered;
+
 /// The buffers of one complementarity solve: the gradients of the rows
 /// held (the others zeroed), which rows the factorization in hand holds
-/// and at what compliance, and `W Jᵀ z`, bead by bead.
+/// and at what compliance, the solves that border it for rows held that
+/// differ from those in a few rows, and `W Jᵀ z`, bead by bead.
 #[derive(Default)]
 struct Linear<V> {
     masked: Vec<V>,
     set_aside: Vec<bool>,
     factored_for: Option<(Vec<bool>, f64)>,
+    bordered: Bordered,
     moved: Vec<V>,
 }
 
@@ -439,6 +445,7 @@ impl<V: WireSpace> Island<V> {
             masked,
             set_aside,
             factored_for,
+            bordered,
             moved,
         } = linear;
         let apply = |z: &[f64], w: &mut Vec<f64>| {
@@ -448,11 +455,46 @@ impl<V: WireSpace> Island<V> {
                 q[r] + self.along(r, gradient, moved) + soft * problem.diagonal[r] * z[r]
             }));
         };
+        let mut column_moved = Vec::new();
+        let mut column = |s: usize| -> Vec<(usize, f64)> {
+            column_moved.clear();
+            column_moved.resize(self.beads(), V::ZERO);
+            self.move_along(gradient, s, 1.0, &mut column_moved);
+            (0..rows)
+                .filter_map(|r| {
+                    let m = self.along(r, gradient, &column_moved)
+                        + if r == s {
+                            soft * problem.diagonal[r]
+                        } else {
+                            0.0
+                        };
+                    (m != 0.0).then_some((r, m))
+                })
+                .collect()
+        };
+        // The Newton step on the rows `free` holds: with the factorization
+        // in hand where it was made for those rows, bordered where they
+        // differ from its own in a few, else with a new one.
         let newton = |free: &[bool], w: &[f64], d: &mut Vec<f64>| {
-            if factored_for
-                .as_ref()
-                .is_none_or(|(held, s)| held[..] != *free || *s != soft)
-            {
+            let b: Vec<f64> = (0..rows)
+                .map(|r| if free[r] { -w[r] } else { 0.0 })
+                .collect();
+            let near = factored_for.as_ref().filter(|(held, s)| {
+                *s == soft
+                    && held.iter().zip(free).filter(|(h, f)| h != f).count() <= MOST_DIFFERING
+            });
+            let current = match near {
+                Some((held, _)) if held[..] == *free => true,
+                Some((held, _)) => {
+                    let solve = |x: &mut [f64]| self.normal.solve(factored, x);
+                    if bordered.solve((free, held), &b, d, &mut column, solve) {
+                        return Ok(());
+                    }
+                    false
+                }
+                None => false,
+            };
+            if !current {
                 masked.clear();
                 masked.extend_from_slice(gradient);
                 set_aside.clear();
@@ -462,13 +504,14 @@ impl<V: WireSpace> Island<V> {
                         masked[self.row_start[r]..self.row_start[r + 1]].fill(V::ZERO);
                     }
                 }
+                bordered.clear();
                 self.normal
                     .factor_compliant(&self.inverse_mass, masked, set_aside, soft, factored)
                     .map_err(|r| singular(x[self.entry_bead[self.row_start[r]]]))?;
                 *factored_for = Some((free.to_vec(), soft));
             }
             d.clear();
-            d.extend((0..rows).map(|r| if free[r] { -w[r] } else { 0.0 }));
+            d.extend_from_slice(&b);
             self.normal.solve(factored, d);
             for (d, &f) in d.iter_mut().zip(free) {
                 if !f {
