@@ -8,6 +8,8 @@
 //! unique, every contact pushing only, and no pass holds rows one layer
 //! of a pile at a time.
 
+mod bordered;
+
 use bordered::{Bordered, MOST_DIFFERING};
 
 use super::integrators::PUSHING_SLACK;
@@ -62,8 +64,6 @@ fn softness(taken: f64) -> f64 {
 /// How many Newton steps more than the rows a complementarity solve may
 /// take.
 const LCP_STEPS: usize = 16;
-
-mod bordered;
 
 /// The buffers of one complementarity solve: the gradients of the rows
 /// held (the others zeroed), which rows the factorization in hand holds
@@ -425,10 +425,12 @@ impl<V: WireSpace> Island<V> {
     /// The linear complementarity problem `w = q + (J W Jᵀ + E) z` of
     /// `problem` (`J` the rows' `gradient`, `E` their compliances), by
     /// projected Newton steps ([`solve_lcp`]) from `z`. Returns with `z`
-    /// the solution. Each new set of free rows is factored once
-    /// ([`NormalMatrix::factor_compliant`]), kept in `linear` for the next
-    /// solve with the same gradients. A row whose diagonal vanishes is a
-    /// singular point, at its bead in `x`.
+    /// the solution. A set of free rows is factored
+    /// ([`NormalMatrix::factor_compliant`]) and kept in `linear` for the
+    /// next solve with the same gradients and compliance; a Newton step
+    /// whose free rows differ from those in at most [`MOST_DIFFERING`] is
+    /// solved with it bordered ([`Bordered`]). A row whose diagonal
+    /// vanishes is a singular point, at its bead in `x`.
     ///
     /// [`NormalMatrix::factor_compliant`]: crate::solver::coupled::normal::NormalMatrix::factor_compliant
     fn complementarity(
