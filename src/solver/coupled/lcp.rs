@@ -232,7 +232,7 @@ fn violation(bounds: &[Bound], z: &[f64], w: &[f64]) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(in crate::solver::coupled) mod tests {
     use super::{Bound, LcpError, held, solve_lcp};
     use proptest::prelude::*;
 
@@ -244,7 +244,12 @@ mod tests {
 
     /// `M_FF d_F = −w_F` by Gaussian elimination with partial pivoting,
     /// zero elsewhere.
-    fn newton(m: &[Vec<f64>], free: &[bool], w: &[f64], d: &mut Vec<f64>) {
+    pub(in crate::solver::coupled) fn newton(
+        m: &[Vec<f64>],
+        free: &[bool],
+        w: &[f64],
+        d: &mut Vec<f64>,
+    ) {
         let rows: Vec<usize> = (0..w.len()).filter(|&r| free[r]).collect();
         let k = rows.len();
         let mut a: Vec<Vec<f64>> = rows

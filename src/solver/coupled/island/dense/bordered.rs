@@ -172,42 +172,17 @@ impl Bordered {
 #[cfg(test)]
 mod tests {
     use super::Bordered;
+    use crate::solver::coupled::lcp::tests::newton;
     use proptest::prelude::*;
 
-    /// `m` restricted to the rows `held` (a unit diagonal elsewhere),
-    /// solved for `b` by Gaussian elimination with partial pivoting.
-    fn solve_masked(m: &[Vec<f64>], held: &[bool], b: &mut [f64]) {
-        let n = b.len();
-        let mut a: Vec<Vec<f64>> = (0..n)
-            .map(|i| {
-                let mut row: Vec<f64> = (0..n)
-                    .map(|j| match (held[i] && held[j], i == j) {
-                        (true, _) => m[i][j],
-                        (false, true) => 1.0,
-                        (false, false) => 0.0,
-                    })
-                    .collect();
-                row.push(b[i]);
-                row
-            })
-            .collect();
-        for c in 0..n {
-            let p = (c..n)
-                .max_by(|&x, &y| a[x][c].abs().total_cmp(&a[y][c].abs()))
-                .unwrap_or(c);
-            a.swap(c, p);
-            let pivot = a[c].clone();
-            for row in a.iter_mut().skip(c + 1) {
-                let f = row[c] / pivot[c];
-                for (v, p) in row.iter_mut().zip(&pivot).skip(c) {
-                    *v -= f * p;
-                }
-            }
-        }
-        for c in (0..n).rev() {
-            let s: f64 = (c + 1..n).map(|j| a[c][j] * b[j]).sum();
-            b[c] = (a[c][n] - s) / a[c][c];
-        }
+    /// `m` on the rows `held` solved for `x` in place, zero elsewhere (a
+    /// right-hand side zero off them, as every one here is: `K`'s own
+    /// solve, its unit diagonal off the rows held).
+    fn solve_held(m: &[Vec<f64>], held: &[bool], x: &mut [f64]) {
+        let minus: Vec<f64> = x.iter().map(|v| -v).collect();
+        let mut solved = Vec::new();
+        newton(m, held, &minus, &mut solved);
+        x.copy_from_slice(&solved);
     }
 
     proptest! {
@@ -248,14 +223,14 @@ mod tests {
                 }
                 let b: Vec<f64> = (0..n).map(|r| if free[r] { rhs[r] } else { 0.0 }).collect();
                 let mut wanted = b.clone();
-                solve_masked(&m, &free, &mut wanted);
+                solve_held(&m, &free, &mut wanted);
                 let mut got = Vec::new();
                 let solved = bordered.solve(
                     (&free, &base),
                     &b,
                     &mut got,
                     |s| (0..n).map(|r| (r, m[r][s])).collect(),
-                    |x| solve_masked(&m, &base, x),
+                    |x| solve_held(&m, &base, x),
                 );
                 prop_assert!(solved);
                 let size = wanted.iter().fold(1.0f64, |a, x| a.max(x.abs()));
