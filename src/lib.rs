@@ -79,6 +79,8 @@
 //! thread.
 #![warn(missing_docs)]
 
+#[cfg(feature = "avian2d")]
+pub mod avian;
 pub mod controls;
 #[cfg(feature = "debug-render")]
 pub mod debug_render;

@@ -17,6 +17,7 @@
 //! | `impact` | `resolve_impacts`: strikes between beads that touch, eq. (18), one pair at a time |
 //! | `touch/` (`group`) | `settle_touches`: where within a step beads meet (broad phase, regula falsi), the step cut there |
 //! | `lanes/` (`circle`) | the batched step: eight beads on circles at once, bit for bit [`step`](fn@step), many such batches in one call; the solves on each lane's circle (crate-private) |
+//! | `path` | a rigid body's anchor held on a wire, and its angle turned with it: the corrections of an engine's substep (a path joint) |
 //! | `coupled/` (`island/`, `normal/`, …) | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (12)–(14) |
 //!
 //! The equations below are numbered as the code and the tests cite them.
@@ -31,6 +32,8 @@ mod impact;
 mod lanes;
 mod method;
 mod newton;
+#[cfg_attr(not(feature = "avian2d"), allow(dead_code))]
+pub(crate) mod path;
 mod projection;
 mod rattle;
 mod restore;

@@ -25,6 +25,7 @@ const LAYERS: &[&str] = &[
     "solver",
     "dynamics",
     "plugin",
+    "avian",
     "controls",
     "preset",
     "headless",

@@ -3,6 +3,8 @@
 //! `window` checks the files `.ci/run` makes in a real window and is ignored
 //! by a plain `cargo test`.
 
+#[cfg(feature = "avian2d")]
+mod avian;
 mod bad_input;
 mod baumgarte;
 mod common;
