@@ -239,7 +239,7 @@ fn solve_path_joints(
         let mut plane = PlaneBody {
             centre,
             anchor: centre + DVec2::from_angle(angle).rotate(state.arm),
-            inverse_mass: f64::from(inertia.effective_inv_mass().x),
+            inverse_mass: DVec2::from(inertia.effective_inv_mass()),
             inverse_inertia: f64::from(inertia.effective_inv_angular_inertia()),
         };
         if !(plane.anchor.is_finite() && angle.is_finite()) {

@@ -20,8 +20,9 @@ pub(crate) struct PlaneBody {
     pub centre: DVec2,
     /// The anchor, world frame.
     pub anchor: DVec2,
-    /// `1 / m` (0 for a body that does not move).
-    pub inverse_mass: f64,
+    /// `1 / m` along each axis (0 along an axis the body does not move
+    /// along, as an engine's locked axes).
+    pub inverse_mass: DVec2,
     /// `1 / I` about the centre of mass (0 for a body that does not turn).
     pub inverse_inertia: f64,
 }
@@ -126,9 +127,10 @@ fn wrap(angle: f64) -> f64 {
 }
 
 /// One XPBD correction of `row` (Macklin et al. 2016, eq. 18): with the
-/// generalized inverse mass `w = ∂C/∂c · ∂C/∂c / m + (∂C/∂θ)² / I` and
-/// `α̃ = compliance / h²`, `Δλ = (−C − α̃ λ) / (w + α̃)`, and the body moves
-/// by `Δc = ∂C/∂c Δλ / m`, `Δθ = ∂C/∂θ Δλ / I`. Nothing moves where `w`
+/// generalized inverse mass `w = ∂C/∂c · W ∂C/∂c + (∂C/∂θ)² / I` (`W` the
+/// inverse mass along each axis) and `α̃ = compliance / h²`,
+/// `Δλ = (−C − α̃ λ) / (w + α̃)`, and the body moves by `Δc = W ∂C/∂c Δλ`,
+/// `Δθ = ∂C/∂θ Δλ / I`. Nothing moves where `w`
 /// and `α̃` vanish (a body that cannot move) or the row is not finite.
 pub(crate) fn correct(
     row: &BodyRow,
@@ -137,7 +139,7 @@ pub(crate) fn correct(
     compliance: f64,
     h: f64,
 ) -> Correction {
-    let w = row.along_centre.length_squared() * body.inverse_mass
+    let w = (row.along_centre * row.along_centre).dot(body.inverse_mass)
         + row.along_angle * row.along_angle * body.inverse_inertia;
     let tilde = compliance / (h * h);
     let delta = (-row.value - tilde * lambda) / (w + tilde);
@@ -146,7 +148,7 @@ pub(crate) fn correct(
     }
     Correction {
         lambda: delta,
-        centre: row.along_centre * (delta * body.inverse_mass),
+        centre: row.along_centre * body.inverse_mass * delta,
         angle: row.along_angle * delta * body.inverse_inertia,
     }
 }
@@ -161,7 +163,7 @@ mod tests {
         PlaneBody {
             centre,
             anchor,
-            inverse_mass: 0.5,
+            inverse_mass: DVec2::splat(0.5),
             inverse_inertia: 2.0,
         }
     }
@@ -249,7 +251,7 @@ mod tests {
     fn a_body_that_cannot_move_or_a_singular_point_moves_nothing() {
         let curve = Circle { radius: 1.0 };
         let fixed = PlaneBody {
-            inverse_mass: 0.0,
+            inverse_mass: DVec2::ZERO,
             inverse_inertia: 0.0,
             ..body(DVec2::new(0.0, -1.2), DVec2::new(0.0, -1.2))
         };
