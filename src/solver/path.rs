@@ -59,7 +59,8 @@ fn perp(v: DVec2) -> DVec2 {
 
 /// The anchor's distance from the curve to first order, `C(a) / |∇C(a)|`,
 /// as a row of the body: its gradient is the curve's unit normal at the
-/// centre and that normal's moment about the centre at the angle. `None`
+/// anchor along the centre, and that normal's moment about the centre
+/// along the angle. `None`
 /// where the curve's gradient vanishes (a singular point) or is not
 /// finite.
 pub(crate) fn on_curve(curve: &impl ImplicitCurve, body: &PlaneBody) -> Option<BodyRow> {
