@@ -49,9 +49,9 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::dynamics::{Wire, WirePose};
-use crate::geometry::{Near, Placed, PosePath};
+use crate::geometry::{Near, Placed};
 use crate::solver::path::{BodyRow, PlaneBody, correct, on_curve, turn_offset, turned_with_curve};
-use crate::{SimClock, SimParams, WireShape};
+use crate::{SimClock, SimParams};
 
 /// How a body held on a wire by a [`PathJoint`] may turn.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
@@ -108,12 +108,9 @@ impl PathJoint {
 }
 
 /// What a path joint holds from one substep to the next: the body where
-/// the step began, the wire's shape and path, and the offset of a body
-/// turned with the wire.
+/// the step began and the offset of a body turned with the wire.
 #[derive(Component, Clone, Debug)]
 struct PathJointState {
-    /// The wire, where the joint's wire has one.
-    wire: Option<(WireShape, PosePath)>,
     /// The time the step began at, and how far into it the substeps are.
     time: (f64, f64),
     /// The centre of mass and the angle where the step began.
@@ -132,7 +129,6 @@ struct PathJointState {
 impl Default for PathJointState {
     fn default() -> Self {
         Self {
-            wire: None,
             time: (0.0, 0.0),
             start: (DVec2::ZERO, 0.0),
             arm: DVec2::ZERO,
@@ -163,8 +159,8 @@ impl Plugin for PathJointPlugin {
     }
 }
 
-/// Reads each joint's body where the step begins and its wire's shape and
-/// path.
+/// Reads each joint's body where the step begins; says once of a joint
+/// whose wire is missing that it holds nothing.
 fn prepare_path_joints(
     mut joints: Query<(
         Entity,
@@ -188,11 +184,10 @@ fn prepare_path_joints(
         );
         state.arm = joint.anchor - local_centre;
         state.time = (clock.time - params.timestep, 0.0);
-        state.wire = match wires.get(joint.wire) {
-            Ok((wire, pose)) => pose.path().map(|path| (wire.shape().clone(), path)),
-            Err(_) => None,
-        };
-        if state.wire.is_none() && !state.warned {
+        let placed = wires
+            .get(joint.wire)
+            .is_ok_and(|(_, pose)| pose.path().is_some());
+        if !placed && !state.warned {
             warn!(
                 "wirebead: the path joint of body {entity} holds nothing: entity {} is not a wire \
                  with a finite pose",
@@ -211,6 +206,7 @@ fn solve_path_joints(
         &mut SolverBody,
         &SolverBodyInertia,
     )>,
+    wires: Query<(&Wire, &WirePose<DVec2>)>,
     time: Res<Time>,
 ) {
     let h = time.delta_secs_f64();
@@ -224,7 +220,11 @@ fn solve_path_joints(
         if body.flags.is_kinematic() {
             continue;
         }
-        let Some((shape, path)) = state.wire.clone() else {
+        let Some((shape, path)) = wires
+            .get(joint.wire)
+            .ok()
+            .and_then(|(wire, pose)| Some((wire.shape(), pose.path()?)))
+        else {
             continue;
         };
         let pose = path.pose(state.time.0 + state.time.1);
