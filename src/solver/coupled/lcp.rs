@@ -63,9 +63,10 @@ pub(crate) fn held(bounds: &[Bound], z: &[f64]) -> impl Iterator<Item = bool> {
 /// the bounds first), `diagonal` the diagonal of `M`. A row barely held
 /// (`z` within `ε` of its bound, `ε` the smaller of a thousandth of the
 /// largest `z` and how far one diagonal step would take any row) that
-/// the gradient presses toward its bound is put there before each step
-/// (Bertsekas' `ε`-active set): a jammed pile's rows that carry almost
-/// nothing are not freed and cut back step after step. `apply(z, w)`
+/// the gradient presses past its bound is put there before each step
+/// where that lowers the objective (Bertsekas' `ε`-active set): a jammed
+/// pile's rows that carry almost nothing are not freed and cut back step
+/// after step. `apply(z, w)`
 /// puts `w = q + M z` into `w`;
 /// `newton(free, w, d)` puts into `d` the Newton step of the rows `free`,
 /// `M_FF d_F = −w_F`, zero elsewhere (it may keep the factorization of a
@@ -109,20 +110,31 @@ pub(crate) fn solve_lcp<E>(
             natural = natural.max((z[r] - stepped).abs());
         }
         let epsilon = natural.min(BARELY * largest);
+        // Each such row alone lowers the objective where its own diagonal
+        // step would take it past its bound (`side·w ≥ side·z·M_rr`); all
+        // of them at once are put there only where that lowers it too, so
+        // that no step raises the objective and the iteration cannot
+        // cycle.
         let mut barely = false;
+        trial.clear();
+        trial.extend_from_slice(z);
         for r in 0..rows {
             if let Bound::Side(side) = bounds[r]
                 && side * z[r] > 0.0
                 && side * z[r] <= epsilon
-                && side * w[r] > 0.0
+                && side * w[r] >= side * z[r] * diagonal[r]
             {
-                z[r] = 0.0;
+                trial[r] = 0.0;
                 barely = true;
             }
         }
         if barely {
-            apply(z, w);
-            exact = false;
+            apply(&trial, &mut w_trial);
+            if objective_change((z, w), (&trial, &w_trial)) < 0.0 {
+                std::mem::swap(z, &mut trial);
+                std::mem::swap(w, &mut w_trial);
+                exact = false;
+            }
         }
         // The rows at their bound that the gradient presses against it.
         let mut violated = false;
@@ -189,15 +201,8 @@ pub(crate) fn solve_lcp<E>(
                 cut = true;
             }
             apply(&trial, &mut w_trial);
-            // f(trial) − f(z) = Δᵀ (w + w_trial) / 2, Δ = trial − z
-            // (exact for a quadratic).
-            let mut change = 0.0;
-            let mut first = 0.0;
-            for r in 0..rows {
-                let delta = trial[r] - z[r];
-                change += 0.5 * delta * (w[r] + w_trial[r]);
-                first += delta * w[r];
-            }
+            let change = objective_change((z, w), (&trial, &w_trial));
+            let first: f64 = (0..rows).map(|r| (trial[r] - z[r]) * w[r]).sum();
             if change <= SUFFICIENT * first || first == 0.0 || (bounded.is_some() && change <= 0.0)
             {
                 exact = alpha == 1.0 && !cut;
@@ -216,6 +221,15 @@ pub(crate) fn solve_lcp<E>(
         steps: max_steps,
         violation: violation(bounds, z, w),
     })
+}
+
+/// How much the objective changes from `z` to `trial`, `w` and `w_trial`
+/// the gradients there: `Δᵀ (w + w_trial) / 2`, `Δ = trial − z`, exact
+/// for a quadratic.
+fn objective_change((z, w): (&[f64], &[f64]), (trial, w_trial): (&[f64], &[f64])) -> f64 {
+    (0..z.len())
+        .map(|r| 0.5 * (trial[r] - z[r]) * (w[r] + w_trial[r]))
+        .sum()
 }
 
 /// The worst row's violation at `(z, w)` (see [`LcpError::Unsettled`]).
@@ -293,18 +307,61 @@ pub(in crate::solver::coupled) mod tests {
         z: &mut Vec<f64>,
         w: &mut Vec<f64>,
     ) -> Result<usize, LcpError<()>> {
+        solve_watched(m, q, bounds, z, w).0
+    }
+
+    /// `½ zᵀ M z + qᵀ z = ½ zᵀ (w + q)` where the gradient is `w`, `z`
+    /// found from it as `M⁻¹ (w − q)`.
+    fn objective_at(m: &[Vec<f64>], q: &[f64], w: &[f64]) -> f64 {
+        let shifted: Vec<f64> = q.iter().zip(w).map(|(q, w)| q - w).collect();
+        let mut z = Vec::new();
+        newton(m, &vec![true; q.len()], &shifted, &mut z);
+        (0..q.len()).map(|r| 0.5 * z[r] * (w[r] + q[r])).sum()
+    }
+
+    /// [`solve`], with the objective where it starts (within the bounds)
+    /// and where each Newton step is taken from.
+    fn solve_watched(
+        m: &[Vec<f64>],
+        q: &[f64],
+        bounds: &[Bound],
+        z: &mut Vec<f64>,
+        w: &mut Vec<f64>,
+    ) -> (Result<usize, LcpError<()>>, Vec<f64>) {
         let diagonal: Vec<f64> = (0..q.len()).map(|r| m[r][r]).collect();
-        solve_lcp(
+        let within: Vec<f64> = z
+            .iter()
+            .zip(bounds)
+            .map(|(&z, bound)| match *bound {
+                Bound::Side(side) if side * z < 0.0 => 0.0,
+                Bound::Out => 0.0,
+                _ => z,
+            })
+            .collect();
+        let mut start = Vec::new();
+        apply(m, q, &within, &mut start);
+        let mut objectives = vec![objective_at(m, q, &start)];
+        let solved = solve_lcp(
             (bounds, &diagonal),
             &vec![0.0; q.len()],
             (z, w),
             100,
             |z, w| apply(m, q, z, w),
             |free, w, d| {
+                objectives.push(objective_at(m, q, w));
                 newton(m, free, w, d);
                 Ok(())
             },
-        )
+        );
+        (solved, objectives)
+    }
+
+    /// Whether each of `objectives` is no higher than the one before, to
+    /// rounding.
+    fn descending(objectives: &[f64]) -> bool {
+        objectives
+            .windows(2)
+            .all(|pair| pair[1] <= pair[0] + 1e-12 * pair[0].abs().max(1.0))
     }
 
     /// `BᵀB + δI`, positive definite.
@@ -357,8 +414,9 @@ pub(in crate::solver::coupled) mod tests {
                 })
                 .collect();
             let (mut z, mut w) = (start[..n].to_vec(), Vec::new());
-            let steps = solve(&m, q, &bounds, &mut z, &mut w);
+            let (steps, objectives) = solve_watched(&m, q, &bounds, &mut z, &mut w);
             prop_assert!(steps.is_ok(), "{steps:?}");
+            prop_assert!(descending(&objectives), "{objectives:?}");
             prop_assert!(complementary(&bounds, &z, &w, 1e-9), "z {z:?} w {w:?}");
             // Every guess: the complementary one is the same.
             for mask in 0u32..1 << n {
@@ -383,6 +441,24 @@ pub(in crate::solver::coupled) mod tests {
                 prop_assert_eq!(holds[r], *bound == Bound::Equal || matches!(*bound, Bound::Side(s) if s * z[r] > 0.0));
             }
         }
+    }
+
+    /// A row barely held that its gradient presses toward its bound too
+    /// weakly for the bound to be nearer its least (`z = 4e-4`,
+    /// `w = 1e-4`, `M_rr = 1`: put on its bound, the objective would rise
+    /// by 4e-8) is left free: the objective falls at every step, and the
+    /// iteration ends at the solution.
+    #[test]
+    fn a_row_barely_held_is_put_on_its_bound_only_where_that_descends() {
+        let m = vec![vec![1.0, 0.5], vec![0.5, 1.0]];
+        let q = [-0.9995, -0.5003];
+        let bounds = [Bound::Side(1.0); 2];
+        let (mut z, mut w) = (vec![1.0, 4e-4], Vec::new());
+        let (steps, objectives) = solve_watched(&m, &q, &bounds, &mut z, &mut w);
+        assert!(steps.is_ok(), "{steps:?}");
+        assert!(objectives.len() >= 2, "{objectives:?}");
+        assert!(descending(&objectives), "{objectives:?}");
+        assert!(complementary(&bounds, &z, &w, 1e-12), "z {z:?}, w {w:?}");
     }
 
     /// Five contacts on two beads' worth of freedom (a jammed corner: the
