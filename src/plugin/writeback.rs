@@ -18,8 +18,10 @@ use crate::dynamics::{
 use crate::geometry::{SpaceShape, WireSpace};
 
 /// Keeps each bead's `Transform` at its position where the step did not
-/// write it itself (a restart, a game's own edit), and the
-/// [`SceneEnergy`] where the app has it.
+/// write it itself (a restart, a game's own edit), places it there as
+/// the bead is spawned (drawn where it is before its first step, in a
+/// scene loaded paused), and keeps the [`SceneEnergy`] where the app has
+/// it.
 #[derive(Default)]
 pub struct WritebackPlugin;
 
@@ -41,6 +43,8 @@ impl Plugin for WritebackPlugin {
                 )
                     .in_set(WireBeadSystems::Writeback),
             )
+            .add_observer(place_spawned::<Bead, DVec2>)
+            .add_observer(place_spawned::<SpaceBead, DVec3>)
             .register_type::<SceneEnergy>()
             .add_systems(
                 FixedUpdate,
@@ -89,6 +93,17 @@ fn write_transforms<V: Dimension>(
         beads.par_iter_mut().for_each(write);
     } else {
         beads.iter_mut().for_each(write);
+    }
+}
+
+/// Places a bead's `Transform` at its position as the bead (marked `B`)
+/// is spawned; a bead without one (a lean bead) is left as it is.
+fn place_spawned<B: Component, V: Dimension>(
+    added: On<Add, B>,
+    mut beads: Query<(&BeadPosition<V>, &mut Transform)>,
+) {
+    if let Ok((position, mut transform)) = beads.get_mut(added.entity) {
+        V::place(&mut transform, position.0);
     }
 }
 

@@ -183,3 +183,30 @@ fn lean_beads_step_like_full_ones_without_their_extras() {
     let first = lean.world().get::<Diverged>(lean_beads[BEADS_PER_WIRE]);
     assert_eq!(first.map(|d| d.time), Some(dt));
 }
+
+/// A bead's `Transform` is where the bead is spawned before any step (a
+/// scene loaded paused draws its beads in place, not at the origin), in
+/// the plane and in space; a lean bead gets none.
+#[test]
+fn a_bead_is_placed_where_it_is_spawned_before_its_first_step() {
+    let mut app = Headless::new(WireBeadPlugin::default()).build();
+    let plane = app
+        .world_mut()
+        .spawn(Bead::at_rest(1.0, DVec2::new(0.25, -1.5)).unwrap())
+        .id();
+    let space = app
+        .world_mut()
+        .spawn(wirebead::SpaceBead::at_rest(1.0, bevy::math::DVec3::new(-2.0, 0.5, 3.0)).unwrap())
+        .id();
+    let at = |app: &App, bead: Entity| app.world().get::<Transform>(bead).unwrap().translation;
+    assert_eq!(at(&app, plane), Vec3::new(0.25, -1.5, 0.0));
+    assert_eq!(at(&app, space), Vec3::new(-2.0, 0.5, 3.0));
+    assert_eq!(app.world().resource::<SimClock>().steps, 0);
+
+    let mut lean = Headless::new(WireBeadPlugin::default().lean()).build();
+    let bead = lean
+        .world_mut()
+        .spawn(Bead::at_rest(1.0, DVec2::new(0.25, -1.5)).unwrap())
+        .id();
+    assert!(!lean.world().entity(bead).contains::<Transform>());
+}
