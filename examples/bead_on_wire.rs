@@ -43,6 +43,10 @@ struct Args {
     /// Write a final report on exit.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// End the run 20 frames after this file appears, as if its frames
+    /// were done (needs --frames, which stays the longest it runs).
+    #[arg(long, requires = "frames")]
+    finish_when: Option<PathBuf>,
     /// Window width in pixels.
     #[arg(long, default_value_t = 1280)]
     width: u32,
@@ -85,6 +89,7 @@ fn main() -> AppExit {
             screenshot: args.screenshot,
             ready: args.ready,
             report: args.report,
+            finish_when: args.finish_when,
         })
         .add_systems(Startup, move |mut loads: MessageWriter<LoadPreset>| {
             loads.write(LoadPreset(preset.clone()));

@@ -198,6 +198,12 @@ pub struct AutomationPlugin {
     pub ready: Option<PathBuf>,
     /// Write the final [`FrameReport`] here on exit.
     pub report: Option<PathBuf>,
+    /// End the run as soon as a file appears here: 20 frames later, with
+    /// the screenshot and reports as at the end of `frames`, which stays
+    /// the longest the run takes. A script that drives the window ends it
+    /// when its keys and drags are done rather than after frames enough
+    /// for the slowest machine.
+    pub finish_when: Option<PathBuf>,
 }
 
 #[derive(Resource, Clone, Debug, Default)]
@@ -605,9 +611,19 @@ fn automation(
         }
     }
 
-    let Some(frames) = state.config.frames else {
+    let Some(mut frames) = state.config.frames else {
         return;
     };
+    if frame + 21 < frames
+        && state
+            .config
+            .finish_when
+            .as_ref()
+            .is_some_and(|path| path.exists())
+    {
+        frames = frame + 21;
+        state.config.frames = Some(frames);
+    }
     if let Some(path) = state.config.screenshot.clone() {
         // Freeze the scene so the screenshot and its report agree.
         if frame + 20 == frames {
