@@ -84,19 +84,14 @@ pub(crate) fn solve_lcp<E>(
 ) -> Result<usize, LcpError<E>> {
     let rows = bounds.len();
     z.resize(rows, 0.0);
-    for (z, bound) in z.iter_mut().zip(bounds) {
-        match *bound {
-            Bound::Side(side) if side * *z < 0.0 || !z.is_finite() => *z = 0.0,
-            Bound::Out => *z = 0.0,
-            _ if !z.is_finite() => *z = 0.0,
-            _ => {}
-        }
+    for (z, &bound) in z.iter_mut().zip(bounds) {
+        *z = if z.is_finite() {
+            within(bound, *z)
+        } else {
+            0.0
+        };
     }
-    let project = |r: usize, value: f64| match bounds[r] {
-        Bound::Side(side) if side * value < 0.0 => 0.0,
-        Bound::Out => 0.0,
-        _ => value,
-    };
+    let project = |r: usize, value: f64| within(bounds[r], value);
     apply(z, w);
     let mut free = vec![false; rows];
     let (mut d, mut trial, mut w_trial) = (Vec::new(), Vec::new(), Vec::new());
@@ -116,16 +111,18 @@ pub(crate) fn solve_lcp<E>(
         // that no step raises the objective and the iteration cannot
         // cycle.
         let mut barely = false;
-        trial.clear();
-        trial.extend_from_slice(z);
         for r in 0..rows {
             if let Bound::Side(side) = bounds[r]
                 && side * z[r] > 0.0
                 && side * z[r] <= epsilon
                 && side * w[r] >= side * z[r] * diagonal[r]
             {
+                if !barely {
+                    trial.clear();
+                    trial.extend_from_slice(z);
+                    barely = true;
+                }
                 trial[r] = 0.0;
-                barely = true;
             }
         }
         if barely {
@@ -223,6 +220,16 @@ pub(crate) fn solve_lcp<E>(
     })
 }
 
+/// `value` moved within `bound`: zero where it is on the wrong side of a
+/// one-sided bound or left out.
+fn within(bound: Bound, value: f64) -> f64 {
+    match bound {
+        Bound::Side(side) if side * value < 0.0 => 0.0,
+        Bound::Out => 0.0,
+        _ => value,
+    }
+}
+
 /// How much the objective changes from `z` to `trial`, `w` and `w_trial`
 /// the gradients there: `Δᵀ (w + w_trial) / 2`, `Δ = trial − z`, exact
 /// for a quadratic.
@@ -247,7 +254,7 @@ fn violation(bounds: &[Bound], z: &[f64], w: &[f64]) -> f64 {
 
 #[cfg(test)]
 pub(in crate::solver::coupled) mod tests {
-    use super::{Bound, LcpError, held, solve_lcp};
+    use super::{Bound, LcpError, held, solve_lcp, within};
     use proptest::prelude::*;
 
     /// `w = q + M z`.
@@ -329,17 +336,13 @@ pub(in crate::solver::coupled) mod tests {
         w: &mut Vec<f64>,
     ) -> (Result<usize, LcpError<()>>, Vec<f64>) {
         let diagonal: Vec<f64> = (0..q.len()).map(|r| m[r][r]).collect();
-        let within: Vec<f64> = z
+        let moved: Vec<f64> = z
             .iter()
             .zip(bounds)
-            .map(|(&z, bound)| match *bound {
-                Bound::Side(side) if side * z < 0.0 => 0.0,
-                Bound::Out => 0.0,
-                _ => z,
-            })
+            .map(|(&z, &bound)| within(bound, z))
             .collect();
         let mut start = Vec::new();
-        apply(m, q, &within, &mut start);
+        apply(m, q, &moved, &mut start);
         let mut objectives = vec![objective_at(m, q, &start)];
         let solved = solve_lcp(
             (bounds, &diagonal),
