@@ -133,13 +133,14 @@ pub type PendingBead = NextBeadParams;
 #[deprecated(note = "renamed to `NextWireShape`: a wire's shape for the next restart")]
 pub type PendingWire = NextWireShape;
 
-/// The nouns a game uses: `use wirebead::prelude::*;`. Everything else
-/// is at the crate root (`wirebead::Islands`, `wirebead::NextParams`, …).
+/// The twenty nouns a game uses: `use wirebead::prelude::*;`. Everything
+/// else is at the crate root (`wirebead::PrescribedMotion`,
+/// `wirebead::Contacts`, `wirebead::BeadsStruck`, `wirebead::Islands`, …).
 pub mod prelude {
     pub use crate::{
         Bead, BeadDiagnostics, BeadForces, BeadMass, BeadParams, BeadPosition, BeadRadius,
-        BeadVelocity, BeadsStruck, Contacts, Diverged, Method, OnWire, Pin, PrescribedMotion,
-        Restart, Rod, SimParams, Spring, Wire, WireBeadPlugin, WireBeadSystems, WireShape,
+        BeadVelocity, Diverged, Method, OnWire, Pin, Restart, Rod, SimParams, Spring, Wire,
+        WireBeadPlugin, WireBeadSystems, WireShape,
     };
 }
 

@@ -9,7 +9,8 @@ use wirebead::geometry::{Circle, Helix, OnPlane, Pose3, SpaceMotion, SpacePath, 
 use wirebead::headless::{Headless, run_for, space_bead_state};
 use wirebead::prelude::*;
 use wirebead::{
-    BeadMass, ConstraintDiagnostics, Islands, NextBeadParams, SceneEnergy, SpaceBead, SpaceWire,
+    BeadMass, ConstraintDiagnostics, Islands, NextBeadParams, PrescribedMotion, SceneEnergy,
+    SpaceBead, SpaceWire,
 };
 
 use crate::space::conical_start;

@@ -9,8 +9,8 @@ use wirebead::prelude::*;
 use wirebead::preset::{GRAIN_RADIUS, Hourglass, Pour};
 use wirebead::solver::BeadState;
 use wirebead::{
-    CatchesBeads, Integrator, Islands, Restitution, SceneEnergy, SceneFile, ScenePreset, SimClock,
-    WireContact, preset::PILE_RADIUS,
+    BeadsStruck, CatchesBeads, Contacts, Integrator, Islands, Restitution, SceneEnergy, SceneFile,
+    ScenePreset, SimClock, WireContact, preset::PILE_RADIUS,
 };
 
 /// A headless app at `dt` with RATTLE, no gravity along the track.

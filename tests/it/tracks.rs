@@ -7,7 +7,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use wirebead::prelude::*;
 use wirebead::{ContactChanged, Side, SimClock, Stabilization, Surface, WireContact};
-use wirebead::{Oscillate, ScenePreset, WireMotion};
+use wirebead::{Oscillate, PrescribedMotion, ScenePreset, WireMotion};
 
 use crate::common::{Recording, app, run_for, spawn_bead, spawn_wire};
 
