@@ -58,7 +58,7 @@ pub use space::{
 };
 pub use spline::{CubicPath, Spline, SplineKind, SplineSpec};
 pub use surface::{Friction, Side, Surface};
-pub use traced::{HINT_WINDOW, Parametric, Traced};
+pub use traced::{Parametric, Traced};
 pub use twist::Twist;
 pub use wire_space::{SpaceRow, SpaceShape, WireSpace};
 

@@ -44,7 +44,7 @@ pub trait Parametric<V: Coordinates = DVec2> {
 const SAMPLES_PER_UNIT: f64 = 24.0;
 
 /// How far in parameter from a hint the nearest-point search looks.
-pub const HINT_WINDOW: f64 = 0.75;
+const HINT_WINDOW: f64 = 0.75;
 
 /// A [`Parametric`] curve as a wire: by its signed distance in the plane,
 /// by its offset along two normals in space (see
@@ -141,7 +141,7 @@ impl<V: Coordinates, P: Parametric<V>> Traced<P, V> {
         self.samples.iter().map(|(_, p)| *p)
     }
 
-    /// The sample nearest `x` among those within [`HINT_WINDOW`] of the
+    /// The sample nearest `x` among those within 0.75 (a unit's 18 samples) of the
     /// parameter `hint` (on a curve that crosses itself, the branch the
     /// bead is on); none if the hint is not finite or the window's nearest
     /// sample is at its edge (the bead went farther: the whole curve is
@@ -209,7 +209,7 @@ impl<V: Coordinates, P: Parametric<V>> Traced<P, V> {
     }
 
     /// The curve's parameter at the point nearest `x`, searched near
-    /// `hint` (within [`HINT_WINDOW`] of it, else anywhere).
+    /// `hint` (within 0.75 of it, else anywhere).
     pub fn parameter(&self, x: V, hint: f64) -> f64 {
         self.nearest(x, hint).s
     }

@@ -57,7 +57,7 @@ pub use method::{Integrator, Method, Stabilization};
 pub use projection::project;
 pub use rattle::rattle;
 pub use rk4::rk4;
-pub use settings::{Gains, SHORT_PART, StepSettings};
+pub use settings::{Gains, StepSettings};
 pub use solve::{SolveError, Solved, lambda, solve};
 pub use state::{Advance, BeadState, LinearForce};
 pub use step::{StepOutput, constraint_state, constraint_state_on, step, step_on};

@@ -24,11 +24,11 @@ pub struct StepSettings {
 /// by a method whose velocity does not come from a position difference
 /// over the part (RK4 with projection): RATTLE's loses the digits the
 /// part is short by.
-pub const SHORT_PART: f64 = 1e-3;
+const SHORT_PART: f64 = 1e-3;
 
 impl StepSettings {
     /// The settings for a part `h` of this step: RK4 with projection where
-    /// the part is shorter than [`SHORT_PART`] of the step, the step's own
+    /// the part is shorter than a thousandth of the step, the step's own
     /// method otherwise.
     pub fn part(&self, h: f64) -> Self {
         let method = if h < SHORT_PART * self.dt {

@@ -506,7 +506,10 @@ pub(super) fn prepare_islands<V: LoneStep>(
                 island.set_side(row, surface.side, surface.restitution);
                 if surface.resists() {
                     let stick = sticks.iter().find(|s| s.0 == row).map(|s| s.1);
-                    island.set_rough(row, surface.friction, surface.damping, stick);
+                    if let Err(e) = island.set_rough(row, surface.friction, surface.damping, stick)
+                    {
+                        warn!("a rough wire's row of an island: {e}; that wire is left smooth");
+                    }
                     if let Some(partner) = partner {
                         island.pair_rows(row, partner);
                     }

@@ -281,7 +281,7 @@ pub(super) fn step_islands<V: LoneStep>(
         cached.report.drift = (0..rows.len())
             .filter(|&row| cached.work.holds(row))
             .fold(0.0, |drift, row| f64::max(drift, rows[row].c.abs()));
-        cached.report.energy = cached.island.energy(&cached.states, gravity);
+        cached.report.energy = cached.island.energy_of(&cached.states, gravity);
         cached.report.redundant = cached.work.redundant();
         cached.report.substeps = cached.work.substeps();
         cached.report.steps += 1;

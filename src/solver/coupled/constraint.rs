@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use bevy::math::DVec2;
 
+use super::IslandError;
 use crate::geometry::{Coordinates, WireSpace, placed_geometry};
 
 /// A constraint of a game's own among one or more beads: `C(x₁, …, xₖ) = 0`.
@@ -183,9 +184,40 @@ pub struct SpringLink {
 }
 
 impl SpringLink {
-    /// The force on bead `a` where the beads are at `x` with velocities `v`.
+    /// The force on bead `a` where the beads are at `x` with velocities
+    /// `v`; an error names the bead `x` or `v` has no entry for.
+    pub fn force<V: Coordinates>(&self, x: &[V], v: &[V]) -> Result<V, IslandError> {
+        self.holds("positions", x.len())?;
+        self.holds("velocities", v.len())?;
+        Ok(self.pull(x, v))
+    }
+
+    /// The energy stored in the spring where the beads are at `x`; an
+    /// error names the bead `x` has no entry for.
+    pub fn energy<V: Coordinates>(&self, x: &[V]) -> Result<f64, IslandError> {
+        self.holds("positions", x.len())?;
+        Ok(self.stored(x[self.a], x[self.b]))
+    }
+
+    /// Whether a slice of `len` entries, `what` in words, has both ends.
+    fn holds(&self, what: &str, len: usize) -> Result<(), IslandError> {
+        match [self.a, self.b].into_iter().find(|&bead| bead >= len) {
+            Some(bead) => Err(IslandError::MissingBead {
+                item: format!(
+                    "the spring from bead {} to bead {} ({what})",
+                    self.a, self.b
+                ),
+                bead,
+                beads: len,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// [`SpringLink::force`] where `x` and `v` are known to hold both
+    /// ends.
     #[inline]
-    pub fn force<V: Coordinates>(&self, x: &[V], v: &[V]) -> V {
+    pub(crate) fn pull<V: Coordinates>(&self, x: &[V], v: &[V]) -> V {
         let d = x[self.a] - x[self.b];
         let distance = d.dot(d).sqrt();
         if distance.is_nan() || distance <= 0.0 {
@@ -195,11 +227,6 @@ impl SpringLink {
         let stretch = distance - self.rest_length;
         let rate = (v[self.a] - v[self.b]).dot(u);
         u * -(self.stiffness * stretch + self.damping * rate)
-    }
-
-    /// The energy stored in the spring where the beads are at `x`.
-    pub fn energy<V: Coordinates>(&self, x: &[V]) -> f64 {
-        self.stored(x[self.a], x[self.b])
     }
 
     /// The energy stored in the spring with its ends at `a` and `b`.

@@ -107,7 +107,7 @@ pub trait TouchBody<V: Coordinates> {
     fn end(&self) -> &[BeadState<V>];
     /// Steps `states`, at `time`, on by `h`, from what the body kept at
     /// the last [`TouchBody::keep`] (or before the step). A part shorter
-    /// than [`SHORT_PART`](crate::solver::SHORT_PART) of the step wants a
+    /// than a thousandth of the step wants a
     /// method whose velocity does not come from a position difference
     /// ([`StepSettings::part`](crate::solver::StepSettings::part)).
     fn advance(&mut self, time: f64, h: f64, states: &mut [BeadState<V>])

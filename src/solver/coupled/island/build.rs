@@ -61,6 +61,30 @@ pub enum IslandError {
         /// What it was.
         value: f64,
     },
+    /// A slice given for the island's beads holds one entry per bead of
+    /// another island.
+    #[error("{what} holds {given} entries, but the island has {beads} beads")]
+    Length {
+        /// The slice, in words.
+        what: &'static str,
+        /// How many entries it holds.
+        given: usize,
+        /// How many beads the island has.
+        beads: usize,
+    },
+    /// A row named for friction is not a wire's row of the island, or the
+    /// row named to hold its bead still is not an axis row of that bead.
+    #[error("{what} {row} is not {expected} (the island has {rows} rows)")]
+    Row {
+        /// The argument, in words.
+        what: &'static str,
+        /// The row it named.
+        row: usize,
+        /// What that row had to be.
+        expected: &'static str,
+        /// How many rows the island has.
+        rows: usize,
+    },
     /// faer could not allocate the symbolic factorization.
     #[error("the island's matrix could not be set up (out of memory)")]
     OutOfMemory,

@@ -348,22 +348,37 @@ impl<V: WireSpace> Island<V> {
     /// placed across the wire where the bead stops, and set aside again
     /// when the force it needs passes `μs |λ∇C|`. Kinetic friction and
     /// damping act as forces held at their value at the step's start. A
-    /// bead on a moving wire does not stick in an island (it slides).
+    /// bead on a moving wire does not stick in an island (it slides). An
+    /// error, and nothing changed, where `row` is not a wire's row or
+    /// `stick` not an axis row of its bead.
     pub fn set_rough(
         &mut self,
         row: usize,
         friction: Friction,
         damping: f64,
         stick: Option<usize>,
-    ) {
-        let stick = stick.filter(|&s| {
-            matches!(self.rows.get(s), Some(RowKind::Axis { .. }))
-                && self.entry_bead.get(self.row_start[s])
-                    == self.entry_bead.get(self.row_start[row])
-        });
-        if let (Some(RowKind::Wire { .. }), Some(slot)) =
-            (self.rows.get(row), self.rough.get_mut(row))
-        {
+    ) -> Result<(), IslandError> {
+        let rows = self.rows.len();
+        if !matches!(self.rows.get(row), Some(RowKind::Wire { .. })) {
+            return Err(IslandError::Row {
+                what: "the rough row",
+                row,
+                expected: "a wire's row",
+                rows,
+            });
+        }
+        if let Some(s) = stick.filter(|&s| {
+            !matches!(self.rows.get(s), Some(RowKind::Axis { .. }))
+                || self.entry_bead[self.row_start[s]] != self.entry_bead[self.row_start[row]]
+        }) {
+            return Err(IslandError::Row {
+                what: "the row holding it still",
+                row: s,
+                expected: "an axis row of the rough row's bead",
+                rows,
+            });
+        }
+        if let Some(slot) = self.rough.get_mut(row) {
             let partner = slot.and_then(|rough| rough.partner);
             let was = slot.replace(RoughRow {
                 friction,
@@ -375,6 +390,7 @@ impl<V: WireSpace> Island<V> {
                 self.rough_rows += 1;
             }
         }
+        Ok(())
     }
 
     /// Joins wire row `second` to the rough wire row `first` (see
@@ -437,8 +453,20 @@ impl<V: WireSpace> Island<V> {
     }
 
     /// Kinetic plus gravitational energy of the beads in `states`, plus the
-    /// springs' stored energy.
-    pub fn energy(&self, states: &[BeadState<V>], gravity: V) -> f64 {
+    /// springs' stored energy; an error if `states` is not one per bead.
+    pub fn energy(&self, states: &[BeadState<V>], gravity: V) -> Result<f64, IslandError> {
+        if states.len() != self.beads() {
+            return Err(IslandError::Length {
+                what: "the beads' states",
+                given: states.len(),
+                beads: self.beads(),
+            });
+        }
+        Ok(self.energy_of(states, gravity))
+    }
+
+    /// [`Island::energy`] where `states` is known to be one per bead.
+    pub(crate) fn energy_of(&self, states: &[BeadState<V>], gravity: V) -> f64 {
         let beads: f64 = states
             .iter()
             .zip(&self.inverse_mass)

@@ -203,7 +203,12 @@ impl<V: WireSpace> Island<V> {
                 }
                 let potential = |x: &[V]| -> f64 {
                     let applied: f64 = forces.iter().zip(x).map(|(f, x)| f.potential(*x)).sum();
-                    applied + self.springs.iter().map(|s| s.energy(x)).sum::<f64>()
+                    applied
+                        + self
+                            .springs
+                            .iter()
+                            .map(|s| s.stored(x[s.a], x[s.b]))
+                            .sum::<f64>()
                 };
                 let target = kinetic(&work.v0) + potential(&work.x0) - potential(&work.x);
                 let scale = energy_scale(target, now);

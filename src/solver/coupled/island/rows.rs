@@ -416,7 +416,7 @@ impl<V: WireSpace> Island<V> {
         out.clear();
         out.extend(forces.iter().zip(x).map(|(f, &p)| f.at(p)));
         for spring in &self.springs {
-            let f = spring.force(x, v);
+            let f = spring.pull(x, v);
             out[spring.a] += f;
             out[spring.b] -= f;
         }

@@ -181,9 +181,43 @@ fn rough_cart(degrees: f64, friction: crate::geometry::Friction) -> Island {
         vec![],
     )
     .unwrap();
-    island.set_rough(0, friction, 0.0, Some(3));
-    island.set_rough(1, friction, 0.0, Some(4));
     island
+        .set_rough(0, friction, 0.0, Some(3))
+        .expect("row 0 is a wire's, row 3 an axis of its bead");
+    island
+        .set_rough(1, friction, 0.0, Some(4))
+        .expect("row 1 is a wire's, row 4 an axis of its bead");
+    island
+}
+
+#[test]
+fn friction_on_a_row_that_is_no_wire_or_held_by_another_beads_row_is_refused_in_words() {
+    let friction = crate::geometry::Friction {
+        static_coefficient: 0.5,
+        kinetic_coefficient: 0.4,
+    };
+    let mut island = rough_cart(0.0, friction);
+    assert_eq!(
+        island
+            .set_rough(2, friction, 0.0, None)
+            .unwrap_err()
+            .to_string(),
+        "the rough row 2 is not a wire's row (the island has 5 rows)"
+    );
+    assert_eq!(
+        island
+            .set_rough(9, friction, 0.0, None)
+            .unwrap_err()
+            .to_string(),
+        "the rough row 9 is not a wire's row (the island has 5 rows)"
+    );
+    assert_eq!(
+        island
+            .set_rough(0, friction, 0.0, Some(4))
+            .unwrap_err()
+            .to_string(),
+        "the row holding it still 4 is not an axis row of the rough row's bead (the island has 5 rows)"
+    );
 }
 
 /// Friction in an island: a two-bead cart sent at 3 m/s along a rough

@@ -96,7 +96,7 @@ fn double_pendulum() -> (Island, Vec<BeadState>, Vec<LinearForce>) {
 /// largest `|C|` and the largest energy change (J) over the run.
 fn double_pendulum_run(method: Method, dt: f64, steps: usize) -> (f64, f64) {
     let (island, mut states, forces) = double_pendulum();
-    let e0 = island.energy(&states, G);
+    let e0 = island.energy(&states, G).expect("a state per bead");
     let mut worst = (0.0f64, 0.0f64);
     run(
         &island,
@@ -106,7 +106,9 @@ fn double_pendulum_run(method: Method, dt: f64, steps: usize) -> (f64, f64) {
         steps,
         |states, work| {
             worst.0 = worst.0.max(max_drift(work, 1.0));
-            worst.1 = worst.1.max((island.energy(states, G) - e0).abs());
+            worst.1 = worst
+                .1
+                .max((island.energy(states, G).expect("a state per bead") - e0).abs());
         },
     );
     worst

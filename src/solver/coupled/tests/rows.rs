@@ -179,6 +179,41 @@ fn bad_islands_are_refused_in_words() {
 }
 
 #[test]
+fn a_spring_or_an_island_given_too_few_beads_says_so_and_a_right_slice_is_answered() {
+    let spring = SpringLink {
+        a: 0,
+        b: 2,
+        rest_length: 1.0,
+        stiffness: 10.0,
+        damping: 0.0,
+    };
+    let x = [DVec2::ZERO, DVec2::X, DVec2::new(2.0, 0.0)];
+    let v = [DVec2::ZERO; 3];
+    assert_eq!(
+        spring.force(&x[..2], &v).unwrap_err().to_string(),
+        "the spring from bead 0 to bead 2 (positions) names bead 2, but there are only 2 beads"
+    );
+    assert_eq!(
+        spring.force(&x, &v[..1]).unwrap_err().to_string(),
+        "the spring from bead 0 to bead 2 (velocities) names bead 2, but there are only 1 beads"
+    );
+    assert!(spring.energy(&x[..1]).is_err());
+    // Stretched by 1 m at 10 N/m: 10 N pulling bead 0 toward bead 2, 5 J.
+    let pull = spring.force(&x, &v).expect("both ends given");
+    assert!((pull - DVec2::new(10.0, 0.0)).length() <= 1e-12, "{pull}");
+    let stored = spring.energy(&x).expect("both ends given");
+    assert!((stored - 5.0).abs() <= 1e-12, "{stored}");
+
+    let (island, states, _) = double_pendulum();
+    assert_eq!(
+        island.energy(&states[..1], G).unwrap_err().to_string(),
+        "the beads' states holds 1 entries, but the island has 3 beads"
+    );
+    let energy = island.energy(&states, G).expect("a state per bead");
+    assert!(energy.is_finite());
+}
+
+#[test]
 fn a_rod_of_two_coincident_beads_is_a_singular_point_not_a_nan() {
     let (island, _, forces) = double_pendulum();
     let mut states = at_rest(&[DVec2::ZERO, DVec2::ZERO, DVec2::new(1.0, 0.0)]);
