@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use bevy::math::DVec2;
 
-use super::IslandError;
+use super::error::IslandError;
 use crate::geometry::{Coordinates, WireSpace, placed_geometry};
 
 /// A constraint of a game's own among one or more beads: `C(x₁, …, xₖ) = 0`.

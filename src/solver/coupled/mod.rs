@@ -8,6 +8,7 @@
 //! | file | what it holds |
 //! |---|---|
 //! | `constraint` | [`Constraint`], [`RowKind`] (what one row contributes), [`SpringLink`] |
+//! | `error` | [`IslandError`]: why an island cannot be built or answer |
 //! | `group` | [`islands`]: which beads are joined |
 //! | `lcp` | the complementarity problems of dense contact, by projected Newton steps |
 //! | `normal/` (`pattern`, `order`, `band_ldlt`, `band_lu`, `sparse_ldlt`, `sparse_lu`) | `J W Jᵀ`: its patterns, band ordering, and band and sparse (faer) factorizations |
@@ -15,6 +16,7 @@
 //! | `tests/` (`methods`, `rows`, `ropes`, `contact`) | islands against the single-bead solver and physics |
 
 mod constraint;
+mod error;
 mod group;
 mod island;
 mod lcp;
@@ -23,9 +25,10 @@ mod normal;
 mod tests;
 
 pub use constraint::{Constraint, RowKind, SpringLink};
+pub use error::IslandError;
 pub use group::islands;
 pub(crate) use island::TOUCHING;
-pub use island::{Island, IslandError, IslandMark, IslandRow, IslandWork, RowReport};
+pub use island::{Island, IslandMark, IslandRow, IslandWork, RowReport};
 pub(crate) use island::{
     closes, ends_in_touch, meets_near, meets_slowly, opening_rate, pair_gap, pair_speeds, parts,
     step_speed,

@@ -41,7 +41,8 @@ mod rows;
 mod step;
 mod work;
 
-pub use build::{IslandError, IslandRow};
+use super::IslandError;
+pub use build::IslandRow;
 pub(crate) use pairs::TOUCHING;
 pub(crate) use pairs::{
     CONTACT_SLACK, closes, ends_in_touch, meets_near, meets_slowly, opening_rate, pair_gap,

@@ -159,7 +159,7 @@ fn a_two_bead_cart_too_fast_for_a_one_sided_hump_flies_off_it() {
 
 /// A cart of two beads joined by a rod, both on a rough line tilted by
 /// `degrees`, the rough rows with their stick rows.
-fn rough_cart(degrees: f64, friction: crate::geometry::Friction) -> Island {
+pub(super) fn rough_cart(degrees: f64, friction: crate::geometry::Friction) -> Island {
     let line = WireShape::Line(Line);
     let pose = Pose::new(DVec2::ZERO, degrees.to_radians());
     let stick = |bead| IslandRow {
@@ -188,36 +188,6 @@ fn rough_cart(degrees: f64, friction: crate::geometry::Friction) -> Island {
         .set_rough(1, friction, 0.0, Some(4))
         .expect("row 1 is a wire's, row 4 an axis of its bead");
     island
-}
-
-#[test]
-fn friction_on_a_row_that_is_no_wire_or_held_by_another_beads_row_is_refused_in_words() {
-    let friction = crate::geometry::Friction {
-        static_coefficient: 0.5,
-        kinetic_coefficient: 0.4,
-    };
-    let mut island = rough_cart(0.0, friction);
-    assert_eq!(
-        island
-            .set_rough(2, friction, 0.0, None)
-            .unwrap_err()
-            .to_string(),
-        "the rough row 2 is not a wire's row (the island has 5 rows)"
-    );
-    assert_eq!(
-        island
-            .set_rough(9, friction, 0.0, None)
-            .unwrap_err()
-            .to_string(),
-        "the rough row 9 is not a wire's row (the island has 5 rows)"
-    );
-    assert_eq!(
-        island
-            .set_rough(0, friction, 0.0, Some(4))
-            .unwrap_err()
-            .to_string(),
-        "the row holding it still 4 is not an axis row of the rough row's bead (the island has 5 rows)"
-    );
 }
 
 /// Friction in an island: a two-bead cart sent at 3 m/s along a rough

@@ -234,3 +234,36 @@ fn a_rod_of_two_coincident_beads_is_a_singular_point_not_a_nan() {
         assert_eq!(states, before, "{method}: the state changed");
     }
 }
+
+#[test]
+fn friction_on_a_row_that_is_no_wire_or_held_by_another_beads_row_is_refused_in_words() {
+    let friction = crate::geometry::Friction {
+        static_coefficient: 0.5,
+        kinetic_coefficient: 0.4,
+    };
+    // Rows: the two beads' wires (0, 1), their rod (2), their stick axes
+    // (3, 4).
+    let mut island = super::contact::rough_cart(0.0, friction);
+    assert_eq!(
+        island
+            .set_rough(2, friction, 0.0, None)
+            .unwrap_err()
+            .to_string(),
+        "the rough row 2 is not a wire's row (the island has 5 rows)"
+    );
+    assert_eq!(
+        island
+            .set_rough(9, friction, 0.0, None)
+            .unwrap_err()
+            .to_string(),
+        "the rough row 9 is not a wire's row (the island has 5 rows)"
+    );
+    assert_eq!(
+        island
+            .set_rough(0, friction, 0.0, Some(4))
+            .unwrap_err()
+            .to_string(),
+        "the row holding it still 4 is not an axis row of the rough row's bead (the island has 5 rows)"
+    );
+    assert!(island.set_rough(0, friction, 0.0, Some(3)).is_ok());
+}
