@@ -4,7 +4,7 @@
 
 use bevy::math::DVec2;
 
-use super::euler::{explicit_euler, semi_implicit_euler};
+use super::euler::Euler;
 use super::method::Method;
 use super::projection::project_on;
 use super::rattle::rattle_on;
@@ -66,15 +66,12 @@ pub fn step_on<V: Coordinates, T: Track<V> + ?Sized>(
     let h = settings.dt;
     let t1 = t + h;
     let gains = settings.gains();
-    let advance = match settings.method {
-        Method::Rattle => rattle_on(track, t, state, force, mass, h)?,
-        Method::ExplicitEuler(_) => {
-            explicit_euler(state, &solve_on(track, t, state, force, mass, gains)?, h)
+    let advance = match (settings.method, Euler::of(settings.method)) {
+        (Method::Rattle, _) => rattle_on(track, t, state, force, mass, h)?,
+        (_, Some(euler)) => {
+            euler.advance(state, &solve_on(track, t, state, force, mass, gains)?, h)
         }
-        Method::SemiImplicitEuler(_) => {
-            semi_implicit_euler(state, &solve_on(track, t, state, force, mass, gains)?, h)
-        }
-        Method::Rk4(_) => {
+        _ => {
             let first = solve_on(track, t, state, force, mass, gains)?;
             rk4_on(track, t, state, force, mass, gains, &first, h)?
         }

@@ -5,7 +5,7 @@
 use super::locate::locate;
 use super::{Contact, ContactEvent, MAX_EVENTS, SurfaceStep, Walk, bounces};
 use crate::geometry::{Coordinates, Track};
-use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
+use crate::solver::euler::Euler;
 use crate::solver::method::Method;
 use crate::solver::projection::project_on;
 use crate::solver::rk4::{Stages, rk4_lanes};
@@ -126,14 +126,13 @@ pub fn free_step<V: Coordinates>(
     let (x, v) = (state.position, state.velocity);
     let accel = |p: V| force.at(p) / mass;
     let a = accel(state.position);
-    let (x1, v1) = match method {
-        Method::ExplicitEuler(_) => explicit_euler_lanes(x, v, a, h),
-        Method::SemiImplicitEuler(_) => semi_implicit_euler_lanes(x, v, a, h),
-        Method::Rk4(_) => {
+    let (x1, v1) = match (method, Euler::of(method)) {
+        (_, Some(euler)) => euler.lanes(x, v, a, h),
+        (Method::Rk4(_), _) => {
             let Ok(end) = rk4_lanes(x, v, a, h, &mut Free { force, mass });
             end
         }
-        Method::Rattle => {
+        _ => {
             let half = state.velocity + accel(state.position) * (0.5 * h);
             let position = state.position + half * h;
             let velocity = half + accel(position) * (0.5 * h);

@@ -12,7 +12,7 @@
 #[cfg(target_arch = "x86_64")]
 use self::circle::{Advanced, OnRounds, RoundStages, solve_on_rounds};
 #[cfg(target_arch = "x86_64")]
-use super::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
+use super::euler::Euler;
 #[cfg(target_arch = "x86_64")]
 use super::method::Method;
 #[cfg(target_arch = "x86_64")]
@@ -248,9 +248,10 @@ fn step_lanes<S: LaneSpace>(
         let (first, normal, mut regular) =
             solve_on_rounds::<F64x8, S>(x, v, centre, radius, &force, m, settings);
         let a = first.acceleration;
-        let (x1, v1) = match settings.method {
-            Method::ExplicitEuler(_) => explicit_euler_lanes(x, v, a, h),
-            Method::Rk4(_) => {
+        let (x1, v1) = match Euler::of(settings.method) {
+            Some(euler) => euler.lanes(x, v, a, h),
+            // RK4 (RATTLE took the other branch).
+            None => {
                 let mut stages = RoundStages::<F64x8, S> {
                     centre,
                     radius,
@@ -263,8 +264,6 @@ fn step_lanes<S: LaneSpace>(
                 regular = stages.regular;
                 stepped
             }
-            // RATTLE took the other branch.
-            Method::SemiImplicitEuler(_) | Method::Rattle => semi_implicit_euler_lanes(x, v, a, h),
         };
         Advanced {
             x: x1,

@@ -11,7 +11,7 @@ use super::{
     CALM_STEPS, CONTACT_PASSES, Island, IslandWork, MAX_HALVINGS, OFF_THE_WIRE, RoughRow,
     RowReport, TOUCHING,
 };
-use crate::solver::euler::{explicit_euler_lanes, semi_implicit_euler_lanes};
+use crate::solver::euler::Euler;
 use crate::solver::method::Method;
 use crate::solver::settings::StepSettings;
 use crate::solver::solve::SolveError;
@@ -434,22 +434,17 @@ impl<V: WireSpace> Island<V> {
         let h = settings.dt;
         let gains = settings.gains();
         work.time = time;
-        match settings.method {
-            Method::Rattle => self.rattle(forces, h, work)?,
-            Method::ExplicitEuler(_) | Method::SemiImplicitEuler(_) => {
+        match (settings.method, Euler::of(settings.method)) {
+            (Method::Rattle, _) => self.rattle(forces, h, work)?,
+            (_, Some(euler)) => {
                 self.accelerate(forces, gains, work, Stage::Start)?;
-                let euler = if matches!(settings.method, Method::SemiImplicitEuler(_)) {
-                    semi_implicit_euler_lanes
-                } else {
-                    explicit_euler_lanes
-                };
                 for i in 0..n {
                     let (x, v, a) = (work.x0[i], work.v0[i], work.acceleration[i]);
-                    (work.x[i], work.v[i]) = euler(x, v, a, h);
+                    (work.x[i], work.v[i]) = euler.lanes(x, v, a, h);
                 }
                 self.keep_lambda(work);
             }
-            Method::Rk4(_) => self.rk4(forces, gains, h, work)?,
+            _ => self.rk4(forces, gains, h, work)?,
         }
         if work.x.iter().chain(&work.v).any(|p| !p.is_finite()) {
             return Err(SolveError::NonFinite);
