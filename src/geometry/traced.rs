@@ -141,7 +141,7 @@ impl<V: Coordinates, P: Parametric<V>> Traced<P, V> {
         self.samples.iter().map(|(_, p)| *p)
     }
 
-    /// The sample nearest `x` among those within 0.75 (a unit's 18 samples) of the
+    /// The sample nearest `x` among those within [`HINT_WINDOW`] of the
     /// parameter `hint` (on a curve that crosses itself, the branch the
     /// bead is on); none if the hint is not finite or the window's nearest
     /// sample is at its edge (the bead went farther: the whole curve is

@@ -71,6 +71,7 @@ pub fn step_on<V: Coordinates, T: Track<V> + ?Sized>(
         (_, Some(euler)) => {
             euler.advance(state, &solve_on(track, t, state, force, mass, gains)?, h)
         }
+        // RK4.
         _ => {
             let first = solve_on(track, t, state, force, mass, gains)?;
             rk4_on(track, t, state, force, mass, gains, &first, h)?

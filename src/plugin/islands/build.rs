@@ -502,13 +502,17 @@ pub(super) fn prepare_islands<V: LoneStep>(
             for &row in &catching {
                 island.set_catching(row);
             }
-            for (row, _, surface, partner) in sides {
+            for (row, local, surface, partner) in sides {
                 island.set_side(row, surface.side, surface.restitution);
                 if surface.resists() {
                     let stick = sticks.iter().find(|s| s.0 == row).map(|s| s.1);
                     if let Err(e) = island.set_rough(row, surface.friction, surface.damping, stick)
                     {
-                        warn!("a rough wire's row of an island: {e}; that wire is left smooth");
+                        warn!(
+                            "wirebead: the rough wire under bead {}: {e}; it is left smooth \
+                             for that bead",
+                            entities[local]
+                        );
                     }
                     if let Some(partner) = partner {
                         island.pair_rows(row, partner);

@@ -132,6 +132,7 @@ pub fn free_step<V: Coordinates>(
             let Ok(end) = rk4_lanes(x, v, a, h, &mut Free { force, mass });
             end
         }
+        // RATTLE's velocity Verlet.
         _ => {
             let half = state.velocity + accel(state.position) * (0.5 * h);
             let position = state.position + half * h;

@@ -1,8 +1,9 @@
 //! Why an island cannot be built or answer what it is asked
 //! ([`IslandError`]).
 
-/// Why an island cannot be built: a constraint or spring that names a bead
-/// it cannot join.
+/// Why an island cannot be built (a constraint or spring that names a bead
+/// it cannot join, a bad mass or value) or cannot answer what it is asked
+/// (a slice or row that does not fit it).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum IslandError {
     /// A bead's mass is not positive and finite.
@@ -53,9 +54,9 @@ pub enum IslandError {
         /// What it was.
         value: f64,
     },
-    /// A slice given for the island's beads holds one entry per bead of
-    /// another island.
-    #[error("{what} holds {given} entries, but the island has {beads} beads")]
+    /// A slice meant to hold one entry per bead of the island holds
+    /// another number.
+    #[error("{what}: {given} given, but the island has {beads} beads")]
     Length {
         /// The slice, in words.
         what: &'static str,

@@ -373,7 +373,7 @@ impl<V: WireSpace> Island<V> {
                 || self.entry_bead[self.row_start[s]] != self.entry_bead[self.row_start[row]]
         }) {
             return Err(IslandError::Row {
-                what: "the row holding it still",
+                what: "the stick row",
                 row: s,
                 expected: "an axis row of the rough row's bead",
                 rows,

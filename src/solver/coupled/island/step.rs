@@ -444,6 +444,7 @@ impl<V: WireSpace> Island<V> {
                 }
                 self.keep_lambda(work);
             }
+            // RK4.
             _ => self.rk4(forces, gains, h, work)?,
         }
         if work.x.iter().chain(&work.v).any(|p| !p.is_finite()) {

@@ -207,7 +207,7 @@ fn a_spring_or_an_island_given_too_few_beads_says_so_and_a_right_slice_is_answer
     let (island, states, _) = double_pendulum();
     assert_eq!(
         island.energy(&states[..1], G).unwrap_err().to_string(),
-        "the beads' states holds 1 entries, but the island has 3 beads"
+        "the beads' states: 1 given, but the island has 3 beads"
     );
     let energy = island.energy(&states, G).expect("a state per bead");
     assert!(energy.is_finite());
@@ -263,7 +263,7 @@ fn friction_on_a_row_that_is_no_wire_or_held_by_another_beads_row_is_refused_in_
             .set_rough(0, friction, 0.0, Some(4))
             .unwrap_err()
             .to_string(),
-        "the row holding it still 4 is not an axis row of the rough row's bead (the island has 5 rows)"
+        "the stick row 4 is not an axis row of the rough row's bead (the island has 5 rows)"
     );
     assert!(island.set_rough(0, friction, 0.0, Some(3)).is_ok());
 }
