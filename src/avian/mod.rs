@@ -4,11 +4,15 @@
 //! avian's `PhysicsPlugins` and the [`WireBeadPlugin`](crate::WireBeadPlugin).
 //!
 //! The joint is solved in avian's substep loop, after its contacts and
-//! its own joints, by the position corrections of extended position-based
-//! dynamics, so that it composes with everything avian simulates (docs/method.md,
-//! "Rigid bodies on wires"). The wire's curve and pose stay `f64`; the
-//! body's state converts at the edge, in whatever precision the game
-//! built avian with.
+//! its own joints, as RATTLE holds a bead: the body's position is put
+//! back on the wire along the joint's gradients where the substep began,
+//! to rounding, and its velocity onto the wire where it ends, so that it
+//! composes with everything avian simulates and swings with the period of
+//! the exact motion (docs/method.md, "Rigid bodies on wires"). A motor
+//! drives it along the wire with a bounded force, friction holds it while
+//! no motor does, and the ends of an open wire stop it. The wire's curve
+//! and pose stay `f64`; the body's state converts at the edge, in
+//! whatever precision the game built avian with.
 //!
 //! ```
 //! use avian2d::prelude::*;
@@ -40,7 +44,7 @@
 //!     .update();
 //! ```
 
-use avian2d::dynamics::solver::schedule::{SolverSystems, SubstepSchedule};
+use avian2d::dynamics::solver::schedule::{SolverSystems, SubstepSchedule, SubstepSolverSystems};
 use avian2d::dynamics::solver::solver_body::{SolverBody, SolverBodyInertia};
 use avian2d::dynamics::solver::xpbd::XpbdSolverSystems;
 use avian2d::math::AdjustPrecision;
@@ -49,8 +53,11 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::dynamics::{Wire, WirePose};
-use crate::geometry::{Near, Placed};
-use crate::solver::path::{BodyRow, PlaneBody, correct, on_curve, turn_offset, turned_with_curve};
+use crate::geometry::{ImplicitCurve, Near, Placed, PosePath, WireShape};
+use crate::solver::path::{
+    BodyRow, Drive, PlaneBody, PlaneVelocity, Rows, along_curve, on_curve, past_end, project,
+    project_driven, project_velocity, turn_offset, turned_with_curve,
+};
 use crate::{SimClock, SimParams};
 
 /// How a body held on a wire by a [`PathJoint`] may turn.
@@ -64,13 +71,47 @@ pub enum PathRotation {
     Turned,
 }
 
+/// What drives a body along its wire.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+pub enum PathMotor {
+    /// The anchor's speed along the wire, relative to the wire, brought
+    /// to `speed` (m/s, along the wire's own direction: a line's +x, a
+    /// circle or an ellipse counter-clockwise, a graph's growing x, a
+    /// spline's or a cycloid's parameter) by a force of at most
+    /// `max_force` (N) along it.
+    Velocity {
+        /// The speed the motor holds, m/s.
+        speed: f64,
+        /// The largest force it gives, N.
+        max_force: f64,
+    },
+    /// The anchor drawn along the wire towards `target` (a point of the
+    /// wire, in the wire's frame) as by a spring of `frequency` (Hz) and
+    /// `damping_ratio` (1: critical), by a force of at most `max_force`
+    /// (N). The spring pulls along the wire's tangent at the anchor by the
+    /// target's distance along it, so it draws the anchor to a target
+    /// nearer than a quarter of the wire's turn (a quarter circle on a
+    /// hoop); a farther one is reached by moving it as the anchor goes.
+    Position {
+        /// The point of the wire the anchor is drawn to, wire's frame.
+        target: DVec2,
+        /// The spring's frequency, Hz.
+        frequency: f64,
+        /// Its damping ratio (1: critically damped).
+        damping_ratio: f64,
+        /// The largest force it gives, N.
+        max_force: f64,
+    },
+}
+
 /// Holds a point of the rigid body it is on (the anchor, in the body's
 /// frame from its origin, as avian's joints take theirs) on the wire
 /// `wire`, free to slide along it. The body needs avian's `RigidBody`
 /// (a dynamic one: a kinematic or static body is not moved by its joint);
 /// the wire is an entity with a [`Wire`] (fixed, or moving as any wire of
 /// ours moves). A joint naming an entity that is no wire holds nothing,
-/// and says so once in the log.
+/// and says so once in the log. The ends of an open wire (a spline, a
+/// cycloid) stop the anchor there, as a buffer stops a cart.
 #[derive(Component, Clone, Debug, PartialEq, Reflect)]
 #[require(PathJointState)]
 pub struct PathJoint {
@@ -80,18 +121,27 @@ pub struct PathJoint {
     pub anchor: DVec2,
     /// How the body may turn.
     pub rotation: PathRotation,
+    /// What drives the body along the wire, if anything.
+    pub motor: Option<PathMotor>,
+    /// The largest force (N) that holds the body against sliding along
+    /// the wire while no motor drives it (0: it slides freely).
+    pub friction: f64,
     /// How far the anchor yields per newton, m/N (0: rigid), as avian's
-    /// joint compliance.
+    /// joint compliance. A compliant joint is met in position only, as
+    /// avian's joints are, and its velocity is not projected.
     pub compliance: f64,
 }
 
 impl PathJoint {
-    /// The body's origin held on `wire`, free to turn, rigidly.
+    /// The body's origin held on `wire`, free to turn and to slide,
+    /// rigidly.
     pub fn new(wire: Entity) -> Self {
         Self {
             wire,
             anchor: DVec2::ZERO,
             rotation: PathRotation::Free,
+            motor: None,
+            friction: 0.0,
             compliance: 0.0,
         }
     }
@@ -105,16 +155,31 @@ impl PathJoint {
     pub fn with_rotation(self, rotation: PathRotation) -> Self {
         Self { rotation, ..self }
     }
+
+    /// The joint driven by `motor`.
+    pub fn with_motor(self, motor: PathMotor) -> Self {
+        Self {
+            motor: Some(motor),
+            ..self
+        }
+    }
+
+    /// The joint holding the body against sliding with a force of at most
+    /// `friction` (N) while no motor drives it.
+    pub fn with_friction(self, friction: f64) -> Self {
+        Self { friction, ..self }
+    }
 }
 
-/// What a path joint holds from one substep to the next: the body where
-/// the step began and the offset of a body turned with the wire.
+/// What a path joint holds from one substep to the next.
 #[derive(Component, Clone, Debug)]
 struct PathJointState {
     /// The time the step began at, and how far into it the substeps are.
     time: (f64, f64),
     /// The centre of mass and the angle where the step began.
     start: (DVec2, f64),
+    /// The centre of mass and the angle where the substep began.
+    previous: (DVec2, f64),
     /// The anchor from the centre of mass, in the body's frame.
     arm: DVec2,
     /// The body's angle less the wire's at the anchor, once set.
@@ -131,6 +196,7 @@ impl Default for PathJointState {
         Self {
             time: (0.0, 0.0),
             start: (DVec2::ZERO, 0.0),
+            previous: (DVec2::ZERO, 0.0),
             arm: DVec2::ZERO,
             offset: None,
             // Anywhere on the curve, until the anchor has been on it.
@@ -154,7 +220,14 @@ impl Plugin for PathJointPlugin {
             )
             .add_systems(
                 SubstepSchedule,
-                solve_path_joints.in_set(XpbdSolverSystems::SolveUserConstraints),
+                (
+                    solve_path_joints.in_set(XpbdSolverSystems::SolveUserConstraints),
+                    // After avian turns the substep's corrections into
+                    // velocity, before it damps it.
+                    project_path_joint_velocities
+                        .after(XpbdSolverSystems::VelocityProjection)
+                        .before(SubstepSolverSystems::Damping),
+                ),
             );
     }
 }
@@ -182,6 +255,7 @@ fn prepare_path_joints(
             origin + DVec2::from_angle(angle).rotate(local_centre),
             angle,
         );
+        state.previous = state.start;
         state.arm = joint.anchor - local_centre;
         state.time = (clock.time - params.timestep, 0.0);
         let placed = wires
@@ -198,7 +272,65 @@ fn prepare_path_joints(
     }
 }
 
-/// One XPBD correction of each joint's rows in the substep.
+/// The body as the joint sees it: its centre and angle where the substep
+/// has it (`start` moved by the substep's `delta`).
+fn plane_body(state: &PathJointState, body: &SolverBody, inertia: &SolverBodyInertia) -> PlaneBody {
+    let (start, start_angle) = state.start;
+    PlaneBody {
+        centre: start + DVec2::from(body.delta_position),
+        angle: start_angle + f64::from(body.delta_rotation.as_radians()),
+        arm: state.arm,
+        inverse_mass: DVec2::from(inertia.effective_inv_mass()),
+        inverse_inertia: f64::from(inertia.effective_inv_angular_inertia()),
+    }
+}
+
+/// The rows a joint holds: the anchor on the wire and, turned with it,
+/// the body's angle; `None` at a singular point.
+fn held_rows(
+    joint: &PathJoint,
+    offset: Option<f64>,
+    curve: &impl ImplicitCurve,
+    body: &PlaneBody,
+) -> Option<Rows> {
+    let mut rows = Rows::default();
+    rows.push(on_curve(curve, body)?);
+    if let (PathRotation::Turned, Some(offset)) = (joint.rotation, offset) {
+        rows.push(turned_with_curve(curve, body, offset)?);
+    }
+    Some(rows)
+}
+
+/// The joint's rows with, where `end` is given, the end the anchor is
+/// past.
+fn rows_with_end(
+    joint: &PathJoint,
+    offset: Option<f64>,
+    curve: &impl ImplicitCurve,
+    body: &PlaneBody,
+    end: bool,
+) -> Option<Rows> {
+    let mut rows = held_rows(joint, offset, curve, body)?;
+    if end {
+        rows.push(past_end(curve, body)?);
+    }
+    Some(rows)
+}
+
+/// The wire of a joint: its shape and where it is over time.
+fn wire_of<'a>(
+    wires: &'a Query<(&Wire, &WirePose<DVec2>)>,
+    joint: &PathJoint,
+) -> Option<(&'a WireShape, PosePath)> {
+    wires
+        .get(joint.wire)
+        .ok()
+        .and_then(|(wire, pose)| Some((wire.shape(), pose.path()?)))
+}
+
+/// SHAKE's step for each joint in the substep: the body, moved freely by
+/// avian's substep, put back on its rows along their gradients where the
+/// substep began, to rounding.
 fn solve_path_joints(
     mut joints: Query<(
         &PathJoint,
@@ -220,58 +352,193 @@ fn solve_path_joints(
         if body.flags.is_kinematic() {
             continue;
         }
-        let Some((shape, path)) = wires
-            .get(joint.wire)
-            .ok()
-            .and_then(|(wire, pose)| Some((wire.shape(), pose.path()?)))
-        else {
+        let Some((shape, path)) = wire_of(&wires, joint) else {
             continue;
         };
-        let pose = path.pose(state.time.0 + state.time.1);
+        let now = state.time.0 + state.time.1;
         let near = Near {
             curve: shape.curve(),
             hint: state.hint,
         };
-        let curve = Placed { curve: &near, pose };
-        let (start, start_angle) = state.start;
-        let centre = start + DVec2::from(body.delta_position);
-        let angle = start_angle + f64::from(body.delta_rotation.as_radians());
-        let mut plane = PlaneBody {
-            centre,
-            anchor: centre + DVec2::from_angle(angle).rotate(state.arm),
-            inverse_mass: DVec2::from(inertia.effective_inv_mass()),
-            inverse_inertia: f64::from(inertia.effective_inv_angular_inertia()),
+        let before = Placed {
+            curve: &near,
+            pose: path.pose(now - h),
         };
-        if !(plane.anchor.is_finite() && angle.is_finite()) {
+        let after = Placed {
+            curve: &near,
+            pose: path.pose(now),
+        };
+        let predicted = plane_body(&state, &body, inertia);
+        let previous = PlaneBody {
+            centre: state.previous.0,
+            angle: state.previous.1,
+            ..predicted
+        };
+        if !(predicted.anchor().is_finite() && predicted.angle.is_finite()) {
             continue;
         }
-        let arm = state.arm;
-        let mut moved = (DVec2::ZERO, 0.0);
-        let apply = |row: Option<BodyRow>, plane: &mut PlaneBody, moved: &mut (DVec2, f64)| {
-            let Some(row) = row else { return };
-            let step = correct(&row, plane, 0.0, joint.compliance, h);
-            moved.0 += step.centre;
-            moved.1 += step.angle;
-            plane.centre += step.centre;
-            plane.anchor = plane.centre + DVec2::from_angle(angle + moved.1).rotate(arm);
-        };
-        apply(on_curve(&curve, &plane), &mut plane, &mut moved);
-        if joint.rotation == PathRotation::Turned {
-            if state.offset.is_none() {
-                state.offset = turn_offset(&curve, &plane, angle + moved.1);
-            }
-            if let Some(offset) = state.offset {
-                apply(
-                    turned_with_curve(&curve, &plane, angle + moved.1, offset),
-                    &mut plane,
-                    &mut moved,
-                );
-            }
+        if joint.rotation == PathRotation::Turned && state.offset.is_none() {
+            state.offset = turn_offset(&before, &previous);
         }
+        let end = past_end(&after, &predicted).is_some_and(|row| row.value > 0.0);
+        let offset = state.offset;
+        let Some(start) = rows_with_end(joint, offset, &before, &previous, end) else {
+            continue;
+        };
+        let tolerance = 1e-12 * shape.curve().scale().max(1.0);
+        let compliance = joint.compliance / (h * h);
+        let rows_at = |b: &PlaneBody| rows_with_end(joint, offset, &after, b, end);
+        // At an end the buffer holds the anchor, whatever drives it.
+        let drive = if end {
+            None
+        } else {
+            let v = PlaneVelocity {
+                linear: DVec2::from(body.linear_velocity),
+                spin: f64::from(body.angular_velocity),
+            };
+            let (_, twist) = path.at(now - h);
+            let frame = PlaneVelocity {
+                linear: twist.velocity_at(previous.centre),
+                spin: twist.angular_velocity,
+            };
+            drive_of(joint, &before, shape, &previous, v, frame, h)
+        };
+        let projected = match drive {
+            Some(drive) => project_driven(
+                &start, &previous, &drive, predicted, compliance, tolerance, rows_at,
+            )
+            .map(|(projected, _)| projected),
+            None => project(&start, predicted, compliance, tolerance, rows_at),
+        };
+        let Some(projected) = projected else {
+            continue;
+        };
+        let moved = projected.body;
         state.hint = shape
             .curve()
-            .parameter(pose.to_local(plane.anchor), state.hint);
-        body.delta_position += moved.0.adjust_precision();
-        body.delta_rotation = Rotation::radians((angle + moved.1 - start_angle).adjust_precision());
+            .parameter(after.pose.to_local(moved.anchor()), state.hint);
+        body.delta_position += (moved.centre - predicted.centre).adjust_precision();
+        body.delta_rotation = Rotation::radians((moved.angle - state.start.1).adjust_precision());
     }
+}
+
+/// RATTLE's velocity step for each joint, after avian has turned the
+/// substep's corrections into velocity: the motor or friction along the
+/// wire, then the velocity onto the rows where the substep ends, the end
+/// of an open wire stopping an anchor that would pass it.
+fn project_path_joint_velocities(
+    mut joints: Query<(
+        &PathJoint,
+        &mut PathJointState,
+        &mut SolverBody,
+        &SolverBodyInertia,
+    )>,
+    wires: Query<(&Wire, &WirePose<DVec2>)>,
+    time: Res<Time>,
+) {
+    let h = time.delta_secs_f64();
+    if h.is_nan() || h <= 0.0 {
+        return;
+    }
+    for (joint, mut state, mut body, inertia) in &mut joints {
+        let plane = plane_body(&state, &body, inertia);
+        state.previous = (plane.centre, plane.angle);
+        if body.flags.is_kinematic() {
+            continue;
+        }
+        let Some((shape, path)) = wire_of(&wires, joint) else {
+            continue;
+        };
+        let near = Near {
+            curve: shape.curve(),
+            hint: state.hint,
+        };
+        let (pose, twist) = path.at(state.time.0 + state.time.1);
+        let curve = Placed { curve: &near, pose };
+        let v = PlaneVelocity {
+            linear: DVec2::from(body.linear_velocity),
+            spin: f64::from(body.angular_velocity),
+        };
+        let frame = PlaneVelocity {
+            linear: twist.velocity_at(plane.centre),
+            spin: twist.angular_velocity,
+        };
+        let Some(v) = joint_velocity(joint, state.offset, &curve, &plane, v, frame) else {
+            continue;
+        };
+        if v.linear.is_finite() && v.spin.is_finite() {
+            body.linear_velocity = v.linear.adjust_precision();
+            body.angular_velocity = v.spin.adjust_precision();
+        }
+    }
+}
+
+/// The drive of a joint in the substep that begins with the body at
+/// `previous` moving at `v` (the wire's frame at `frame`): its motor, or
+/// its friction while no motor drives it, as a displacement along the
+/// wire and a bound; `None` for a joint that neither drives nor holds.
+fn drive_of<C: ImplicitCurve>(
+    joint: &PathJoint,
+    curve: &Placed<'_, C>,
+    shape: &WireShape,
+    previous: &PlaneBody,
+    v: PlaneVelocity,
+    frame: PlaneVelocity,
+    h: f64,
+) -> Option<Drive> {
+    let along = along_curve(curve, previous, shape.travel())?;
+    let relative = along.rate(v) - along.rate(frame);
+    let (speed, max_force) = match joint.motor {
+        Some(PathMotor::Velocity { speed, max_force }) => (speed, max_force),
+        Some(PathMotor::Position {
+            target,
+            frequency,
+            damping_ratio,
+            max_force,
+        }) => {
+            // The spring–damper's implicit step, as avian's motors take it.
+            let error = along
+                .along_centre
+                .dot(curve.pose.to_world(target) - previous.anchor());
+            let omega = std::f64::consts::TAU * frequency;
+            let damping = 2.0 * damping_ratio * omega;
+            let change = (omega * omega * error - damping * relative) * h
+                / (1.0 + damping * h + omega * omega * h * h);
+            (relative + change, max_force)
+        }
+        None if joint.friction > 0.0 => (0.0, joint.friction),
+        None => return None,
+    };
+    let (speed, max_force) = (speed + along.rate(frame), max_force.max(0.0));
+    (speed.is_finite() && !max_force.is_nan()).then(|| Drive {
+        direction: along.along_centre,
+        from: previous.anchor(),
+        shift: speed * h,
+        bound: max_force * h * h,
+    })
+}
+
+/// The velocity a joint leaves its body with: on its rows where the
+/// substep ends, stopped at an end of an open wire it would pass.
+fn joint_velocity(
+    joint: &PathJoint,
+    offset: Option<f64>,
+    curve: &impl ImplicitCurve,
+    body: &PlaneBody,
+    v: PlaneVelocity,
+    frame: PlaneVelocity,
+) -> Option<PlaneVelocity> {
+    // A compliant joint is met in position only.
+    let mut rows = if joint.compliance > 0.0 {
+        Rows::default()
+    } else {
+        held_rows(joint, offset, curve, body)?
+    };
+    if let Some(end) = past_end(curve, body)
+        && end.value > -1e-9 * curve.scale()
+        && end.rate(v) > end.rate(frame)
+    {
+        rows.push(BodyRow { value: 0.0, ..end });
+    }
+    Some(project_velocity(&rows, body, v, frame)?.0)
 }

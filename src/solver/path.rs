@@ -1,25 +1,33 @@
 //! A rigid body held on a wire by a point of its own (a path joint), in
-//! the plane: the position corrections of extended position-based
-//! dynamics (XPBD) that a physics engine's substep applies, as pure
-//! functions of the body's state (docs/method.md, "Rigid bodies on
-//! wires"). The body's centre of mass `c` and angle `θ` are its
-//! coordinates; its anchor `a = c + R(θ) r` (`r` the anchor's offset from
-//! the centre of mass in the body's frame) is held on the curve, and where
-//! the body turns with the wire, `θ` is held at the wire's direction at
-//! the anchor plus the offset it had when the joint began.
+//! the plane, as pure functions of the body's state (docs/method.md,
+//! "Rigid bodies on wires"). The body's centre of mass `c` and angle `θ`
+//! are its coordinates `q`; its anchor `a = c + R(θ) r` (`r` the anchor's
+//! arm from the centre of mass in the body's frame) is held on the curve,
+//! and where the body turns with the wire, `θ` is held at the wire's
+//! direction at the anchor plus the offset it had when the joint began.
+//!
+//! A physics engine's substep moves the body freely; the joint then puts
+//! it back as RATTLE does a bead (Andersen 1983): the positions along the
+//! rows' gradients where the substep began, solved by Newton's method to
+//! rounding ([`project`]), and the velocity onto the rows' tangent space
+//! where it ends ([`project_velocity`]). A motor or friction is one more
+//! row of the position step, along the wire, whose multiplier is bounded
+//! ([`project_driven`]).
 
-use bevy::math::DVec2;
+use bevy::math::{DMat3, DVec2, DVec3};
 
 use crate::geometry::ImplicitCurve;
 
-/// A rigid body in the plane as a correction sees it: where its centre of
-/// mass is, where its anchor is, and how hard each is to move.
+/// A rigid body in the plane as the joint sees it: where it is, where its
+/// anchor is on it, and how hard it is to move.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct PlaneBody {
     /// The centre of mass, world frame.
     pub centre: DVec2,
-    /// The anchor, world frame.
-    pub anchor: DVec2,
+    /// The body's angle, counter-clockwise.
+    pub angle: f64,
+    /// The anchor from the centre of mass, in the body's frame.
+    pub arm: DVec2,
     /// `1 / m` along each axis (0 along an axis the body does not move
     /// along, as an engine's locked axes).
     pub inverse_mass: DVec2,
@@ -27,9 +35,48 @@ pub(crate) struct PlaneBody {
     pub inverse_inertia: f64,
 }
 
+impl PlaneBody {
+    /// The anchor, world frame.
+    pub fn anchor(&self) -> DVec2 {
+        self.centre + DVec2::from_angle(self.angle).rotate(self.arm)
+    }
+
+    /// The body moved by the multipliers `lambda` along `rows`:
+    /// `c + W Σ λᵢ ∂Cᵢ/∂c`, `θ + Σ λᵢ ∂Cᵢ/∂θ / I`.
+    pub fn moved(&self, rows: &Rows, lambda: DVec3) -> PlaneBody {
+        let mut body = *self;
+        for (row, l) in rows.iter().zip(lambda.to_array()) {
+            body.centre += row.along_centre * self.inverse_mass * l;
+            body.angle += row.along_angle * self.inverse_inertia * l;
+        }
+        body
+    }
+}
+
+/// A body's velocity: its centre's, and its spin (counter-clockwise).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct PlaneVelocity {
+    /// `ċ`.
+    pub linear: DVec2,
+    /// `θ̇`.
+    pub spin: f64,
+}
+
+impl PlaneVelocity {
+    /// The velocity changed by the impulses `impulse` along `rows`.
+    fn kicked(self, body: &PlaneBody, rows: &Rows, impulse: DVec3) -> PlaneVelocity {
+        let mut v = self;
+        for (row, i) in rows.iter().zip(impulse.to_array()) {
+            v.linear += row.along_centre * body.inverse_mass * i;
+            v.spin += row.along_angle * body.inverse_inertia * i;
+        }
+        v
+    }
+}
+
 /// One row of a body's constraint: its value and its gradient with
 /// respect to the centre of mass and the angle.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct BodyRow {
     /// `C`.
     pub value: f64,
@@ -39,17 +86,96 @@ pub(crate) struct BodyRow {
     pub along_angle: f64,
 }
 
-/// What one XPBD correction does: the change of the row's multiplier
-/// (an impulse times the substep, `λ = J h`), of the centre of mass and of
-/// the angle.
+impl BodyRow {
+    /// `Ċ = J q̇` at the velocity `v`.
+    pub fn rate(&self, v: PlaneVelocity) -> f64 {
+        self.along_centre.dot(v.linear) + self.along_angle * v.spin
+    }
+
+    /// `Jᵢ M⁻¹ Jⱼᵀ`: how far this row moves as `other`'s multiplier does.
+    fn coupling(&self, other: &BodyRow, body: &PlaneBody) -> f64 {
+        (self.along_centre * body.inverse_mass).dot(other.along_centre)
+            + self.along_angle * other.along_angle * body.inverse_inertia
+    }
+}
+
+/// The rows of one joint: at most three, a body in the plane having three
+/// coordinates.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct Correction {
-    /// `Δλ`.
-    pub lambda: f64,
-    /// `Δc`.
-    pub centre: DVec2,
-    /// `Δθ`.
-    pub angle: f64,
+pub(crate) struct Rows {
+    rows: [BodyRow; 3],
+    len: usize,
+}
+
+impl Rows {
+    /// Adds `row`; a fourth row is dropped (three fix the body).
+    pub fn push(&mut self, row: BodyRow) {
+        if self.len < 3 {
+            self.rows[self.len] = row;
+            self.len += 1;
+        }
+    }
+
+    /// How many rows there are.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// The rows.
+    pub fn iter(&self) -> impl Iterator<Item = &BodyRow> {
+        self.rows[..self.len].iter()
+    }
+
+    /// The rows' values, zero past the last.
+    fn values(&self) -> DVec3 {
+        DVec3::from_array(std::array::from_fn(|i| {
+            if i < self.len {
+                self.rows[i].value
+            } else {
+                0.0
+            }
+        }))
+    }
+
+    /// `J q̇` at `v`, zero past the last row.
+    fn rates(&self, v: PlaneVelocity) -> DVec3 {
+        DVec3::from_array(std::array::from_fn(|i| {
+            if i < self.len {
+                self.rows[i].rate(v)
+            } else {
+                0.0
+            }
+        }))
+    }
+
+    /// `A = J M⁻¹ Gᵀ` for the rows `J` (self) and `G` (`along`), with
+    /// `compliance` added to the diagonal and ones where no row is.
+    fn matrix(&self, along: &Rows, body: &PlaneBody, compliance: f64) -> DMat3 {
+        let column = |j: usize| {
+            DVec3::from_array(std::array::from_fn(|i| {
+                match (i < self.len, j < along.len) {
+                    (true, true) => {
+                        self.rows[i].coupling(&along.rows[j], body)
+                            + if i == j { compliance } else { 0.0 }
+                    }
+                    _ if i == j => 1.0,
+                    _ => 0.0,
+                }
+            }))
+        };
+        DMat3::from_cols(column(0), column(1), column(2))
+    }
+}
+
+/// `A x = b`, or `None` where `A` is singular or the answer not finite.
+fn solve(a: DMat3, b: DVec3) -> Option<DVec3> {
+    let det = a.determinant();
+    let size = a.to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if !(det.abs() > 1e-13 * size * size * size && det.is_finite()) {
+        return None;
+    }
+    let x = a.inverse() * b;
+    x.is_finite().then_some(x)
 }
 
 /// `v` turned a quarter counter-clockwise.
@@ -57,23 +183,73 @@ fn perp(v: DVec2) -> DVec2 {
     DVec2::new(-v.y, v.x)
 }
 
-/// The anchor's distance from the curve to first order, `C(a) / |∇C(a)|`,
-/// as a row of the body: its gradient is the curve's unit normal at the
-/// anchor along the centre, and that normal's moment about the centre
-/// along the angle. `None`
-/// where the curve's gradient vanishes (a singular point) or is not
-/// finite.
-pub(crate) fn on_curve(curve: &impl ImplicitCurve, body: &PlaneBody) -> Option<BodyRow> {
-    let geometry = curve.geometry(body.anchor);
+/// The curve's unit normal at `p`, or `None` at a singular point.
+fn unit_normal(curve: &impl ImplicitCurve, p: DVec2) -> Option<(f64, DVec2)> {
+    let geometry = curve.geometry(p);
     let length = geometry.normal.length();
-    if !(length > 0.0 && length.is_finite() && geometry.c.is_finite()) {
+    (length > 0.0 && length.is_finite() && geometry.c.is_finite())
+        .then(|| (geometry.c / length, geometry.normal / length))
+}
+
+/// The anchor's distance from the curve to first order, `C(a) / |∇C(a)|`
+/// (zero exactly on the curve), as a row of the body: its gradient is the
+/// curve's unit normal at the anchor along the centre, and that normal's
+/// moment about the centre along the angle. `None` at a singular point.
+pub(crate) fn on_curve(curve: &impl ImplicitCurve, body: &PlaneBody) -> Option<BodyRow> {
+    let anchor = body.anchor();
+    let (value, normal) = unit_normal(curve, anchor)?;
+    Some(BodyRow {
+        value,
+        along_centre: normal,
+        along_angle: normal.dot(perp(anchor - body.centre)),
+    })
+}
+
+/// The anchor's motion along the curve as a row of the body (its value
+/// zero): the curve's unit tangent `t = travel ∇C⊥ / |∇C|` at the anchor
+/// along the centre, its moment about the centre along the angle. `travel`
+/// (±1) says which way the wire's own direction runs. `None` at a
+/// singular point.
+pub(crate) fn along_curve(
+    curve: &impl ImplicitCurve,
+    body: &PlaneBody,
+    travel: f64,
+) -> Option<BodyRow> {
+    let anchor = body.anchor();
+    let (_, normal) = unit_normal(curve, anchor)?;
+    let tangent = travel * perp(normal);
+    Some(BodyRow {
+        value: 0.0,
+        along_centre: tangent,
+        along_angle: tangent.dot(perp(anchor - body.centre)),
+    })
+}
+
+/// How far past an end of an open curve the anchor is, along the end's
+/// tangent (zero or less: on the curve between its ends), as a row of
+/// the body whose gradient points out past that end. `None` for a curve
+/// with no end, or at a singular point.
+pub(crate) fn past_end(curve: &impl ImplicitCurve, body: &PlaneBody) -> Option<BodyRow> {
+    if !curve.has_ends() {
         return None;
     }
-    let normal = geometry.normal / length;
-    Some(BodyRow {
-        value: geometry.c / length,
-        along_centre: normal,
-        along_angle: normal.dot(perp(body.anchor - body.centre)),
+    let anchor = body.anchor();
+    let value = curve.past_end(anchor);
+    let (_, normal) = unit_normal(curve, anchor)?;
+    // Which way is out: past an end the curve goes on along its tangent,
+    // so `past_end` grows by the step along it, one way or the other.
+    let tangent = perp(normal);
+    let step = 1e-6 * curve.scale();
+    let out = if curve.past_end(anchor + step * tangent) >= curve.past_end(anchor - step * tangent)
+    {
+        tangent
+    } else {
+        -tangent
+    };
+    value.is_finite().then(|| BodyRow {
+        value,
+        along_centre: out,
+        along_angle: out.dot(perp(anchor - body.centre)),
     })
 }
 
@@ -99,25 +275,24 @@ fn tangent_angle(curve: &impl ImplicitCurve, anchor: DVec2) -> Option<(f64, DVec
 pub(crate) fn turned_with_curve(
     curve: &impl ImplicitCurve,
     body: &PlaneBody,
-    angle: f64,
     offset: f64,
 ) -> Option<BodyRow> {
-    let (psi, gradient) = tangent_angle(curve, body.anchor)?;
-    let value = wrap(angle - psi - offset);
+    let anchor = body.anchor();
+    let (psi, gradient) = tangent_angle(curve, anchor)?;
     // ψ depends on the anchor, which moves with the centre and turns about
     // it: ∂a/∂c = I, ∂a/∂θ = (a − c)⊥.
     Some(BodyRow {
-        value,
+        value: wrap(body.angle - psi - offset),
         along_centre: -gradient,
-        along_angle: 1.0 - gradient.dot(perp(body.anchor - body.centre)),
+        along_angle: 1.0 - gradient.dot(perp(anchor - body.centre)),
     })
 }
 
 /// The tangent angle at the anchor that a body turned with the curve keeps
-/// its own angle from: `angle − ψ`, wrapped. `None` at a singular point.
-pub(crate) fn turn_offset(curve: &impl ImplicitCurve, body: &PlaneBody, angle: f64) -> Option<f64> {
-    let (psi, _) = tangent_angle(curve, body.anchor)?;
-    Some(wrap(angle - psi))
+/// its own angle from: `θ − ψ`, wrapped. `None` at a singular point.
+pub(crate) fn turn_offset(curve: &impl ImplicitCurve, body: &PlaneBody) -> Option<f64> {
+    let (psi, _) = tangent_angle(curve, body.anchor())?;
+    Some(wrap(body.angle - psi))
 }
 
 /// `angle` wrapped into `(−π, π]`.
@@ -127,138 +302,150 @@ fn wrap(angle: f64) -> f64 {
     if wrapped > PI { wrapped - TAU } else { wrapped }
 }
 
-/// One XPBD correction of `row` (Macklin et al. 2016, eq. 18): with the
-/// generalized inverse mass `w = ∂C/∂c · W ∂C/∂c + (∂C/∂θ)² / I` (`W` the
-/// inverse mass along each axis) and `α̃ = compliance / h²`,
-/// `Δλ = (−C − α̃ λ) / (w + α̃)`, and the body moves by `Δc = W ∂C/∂c Δλ`,
-/// `Δθ = ∂C/∂θ Δλ / I`. Nothing moves where `w`
-/// and `α̃` vanish (a body that cannot move) or the row is not finite.
-pub(crate) fn correct(
-    row: &BodyRow,
-    body: &PlaneBody,
-    lambda: f64,
+/// What [`project`] found: the body on its rows, the multipliers that put
+/// it there (`λ`, an impulse times the substep) and whether Newton's
+/// method met the tolerance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Projected {
+    /// The body moved onto its rows.
+    pub body: PlaneBody,
+    /// `λ`, one per row.
+    pub lambda: DVec3,
+    /// Whether every row met the tolerance.
+    pub converged: bool,
+}
+
+/// The most Newton steps [`project`] takes.
+const PROJECTION_STEPS: usize = 16;
+
+/// SHAKE's position step for a body the substep moved freely to
+/// `predicted`: the multipliers `λ` such that the body moved along the
+/// rows' gradients where the substep began, `q = q̃ + M⁻¹ Gᵀ λ` (`G` the
+/// rows of `start`), meets its rows `C(q) + α̃ λ = 0` (`rows_at` gives
+/// them, the same rows in the same order; `compliance` is `α̃ = α / h²`),
+/// by Newton's method to `tolerance`. `None` where a row is singular or
+/// the step is not finite.
+pub(crate) fn project(
+    start: &Rows,
+    predicted: PlaneBody,
     compliance: f64,
-    h: f64,
-) -> Correction {
-    let w = (row.along_centre * row.along_centre).dot(body.inverse_mass)
-        + row.along_angle * row.along_angle * body.inverse_inertia;
-    let tilde = compliance / (h * h);
-    let delta = (-row.value - tilde * lambda) / (w + tilde);
-    if w + tilde <= 0.0 || !delta.is_finite() {
-        return Correction::default();
+    tolerance: f64,
+    rows_at: impl Fn(&PlaneBody) -> Option<Rows>,
+) -> Option<Projected> {
+    let mut lambda = DVec3::ZERO;
+    let mut body = predicted;
+    for _ in 0..PROJECTION_STEPS {
+        let rows = rows_at(&body)?;
+        let residual = rows.values() + compliance * lambda;
+        if residual.abs().max_element() <= tolerance {
+            return Some(Projected {
+                body,
+                lambda,
+                converged: true,
+            });
+        }
+        lambda += solve(rows.matrix(start, &body, compliance), -residual)?;
+        body = predicted.moved(start, lambda);
     }
-    Correction {
-        lambda: delta,
-        centre: row.along_centre * body.inverse_mass * delta,
-        angle: row.along_angle * delta * body.inverse_inertia,
+    let converged = rows_at(&body)
+        .is_some_and(|rows| (rows.values() + compliance * lambda).abs().max_element() <= tolerance);
+    Some(Projected {
+        body,
+        lambda,
+        converged,
+    })
+}
+
+/// RATTLE's velocity step: the velocity `v` less the part along the rows'
+/// gradients that moves them against the wire's own motion `frame` (the
+/// velocity the body would have riding rigidly with the wire, along which
+/// every row is unchanged), `v − M⁻¹ Jᵀ (J M⁻¹ Jᵀ)⁻¹ J (v − frame)`; and
+/// the impulses that took it off. `None` where the rows are singular.
+pub(crate) fn project_velocity(
+    rows: &Rows,
+    body: &PlaneBody,
+    v: PlaneVelocity,
+    frame: PlaneVelocity,
+) -> Option<(PlaneVelocity, DVec3)> {
+    if rows.len() == 0 {
+        return Some((v, DVec3::ZERO));
     }
+    let excess = rows.rates(v) - rows.rates(frame);
+    let impulse = solve(rows.matrix(rows, body, 0.0), -excess)?;
+    Some((v.kicked(body, rows, impulse), impulse))
+}
+
+/// A motor (or friction: a motor holding the anchor where it is on the
+/// wire) as one more row of the position step: the anchor's displacement
+/// over the substep along the wire's direction `direction` where it began
+/// (from `from`) brought to `shift`, by a multiplier of at most `bound`
+/// either way (the force limit times the substep squared).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Drive {
+    /// The wire's unit tangent where the substep began, its own way.
+    pub direction: DVec2,
+    /// The anchor where the substep began.
+    pub from: DVec2,
+    /// The displacement along `direction` the drive asks for, m.
+    pub shift: f64,
+    /// The largest multiplier it gives, `F h²`.
+    pub bound: f64,
+}
+
+impl Drive {
+    /// The drive's row at `body`: `d · (a − from) − shift`.
+    pub fn row(&self, body: &PlaneBody) -> BodyRow {
+        let anchor = body.anchor();
+        BodyRow {
+            value: self.direction.dot(anchor - self.from) - self.shift,
+            along_centre: self.direction,
+            along_angle: self.direction.dot(perp(anchor - body.centre)),
+        }
+    }
+}
+
+/// [`project`] with a drive: the rows and the drive met together where
+/// the drive's multiplier is within its bound; where it is not, the drive
+/// gives its bound (the body moved by it from `predicted` along its
+/// gradient at `previous`, where the substep began) and the rows are met
+/// beside it. The projection and the drive's multiplier.
+pub(crate) fn project_driven(
+    start: &Rows,
+    previous: &PlaneBody,
+    drive: &Drive,
+    predicted: PlaneBody,
+    compliance: f64,
+    tolerance: f64,
+    rows_at: impl Fn(&PlaneBody) -> Option<Rows>,
+) -> Option<(Projected, f64)> {
+    if start.len() >= 3 {
+        // Held in every coordinate: nothing left to drive.
+        return Some((
+            project(start, predicted, compliance, tolerance, rows_at)?,
+            0.0,
+        ));
+    }
+    let mut both = *start;
+    both.push(drive.row(previous));
+    let last = start.len();
+    let together = project(&both, predicted, compliance, tolerance, |b| {
+        let mut rows = rows_at(b)?;
+        rows.push(drive.row(b));
+        Some(rows)
+    })?;
+    let multiplier = together.lambda[last];
+    if multiplier.abs() <= drive.bound {
+        return Some((together, multiplier));
+    }
+    let bounded = multiplier.clamp(-drive.bound, drive.bound);
+    let mut alone = Rows::default();
+    alone.push(drive.row(previous));
+    let pushed = predicted.moved(&alone, DVec3::new(bounded, 0.0, 0.0));
+    Some((
+        project(start, pushed, compliance, tolerance, rows_at)?,
+        bounded,
+    ))
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::geometry::{Circle, Ellipse};
-    use bevy::math::DVec2;
-
-    fn body(centre: DVec2, anchor: DVec2) -> PlaneBody {
-        PlaneBody {
-            centre,
-            anchor,
-            inverse_mass: DVec2::splat(0.5),
-            inverse_inertia: 2.0,
-        }
-    }
-
-    /// Rows whose gradients are those of their values where the anchor is
-    /// on the curve (the distance row is first order off it): central
-    /// differences of `C` over the centre (the anchor moving with it) and
-    /// over the angle (the anchor turning about the centre) agree with the
-    /// gradients to 1e-7, on an ellipse.
-    #[test]
-    fn rows_have_the_gradients_of_their_values() {
-        let curve = Ellipse { a: 2.0, b: 1.0 };
-        let (offset, angle) = (DVec2::new(0.25, -0.4), 0.7);
-        let on = DVec2::new(2.0 * 1.1f64.cos(), 1.1f64.sin());
-        let centre = on - DVec2::from_angle(angle).rotate(offset);
-        let at = |centre: DVec2, angle: f64| {
-            body(centre, centre + DVec2::from_angle(angle).rotate(offset))
-        };
-        let rows: [&dyn Fn(&PlaneBody, f64) -> BodyRow; 2] =
-            [&|b, _| on_curve(&curve, b).expect("a row"), &|b, angle| {
-                turned_with_curve(&curve, b, angle, 0.3).expect("a row")
-            }];
-        let e = 1e-6;
-        for row in rows {
-            let exact = row(&at(centre, angle), angle);
-            for axis in [DVec2::X, DVec2::Y] {
-                let plus = row(&at(centre + e * axis, angle), angle).value;
-                let minus = row(&at(centre - e * axis, angle), angle).value;
-                let numeric = (plus - minus) / (2.0 * e);
-                assert!(
-                    (numeric - exact.along_centre.dot(axis)).abs() <= 1e-7,
-                    "∂C/∂c along {axis}: {numeric} against {}",
-                    exact.along_centre.dot(axis)
-                );
-            }
-            let plus = row(&at(centre, angle + e), angle + e).value;
-            let minus = row(&at(centre, angle - e), angle - e).value;
-            let numeric = (plus - minus) / (2.0 * e);
-            assert!(
-                (numeric - exact.along_angle).abs() <= 1e-7,
-                "∂C/∂θ: {numeric} against {}",
-                exact.along_angle
-            );
-        }
-    }
-
-    /// A body whose anchor is its centre, off a unit circle by 0.1 along
-    /// the radius, with no compliance: one correction puts the anchor on the
-    /// circle (to first order exactly: the row is the distance) and leaves
-    /// the body's angle alone, since the pull passes through its centre.
-    #[test]
-    fn a_stiff_correction_puts_a_centred_anchor_on_the_curve() {
-        let curve = Circle { radius: 1.0 };
-        let start = DVec2::new(0.0, -1.1);
-        let b = body(start, start);
-        let row = on_curve(&curve, &b).expect("a row");
-        let moved = correct(&row, &b, 0.0, 0.0, 1.0 / 360.0);
-        let end = start + moved.centre;
-        assert!(
-            (end.length() - 1.0).abs() <= 1e-12,
-            "the anchor ends at {end}"
-        );
-        assert_eq!(moved.angle, 0.0, "a pull through the centre turns nothing");
-    }
-
-    /// A correction keeps momentum's balance: the impulse `Δλ ∂C/∂c`
-    /// moves the centre by it over the mass, and the angle by its moment
-    /// about the centre over the inertia.
-    #[test]
-    fn a_correction_moves_the_centre_and_turns_the_body_by_one_impulse() {
-        let curve = Circle { radius: 1.0 };
-        let (centre, anchor) = (DVec2::new(0.1, -1.3), DVec2::new(0.3, -1.15));
-        let b = body(centre, anchor);
-        let row = on_curve(&curve, &b).expect("a row");
-        let moved = correct(&row, &b, 0.0, 1e-6, 1.0 / 60.0);
-        let impulse = row.along_centre * moved.lambda;
-        assert!((moved.centre - impulse * b.inverse_mass).length() <= 1e-15);
-        let moment = perp(anchor - centre).dot(impulse);
-        assert!((moved.angle - moment * b.inverse_inertia).abs() <= 1e-15);
-    }
-
-    /// Nothing moves a body with no mass to move, nor one at a singular
-    /// point of its curve.
-    #[test]
-    fn a_body_that_cannot_move_or_a_singular_point_moves_nothing() {
-        let curve = Circle { radius: 1.0 };
-        let fixed = PlaneBody {
-            inverse_mass: DVec2::ZERO,
-            inverse_inertia: 0.0,
-            ..body(DVec2::new(0.0, -1.2), DVec2::new(0.0, -1.2))
-        };
-        let row = on_curve(&curve, &fixed).expect("a row");
-        assert_eq!(correct(&row, &fixed, 0.0, 0.0, 0.01), Correction::default());
-        let centred = body(DVec2::ZERO, DVec2::ZERO);
-        assert!(turned_with_curve(&curve, &centred, 0.0, 0.0).is_none());
-    }
-}
+mod tests;

@@ -1,0 +1,229 @@
+use super::*;
+use crate::geometry::{Circle, Ellipse, Line, Spline, SplineKind, SplineSpec};
+use bevy::math::DVec2;
+
+fn body(centre: DVec2, angle: f64, arm: DVec2) -> PlaneBody {
+    PlaneBody {
+        centre,
+        angle,
+        arm,
+        inverse_mass: DVec2::splat(0.5),
+        inverse_inertia: 2.0,
+    }
+}
+
+fn rows_of(list: &[BodyRow]) -> Rows {
+    let mut rows = Rows::default();
+    for row in list {
+        rows.push(*row);
+    }
+    rows
+}
+
+/// Rows whose gradients are those of their values where the anchor is on
+/// the curve (the distance row is first order off it): central
+/// differences of `C` over the centre (the anchor moving with it) and over
+/// the angle (the anchor turning about the centre) agree with the
+/// gradients to 1e-7, on an ellipse.
+#[test]
+fn rows_have_the_gradients_of_their_values() {
+    let curve = Ellipse { a: 2.0, b: 1.0 };
+    let (arm, angle) = (DVec2::new(0.25, -0.4), 0.7);
+    let on = DVec2::new(2.0 * 1.1f64.cos(), 1.1f64.sin());
+    let at = |centre: DVec2, angle: f64| body(centre, angle, arm);
+    let centre = on - DVec2::from_angle(angle).rotate(arm);
+    let rows: [&dyn Fn(&PlaneBody) -> BodyRow; 2] =
+        [&|b| on_curve(&curve, b).expect("a row"), &|b| {
+            turned_with_curve(&curve, b, 0.3).expect("a row")
+        }];
+    let e = 1e-6;
+    for row in rows {
+        let exact = row(&at(centre, angle));
+        for axis in [DVec2::X, DVec2::Y] {
+            let plus = row(&at(centre + e * axis, angle)).value;
+            let minus = row(&at(centre - e * axis, angle)).value;
+            let numeric = (plus - minus) / (2.0 * e);
+            assert!(
+                (numeric - exact.along_centre.dot(axis)).abs() <= 1e-7,
+                "∂C/∂c along {axis}: {numeric} against {}",
+                exact.along_centre.dot(axis)
+            );
+        }
+        let plus = row(&at(centre, angle + e)).value;
+        let minus = row(&at(centre, angle - e)).value;
+        let numeric = (plus - minus) / (2.0 * e);
+        assert!(
+            (numeric - exact.along_angle).abs() <= 1e-7,
+            "∂C/∂θ: {numeric} against {}",
+            exact.along_angle
+        );
+    }
+}
+
+/// SHAKE's step: a body off a unit circle, its anchor off its centre, is
+/// put back on it to 1e-14 m, moved only along the row's gradient where
+/// the substep began (its centre along the start normal over its mass,
+/// its angle by that normal's moment over its inertia, one multiplier for
+/// both).
+#[test]
+fn a_projection_puts_the_anchor_on_the_curve_along_the_start_gradient() {
+    let curve = Circle { radius: 1.0 };
+    let arm = DVec2::new(0.2, 0.1);
+    let start = body(DVec2::new(0.0, -1.0) - arm, 0.0, arm);
+    let start_rows = rows_of(&[on_curve(&curve, &start).expect("a row")]);
+    let predicted = PlaneBody {
+        centre: start.centre + DVec2::new(0.05, -0.03),
+        angle: 0.02,
+        ..start
+    };
+    let projected = project(&start_rows, predicted, 0.0, 1e-15, |b| {
+        Some(rows_of(&[on_curve(&curve, b)?]))
+    })
+    .expect("a projection");
+    assert!(projected.converged);
+    let off = (projected.body.anchor().length() - 1.0).abs();
+    assert!(off <= 1e-14, "the anchor is {off:e} m off the circle");
+    let g = start_rows.iter().next().expect("a row");
+    let moved = projected.body.centre - predicted.centre;
+    let expected = g.along_centre * start.inverse_mass * projected.lambda.x;
+    assert!(
+        (moved - expected).length() <= 1e-15,
+        "{moved} against {expected}"
+    );
+    let turned = projected.body.angle - predicted.angle;
+    let expected = g.along_angle * start.inverse_inertia * projected.lambda.x;
+    assert!((turned - expected).abs() <= 1e-15);
+}
+
+/// A compliant row is met as `C + α̃ λ = 0`: it yields in proportion to
+/// its multiplier, to 1e-15.
+#[test]
+fn a_compliant_projection_yields_by_its_multiplier() {
+    let curve = Line;
+    let start = body(DVec2::ZERO, 0.0, DVec2::ZERO);
+    let start_rows = rows_of(&[on_curve(&curve, &start).expect("a row")]);
+    let predicted = body(DVec2::new(0.3, -0.1), 0.0, DVec2::ZERO);
+    let compliance = 2.0;
+    let projected = project(&start_rows, predicted, compliance, 1e-15, |b| {
+        Some(rows_of(&[on_curve(&curve, b)?]))
+    })
+    .expect("a projection");
+    let c = projected.body.centre.y;
+    assert!((c + compliance * projected.lambda.x).abs() <= 1e-15);
+    // w = 1/2, so C = −0.1 + λ/2 = −2λ: λ = 0.04, C = −0.08.
+    assert!((c + 0.08).abs() <= 1e-15, "the row holds at {c}");
+}
+
+/// RATTLE's velocity step leaves a body on a circle moving along it: the
+/// row's rate is the wire's (here still) to 1e-15, and the kinetic energy
+/// only falls (the part taken is the part along the normal).
+#[test]
+fn a_velocity_projection_takes_off_the_normal_part() {
+    let curve = Circle { radius: 1.0 };
+    let arm = DVec2::new(0.1, 0.0);
+    let b = body(DVec2::new(0.0, -1.0) - arm, 0.0, arm);
+    let rows = rows_of(&[on_curve(&curve, &b).expect("a row")]);
+    let v = PlaneVelocity {
+        linear: DVec2::new(1.0, 0.4),
+        spin: -0.7,
+    };
+    let energy = |v: PlaneVelocity| {
+        0.5 * (v.linear.length_squared() / 0.5 + v.spin * v.spin / b.inverse_inertia)
+    };
+    let (after, _) =
+        project_velocity(&rows, &b, v, PlaneVelocity::default()).expect("a projection");
+    let rate = rows.iter().next().expect("a row").rate(after);
+    assert!(
+        rate.abs() <= 1e-15,
+        "the anchor leaves the circle at {rate:e} m/s"
+    );
+    assert!(energy(after) < energy(v));
+}
+
+/// A drive with room to spare moves the anchor along the wire by its
+/// shift, the held row kept; a bounded one gives exactly its bound: a
+/// body of mass 2 held at its centre on a line, predicted 0.1 m along and
+/// 0.05 m off it, is moved 0.3 m along by an unbounded drive asking for
+/// that, and `bound / m` beyond its prediction by a bounded one.
+#[test]
+fn a_drive_moves_by_its_shift_or_gives_its_bound() {
+    let curve = Line;
+    let previous = body(DVec2::ZERO, 0.0, DVec2::ZERO);
+    let start = rows_of(&[on_curve(&curve, &previous).expect("a row")]);
+    let along = along_curve(&curve, &previous, -1.0).expect("a row");
+    assert_eq!(along.along_centre, DVec2::X, "a line's own direction is +x");
+    let predicted = body(DVec2::new(0.1, 0.05), 0.0, DVec2::ZERO);
+    let drive = |bound: f64| Drive {
+        direction: along.along_centre,
+        from: previous.anchor(),
+        shift: 0.3,
+        bound,
+    };
+    let rows_at = |b: &PlaneBody| Some(rows_of(&[on_curve(&curve, b)?]));
+    let (free, multiplier) = project_driven(
+        &start,
+        &previous,
+        &drive(1.0),
+        predicted,
+        0.0,
+        1e-15,
+        rows_at,
+    )
+    .expect("a projection");
+    assert!((free.body.centre - DVec2::new(0.3, 0.0)).length() <= 1e-15);
+    // The body moved 0.2 m along at 1/m = 1/2: λ = 0.4.
+    assert!(
+        (multiplier - 0.4).abs() <= 1e-15,
+        "a multiplier of {multiplier}"
+    );
+    let (bounded, multiplier) = project_driven(
+        &start,
+        &previous,
+        &drive(0.1),
+        predicted,
+        0.0,
+        1e-15,
+        rows_at,
+    )
+    .expect("a projection");
+    assert_eq!(multiplier, 0.1);
+    assert!((bounded.body.centre - DVec2::new(0.15, 0.0)).length() <= 1e-15);
+}
+
+/// Past the end of an open curve the end row is positive and points out:
+/// on a straight open spline from the origin to (2, 0), a point beyond
+/// its right end is past it by its distance along the end's tangent, to
+/// 1e-12, with the row pointing along +x; one before its left end, along
+/// −x; one between the ends is not past either.
+#[test]
+fn past_an_end_the_row_points_out() {
+    let spec = SplineSpec {
+        kind: SplineKind::CatmullRom,
+        points: vec![DVec2::ZERO, DVec2::new(1.0, 0.0), DVec2::new(2.0, 0.0)],
+        closed: false,
+    };
+    let curve = Spline::new(spec).expect("a spline");
+    let at = |x: f64| body(DVec2::new(x, 0.1), 0.0, DVec2::ZERO);
+    let right = past_end(&curve, &at(2.5)).expect("a row");
+    assert!(
+        (right.value - 0.5).abs() <= 1e-12,
+        "past by {}",
+        right.value
+    );
+    assert!((right.along_centre - DVec2::X).length() <= 1e-12);
+    let left = past_end(&curve, &at(-0.25)).expect("a row");
+    assert!((left.value - 0.25).abs() <= 1e-12, "past by {}", left.value);
+    assert!((left.along_centre + DVec2::X).length() <= 1e-12);
+    assert!(past_end(&curve, &at(1.5)).expect("a row").value < 0.0);
+    assert!(past_end(&Circle { radius: 1.0 }, &at(1.5)).is_none());
+}
+
+/// Nothing moves a body at a singular point of its curve: no row.
+#[test]
+fn a_singular_point_gives_no_row() {
+    let curve = Circle { radius: 1.0 };
+    let centred = body(DVec2::ZERO, 0.0, DVec2::ZERO);
+    assert!(on_curve(&curve, &centred).is_none());
+    assert!(turned_with_curve(&curve, &centred, 0.0).is_none());
+    assert!(along_curve(&curve, &centred, 1.0).is_none());
+}
