@@ -113,7 +113,7 @@ pub enum PathMotor {
 /// and says so once in the log. The ends of an open wire (a spline, a
 /// cycloid) stop the anchor there, as a buffer stops a cart.
 #[derive(Component, Clone, Debug, PartialEq, Reflect)]
-#[require(PathJointState)]
+#[require(PathJointState, PathJointForces)]
 pub struct PathJoint {
     /// The wire's entity.
     pub wire: Entity,
@@ -171,6 +171,22 @@ impl PathJoint {
     }
 }
 
+/// What a [`PathJoint`] did to its body over the last physics step, as
+/// avian's `JointForces` says it of avian's joints: the mean force and
+/// torque the joint applied (through the body's centre of mass, the
+/// wire's push, its motor or friction and its ends together), and the
+/// part of the force its motor or friction gave along the wire.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
+pub struct PathJointForces {
+    /// The force on the body, N, world frame.
+    pub force: DVec2,
+    /// The torque about its centre of mass, N·m, counter-clockwise.
+    pub torque: f64,
+    /// The motor's (or friction's) force along the wire's own direction,
+    /// N.
+    pub motor_force: f64,
+}
+
 /// What a path joint holds from one substep to the next.
 #[derive(Component, Clone, Debug)]
 struct PathJointState {
@@ -189,6 +205,9 @@ struct PathJointState {
     hint: f64,
     /// Why the joint holds nothing, once said.
     warned: bool,
+    /// The impulse the joint gave over the step so far: linear, angular,
+    /// and its drive's along the wire.
+    impulse: (DVec2, f64, f64),
 }
 
 impl Default for PathJointState {
@@ -202,6 +221,7 @@ impl Default for PathJointState {
             // Anywhere on the curve, until the anchor has been on it.
             hint: f64::NAN,
             warned: false,
+            impulse: (DVec2::ZERO, 0.0, 0.0),
         }
     }
 }
@@ -214,9 +234,13 @@ pub struct PathJointPlugin;
 impl Plugin for PathJointPlugin {
     fn build(&self, app: &mut App) {
         app.register_type::<PathJoint>()
+            .register_type::<PathJointForces>()
             .add_systems(
                 PhysicsSchedule,
-                prepare_path_joints.in_set(SolverSystems::PrepareJoints),
+                (
+                    prepare_path_joints.in_set(SolverSystems::PrepareJoints),
+                    write_path_joint_forces.in_set(SolverSystems::Finalize),
+                ),
             )
             .add_systems(
                 SubstepSchedule,
@@ -256,6 +280,7 @@ fn prepare_path_joints(
             angle,
         );
         state.previous = state.start;
+        state.impulse = (DVec2::ZERO, 0.0, 0.0);
         state.arm = joint.anchor - local_centre;
         state.time = (clock.time - params.timestep, 0.0);
         let placed = wires
@@ -315,6 +340,40 @@ fn rows_with_end(
         rows.push(past_end(curve, body)?);
     }
     Some(rows)
+}
+
+/// The impulse that changes a body's velocity by `linear` and `spin`
+/// (`M Δv`), along the axes it moves along (a locked axis takes what it
+/// is given, unknown, and reports none).
+fn impulse_of(body: &PlaneBody, linear: DVec2, spin: f64) -> (DVec2, f64) {
+    let over = |change: f64, inverse: f64| if inverse > 0.0 { change / inverse } else { 0.0 };
+    (
+        DVec2::new(
+            over(linear.x, body.inverse_mass.x),
+            over(linear.y, body.inverse_mass.y),
+        ),
+        over(spin, body.inverse_inertia),
+    )
+}
+
+/// Each joint's impulses over the step, as its mean forces.
+fn write_path_joint_forces(mut joints: Query<(&PathJointState, &mut PathJointForces)>) {
+    for (state, mut forces) in &mut joints {
+        // The step's length: its substeps together.
+        let dt = state.time.1;
+        if dt <= 0.0 {
+            continue;
+        }
+        let (linear, angular, driven) = state.impulse;
+        let mean = PathJointForces {
+            force: linear / dt,
+            torque: angular / dt,
+            motor_force: driven / dt,
+        };
+        if mean.force.is_finite() && mean.torque.is_finite() && mean.motor_force.is_finite() {
+            *forces = mean;
+        }
+    }
 }
 
 /// The wire of a joint: its shape and where it is over time.
@@ -406,13 +465,21 @@ fn solve_path_joints(
         let projected = match drive {
             Some(drive) => project_driven(
                 &start, &previous, &drive, predicted, compliance, tolerance, rows_at,
-            )
-            .map(|(projected, _)| projected),
-            None => project(&start, predicted, compliance, tolerance, rows_at),
+            ),
+            None => project(&start, predicted, compliance, tolerance, rows_at).map(|p| (p, 0.0)),
         };
-        let Some(projected) = projected else {
+        let Some((projected, driven)) = projected else {
             continue;
         };
+        // The move is the impulse over the substep: Δq = h M⁻¹ p.
+        let (linear, angular) = impulse_of(
+            &predicted,
+            projected.body.centre - predicted.centre,
+            projected.body.angle - predicted.angle,
+        );
+        state.impulse.0 += linear / h;
+        state.impulse.1 += angular / h;
+        state.impulse.2 += driven / h;
         let moved = projected.body;
         state.hint = shape
             .curve()
@@ -463,10 +530,14 @@ fn project_path_joint_velocities(
             linear: twist.velocity_at(plane.centre),
             spin: twist.angular_velocity,
         };
+        let old = v;
         let Some(v) = joint_velocity(joint, state.offset, &curve, &plane, v, frame) else {
             continue;
         };
         if v.linear.is_finite() && v.spin.is_finite() {
+            let (linear, angular) = impulse_of(&plane, v.linear - old.linear, v.spin - old.spin);
+            state.impulse.0 += linear;
+            state.impulse.1 += angular;
             body.linear_velocity = v.linear.adjust_precision();
             body.angular_velocity = v.spin.adjust_precision();
         }

@@ -7,7 +7,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use wirebead::Integrator;
-use wirebead::avian::{PathJoint, PathJointPlugin, PathMotor, PathRotation};
+use wirebead::avian::{PathJoint, PathJointForces, PathJointPlugin, PathMotor, PathRotation};
 use wirebead::geometry::{ImplicitCurve, Spline, SplineKind, SplineSpec, WireShape};
 use wirebead::prelude::*;
 use wirebead::reference::pendulum_period;
@@ -87,6 +87,8 @@ struct Swing {
     off_the_wire: f64,
     turned_against_orbit: f64,
     turned: f64,
+    /// The fastest its centre moved across the circle, m/s.
+    across: f64,
     /// The largest change of `½ m v² + ½ I ω² + m g y` from the start, J.
     energy: f64,
 }
@@ -101,12 +103,13 @@ fn swing(app: &mut App, body: Entity, seconds: f64, inertia: f64) -> Swing {
     let mut energy = 0.0f64;
     let orbit0 = start.x.atan2(-start.y);
     let mut crossings = Vec::new();
-    let (mut off, mut against, mut turned) = (0.0f64, 0.0f64, 0.0f64);
+    let (mut off, mut against, mut turned, mut across) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut last = start;
     let steps = (seconds / dt).round() as usize;
     for step in 1..=steps {
         app.update();
-        let (p, _, angle, _) = body_state(app, body);
+        let (p, v, angle, _) = body_state(app, body);
+        across = across.max(p.normalize().dot(v).abs());
         energy = energy.max((energy_of(body_state(app, body)) - e0).abs());
         off = off.max((p.length() - 1.0).abs());
         let orbit = p.x.atan2(-p.y);
@@ -130,6 +133,7 @@ fn swing(app: &mut App, body: Entity, seconds: f64, inertia: f64) -> Swing {
         off_the_wire: off,
         turned_against_orbit: against,
         turned,
+        across,
         energy,
     }
 }
@@ -174,7 +178,8 @@ impl Swings {
 /// pendulum: its period is the elliptic integral's, to 1e-3 at 60 Hz and
 /// to 1e-5 at 1 ms with avian's six substeps (the joint is RATTLE on
 /// avian's symplectic substep, so the period's error is second order in
-/// the substep); its centre stays on the circle to 1e-5 m, and no torque
+/// the substep); its centre stays on the circle to 1e-5 m and moves along
+/// it (across it at 1e-5 m/s at most: RATTLE's velocity step), and no torque
 /// acts on it about its centre, so it never turns (1e-5 rad).
 #[test]
 fn a_body_held_at_its_centre_swings_as_a_point_pendulum_and_never_turns() {
@@ -182,8 +187,8 @@ fn a_body_held_at_its_centre_swings_as_a_point_pendulum_and_never_turns() {
     let (coarse, fine) = s.errors();
     eprintln!(
         "free: period error {coarse:+.2e} at 60 Hz, {fine:+.2e} at 1 ms; off the wire {:.2e} m, \
-         turned {:.2e} rad, energy {:.2e} J at 60 Hz",
-        s.coarse.off_the_wire, s.coarse.turned, s.coarse.energy
+         across it at {:.2e} m/s, turned {:.2e} rad, energy {:.2e} J at 60 Hz",
+        s.coarse.off_the_wire, s.coarse.across, s.coarse.turned, s.coarse.energy
     );
     assert!(coarse.abs() <= 1e-3, "period at 60 Hz off by {coarse:+e}");
     assert!(fine.abs() <= 1e-5, "period at 1 ms off by {fine:+e}");
@@ -312,7 +317,9 @@ fn on_a_line(app: &mut App, mass: f32, angle: f32, joint: impl Fn(Entity) -> Pat
 /// A velocity motor of at most 4 N on a body of 2 kg at rest on a line
 /// accelerates it at F/m = 2 m/s² (its speed after 1 s is 2 m/s to 1 %),
 /// up to the 3 m/s it asks for, and holds that (to 1e-3 m/s) for a
-/// second after; the body stays on the line (1e-5 m).
+/// second after; the body stays on the line (1e-5 m). The joint's forces
+/// say so: 4 N from the motor while it accelerates, none once at speed,
+/// and the body's weight from the wire throughout (to 1e-3).
 #[test]
 fn a_velocity_motor_accelerates_at_its_force_over_the_mass_and_holds_its_speed() {
     let mut app = physics_app(SUBSTEPS);
@@ -324,12 +331,29 @@ fn a_velocity_motor_accelerates_at_its_force_over_the_mass_and_holds_its_speed()
     });
     let mut off = 0.0f64;
     let mut speed_at = Vec::new();
+    let mut forces = Vec::new();
     for _ in 0..150 {
         app.update();
         let (p, v, ..) = body_state(&app, body);
         off = off.max(p.y.abs());
         speed_at.push(v);
+        forces.push(*app.world().get::<PathJointForces>(body).expect("forces"));
     }
+    // Accelerating, the motor gives its 4 N and the wire holds the weight;
+    // at speed, the motor gives nothing.
+    let pushing = forces[30];
+    let weight = 2.0 * G;
+    assert!(
+        (pushing.motor_force - 4.0).abs() <= 1e-3
+            && (pushing.force - DVec2::new(4.0, weight)).length() <= 1e-3 * weight,
+        "accelerating, the joint gave {pushing:?}"
+    );
+    let cruising = forces[140];
+    assert!(
+        cruising.motor_force.abs() <= 1e-3
+            && (cruising.force - DVec2::new(0.0, weight)).length() <= 1e-3 * weight,
+        "at speed, the joint gave {cruising:?}"
+    );
     let after_one = speed_at[59].x;
     assert!(
         (after_one - 2.0).abs() <= 0.02,
