@@ -143,6 +143,18 @@ macro_rules! harness {
             gravity: $vector,
             substeps: Option<u32>,
         ) -> App {
+            physics_app_with(step, threads, gravity, substeps, |_| {})
+        }
+
+        /// [`physics_app`] with more plugins, added by `more` after avian's.
+        #[allow(dead_code)]
+        pub fn physics_app_with(
+            step: Duration,
+            threads: Option<usize>,
+            gravity: $vector,
+            substeps: Option<u32>,
+            more: impl FnOnce(&mut App),
+        ) -> App {
             let mut app = App::new();
 
             // Bevy's task pools are process-wide and created once: a later
@@ -172,6 +184,7 @@ macro_rules! harness {
                 transform_to_collider_scale: false,
             });
             app.add_plugins((minimal, PhysicsPlugins::default()));
+            more(&mut app);
 
             app.insert_resource(Gravity(gravity));
             if let Some(k) = substeps {
@@ -246,7 +259,7 @@ mod plane {
     use bevy::math::DVec2;
     harness!(avian2d, DVec2);
 }
-pub use plane::{physics_app, timed_step, warm_up};
+pub use plane::{physics_app, physics_app_with, timed_step, warm_up};
 
 /// avian2d's default number of substeps per step (`impl Default for
 /// SubstepCount`, `src/dynamics/solver/schedule.rs`): 6.

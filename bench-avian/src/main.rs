@@ -8,6 +8,7 @@
 //! cargo run --release -p wirebead-vs-avian -- spheres [--steps 600] [--sizes 1,10000]
 //! cargo run --release -p wirebead-vs-avian -- touch [--dt 0.016667] [--steps 120] [--substeps 50]
 //! cargo run --release -p wirebead-vs-avian -- pile [--beads 1000] [--steps 180] [--piles plane|space|both] [--budget 300]
+//! cargo run --release -p wirebead-vs-avian -- path [--steps 600] [--sizes 1,1000]
 //! ```
 //!
 //! - `circle` (the default, also without a subcommand): a bead on a circle
@@ -40,6 +41,9 @@
 //!   [`pile`]). Prints ms per step as the pile falls, lands and settles,
 //!   the worst overlap of two beads and into the bowl, and how the energy
 //!   rose.
+//! - `path`: N carts on straight rails, each held by our `PathJoint` or by
+//!   avian2d's `PrismaticJoint` (see [`path`]). Prints ms per step, ns per
+//!   cart-step, the rail error and turn, and the time ratio.
 //!
 //! Every job uses Bevy's process-wide task pools with a compute thread per
 //! core, on both sides.
@@ -48,6 +52,7 @@
 
 mod avian_side;
 mod carts;
+mod path;
 mod pile;
 mod rope;
 mod spheres;
@@ -99,6 +104,8 @@ enum Job {
     Touch(touch::TouchArgs),
     /// Beads poured into a bowl, against avian2d's and avian3d's colliders.
     Pile(pile::PileArgs),
+    /// N carts on straight rails: our path joint against avian2d's prismatic joint.
+    Path(path::PathArgs),
 }
 
 /// Options of the circle job.
@@ -213,6 +220,7 @@ fn main() {
         Some(Job::Spheres(args)) => spheres::run(&args),
         Some(Job::Touch(args)) => touch::run(&args),
         Some(Job::Pile(args)) => pile::run(&args),
+        Some(Job::Path(args)) => path::run(&args),
     }
 }
 

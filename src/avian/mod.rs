@@ -55,8 +55,8 @@ use bevy::prelude::*;
 use crate::dynamics::{Wire, WirePose};
 use crate::geometry::{ImplicitCurve, Near, Placed, PosePath, WireShape};
 use crate::solver::path::{
-    BodyRow, Drive, PlaneBody, PlaneVelocity, Rows, along_curve, on_curve, past_end, project,
-    project_driven, project_velocity, turn_offset, turned_with_curve,
+    BodyRow, Drive, PlaneBody, PlaneVelocity, Rows, along_curve, held, past_end, project,
+    project_driven, project_velocity, turn_offset, turns_a_corner,
 };
 use crate::{SimClock, SimParams};
 
@@ -318,12 +318,11 @@ fn held_rows(
     curve: &impl ImplicitCurve,
     body: &PlaneBody,
 ) -> Option<Rows> {
-    let mut rows = Rows::default();
-    rows.push(on_curve(curve, body)?);
-    if let (PathRotation::Turned, Some(offset)) = (joint.rotation, offset) {
-        rows.push(turned_with_curve(curve, body, offset)?);
-    }
-    Some(rows)
+    let turned = match joint.rotation {
+        PathRotation::Turned => offset,
+        PathRotation::Free => None,
+    };
+    held(curve, body, turned)
 }
 
 /// The joint's rows with, where `end` is given, the end the anchor is
@@ -404,89 +403,113 @@ fn solve_path_joints(
     if h.is_nan() || h <= 0.0 {
         return;
     }
-    for (joint, mut state, mut body, inertia) in &mut joints {
-        state.time.1 += h;
-        // A kinematic body goes where the game sends it; a static one has
-        // no solver body at all.
-        if body.flags.is_kinematic() {
-            continue;
-        }
-        let Some((shape, path)) = wire_of(&wires, joint) else {
-            continue;
-        };
-        let now = state.time.0 + state.time.1;
-        let near = Near {
-            curve: shape.curve(),
-            hint: state.hint,
-        };
-        let before = Placed {
-            curve: &near,
-            pose: path.pose(now - h),
-        };
-        let after = Placed {
-            curve: &near,
-            pose: path.pose(now),
-        };
-        let predicted = plane_body(&state, &body, inertia);
-        let previous = PlaneBody {
-            centre: state.previous.0,
-            angle: state.previous.1,
-            ..predicted
-        };
-        if !(predicted.anchor().is_finite() && predicted.angle.is_finite()) {
-            continue;
-        }
-        if joint.rotation == PathRotation::Turned && state.offset.is_none() {
-            state.offset = turn_offset(&before, &previous);
-        }
-        let end = past_end(&after, &predicted).is_some_and(|row| row.value > 0.0);
-        let offset = state.offset;
-        let Some(start) = rows_with_end(joint, offset, &before, &previous, end) else {
-            continue;
-        };
-        let tolerance = 1e-12 * shape.curve().scale().max(1.0);
-        let compliance = joint.compliance / (h * h);
-        let rows_at = |b: &PlaneBody| rows_with_end(joint, offset, &after, b, end);
-        // At an end the buffer holds the anchor, whatever drives it.
-        let drive = if end {
-            None
-        } else {
-            let v = PlaneVelocity {
-                linear: DVec2::from(body.linear_velocity),
-                spin: f64::from(body.angular_velocity),
-            };
-            let (_, twist) = path.at(now - h);
-            let frame = PlaneVelocity {
-                linear: twist.velocity_at(previous.centre),
-                spin: twist.angular_velocity,
-            };
-            drive_of(joint, &before, shape, &previous, v, frame, h)
-        };
-        let projected = match drive {
-            Some(drive) => project_driven(
-                &start, &previous, &drive, predicted, compliance, tolerance, rows_at,
-            ),
-            None => project(&start, predicted, compliance, tolerance, rows_at).map(|p| (p, 0.0)),
-        };
-        let Some((projected, driven)) = projected else {
-            continue;
-        };
-        // The move is the impulse over the substep: Δq = h M⁻¹ p.
-        let (linear, angular) = impulse_of(
-            &predicted,
-            projected.body.centre - predicted.centre,
-            projected.body.angle - predicted.angle,
-        );
-        state.impulse.0 += linear / h;
-        state.impulse.1 += angular / h;
-        state.impulse.2 += driven / h;
-        let moved = projected.body;
-        state.hint = shape
-            .curve()
-            .parameter(after.pose.to_local(moved.anchor()), state.hint);
-        body.delta_position += (moved.centre - predicted.centre).adjust_precision();
-        body.delta_rotation = Rotation::radians((moved.angle - state.start.1).adjust_precision());
+    // Each joint moves its own body only: the joints run in parallel.
+    joints
+        .par_iter_mut()
+        .for_each(|(joint, mut state, mut body, inertia)| {
+            solve_path_joint(joint, &mut state, &mut body, inertia, &wires, h);
+        });
+}
+
+/// SHAKE's step for one joint (see [`solve_path_joints`]).
+fn solve_path_joint(
+    joint: &PathJoint,
+    state: &mut PathJointState,
+    body: &mut SolverBody,
+    inertia: &SolverBodyInertia,
+    wires: &Query<(&Wire, &WirePose<DVec2>)>,
+    h: f64,
+) {
+    state.time.1 += h;
+    // A kinematic body goes where the game sends it; a static one has
+    // no solver body at all.
+    if body.flags.is_kinematic() {
+        return;
     }
+    let Some((shape, path)) = wire_of(wires, joint) else {
+        return;
+    };
+    let now = state.time.0 + state.time.1;
+    let near = Near {
+        curve: shape.curve(),
+        hint: state.hint,
+    };
+    let before = Placed {
+        curve: &near,
+        pose: path.pose(now - h),
+    };
+    let after = Placed {
+        curve: &near,
+        pose: path.pose(now),
+    };
+    let predicted = plane_body(state, body, inertia);
+    let previous = PlaneBody {
+        centre: state.previous.0,
+        angle: state.previous.1,
+        ..predicted
+    };
+    if !(predicted.anchor().is_finite() && predicted.angle.is_finite()) {
+        return;
+    }
+    if joint.rotation == PathRotation::Turned && state.offset.is_none() {
+        state.offset = turn_offset(&before, &previous);
+    }
+    let end = past_end(&after, &predicted).is_some_and(|row| row.value > 0.0);
+    let offset = state.offset;
+    let Some(start) = rows_with_end(joint, offset, &before, &previous, end) else {
+        return;
+    };
+    let tolerance = 1e-12 * shape.curve().scale().max(1.0);
+    let compliance = joint.compliance / (h * h);
+    let rows_at = |b: &PlaneBody| rows_with_end(joint, offset, &after, b, end);
+    // At an end the buffer holds the anchor, whatever drives it.
+    let drive = if end {
+        None
+    } else {
+        let v = PlaneVelocity {
+            linear: DVec2::from(body.linear_velocity),
+            spin: f64::from(body.angular_velocity),
+        };
+        let (_, twist) = path.at(now - h);
+        let frame = PlaneVelocity {
+            linear: twist.velocity_at(previous.centre),
+            spin: twist.angular_velocity,
+        };
+        drive_of(joint, &before, shape, &previous, v, frame, h)
+    };
+    let put_back = |start: &Rows, from: &PlaneBody| match drive {
+        Some(drive) => project_driven(
+            start, from, &drive, predicted, compliance, tolerance, rows_at,
+        ),
+        None => project(start, predicted, compliance, tolerance, rows_at).map(|p| (p, 0.0)),
+    };
+    let Some((mut projected, mut driven)) = put_back(&start, &previous) else {
+        return;
+    };
+    // Past a sharp corner the gradients where the substep began point off
+    // the wire's new direction: put the body back along those where it
+    // is instead, onto the nearest point of the new segment.
+    if turns_a_corner(&before, &previous, &after, &projected.body)
+        && let Some(here) = rows_at(&predicted)
+        && let Some(nearest) = put_back(&here, &predicted)
+    {
+        (projected, driven) = nearest;
+    }
+    // The move is the impulse over the substep: Δq = h M⁻¹ p.
+    let (linear, angular) = impulse_of(
+        &predicted,
+        projected.body.centre - predicted.centre,
+        projected.body.angle - predicted.angle,
+    );
+    state.impulse.0 += linear / h;
+    state.impulse.1 += angular / h;
+    state.impulse.2 += driven / h;
+    let moved = projected.body;
+    state.hint = shape
+        .curve()
+        .parameter(after.pose.to_local(moved.anchor()), state.hint);
+    body.delta_position += (moved.centre - predicted.centre).adjust_precision();
+    body.delta_rotation = Rotation::radians((moved.angle - state.start.1).adjust_precision());
 }
 
 /// RATTLE's velocity step for each joint, after avian has turned the
@@ -507,40 +530,54 @@ fn project_path_joint_velocities(
     if h.is_nan() || h <= 0.0 {
         return;
     }
-    for (joint, mut state, mut body, inertia) in &mut joints {
-        let plane = plane_body(&state, &body, inertia);
-        state.previous = (plane.centre, plane.angle);
-        if body.flags.is_kinematic() {
-            continue;
-        }
-        let Some((shape, path)) = wire_of(&wires, joint) else {
-            continue;
-        };
-        let near = Near {
-            curve: shape.curve(),
-            hint: state.hint,
-        };
-        let (pose, twist) = path.at(state.time.0 + state.time.1);
-        let curve = Placed { curve: &near, pose };
-        let v = PlaneVelocity {
-            linear: DVec2::from(body.linear_velocity),
-            spin: f64::from(body.angular_velocity),
-        };
-        let frame = PlaneVelocity {
-            linear: twist.velocity_at(plane.centre),
-            spin: twist.angular_velocity,
-        };
-        let old = v;
-        let Some(v) = joint_velocity(joint, state.offset, &curve, &plane, v, frame) else {
-            continue;
-        };
-        if v.linear.is_finite() && v.spin.is_finite() {
-            let (linear, angular) = impulse_of(&plane, v.linear - old.linear, v.spin - old.spin);
-            state.impulse.0 += linear;
-            state.impulse.1 += angular;
-            body.linear_velocity = v.linear.adjust_precision();
-            body.angular_velocity = v.spin.adjust_precision();
-        }
+    joints
+        .par_iter_mut()
+        .for_each(|(joint, mut state, mut body, inertia)| {
+            project_path_joint_velocity(joint, &mut state, &mut body, inertia, &wires);
+        });
+}
+
+/// RATTLE's velocity step for one joint (see
+/// [`project_path_joint_velocities`]).
+fn project_path_joint_velocity(
+    joint: &PathJoint,
+    state: &mut PathJointState,
+    body: &mut SolverBody,
+    inertia: &SolverBodyInertia,
+    wires: &Query<(&Wire, &WirePose<DVec2>)>,
+) {
+    let plane = plane_body(state, body, inertia);
+    state.previous = (plane.centre, plane.angle);
+    if body.flags.is_kinematic() {
+        return;
+    }
+    let Some((shape, path)) = wire_of(wires, joint) else {
+        return;
+    };
+    let near = Near {
+        curve: shape.curve(),
+        hint: state.hint,
+    };
+    let (pose, twist) = path.at(state.time.0 + state.time.1);
+    let curve = Placed { curve: &near, pose };
+    let v = PlaneVelocity {
+        linear: DVec2::from(body.linear_velocity),
+        spin: f64::from(body.angular_velocity),
+    };
+    let frame = PlaneVelocity {
+        linear: twist.velocity_at(plane.centre),
+        spin: twist.angular_velocity,
+    };
+    let old = v;
+    let Some(v) = joint_velocity(joint, state.offset, &curve, &plane, v, frame) else {
+        return;
+    };
+    if v.linear.is_finite() && v.spin.is_finite() {
+        let (linear, angular) = impulse_of(&plane, v.linear - old.linear, v.spin - old.spin);
+        state.impulse.0 += linear;
+        state.impulse.1 += angular;
+        body.linear_velocity = v.linear.adjust_precision();
+        body.angular_velocity = v.spin.adjust_precision();
     }
 }
 

@@ -38,6 +38,10 @@ pub(crate) struct PlaneBody {
 impl PlaneBody {
     /// The anchor, world frame.
     pub fn anchor(&self) -> DVec2 {
+        if self.arm == DVec2::ZERO {
+            // Held at its centre of mass, as a cart often is: no turn to take.
+            return self.centre;
+        }
         self.centre + DVec2::from_angle(self.angle).rotate(self.arm)
     }
 
@@ -167,14 +171,31 @@ impl Rows {
     }
 }
 
-/// `A x = b`, or `None` where `A` is singular or the answer not finite.
-fn solve(a: DMat3, b: DVec3) -> Option<DVec3> {
-    let det = a.determinant();
-    let size = a.to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    if !(det.abs() > 1e-13 * size * size * size && det.is_finite()) {
-        return None;
-    }
-    let x = a.inverse() * b;
+/// `A x = b` for the leading `n` rows and columns of `A` (the rest
+/// ignored, zero in `x`), or `None` where they are singular or the answer
+/// not finite.
+fn solve(a: DMat3, b: DVec3, n: usize) -> Option<DVec3> {
+    let x = match n {
+        0 => DVec3::ZERO,
+        1 => DVec3::new(b.x / a.x_axis.x, 0.0, 0.0),
+        2 => {
+            let (p, q, r, t) = (a.x_axis.x, a.y_axis.x, a.x_axis.y, a.y_axis.y);
+            let det = p * t - q * r;
+            let size = p.abs().max(q.abs()).max(r.abs()).max(t.abs());
+            if det.is_nan() || det.abs() <= 1e-13 * size * size {
+                return None;
+            }
+            DVec3::new((b.x * t - q * b.y) / det, (p * b.y - r * b.x) / det, 0.0)
+        }
+        _ => {
+            let det = a.determinant();
+            let size = a.to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            if det.is_nan() || det.abs() <= 1e-13 * size * size * size {
+                return None;
+            }
+            a.inverse() * b
+        }
+    };
     x.is_finite().then_some(x)
 }
 
@@ -191,18 +212,83 @@ fn unit_normal(curve: &impl ImplicitCurve, p: DVec2) -> Option<(f64, DVec2)> {
         .then(|| (geometry.c / length, geometry.normal / length))
 }
 
+/// The curve at a body's anchor, evaluated once for every row that needs
+/// it: the anchor, its arm turned a quarter (`(a − c)⊥`), the distance
+/// `C / |∇C|`, the unit normal and `∇ψ = H t / |∇C|`, the gradient of the
+/// tangent's angle `ψ` (see [`turned_with_curve`]).
+struct AtAnchor {
+    lever: DVec2,
+    distance: f64,
+    normal: DVec2,
+    turn_gradient: DVec2,
+}
+
+impl AtAnchor {
+    /// `None` at a singular point.
+    fn new(curve: &impl ImplicitCurve, body: &PlaneBody) -> Option<Self> {
+        let anchor = body.anchor();
+        let geometry = curve.geometry(anchor);
+        let length = geometry.normal.length();
+        if !(length > 0.0 && length.is_finite() && geometry.c.is_finite()) {
+            return None;
+        }
+        let normal = geometry.normal / length;
+        // The tangent turns as the normal does: dψ = N⊥ · dN / |N|² with
+        // dN = H dx, so ∇ψ = H N⊥ / |N|² = H t / |N|.
+        Some(Self {
+            lever: perp(anchor - body.centre),
+            distance: geometry.c / length,
+            normal,
+            turn_gradient: geometry.hessian * perp(normal) / length,
+        })
+    }
+
+    /// The on-the-curve row (see [`on_curve`]).
+    fn on_curve(&self) -> BodyRow {
+        BodyRow {
+            value: self.distance,
+            along_centre: self.normal,
+            along_angle: self.normal.dot(self.lever),
+        }
+    }
+
+    /// The turned-with-the-curve row (see [`turned_with_curve`]).
+    fn turned(&self, angle: f64, offset: f64) -> BodyRow {
+        let tangent = perp(self.normal);
+        // ψ depends on the anchor, which moves with the centre and turns
+        // about it: ∂a/∂c = I, ∂a/∂θ = (a − c)⊥.
+        BodyRow {
+            value: wrap(angle - tangent.y.atan2(tangent.x) - offset),
+            along_centre: -self.turn_gradient,
+            along_angle: 1.0 - self.turn_gradient.dot(self.lever),
+        }
+    }
+}
+
 /// The anchor's distance from the curve to first order, `C(a) / |∇C(a)|`
 /// (zero exactly on the curve), as a row of the body: its gradient is the
 /// curve's unit normal at the anchor along the centre, and that normal's
 /// moment about the centre along the angle. `None` at a singular point.
+#[cfg(test)]
 pub(crate) fn on_curve(curve: &impl ImplicitCurve, body: &PlaneBody) -> Option<BodyRow> {
-    let anchor = body.anchor();
-    let (value, normal) = unit_normal(curve, anchor)?;
-    Some(BodyRow {
-        value,
-        along_centre: normal,
-        along_angle: normal.dot(perp(anchor - body.centre)),
-    })
+    Some(AtAnchor::new(curve, body)?.on_curve())
+}
+
+/// The rows a joint holds at `body`, the curve evaluated once: the anchor
+/// on the curve and, where `offset` is given, the body's angle turned
+/// with it (see [`turned_with_curve`]). `None` at a singular point.
+pub(crate) fn held(
+    curve: &impl ImplicitCurve,
+    body: &PlaneBody,
+    offset: Option<f64>,
+) -> Option<Rows> {
+    let at = AtAnchor::new(curve, body)?;
+    let mut rows = Rows::default();
+    rows.push(at.on_curve());
+    if let Some(offset) = offset {
+        rows.push(at.turned(body.angle, offset));
+    }
+    Some(rows)
 }
 
 /// The anchor's motion along the curve as a row of the body (its value
@@ -253,46 +339,23 @@ pub(crate) fn past_end(curve: &impl ImplicitCurve, body: &PlaneBody) -> Option<B
     })
 }
 
-/// The angle of the curve's tangent at the anchor, `ψ = atan2(t)` with the
-/// tangent `t = ∇C⊥ / |∇C|`, and its gradient with respect to the anchor,
-/// `∇ψ = H t / |∇C|` (`H` the Hessian of `C`). `None` at a singular point.
-fn tangent_angle(curve: &impl ImplicitCurve, anchor: DVec2) -> Option<(f64, DVec2)> {
-    let geometry = curve.geometry(anchor);
-    let length = geometry.normal.length();
-    if !(length > 0.0 && length.is_finite()) {
-        return None;
-    }
-    let tangent = perp(geometry.normal) / length;
-    // The tangent turns as the normal does: dψ = N⊥ · dN / |N|² with
-    // dN = H dx, so ∇ψ = H N⊥ / |N|² = H t / |N|.
-    let gradient = geometry.hessian * tangent / length;
-    Some((tangent.y.atan2(tangent.x), gradient))
-}
-
 /// The body's angle less the curve's tangent angle at the anchor and
-/// `offset`, wrapped into `(−π, π]`, as a row of the body. `None` at a
-/// singular point.
+/// `offset`, wrapped into `(−π, π]`, as a row of the body: `ψ = atan2(t)`
+/// with the tangent `t = ∇C⊥ / |∇C|` turns as the anchor moves, with
+/// `∇ψ = H t / |∇C|` (`H` the Hessian of `C`). `None` at a singular point.
+#[cfg(test)]
 pub(crate) fn turned_with_curve(
     curve: &impl ImplicitCurve,
     body: &PlaneBody,
     offset: f64,
 ) -> Option<BodyRow> {
-    let anchor = body.anchor();
-    let (psi, gradient) = tangent_angle(curve, anchor)?;
-    // ψ depends on the anchor, which moves with the centre and turns about
-    // it: ∂a/∂c = I, ∂a/∂θ = (a − c)⊥.
-    Some(BodyRow {
-        value: wrap(body.angle - psi - offset),
-        along_centre: -gradient,
-        along_angle: 1.0 - gradient.dot(perp(anchor - body.centre)),
-    })
+    Some(AtAnchor::new(curve, body)?.turned(body.angle, offset))
 }
 
 /// The tangent angle at the anchor that a body turned with the curve keeps
 /// its own angle from: `θ − ψ`, wrapped. `None` at a singular point.
 pub(crate) fn turn_offset(curve: &impl ImplicitCurve, body: &PlaneBody) -> Option<f64> {
-    let (psi, _) = tangent_angle(curve, body.anchor())?;
-    Some(wrap(body.angle - psi))
+    Some(AtAnchor::new(curve, body)?.turned(body.angle, 0.0).value)
 }
 
 /// `angle` wrapped into `(−π, π]`.
@@ -300,6 +363,30 @@ fn wrap(angle: f64) -> f64 {
     use std::f64::consts::{PI, TAU};
     let wrapped = angle.rem_euclid(TAU);
     if wrapped > PI { wrapped - TAU } else { wrapped }
+}
+
+/// How much more a wire may turn between two anchors than its curvature
+/// at them says before the turn is a sharp corner, rad.
+const CORNER_SLACK: f64 = 0.02;
+
+/// Whether the wire turns a sharp corner between the anchor of `from` on
+/// `curve_from` and that of `to` on `curve_to`: its normal turns between
+/// them by more than twice what its curvature at the two (`|∇ψ|`) turns
+/// it over the distance, and [`CORNER_SLACK`] beside. On a smooth wire
+/// the normal turns by the curvature times the distance, to second order.
+pub(crate) fn turns_a_corner(
+    curve_from: &impl ImplicitCurve,
+    from: &PlaneBody,
+    curve_to: &impl ImplicitCurve,
+    to: &PlaneBody,
+) -> bool {
+    let (Some(a), Some(b)) = (AtAnchor::new(curve_from, from), AtAnchor::new(curve_to, to)) else {
+        return false;
+    };
+    let turn = a.normal.angle_to(b.normal).abs();
+    let bend = (a.turn_gradient.length() + b.turn_gradient.length())
+        * (to.anchor() - from.anchor()).length();
+    turn > bend + CORNER_SLACK
 }
 
 /// What [`project`] found: the body on its rows, the multipliers that put
@@ -344,7 +431,7 @@ pub(crate) fn project(
                 converged: true,
             });
         }
-        lambda += solve(rows.matrix(start, &body, compliance), -residual)?;
+        lambda += solve(rows.matrix(start, &body, compliance), -residual, rows.len())?;
         body = predicted.moved(start, lambda);
     }
     let converged = rows_at(&body)
@@ -371,7 +458,7 @@ pub(crate) fn project_velocity(
         return Some((v, DVec3::ZERO));
     }
     let excess = rows.rates(v) - rows.rates(frame);
-    let impulse = solve(rows.matrix(rows, body, 0.0), -excess)?;
+    let impulse = solve(rows.matrix(rows, body, 0.0), -excess, rows.len())?;
     Some((v.kicked(body, rows, impulse), impulse))
 }
 
