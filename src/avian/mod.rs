@@ -386,16 +386,23 @@ fn wire_of<'a>(
         .and_then(|(wire, pose)| Some((wire.shape(), pose.path()?)))
 }
 
+/// Each joint with the body it holds, as the substep's solver has it.
+type JointBodies<'w, 's> = Query<
+    'w,
+    's,
+    (
+        &'static PathJoint,
+        &'static mut PathJointState,
+        &'static mut SolverBody,
+        &'static SolverBodyInertia,
+    ),
+>;
+
 /// SHAKE's step for each joint in the substep: the body, moved freely by
 /// avian's substep, put back on its rows along their gradients where the
 /// substep began, to rounding.
 fn solve_path_joints(
-    mut joints: Query<(
-        &PathJoint,
-        &mut PathJointState,
-        &mut SolverBody,
-        &SolverBodyInertia,
-    )>,
+    mut joints: JointBodies,
     wires: Query<(&Wire, &WirePose<DVec2>)>,
     time: Res<Time>,
 ) {
@@ -513,23 +520,10 @@ fn solve_path_joint(
 }
 
 /// RATTLE's velocity step for each joint, after avian has turned the
-/// substep's corrections into velocity: the motor or friction along the
-/// wire, then the velocity onto the rows where the substep ends, the end
-/// of an open wire stopping an anchor that would pass it.
-fn project_path_joint_velocities(
-    mut joints: Query<(
-        &PathJoint,
-        &mut PathJointState,
-        &mut SolverBody,
-        &SolverBodyInertia,
-    )>,
-    wires: Query<(&Wire, &WirePose<DVec2>)>,
-    time: Res<Time>,
-) {
-    let h = time.delta_secs_f64();
-    if h.is_nan() || h <= 0.0 {
-        return;
-    }
+/// substep's corrections into velocity: the velocity onto the rows where
+/// the substep ends, the end of an open wire stopping an anchor that
+/// would pass it (the motor and friction act in the position step).
+fn project_path_joint_velocities(mut joints: JointBodies, wires: Query<(&Wire, &WirePose<DVec2>)>) {
     joints
         .par_iter_mut()
         .for_each(|(joint, mut state, mut body, inertia)| {

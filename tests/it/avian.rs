@@ -56,14 +56,26 @@ fn pendulum(app: &mut App, theta0: f64, inertia: f32, rotation: PathRotation) ->
         .spawn((Wire::circle(1.0).expect("a circle"), Transform::IDENTITY))
         .id();
     let at = DVec2::new(theta0.sin(), -theta0.cos());
+    held_body(
+        app,
+        at,
+        1.0,
+        inertia,
+        PathJoint::new(wire).with_rotation(rotation),
+    )
+}
+
+/// A dynamic body of `mass` and `inertia` at `at`, never asleep, held by
+/// `joint`.
+fn held_body(app: &mut App, at: DVec2, mass: f32, inertia: f32, joint: PathJoint) -> Entity {
     app.world_mut()
         .spawn((
             RigidBody::Dynamic,
             Position(at.adjust_precision()),
-            Mass(1.0),
+            Mass(mass),
             AngularInertia(inertia),
             SleepingDisabled,
-            PathJoint::new(wire).with_rotation(rotation),
+            joint,
         ))
         .id()
 }
@@ -381,20 +393,16 @@ fn a_motor_drives_a_hoops_body_counter_clockwise() {
         .world_mut()
         .spawn((Wire::circle(1.0).expect("a circle"), Transform::IDENTITY))
         .id();
-    let body = app
-        .world_mut()
-        .spawn((
-            RigidBody::Dynamic,
-            Position::from_xy(0.0, -1.0),
-            Mass(1.0),
-            AngularInertia(0.1),
-            SleepingDisabled,
-            PathJoint::new(wire).with_motor(PathMotor::Velocity {
-                speed: 1.0,
-                max_force: 100.0,
-            }),
-        ))
-        .id();
+    let body = held_body(
+        &mut app,
+        DVec2::new(0.0, -1.0),
+        1.0,
+        0.1,
+        PathJoint::new(wire).with_motor(PathMotor::Velocity {
+            speed: 1.0,
+            max_force: 100.0,
+        }),
+    );
     let mut worst = 0.0f64;
     // Past the first second, once at speed; round once in 2π s.
     for step in 0..420 {
@@ -467,17 +475,13 @@ fn the_end_of_an_open_wire_stops_the_body() {
             Transform::IDENTITY,
         ))
         .id();
-    let body = app
-        .world_mut()
-        .spawn((
-            RigidBody::Dynamic,
-            Position::from_xy(0.0, 0.0),
-            Mass(1.0),
-            AngularInertia(0.1),
-            SleepingDisabled,
-            PathJoint::new(wire),
-        ))
-        .id();
+    let body = held_body(
+        &mut app,
+        DVec2::new(0.0, 0.0),
+        1.0,
+        0.1,
+        PathJoint::new(wire),
+    );
     let end = DVec2::new(2.0, -1.0);
     // Sliding 2.24 m at g sin(26.6°) = 4.39 m/s² takes about a second.
     for _ in 0..90 {
@@ -527,17 +531,13 @@ fn a_position_motor_draws_the_body_to_its_target() {
 fn a_path_joint_on_no_wire_holds_nothing() {
     let mut app = physics_app(SUBSTEPS);
     let not_a_wire = app.world_mut().spawn(Transform::IDENTITY).id();
-    let body = app
-        .world_mut()
-        .spawn((
-            RigidBody::Dynamic,
-            Position::from_xy(0.0, 0.0),
-            Mass(1.0),
-            AngularInertia(0.5),
-            SleepingDisabled,
-            PathJoint::new(not_a_wire),
-        ))
-        .id();
+    let body = held_body(
+        &mut app,
+        DVec2::new(0.0, 0.0),
+        1.0,
+        0.5,
+        PathJoint::new(not_a_wire),
+    );
     for _ in 0..60 {
         app.update();
     }
@@ -610,20 +610,16 @@ fn a_body_keeps_its_branch_where_a_figure_eight_crosses_itself() {
             Transform::IDENTITY,
         ))
         .id();
-    let body = app
-        .world_mut()
-        .spawn((
-            RigidBody::Dynamic,
-            Position::from_xy(0.0, 0.0),
-            Mass(1.0),
-            AngularInertia(0.1),
-            SleepingDisabled,
-            PathJoint::new(wire).with_motor(PathMotor::Velocity {
-                speed: 4.0,
-                max_force: 200.0,
-            }),
-        ))
-        .id();
+    let body = held_body(
+        &mut app,
+        DVec2::new(0.0, 0.0),
+        1.0,
+        0.1,
+        PathJoint::new(wire).with_motor(PathMotor::Velocity {
+            speed: 4.0,
+            max_force: 200.0,
+        }),
+    );
     // The lobe of each visit to a lobe's far part (|x| > 1.5).
     let mut lobes: Vec<bool> = Vec::new();
     let (mut inside, mut off, mut steps) = (false, 0.0f64, 0);
