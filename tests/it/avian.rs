@@ -553,6 +553,91 @@ fn a_path_joint_on_no_wire_holds_nothing() {
     );
 }
 
+/// Numbers a joint cannot use are read as documented, never as NaN: a
+/// compliance that is negative or NaN is rigid, a motor whose speed,
+/// frequency or force limit is NaN drives nothing, and a negative force
+/// limit gives no force. Each such body swings as the plain pendulum
+/// beside it, to 1e-9 m after 2 s, on its hoop to 1e-5 m.
+#[test]
+fn a_joint_given_bad_numbers_holds_its_body_as_a_plain_joint() {
+    let mut app = physics_app(SUBSTEPS);
+    let theta0 = std::f64::consts::FRAC_PI_3;
+    let plain = pendulum(&mut app, theta0, 0.5, PathRotation::Free);
+    let velocity = |speed, max_force| PathMotor::Velocity { speed, max_force };
+    let spring = |frequency| PathMotor::Position {
+        target: DVec2::new(0.0, -1.0),
+        frequency,
+        damping_ratio: 1.0,
+        max_force: 10.0,
+    };
+    let bad: Vec<(&str, Box<dyn Fn(PathJoint) -> PathJoint>)> = vec![
+        (
+            "a negative compliance",
+            Box::new(|j| PathJoint {
+                compliance: -1.0,
+                ..j
+            }),
+        ),
+        (
+            "a NaN compliance",
+            Box::new(|j| PathJoint {
+                compliance: f64::NAN,
+                ..j
+            }),
+        ),
+        (
+            "a NaN motor speed",
+            Box::new(move |j| j.with_motor(velocity(f64::NAN, 10.0))),
+        ),
+        (
+            "a NaN force limit",
+            Box::new(move |j| j.with_motor(velocity(1.0, f64::NAN))),
+        ),
+        (
+            "a negative force limit",
+            Box::new(move |j| j.with_motor(velocity(1.0, -5.0))),
+        ),
+        (
+            "a NaN spring",
+            Box::new(move |j| j.with_motor(spring(f64::NAN))),
+        ),
+        ("a NaN friction", Box::new(|j| j.with_friction(f64::NAN))),
+    ];
+    let bodies: Vec<(&str, Entity)> = bad
+        .iter()
+        .map(|(what, joint)| {
+            let wire = app
+                .world_mut()
+                .spawn((Wire::circle(1.0).expect("a circle"), Transform::IDENTITY))
+                .id();
+            let at = DVec2::new(theta0.sin(), -theta0.cos());
+            (
+                *what,
+                held_body(&mut app, at, 1.0, 0.5, joint(PathJoint::new(wire))),
+            )
+        })
+        .collect();
+    let mut off = vec![0.0f64; bodies.len()];
+    for _ in 0..120 {
+        app.update();
+        for ((_, body), off) in bodies.iter().zip(&mut off) {
+            let (p, ..) = body_state(&app, *body);
+            *off = off.max((p.length() - 1.0).abs());
+        }
+    }
+    let (expected, ..) = body_state(&app, plain);
+    for ((what, body), off) in bodies.iter().zip(&off) {
+        let (p, v, angle, spin) = body_state(&app, *body);
+        assert!(
+            p.is_finite() && v.is_finite() && angle.is_finite() && spin.is_finite(),
+            "{what}: a number is not finite"
+        );
+        assert!(*off <= 1e-5, "{what}: {off} m off the hoop");
+        let apart = (p - expected).length();
+        assert!(apart <= 1e-9, "{what}: {apart} m from the plain pendulum");
+    }
+}
+
 /// A kinematic body goes where the game sends it, its path joint
 /// notwithstanding: sent at 1 m/s from the circle's centre, it is 1 m
 /// along after a second.
