@@ -105,7 +105,7 @@ pub use dynamics::{
     DivergenceReason, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams, NextParams, NextWireShape,
     OnWire, Pin, PrescribedMotion, RailOrientation, Restitution, Rod, SendsBeadsBack, SimParams,
     SpaceBead, SpaceBeadBundle, SpaceParams, SpaceWire, Spring, SpringAnchor, Wire, WireBeads,
-    WireContact, WireRows, pose_of,
+    WireContact, WirePlace, WireRows, pose_of,
 };
 pub use geometry::{
     Friction, ImplicitCurve, Oscillate, Side, Spin, Surface, WireKind, WireMotion, WireShape,

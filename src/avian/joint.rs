@@ -54,7 +54,7 @@ pub enum PathMotor {
 /// frame from its origin, as avian's joints take theirs) on the wire
 /// `wire`, free to slide along it. The body needs avian's `RigidBody`
 /// (a dynamic one: a kinematic or static body is not moved by its joint);
-/// the wire is an entity with a [`Wire`] (fixed, or moving as any wire of
+/// the wire is an entity with a [`Wire`](crate::Wire) (fixed, or moving as any wire of
 /// ours moves). A joint naming an entity that is no wire holds nothing,
 /// and says so once in the log. The ends of an open wire (a spline, a
 /// cycloid) stop the anchor there, as a buffer stops a cart.

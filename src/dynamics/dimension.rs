@@ -5,7 +5,8 @@ use bevy::math::{DQuat, DVec2, DVec3};
 use bevy::prelude::*;
 use bevy::reflect::{GetTypeRegistration, Typed};
 
-use super::wire::WirePose;
+use super::PrescribedMotion;
+use super::wire::{WirePlace, WirePose};
 use super::{Bead, BeadBundle, BeadParams, SimParams, SpaceBead, SpaceBeadBundle, SpaceWire, Wire};
 use crate::geometry::{
     History, HistoryPose, Placement, Pose, Pose3, PoseHistory, PosePath, SpaceHistory, SpacePath,
@@ -207,8 +208,69 @@ fn settle<P: HistoryPose, Path>(
 impl<V: Dimension> WirePose<V> {
     /// The wire held at `transform`, or none if it is not finite.
     pub(crate) fn from_transform(transform: &Transform) -> Self {
-        Self::new(V::pose_of(transform).ok().map(V::fixed_path))
+        Self::placed(transform, None)
     }
+
+    /// The wire held where [`wire_pose`] puts it, or none if neither its
+    /// place nor its `transform` is finite.
+    pub(crate) fn placed(transform: &Transform, place: Option<&WirePlace<V>>) -> Self {
+        Self::new(wire_pose(transform, place).ok().map(V::fixed_path))
+    }
+}
+
+/// A wire's pose: its [`WirePlace`] while its `transform` shows that
+/// place (as [`Dimension::set_pose`] writes it, in `f32`), else the
+/// `transform`'s own; an error if that is not finite.
+pub(crate) fn wire_pose<V: Dimension>(
+    transform: &Transform,
+    place: Option<&WirePlace<V>>,
+) -> Result<V::Pose, ParamError> {
+    match place {
+        Some(&WirePlace(pose))
+            if is_placement::<V>(pose) && shown::<V>(transform, pose) == *transform =>
+        {
+            Ok(pose)
+        }
+        _ => V::pose_of(transform),
+    }
+}
+
+/// `transform` moved to `pose`, in `f32`.
+fn shown<V: Dimension>(transform: &Transform, pose: V::Pose) -> Transform {
+    let mut shown = *transform;
+    V::set_pose(&mut shown, pose);
+    shown
+}
+
+/// Whether `pose` places a wire: its origin finite and its turn a
+/// rotation (each axis turned to a unit direction, to 1e-9).
+fn is_placement<V: Dimension>(pose: V::Pose) -> bool {
+    pose.origin().xyz().is_finite()
+        && V::AXES.iter().all(|&axis| {
+            let turned = pose.rotate(axis).xyz();
+            turned.is_finite() && (turned.length_squared() - 1.0).abs() <= 1e-9
+        })
+}
+
+/// A wire put at its [`WirePlace`], if it has a valid one: its
+/// `transform` written from it and its `pose` there, on its `motion`
+/// about it if it has one. A wire without a place keeps what it has.
+pub(crate) fn put_in_place<V: Dimension>(
+    place: Option<&WirePlace<V>>,
+    motion: Option<&PrescribedMotion<V>>,
+    transform: &mut Mut<Transform>,
+    pose: &mut Mut<WirePose<V>>,
+) {
+    let Some(&WirePlace(at)) = place.filter(|p| is_placement::<V>(p.0)) else {
+        return;
+    };
+    let moved = shown::<V>(transform, at);
+    transform.set_if_neq(moved);
+    let placed = match motion {
+        Some(motion) => WirePose::on(V::prescribed_path(at, motion.motion())),
+        None => WirePose::on(V::fixed_path(at)),
+    };
+    pose.set_if_neq(placed);
 }
 
 /// A point in the frame of `transform`, in the world: `offset` placed by

@@ -20,6 +20,7 @@ pub use bead::{
 pub(crate) use bead::{BeadMotion, BeadMotionItem};
 pub use diagnostics::{BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason};
 pub use dimension::{Dimension, WireRows};
+pub(crate) use dimension::{put_in_place, wire_pose};
 pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
 pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, NextParams, SimParams, SpaceParams};
 pub use rail::RailOrientation;
@@ -29,5 +30,5 @@ pub use touch::{
 pub(crate) use wire::WirePose;
 pub use wire::{
     ContactChanged, NextWireShape, OnWire, PrescribedMotion, SpaceWire, Wire, WireBeads,
-    WireContact, pose_of,
+    WireContact, WirePlace, pose_of,
 };

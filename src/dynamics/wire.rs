@@ -8,8 +8,8 @@ use bevy::prelude::*;
 
 use crate::geometry::not_placeable;
 use crate::geometry::{
-    Circle, Coordinates, Ellipse, ImplicitCurve, ImplicitSurface, Line, Parabola, Pose, Sine,
-    SpaceCurve, SpaceMotion, SpaceShape, Surface, WireMotion, WireShape, WireSpace,
+    Circle, Coordinates, Ellipse, ImplicitCurve, ImplicitSurface, Line, Parabola, Pose, Pose3,
+    Sine, SpaceCurve, SpaceMotion, SpaceShape, Surface, WireMotion, WireShape, WireSpace,
 };
 use crate::solver::{Contact, ContactEvent};
 use crate::validate::ParamError;
@@ -101,6 +101,35 @@ impl Wire {
     /// The shape.
     pub fn shape(&self) -> &WireShape {
         &self.shape
+    }
+}
+
+/// Where a wire is, in `f64`: its origin and turn as the solver takes
+/// them ([`Pose`] in the plane, [`Pose3`] in space), where a `Transform` holds them in `f32`. A wire with one is
+/// placed exactly there: the plugin writes its `Transform` from it (at
+/// that edge, in `f32`), and takes the place, not the `Transform`, while
+/// the `Transform` still shows it. Scene files place their wires so.
+///
+/// A game moves such a wire by writing either: the place (followed
+/// exactly, as a moved `Transform` is followed), or the `Transform` (the
+/// place then follows the `Transform`). On a wire with a
+/// [`PrescribedMotion`] it is the pose the motion is about. A place that
+/// is not finite, or whose turn is not a rotation, is not taken: the
+/// `Transform` places the wire.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct WirePlace<V: WireSpace = DVec2>(pub V::Pose);
+
+impl WirePlace {
+    /// A wire in the plane placed at `pose`.
+    pub fn new(pose: Pose) -> Self {
+        Self(pose)
+    }
+}
+
+impl WirePlace<DVec3> {
+    /// A wire in space placed at `pose`.
+    pub fn in_space(pose: Pose3) -> Self {
+        Self(pose)
     }
 }
 

@@ -11,7 +11,7 @@ use super::wires::prescribed;
 use crate::dynamics::{
     BeadDiagnostics, BeadMotion, BeadMotionItem, BeadParams, Dimension, Diverged, NextBeadParams,
     NextParams, NextWireShape, OnWire, PrescribedMotion, RailOrientation, SimParams, Wire,
-    WireContact, WirePose,
+    WireContact, WirePlace, WirePose,
 };
 use crate::geometry::{MovingTrack, Track, WireSpace};
 use crate::solver::{RowReport, constraint_state_on};
@@ -66,6 +66,7 @@ fn apply_restart(
         &mut WirePose,
         Option<&NextWireShape>,
         Option<&PrescribedMotion>,
+        Option<&WirePlace>,
     )>,
     mut beads: Query<(
         Entity,
@@ -84,12 +85,12 @@ fn apply_restart(
     }
     // Masses and wire shapes may change: the islands are built afresh.
     islands.mark_dirty();
-    for (entity, mut wire, mut transform, mut pose, edit, motion) in &mut wires {
+    for (entity, mut wire, mut transform, mut pose, edit, motion, place) in &mut wires {
         if let Some(edit) = edit {
             *wire = wire.reshaped(edit.shape());
             commands.entity(entity).remove::<NextWireShape>();
         }
-        rest_wire(motion, &mut transform, &mut pose);
+        rest_wire((motion, place), &mut transform, &mut pose);
     }
     *params = pending.get().clone();
     time.set_timestep_seconds(params.timestep);
@@ -130,18 +131,18 @@ fn apply_restart(
 /// A wire back where a run starts: one on a prescribed motion at its
 /// resting pose, one the game moved at rest where it is.
 fn rest_wire<V: Dimension>(
-    motion: Option<&PrescribedMotion<V>>,
+    (motion, place): (Option<&PrescribedMotion<V>>, Option<&WirePlace<V>>),
     transform: &mut Transform,
     pose: &mut WirePose<V>,
 ) {
     match motion {
         Some(motion) => {
-            *pose = prescribed(motion, pose, transform);
+            *pose = prescribed(motion, pose, transform, place);
             if let Ok(path) = pose.get() {
                 V::set_pose(transform, V::path_at(&path, 0.0).0);
             }
         }
-        None => *pose = WirePose::from_transform(transform),
+        None => *pose = WirePose::placed(transform, place),
     }
 }
 
@@ -188,6 +189,7 @@ fn restart_in_space(
         &mut Transform,
         &mut WirePose<DVec3>,
         Option<&PrescribedMotion<DVec3>>,
+        Option<&WirePlace<DVec3>>,
     )>,
     mut beads: Query<(
         Entity,
@@ -206,8 +208,8 @@ fn restart_in_space(
         return;
     }
     islands.mark_dirty();
-    for (mut transform, mut pose, motion) in &mut wires {
-        rest_wire(motion, &mut transform, &mut pose);
+    for (mut transform, mut pose, motion, place) in &mut wires {
+        rest_wire((motion, place), &mut transform, &mut pose);
     }
     let gravity = DVec3::gravity(&params);
     for (entity, mut bead, mut bead_params, edit, diagnostics, contact, on_wire, rail) in &mut beads

@@ -1,7 +1,8 @@
 //! [`WirePosePlugin`]: places every wire for the step, in
 //! [`WireBeadSystems::Prepare`]. It reads each changed wire `Transform`
 //! once, so the beads do not; writes the `Transform` of a wire on a
-//! prescribed motion; and takes in the pose of a wire the game moves.
+//! prescribed motion or at a [`WirePlace`]; and takes in the pose of a
+//! wire the game moves.
 //! Each system runs for the plane's wires and for space's.
 
 use std::marker::PhantomData;
@@ -12,7 +13,9 @@ use bevy::prelude::*;
 
 use super::clock::{SimClock, advance_clock};
 use super::schedule::WireBeadSystems;
-use crate::dynamics::{Dimension, PrescribedMotion, SimParams, WirePose};
+use crate::dynamics::{
+    Dimension, PrescribedMotion, SimParams, WirePlace, WirePose, put_in_place, wire_pose,
+};
 
 /// Places the wires for each step: a wire's pose when it is added, its
 /// prescribed motion, or the motion a game gives it by writing its
@@ -31,11 +34,15 @@ impl Plugin for WirePosePlugin {
 fn add_wire_poses<V: Dimension>(app: &mut App) {
     app.init_resource::<MovingWires<V>>()
         .add_observer(wire_added::<V>)
+        .add_observer(place_inserted::<V>)
         .add_observer(motion_added::<V>)
         .add_systems(
             FixedUpdate,
-            place_wires::<V>
-                .run_if(wires_to_place::<V>)
+            (
+                follow_places::<V>,
+                place_wires::<V>.run_if(wires_to_place::<V>),
+            )
+                .chain()
                 .before(advance_clock)
                 .in_set(WireBeadSystems::Prepare),
         );
@@ -86,9 +93,14 @@ fn wires_to_place<V: Dimension>(
 pub(crate) fn place_wires<V: Dimension>(
     params: Res<SimParams>,
     clock: Res<SimClock>,
-    mut driven: Query<(&PrescribedMotion<V>, &mut Transform, &mut WirePose<V>)>,
+    mut driven: Query<(
+        &PrescribedMotion<V>,
+        &mut Transform,
+        &mut WirePose<V>,
+        Option<&WirePlace<V>>,
+    )>,
     mut followed: Query<
-        (Ref<Transform>, &mut WirePose<V>),
+        (Ref<Transform>, &mut WirePose<V>, Option<&mut WirePlace<V>>),
         (With<V::Wire>, Without<PrescribedMotion<V>>),
     >,
     moved: Query<
@@ -102,8 +114,8 @@ pub(crate) fn place_wires<V: Dimension>(
     mut moving: ResMut<MovingWires<V>>,
 ) {
     let (start, h) = (clock.time, params.timestep);
-    for (motion, mut transform, mut pose) in &mut driven {
-        let placed = prescribed(motion, &pose, &transform);
+    for (motion, mut transform, mut pose, place) in &mut driven {
+        let placed = prescribed(motion, &pose, &transform, place);
         pose.set_if_neq(placed);
         if let Some(path) = placed.path() {
             V::set_pose(&mut transform, V::path_at(&path, start + h).0);
@@ -112,13 +124,21 @@ pub(crate) fn place_wires<V: Dimension>(
     let mut still_moving = EntityHashSet::default();
     let before = moving.0.iter().copied().filter(|&e| !moved.contains(e));
     for entity in moved.iter().chain(before) {
-        let Ok((transform, mut pose)) = followed.get_mut(entity) else {
+        let Ok((transform, mut pose, place)) = followed.get_mut(entity) else {
             continue;
         };
-        let Ok(now) = V::pose_of(&transform) else {
+        let Ok(now) = wire_pose(&transform, place.as_deref()) else {
             pose.set_if_neq(WirePose::from_transform(&transform));
             continue;
         };
+        // A `Transform` the game moved off the wire's place: the place
+        // follows it, without looking changed (which would move the
+        // `Transform` back to it).
+        if let Some(mut place) = place
+            && place.0 != now
+        {
+            place.bypass_change_detection().0 = now;
+        }
         let (path, moves) = V::followed(pose.path(), now, start, h);
         if moves {
             still_moving.insert(entity);
@@ -128,14 +148,58 @@ pub(crate) fn place_wires<V: Dimension>(
     moving.0 = still_moving;
 }
 
-/// Places a wire where its `Transform` puts it the moment it is added, so
-/// that a game moving it from its first step on moves it from there.
-fn wire_added<V: Dimension>(
-    add: On<Add, V::Wire>,
-    mut wires: Query<(&Transform, &mut WirePose<V>)>,
+/// Places a wire the moment it is added, at its [`WirePlace`] if it has
+/// one, else where its `Transform` puts it, so that a game moving it from
+/// its first step on moves it from there.
+fn wire_added<V: Dimension>(add: On<Add, V::Wire>, mut wires: Query<PlacedWire<V>>) {
+    if let Ok((place, motion, mut transform, mut pose)) = wires.get_mut(add.entity) {
+        if place.is_some() {
+            put_in_place(place, motion, &mut transform, &mut pose);
+        } else {
+            *pose = WirePose::from_transform(&transform);
+        }
+    }
+}
+
+/// A wire's place, motion, `Transform` and pose, as [`put_in_place`]
+/// takes them.
+type PlacedWire<V> = (
+    Option<&'static WirePlace<V>>,
+    Option<&'static PrescribedMotion<V>>,
+    &'static mut Transform,
+    &'static mut WirePose<V>,
+);
+
+/// Puts a wire at the [`WirePlace`] inserted on it.
+fn place_inserted<V: Dimension>(insert: On<Insert, WirePlace<V>>, mut wires: Query<PlacedWire<V>>) {
+    if let Ok((place, motion, mut transform, mut pose)) = wires.get_mut(insert.entity) {
+        put_in_place(place, motion, &mut transform, &mut pose);
+    }
+}
+
+/// Moves the `Transform` of each wire whose [`WirePlace`] the game wrote
+/// there, so that [`place_wires`] follows it (from the place itself, in
+/// `f64`); a wire on a prescribed motion moves about its new place.
+fn follow_places<V: Dimension>(
+    mut wires: Query<
+        (
+            &WirePlace<V>,
+            Option<&PrescribedMotion<V>>,
+            &mut Transform,
+            &mut WirePose<V>,
+        ),
+        (With<V::Wire>, Changed<WirePlace<V>>),
+    >,
 ) {
-    if let Ok((transform, mut pose)) = wires.get_mut(add.entity) {
-        *pose = WirePose::from_transform(transform);
+    for (place, motion, mut transform, mut pose) in &mut wires {
+        match motion {
+            Some(_) => put_in_place(Some(place), motion, &mut transform, &mut pose),
+            None => {
+                let mut moved = *transform;
+                V::set_pose(&mut moved, place.0);
+                transform.set_if_neq(moved);
+            }
+        }
     }
 }
 
@@ -144,24 +208,31 @@ fn wire_added<V: Dimension>(
 /// starts its beads on the moving wire.
 fn motion_added<V: Dimension>(
     insert: On<Insert, PrescribedMotion<V>>,
-    mut wires: Query<(&PrescribedMotion<V>, &Transform, &mut WirePose<V>)>,
+    mut wires: Query<(
+        &PrescribedMotion<V>,
+        &Transform,
+        &mut WirePose<V>,
+        Option<&WirePlace<V>>,
+    )>,
 ) {
-    if let Ok((motion, transform, mut pose)) = wires.get_mut(insert.entity) {
-        let placed = prescribed(motion, &pose, transform);
+    if let Ok((motion, transform, mut pose, place)) = wires.get_mut(insert.entity) {
+        let placed = prescribed(motion, &pose, transform, place);
         pose.set_if_neq(placed);
     }
 }
 
 /// A wire on `motion` about its resting pose: the one `pose` already
-/// holds, else its `Transform`'s (when the motion first applies).
+/// holds, else (when the motion first applies) its place or its
+/// `Transform`'s (see [`wire_pose`]).
 pub(crate) fn prescribed<V: Dimension>(
     motion: &PrescribedMotion<V>,
     pose: &WirePose<V>,
     transform: &Transform,
+    place: Option<&WirePlace<V>>,
 ) -> WirePose<V> {
     let base = match pose.path().and_then(|path| V::prescribed_base(&path)) {
         Some(base) => Ok(base),
-        None => V::pose_of(transform),
+        None => wire_pose(transform, place),
     };
     match base {
         Ok(base) => WirePose::on(V::prescribed_path(base, motion.motion())),

@@ -12,7 +12,9 @@ use super::format::{
     catching_and_sending, check_beads_and_links, given_some, is_false, names_of, written_some,
 };
 use super::spawn::{FromPreset, spawn_beads_and_links};
-use crate::dynamics::{CatchesBeads, PrescribedMotion, RailOrientation, SpaceParams, SpaceWire};
+use crate::dynamics::{
+    CatchesBeads, PrescribedMotion, RailOrientation, SpaceParams, SpaceWire, WirePlace,
+};
 use crate::geometry::{
     Circle, Cone, Cycloid, Cylinder, Ellipse, Friction, Helix, Line, OnPlane, Oscillate, Parabola,
     Plane, Pose3, Side, Sine, SpaceMotion, SpaceShape, Sphere, Spline, Surface, Torus, WireShape,
@@ -388,12 +390,11 @@ impl SpaceScene {
         let mut wires = Vec::new();
         for wire in &self.wires {
             let Ok(pose) = wire.pose() else { continue };
-            let transform = Transform::from_translation(pose.origin.as_vec3())
-                .with_rotation(pose.rotation.as_quat());
             let component = SpaceWire::new(wire.shape.shape()).with_surface(wire.surface());
             let motion = wire.motion.motion();
             let wire_entity = component.ok().map(|component| {
-                let mut entity = commands.spawn((component, transform, FromPreset));
+                // In `f64` to the solver; the plugin writes the `Transform`.
+                let mut entity = commands.spawn((component, WirePlace::in_space(pose), FromPreset));
                 if let Ok(prescribed) = PrescribedMotion::in_space(motion)
                     && motion != SpaceMotion::Fixed
                 {

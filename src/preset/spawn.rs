@@ -6,7 +6,7 @@ use bevy::prelude::*;
 use super::format::{BeadPreset, SceneLink, ScenePreset};
 use crate::dynamics::{
     BeadRadius, BeadVelocity, CatchesBeads, Dimension, OnWire, Pin, PrescribedMotion, Rod, Spring,
-    Wire,
+    Wire, WirePlace,
 };
 use crate::geometry::{Pose, Twist};
 
@@ -22,12 +22,11 @@ impl ScenePreset {
     pub fn spawn(&self, commands: &mut Commands) -> Vec<Entity> {
         let mut wires = Vec::new();
         for wire in &self.wires {
-            let transform =
-                Transform::from_xyz(wire.position.x as f32, wire.position.y as f32, 0.0)
-                    .with_rotation(Quat::from_rotation_z(wire.angle_degrees.to_radians() as f32));
+            // In `f64` to the solver; the plugin writes the `Transform`.
+            let base = Pose::new(wire.position, wire.angle_degrees.to_radians());
             let made = Wire::new(wire.shape.clone()).and_then(|w| w.with_surface(wire.surface()));
             let wire_entity = made.ok().map(|component| {
-                let mut entity = commands.spawn((component, transform, FromPreset));
+                let mut entity = commands.spawn((component, WirePlace::new(base), FromPreset));
                 if let Ok(motion) = PrescribedMotion::new(wire.motion)
                     && wire.motion.moves()
                 {
@@ -41,7 +40,6 @@ impl ScenePreset {
                 }
                 entity.id()
             });
-            let base = Pose::new(wire.position, wire.angle_degrees.to_radians());
             let (_, twist) = wire.motion.at(base, 0.0);
             wires.push((wire_entity, twist, wire.beads.as_slice()));
         }

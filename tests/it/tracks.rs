@@ -5,9 +5,10 @@ use std::f64::consts::TAU;
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
+use wirebead::geometry::Pose;
 use wirebead::prelude::*;
 use wirebead::{ContactChanged, Side, SimClock, Stabilization, Surface, WireContact};
-use wirebead::{Oscillate, PrescribedMotion, ScenePreset, WireMotion};
+use wirebead::{Oscillate, PrescribedMotion, ScenePreset, WireMotion, WirePlace};
 
 use crate::common::{Recording, app, run_for, spawn_bead, spawn_wire};
 
@@ -111,10 +112,34 @@ fn shake_wire(
     }
 }
 
+/// Writes the shaken wire's [`WirePlace`] for the end of the coming step,
+/// in `f64`, as a game moving a platform exactly would.
+fn shake_place(
+    clock: Res<SimClock>,
+    params: Res<SimParams>,
+    mut wires: Query<&mut WirePlace, With<Wire>>,
+) {
+    let t = clock.time + params.timestep;
+    let origin = SHAKE.amplitude * (TAU * SHAKE.frequency * t).sin();
+    for mut place in &mut wires {
+        place.0 = Pose::new(origin, 0.0);
+    }
+}
+
+/// How the shaken wire moves.
+#[derive(Clone, Copy, PartialEq)]
+enum Shaken {
+    /// By a [`PrescribedMotion`].
+    Prescribed,
+    /// By the game writing its `Transform`.
+    ByTransform,
+    /// By the game writing its [`WirePlace`].
+    ByPlace,
+}
+
 /// A pendulum on a circle shaken by `SHAKE` for 2 s at `dt`, the wire
-/// driven by a [`PrescribedMotion`] or moved by the game; the bead's last
-/// position.
-fn shaken_pendulum(dt: f64, by_game: bool) -> DVec2 {
+/// moved as `shaken` says; the bead's last position.
+fn shaken_pendulum(dt: f64, shaken: Shaken) -> DVec2 {
     let mut app = app(SimParams {
         timestep: dt,
         method: Method::Rattle,
@@ -124,11 +149,20 @@ fn shaken_pendulum(dt: f64, by_game: bool) -> DVec2 {
         .world_mut()
         .spawn((Wire::circle(1.0).unwrap(), Transform::default()))
         .id();
-    if by_game {
-        app.add_systems(FixedUpdate, shake_wire.before(WireBeadSystems::Prepare));
-    } else {
-        let motion = PrescribedMotion::new(WireMotion::Oscillate(SHAKE)).unwrap();
-        app.world_mut().entity_mut(wire).insert(motion);
+    match shaken {
+        Shaken::ByTransform => {
+            app.add_systems(FixedUpdate, shake_wire.before(WireBeadSystems::Prepare));
+        }
+        Shaken::ByPlace => {
+            app.world_mut()
+                .entity_mut(wire)
+                .insert(WirePlace::new(Pose::IDENTITY));
+            app.add_systems(FixedUpdate, shake_place.before(WireBeadSystems::Prepare));
+        }
+        Shaken::Prescribed => {
+            let motion = PrescribedMotion::new(WireMotion::Oscillate(SHAKE)).unwrap();
+            app.world_mut().entity_mut(wire).insert(motion);
+        }
     }
     let start = DVec2::new(60f64.to_radians().sin(), -60f64.to_radians().cos());
     // At rest relative to the wire, which starts at speed 2π f A.
@@ -142,25 +176,72 @@ fn shaken_pendulum(dt: f64, by_game: bool) -> DVec2 {
     let bead = app.world_mut().spawn((bead, OnWire(wire))).id();
     run_for(&mut app, 2.0);
     assert!(app.world().get::<Diverged>(bead).is_none());
+    if shaken == Shaken::ByPlace {
+        // The `Transform` shows the place, in `f32`.
+        let place = app.world().get::<WirePlace>(wire).unwrap().0.origin;
+        let shown = app.world().get::<Transform>(wire).unwrap().translation;
+        assert_eq!(shown.truncate(), place.as_vec2());
+    }
     app.world().get::<BeadPosition>(bead).unwrap().0
 }
 
 /// A game writing a wire's `Transform` each step gives the trajectory of
 /// the same prescribed motion, to second order in the timestep (the
-/// pose history's quadratic, see `WireBeadSystems::Prepare`).
+/// pose history's quadratic, see `WireBeadSystems::Prepare`); one writing
+/// its [`WirePlace`] in `f64` gives it to 1e-10 (3e-8 through the `f32`
+/// `Transform` at 1/100 s).
 #[test]
 fn a_wire_the_game_moves_gives_the_prescribed_motions_trajectory() {
-    let gap = |dt: f64| (shaken_pendulum(dt, true) - shaken_pendulum(dt, false)).length();
-    let (coarse, fine) = (gap(1.0 / 100.0), gap(1.0 / 200.0));
-    let order = (coarse / fine).log2();
-    eprintln!(
-        "game-moved vs prescribed after 2 s: {coarse:e} at 1/100 s, {fine:e} at 1/200 s, order {order:.2}"
+    let gap = |dt: f64, moved| {
+        (shaken_pendulum(dt, moved) - shaken_pendulum(dt, Shaken::Prescribed)).length()
+    };
+    let (coarse, fine) = (
+        gap(1.0 / 100.0, Shaken::ByTransform),
+        gap(1.0 / 200.0, Shaken::ByTransform),
     );
+    let order = (coarse / fine).log2();
     assert!(
         coarse < 1e-2,
         "the trajectories part by {coarse:e} at 1/100 s"
     );
     assert!(order > 1.8, "observed order {order:.2}");
+    for dt in [1.0 / 100.0, 1.0 / 200.0] {
+        let placed = gap(dt, Shaken::ByPlace);
+        assert!(
+            placed <= 1e-10,
+            "moved by its place, the trajectory parts by {placed:e} at {dt} s"
+        );
+    }
+}
+
+/// A scene's wire is at its [`WirePlace`]; a game that writes its
+/// `Transform` instead moves it there, the place following the
+/// `Transform`, and its bead rides it where it now is.
+#[test]
+fn a_placed_wire_moved_by_its_transform_is_followed_and_its_place_follows() {
+    let scene = preset("pendulum.scene.ron");
+    let mut app = app(scene.params.clone());
+    let bead = scene.spawn(&mut app.world_mut().commands())[0];
+    app.world_mut().flush();
+    let wire = app.world().get::<OnWire>(bead).unwrap().0;
+    let place = app.world().get::<WirePlace>(wire).copied().unwrap();
+    run_for(&mut app, 0.1);
+    let moved_to = Vec3::new(0.25, -0.5, 0.0);
+    app.world_mut()
+        .get_mut::<Transform>(wire)
+        .unwrap()
+        .translation = moved_to;
+    run_for(&mut app, 0.5);
+    let now = app.world().get::<WirePlace>(wire).unwrap().0;
+    assert_ne!(now, place.0);
+    assert_eq!(now.origin, moved_to.truncate().as_dvec2());
+    let shown = app.world().get::<Transform>(wire).unwrap().translation;
+    assert_eq!(shown, moved_to, "the Transform stays where the game put it");
+    // The bead is on the circle where it now is.
+    let at = app.world().get::<BeadPosition>(bead).unwrap().0;
+    let radius = 1.0;
+    let off = ((at - now.origin).length() - radius).abs();
+    assert!(off <= 1e-9, "the bead is {off:e} m off the moved wire");
 }
 
 /// Every contact change, as the plugin sends them.
