@@ -98,6 +98,12 @@ const SHAKE: Oscillate = Oscillate {
     frequency: 1.0,
 };
 
+/// Where the shaken wire is at the end of the coming step.
+fn shaken_origin(clock: &SimClock, params: &SimParams) -> DVec2 {
+    let t = clock.time + params.timestep;
+    SHAKE.amplitude * (TAU * SHAKE.frequency * t).sin()
+}
+
 /// Writes the shaken wire's `Transform` for the end of the coming step, as
 /// a game moving a platform would.
 fn shake_wire(
@@ -105,10 +111,9 @@ fn shake_wire(
     params: Res<SimParams>,
     mut wires: Query<&mut Transform, With<Wire>>,
 ) {
-    let t = clock.time + params.timestep;
-    let origin = SHAKE.amplitude * (TAU * SHAKE.frequency * t).sin();
+    let origin = shaken_origin(&clock, &params).as_vec2();
     for mut transform in &mut wires {
-        transform.translation = Vec3::new(origin.x as f32, origin.y as f32, 0.0);
+        transform.translation = origin.extend(0.0);
     }
 }
 
@@ -119,8 +124,7 @@ fn shake_place(
     params: Res<SimParams>,
     mut wires: Query<&mut WirePlace, With<Wire>>,
 ) {
-    let t = clock.time + params.timestep;
-    let origin = SHAKE.amplitude * (TAU * SHAKE.frequency * t).sin();
+    let origin = shaken_origin(&clock, &params);
     for mut place in &mut wires {
         place.0 = Pose::new(origin, 0.0);
     }
