@@ -244,7 +244,7 @@ fn shown<V: Dimension>(transform: &Transform, pose: V::Pose) -> Transform {
 
 /// Whether `pose` places a wire: its origin finite and its turn a
 /// rotation (each axis turned to a unit direction, to 1e-9).
-fn is_placement<V: Dimension>(pose: V::Pose) -> bool {
+pub(crate) fn is_placement<V: Dimension>(pose: V::Pose) -> bool {
     pose.origin().xyz().is_finite()
         && V::AXES.iter().all(|&axis| {
             let turned = pose.rotate(axis).xyz();
@@ -254,15 +254,16 @@ fn is_placement<V: Dimension>(pose: V::Pose) -> bool {
 
 /// A wire put at its [`WirePlace`], if it has a valid one: its
 /// `transform` written from it and its `pose` there, on its `motion`
-/// about it if it has one. A wire without a place keeps what it has.
+/// about it if it has one; whether it had one. A wire without a valid
+/// place keeps what it has.
 pub(crate) fn put_in_place<V: Dimension>(
     place: Option<&WirePlace<V>>,
     motion: Option<&PrescribedMotion<V>>,
     transform: &mut Mut<Transform>,
     pose: &mut Mut<WirePose<V>>,
-) {
+) -> bool {
     let Some(&WirePlace(at)) = place.filter(|p| is_placement::<V>(p.0)) else {
-        return;
+        return false;
     };
     let moved = shown::<V>(transform, at);
     transform.set_if_neq(moved);
@@ -271,6 +272,7 @@ pub(crate) fn put_in_place<V: Dimension>(
         None => WirePose::on(V::fixed_path(at)),
     };
     pose.set_if_neq(placed);
+    true
 }
 
 /// A point in the frame of `transform`, in the world: `offset` placed by

@@ -14,7 +14,8 @@ use bevy::prelude::*;
 use super::clock::{SimClock, advance_clock};
 use super::schedule::WireBeadSystems;
 use crate::dynamics::{
-    Dimension, PrescribedMotion, SimParams, WirePlace, WirePose, put_in_place, wire_pose,
+    Dimension, PrescribedMotion, SimParams, WirePlace, WirePose, is_placement, put_in_place,
+    wire_pose,
 };
 
 /// Places the wires for each step: a wire's pose when it is added, its
@@ -152,12 +153,10 @@ pub(crate) fn place_wires<V: Dimension>(
 /// one, else where its `Transform` puts it, so that a game moving it from
 /// its first step on moves it from there.
 fn wire_added<V: Dimension>(add: On<Add, V::Wire>, mut wires: Query<PlacedWire<V>>) {
-    if let Ok((place, motion, mut transform, mut pose)) = wires.get_mut(add.entity) {
-        if place.is_some() {
-            put_in_place(place, motion, &mut transform, &mut pose);
-        } else {
-            *pose = WirePose::from_transform(&transform);
-        }
+    if let Ok((place, motion, mut transform, mut pose)) = wires.get_mut(add.entity)
+        && !put_in_place(place, motion, &mut transform, &mut pose)
+    {
+        *pose = WirePose::from_transform(&transform);
     }
 }
 
@@ -192,8 +191,14 @@ fn follow_places<V: Dimension>(
     >,
 ) {
     for (place, motion, mut transform, mut pose) in &mut wires {
+        if !is_placement::<V>(place.0) {
+            // Not taken: the `Transform` places the wire.
+            continue;
+        }
         match motion {
-            Some(_) => put_in_place(Some(place), motion, &mut transform, &mut pose),
+            Some(_) => {
+                put_in_place(Some(place), motion, &mut transform, &mut pose);
+            }
             None => {
                 let mut moved = *transform;
                 V::set_pose(&mut moved, place.0);

@@ -230,3 +230,57 @@ fn a_bead_on_a_cycloids_cusp_is_reported_as_singular() {
     );
     assert!(app.world().get::<Diverged>(fine).is_none());
 }
+
+/// A [`WirePlace`](wirebead::WirePlace) that is not finite, or whose turn
+/// is no rotation, is not taken, at spawn or when a game writes it: the
+/// wire's `Transform` places it, as if it had none. Its bead rides the
+/// circle about the `Transform`'s (0.5, 0) to 1e-9, and the `Transform`
+/// stays finite where it was.
+#[test]
+fn a_wire_place_that_places_nothing_leaves_the_wire_at_its_transform() {
+    use wirebead::WirePlace;
+    use wirebead::geometry::Pose;
+    let nan = Pose {
+        origin: DVec2::new(f64::NAN, 0.0),
+        rotation: DVec2::X,
+    };
+    let no_turn = Pose {
+        origin: DVec2::ZERO,
+        rotation: DVec2::ZERO,
+    };
+    let stretched = Pose {
+        origin: DVec2::ZERO,
+        rotation: DVec2::new(2.0, 0.0),
+    };
+    let centre = DVec2::new(0.5, 0.0);
+    for bad in [nan, no_turn, stretched] {
+        let mut app = app(params(Method::Rattle, 1.0 / 240.0));
+        let wire = app
+            .world_mut()
+            .spawn((
+                Wire::circle(1.0).unwrap(),
+                Transform::from_xyz(0.5, 0.0, 0.0),
+                WirePlace::new(bad),
+            ))
+            .id();
+        let bead = spawn_bead(
+            &mut app,
+            wire,
+            BeadParams {
+                mass: 1.0,
+                initial_position: centre + DVec2::new(0.6, -0.8),
+                initial_velocity: DVec2::ZERO,
+            },
+        );
+        run_for(&mut app, 0.5);
+        // Written again by the game.
+        app.world_mut().get_mut::<WirePlace>(wire).unwrap().0 = bad;
+        run_for(&mut app, 0.5);
+        let at = crate::common::bead(&app, bead).position;
+        let off = ((at - centre).length() - 1.0).abs();
+        assert!(off <= 1e-9, "{bad:?}: the bead is {off:e} m off the circle");
+        assert!(app.world().get::<Diverged>(bead).is_none(), "{bad:?}");
+        let shown = *app.world().get::<Transform>(wire).unwrap();
+        assert_eq!(shown, Transform::from_xyz(0.5, 0.0, 0.0), "{bad:?}");
+    }
+}
