@@ -373,7 +373,8 @@ fn solve_path_joint(
     // Past a sharp corner the gradients where the substep began point off
     // the wire's new direction: put the body back along those where it
     // is instead, onto the nearest point of the new segment.
-    if turns_a_corner(&before, &previous, &after, &projected.body)
+    if let Some(there) = projected.rows
+        && turns_a_corner((&previous, &start), (&projected.body, &there))
         && let Some(here) = rows_at(&predicted)
         && let Some(nearest) = put_back(&here, &predicted)
     {
@@ -465,6 +466,11 @@ fn drive_of<C: ImplicitCurve>(
     frame: PlaneVelocity,
     h: f64,
 ) -> Option<Drive> {
+    // A joint that neither drives nor holds costs no evaluation of the wire.
+    let drives_or_holds = joint.motor.is_some() || joint.friction > 0.0;
+    if !drives_or_holds {
+        return None;
+    }
     let along = along_curve(curve, previous, shape.travel())?;
     let relative = along.rate(v) - along.rate(frame);
     let (speed, max_force) = match joint.motor {

@@ -104,11 +104,20 @@ impl BodyRow {
 }
 
 /// The rows of one joint: at most three, a body in the plane having three
-/// coordinates.
+/// coordinates; and how the wire bends at the anchor they were taken at.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Rows {
     rows: [BodyRow; 3],
     len: usize,
+    bend: Bend,
+}
+
+/// How a wire bends at an anchor: its unit normal there and how fast
+/// that turns along it (`|∇ψ|`, the curvature), for [`turns_a_corner`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Bend {
+    normal: DVec2,
+    curvature: f64,
 }
 
 impl Rows {
@@ -283,7 +292,13 @@ pub(crate) fn held(
     offset: Option<f64>,
 ) -> Option<Rows> {
     let at = AtAnchor::new(curve, body)?;
-    let mut rows = Rows::default();
+    let mut rows = Rows {
+        bend: Bend {
+            normal: at.normal,
+            curvature: at.turn_gradient.length(),
+        },
+        ..Rows::default()
+    };
     rows.push(at.on_curve());
     if let Some(offset) = offset {
         rows.push(at.turned(body.angle, offset));
@@ -369,23 +384,19 @@ fn wrap(angle: f64) -> f64 {
 /// at them says before the turn is a sharp corner, rad.
 const CORNER_SLACK: f64 = 0.02;
 
-/// Whether the wire turns a sharp corner between the anchor of `from` on
-/// `curve_from` and that of `to` on `curve_to`: its normal turns between
-/// them by more than twice what its curvature at the two (`|∇ψ|`) turns
-/// it over the distance, and [`CORNER_SLACK`] beside. On a smooth wire
-/// the normal turns by the curvature times the distance, to second order.
+/// Whether the wire turns a sharp corner between the anchor of `from`
+/// and that of `to`, each with the rows ([`held`]) taken there: its
+/// normal turns between them by more than twice what its curvature at the
+/// two (`|∇ψ|`) turns it over the distance, and [`CORNER_SLACK`] beside.
+/// On a smooth wire the normal turns by the curvature times the distance,
+/// to second order.
 pub(crate) fn turns_a_corner(
-    curve_from: &impl ImplicitCurve,
-    from: &PlaneBody,
-    curve_to: &impl ImplicitCurve,
-    to: &PlaneBody,
+    (from, at_from): (&PlaneBody, &Rows),
+    (to, at_to): (&PlaneBody, &Rows),
 ) -> bool {
-    let (Some(a), Some(b)) = (AtAnchor::new(curve_from, from), AtAnchor::new(curve_to, to)) else {
-        return false;
-    };
+    let (a, b) = (at_from.bend, at_to.bend);
     let turn = a.normal.angle_to(b.normal).abs();
-    let bend = (a.turn_gradient.length() + b.turn_gradient.length())
-        * (to.anchor() - from.anchor()).length();
+    let bend = (a.curvature + b.curvature) * (to.anchor() - from.anchor()).length();
     turn > bend + CORNER_SLACK
 }
 
@@ -398,6 +409,8 @@ pub(crate) struct Projected {
     pub body: PlaneBody,
     /// `λ`, one per row.
     pub lambda: DVec3,
+    /// The rows where the body is, unless that is a singular point.
+    pub rows: Option<Rows>,
     /// Whether every row met the tolerance.
     pub converged: bool,
 }
@@ -428,17 +441,20 @@ pub(crate) fn project(
             return Some(Projected {
                 body,
                 lambda,
+                rows: Some(rows),
                 converged: true,
             });
         }
         lambda += solve(rows.matrix(start, &body, compliance), -residual, rows.len())?;
         body = predicted.moved(start, lambda);
     }
-    let converged = rows_at(&body)
+    let rows = rows_at(&body);
+    let converged = rows
         .is_some_and(|rows| (rows.values() + compliance * lambda).abs().max_element() <= tolerance);
     Some(Projected {
         body,
         lambda,
+        rows,
         converged,
     })
 }
