@@ -133,9 +133,11 @@ impl WirePlace<DVec3> {
     }
 }
 
-/// Moves a wire along a prescribed motion about the pose its `Transform`
-/// has when the motion first applies (its resting pose, to which a
-/// [`Restart`](crate::Restart) returns it). The plugin writes the wire's
+/// Moves a wire along a prescribed motion about its [`WirePlace`], or
+/// without one the pose its `Transform` has when the motion first applies
+/// (its resting pose, to which a [`Restart`](crate::Restart) returns it).
+/// A place written later moves that resting pose at once, with no
+/// motion of its own. The plugin writes the wire's
 /// `Transform` each step, and the beads on it feel the motion exactly: its
 /// velocity and acceleration enter the constraint force (the `∂C/∂t`
 /// terms), with no differencing.

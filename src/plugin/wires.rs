@@ -200,9 +200,9 @@ fn follow_places<V: Dimension>(
                 put_in_place(Some(place), motion, &mut transform, &mut pose);
             }
             None => {
-                let mut moved = *transform;
-                V::set_pose(&mut moved, place.0);
-                transform.set_if_neq(moved);
+                // Marked changed even where the place moved by less than
+                // the `f32` step of its coordinates, so that it is followed.
+                V::set_pose(&mut transform, place.0);
             }
         }
     }

@@ -263,15 +263,7 @@ fn a_wire_place_that_places_nothing_leaves_the_wire_at_its_transform() {
                 WirePlace::new(bad),
             ))
             .id();
-        let bead = spawn_bead(
-            &mut app,
-            wire,
-            BeadParams {
-                mass: 1.0,
-                initial_position: centre + DVec2::new(0.6, -0.8),
-                initial_velocity: DVec2::ZERO,
-            },
-        );
+        let bead = bead_at_rest_on(&mut app, wire, centre);
         run_for(&mut app, 0.5);
         // Written again by the game.
         app.world_mut().get_mut::<WirePlace>(wire).unwrap().0 = bad;

@@ -84,6 +84,20 @@ pub fn spawn_bead(app: &mut App, wire: Entity, params: BeadParams) -> Entity {
         .id()
 }
 
+/// A bead of 1 kg at rest on `wire`, a unit circle about `centre`, at
+/// (0.6, −0.8) from it.
+pub fn bead_at_rest_on(app: &mut App, wire: Entity, centre: DVec2) -> Entity {
+    spawn_bead(
+        app,
+        wire,
+        BeadParams {
+            mass: 1.0,
+            initial_position: centre + DVec2::new(0.6, -0.8),
+            initial_velocity: DVec2::ZERO,
+        },
+    )
+}
+
 /// A circle of radius `r` at the origin with one bead of mass 1 starting at
 /// `x0` with velocity `v0`. Returns the bead.
 pub fn circle_bead(app: &mut App, r: f64, x0: DVec2, v0: DVec2) -> Entity {

@@ -10,7 +10,7 @@ use wirebead::prelude::*;
 use wirebead::{ContactChanged, Side, SimClock, Stabilization, Surface, WireContact};
 use wirebead::{Oscillate, PrescribedMotion, ScenePreset, WireMotion, WirePlace};
 
-use crate::common::{Recording, app, run_for, spawn_bead, spawn_wire};
+use crate::common::{Recording, app, bead_at_rest_on, run_for, spawn_bead, spawn_wire};
 
 fn preset(file: &str) -> ScenePreset {
     let path = format!("{}/assets/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
@@ -216,6 +216,41 @@ fn a_wire_the_game_moves_gives_the_prescribed_motions_trajectory() {
             "moved by its place, the trajectory parts by {placed:e} at {dt} s"
         );
     }
+}
+
+/// A wire far from the origin, at rest for 20 steps, then moved through
+/// its [`WirePlace`] by less than the `f32` step of its coordinates each
+/// step (1e-6 m a step at x = 1000, where `f32` steps by 6.1e-5), is
+/// followed from its first move: its bead stays on the exact moving
+/// circle to 1e-9.
+#[test]
+fn a_wire_moved_by_its_place_less_than_f32_resolves_is_followed() {
+    let centre = |step: u32| DVec2::new(1000.0 + 1e-6 * f64::from(step.saturating_sub(20)), 0.0);
+    let mut app = app(SimParams {
+        timestep: 1.0 / 240.0,
+        method: Method::Rattle,
+        ..default()
+    });
+    let wire = app
+        .world_mut()
+        .spawn((
+            Wire::circle(1.0).unwrap(),
+            WirePlace::new(Pose::new(centre(0), 0.0)),
+        ))
+        .id();
+    let bead = bead_at_rest_on(&mut app, wire, centre(0));
+    let mut off = 0.0f64;
+    for step in 1..=260 {
+        // The place for the end of the coming step, as a game writes it.
+        app.world_mut().get_mut::<WirePlace>(wire).unwrap().0 = Pose::new(centre(step), 0.0);
+        app.update();
+        let at = app.world().get::<BeadPosition>(bead).unwrap().0;
+        off = off.max(((at - centre(step)).length() - 1.0).abs());
+    }
+    assert!(
+        off <= 1e-9,
+        "the bead strayed {off:e} m from the moving circle"
+    );
 }
 
 /// A scene's wire is at its [`WirePlace`]; a game that writes its
