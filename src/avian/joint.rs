@@ -54,10 +54,10 @@ pub enum PathMotor {
 /// frame from its origin, as avian's joints take theirs) on the wire
 /// `wire`, free to slide along it. The body needs avian's `RigidBody`
 /// (a dynamic one: a kinematic or static body is not moved by its joint);
-/// the wire is an entity with a [`Wire`](crate::Wire) (fixed, or moving as any wire of
-/// ours moves). A joint naming an entity that is no wire holds nothing,
-/// and says so once in the log. The ends of an open wire (a spline, a
-/// cycloid) stop the anchor there, as a buffer stops a cart.
+/// the wire is an entity with a [`Wire`](crate::Wire) (fixed, or moving
+/// as any wire of ours moves). A joint naming an entity that is no wire
+/// holds nothing, and says so once in the log. The ends of an open wire
+/// (a spline, a cycloid) stop the anchor there, as a buffer stops a cart.
 #[derive(Component, Clone, Debug, PartialEq, Reflect)]
 #[require(PathJointState, PathJointForces)]
 pub struct PathJoint {
@@ -111,6 +111,12 @@ impl PathJoint {
         }
     }
 
+    /// The joint holding the body against sliding with a force of at most
+    /// `friction` (N) while no motor drives it.
+    pub fn with_friction(self, friction: f64) -> Self {
+        Self { friction, ..self }
+    }
+
     /// The compliance the joint is solved with: its own where that is a
     /// finite positive number, else 0 (rigid).
     pub(super) fn yielding(&self) -> f64 {
@@ -119,12 +125,6 @@ impl PathJoint {
         } else {
             0.0
         }
-    }
-
-    /// The joint holding the body against sliding with a force of at most
-    /// `friction` (N) while no motor drives it.
-    pub fn with_friction(self, friction: f64) -> Self {
-        Self { friction, ..self }
     }
 }
 

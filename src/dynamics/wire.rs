@@ -105,10 +105,11 @@ impl Wire {
 }
 
 /// Where a wire is, in `f64`: its origin and turn as the solver takes
-/// them ([`Pose`] in the plane, [`Pose3`] in space), where a `Transform` holds them in `f32`. A wire with one is
-/// placed exactly there: the plugin writes its `Transform` from it (at
-/// that edge, in `f32`), and takes the place, not the `Transform`, while
-/// the `Transform` still shows it. Scene files place their wires so.
+/// them ([`Pose`] in the plane, [`Pose3`] in space), where a `Transform`
+/// holds them in `f32`. A wire with one is placed exactly there: the
+/// plugin writes its `Transform` from it (at that edge, in `f32`), and
+/// takes the place, not the `Transform`, while the `Transform` still
+/// shows it. Scene files place their wires so.
 ///
 /// A game moves such a wire by writing either: the place (followed
 /// exactly, as a moved `Transform` is followed), or the `Transform` (the
@@ -137,8 +138,8 @@ impl WirePlace<DVec3> {
 /// without one the pose its `Transform` has when the motion first applies
 /// (its resting pose, to which a [`Restart`](crate::Restart) returns it).
 /// A place written later moves that resting pose at once, with no
-/// motion of its own. The plugin writes the wire's
-/// `Transform` each step, and the beads on it feel the motion exactly: its
+/// motion of its own. The plugin writes the wire's `Transform` each
+/// step, and the beads on it feel the motion exactly: its
 /// velocity and acceleration enter the constraint force (the `∂C/∂t`
 /// terms), with no differencing.
 ///

@@ -51,18 +51,19 @@ fn physics_app_at(dt: f64, substeps: u32) -> App {
 /// `theta0` from the bottom of a unit circle about the origin, held on it
 /// at its centre; the body.
 fn pendulum(app: &mut App, theta0: f64, inertia: f32, rotation: PathRotation) -> Entity {
+    let joint = PathJoint::new(Entity::PLACEHOLDER).with_rotation(rotation);
+    pendulum_held_by(app, theta0, inertia, joint)
+}
+
+/// [`pendulum`]'s body held on its circle by `joint` (whose wire is set to
+/// the circle).
+fn pendulum_held_by(app: &mut App, theta0: f64, inertia: f32, joint: PathJoint) -> Entity {
     let wire = app
         .world_mut()
         .spawn((Wire::circle(1.0).expect("a circle"), Transform::IDENTITY))
         .id();
     let at = DVec2::new(theta0.sin(), -theta0.cos());
-    held_body(
-        app,
-        at,
-        1.0,
-        inertia,
-        PathJoint::new(wire).with_rotation(rotation),
-    )
+    held_body(app, at, 1.0, inertia, PathJoint { wire, ..joint })
 }
 
 /// A dynamic body of `mass` and `inertia` at `at`, never asleep, held by
@@ -570,52 +571,40 @@ fn a_joint_given_bad_numbers_holds_its_body_as_a_plain_joint() {
         damping_ratio: 1.0,
         max_force: 10.0,
     };
-    let bad: Vec<(&str, Box<dyn Fn(PathJoint) -> PathJoint>)> = vec![
+    let joint = PathJoint::new(Entity::PLACEHOLDER);
+    let bad = [
         (
             "a negative compliance",
-            Box::new(|j| PathJoint {
+            PathJoint {
                 compliance: -1.0,
-                ..j
-            }),
+                ..joint.clone()
+            },
         ),
         (
             "a NaN compliance",
-            Box::new(|j| PathJoint {
+            PathJoint {
                 compliance: f64::NAN,
-                ..j
-            }),
+                ..joint.clone()
+            },
         ),
         (
             "a NaN motor speed",
-            Box::new(move |j| j.with_motor(velocity(f64::NAN, 10.0))),
+            joint.clone().with_motor(velocity(f64::NAN, 10.0)),
         ),
         (
             "a NaN force limit",
-            Box::new(move |j| j.with_motor(velocity(1.0, f64::NAN))),
+            joint.clone().with_motor(velocity(1.0, f64::NAN)),
         ),
         (
             "a negative force limit",
-            Box::new(move |j| j.with_motor(velocity(1.0, -5.0))),
+            joint.clone().with_motor(velocity(1.0, -5.0)),
         ),
-        (
-            "a NaN spring",
-            Box::new(move |j| j.with_motor(spring(f64::NAN))),
-        ),
-        ("a NaN friction", Box::new(|j| j.with_friction(f64::NAN))),
+        ("a NaN spring", joint.clone().with_motor(spring(f64::NAN))),
+        ("a NaN friction", joint.with_friction(f64::NAN)),
     ];
     let bodies: Vec<(&str, Entity)> = bad
-        .iter()
-        .map(|(what, joint)| {
-            let wire = app
-                .world_mut()
-                .spawn((Wire::circle(1.0).expect("a circle"), Transform::IDENTITY))
-                .id();
-            let at = DVec2::new(theta0.sin(), -theta0.cos());
-            (
-                *what,
-                held_body(&mut app, at, 1.0, 0.5, joint(PathJoint::new(wire))),
-            )
-        })
+        .into_iter()
+        .map(|(what, joint)| (what, pendulum_held_by(&mut app, theta0, 0.5, joint)))
         .collect();
     let mut off = vec![0.0f64; bodies.len()];
     for _ in 0..120 {
