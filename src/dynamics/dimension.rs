@@ -48,6 +48,10 @@ pub trait Dimension:
     ) -> (Self::Path, bool);
     /// Writes a pose into a `Transform`, in `f32` at this edge.
     fn set_pose(transform: &mut Transform, pose: Self::Pose);
+    /// The length of a pose's turn (of `(cos θ, sin θ)` in the plane, of
+    /// the quaternion in space; a rotation's is one), and the pose with
+    /// its turn divided by that length.
+    fn unit_turn(pose: Self::Pose) -> (f64, Self::Pose);
     /// Writes a bead's position into its `Transform`'s translation, in
     /// `f32` at this edge (in the plane, `z` kept); a non-finite position
     /// is not written.
@@ -118,6 +122,11 @@ impl Dimension for DVec2 {
         };
         settle(history, now, start, h, PosePath::Fixed, PosePath::Followed)
     }
+    fn unit_turn(pose: Pose) -> (f64, Pose) {
+        let length = pose.rotation.length();
+        let rotation = pose.rotation / length;
+        (length, Pose { rotation, ..pose })
+    }
     fn set_pose(transform: &mut Transform, pose: Pose) {
         let origin = pose.origin.as_vec2();
         if origin.is_finite() && pose.rotation.is_finite() {
@@ -168,6 +177,11 @@ impl Dimension for DVec3 {
             SpacePath::Fixed,
             SpacePath::Followed,
         )
+    }
+    fn unit_turn(pose: Pose3) -> (f64, Pose3) {
+        let length = pose.rotation.length();
+        let rotation = pose.rotation / length;
+        (length, Pose3 { rotation, ..pose })
     }
     fn set_pose(transform: &mut Transform, pose: Pose3) {
         let origin = pose.origin.as_vec3();
@@ -225,12 +239,8 @@ pub(crate) fn wire_pose<V: Dimension>(
     transform: &Transform,
     place: Option<&WirePlace<V>>,
 ) -> Result<V::Pose, ParamError> {
-    match place {
-        Some(&WirePlace(pose))
-            if is_placement::<V>(pose) && shown::<V>(transform, pose) == *transform =>
-        {
-            Ok(pose)
-        }
+    match place.map(|p| placement::<V>(p.0)) {
+        Some(Ok(pose)) if shown::<V>(transform, pose) == *transform => Ok(pose),
         _ => V::pose_of(transform),
     }
 }
@@ -242,29 +252,44 @@ fn shown<V: Dimension>(transform: &Transform, pose: V::Pose) -> Transform {
     shown
 }
 
-/// Whether `pose` places a wire: its origin finite and its turn a
-/// rotation (each axis turned to a unit direction, to 1e-9).
-pub(crate) fn is_placement<V: Dimension>(pose: V::Pose) -> bool {
-    pose.origin().xyz().is_finite()
-        && V::AXES.iter().all(|&axis| {
-            let turned = pose.rotate(axis).xyz();
-            turned.is_finite() && (turned.length_squared() - 1.0).abs() <= 1e-9
+/// How far the length of a place's turn may be from one: a turn read from
+/// a `Transform` (an `f32` rotation, whose length is one to some 1e-7)
+/// places a wire; one of length 2 does not.
+const TURN_SLACK: f64 = 1e-6;
+
+/// `pose` as a wire's place: its turn made exactly a rotation (divided by
+/// its length, which is one to within [`TURN_SLACK`]), or why it places no
+/// wire, in words: its origin is not finite, or its turn is no rotation.
+pub(crate) fn placement<V: Dimension>(pose: V::Pose) -> Result<V::Pose, ParamError> {
+    let origin = pose.origin().xyz();
+    if !origin.is_finite() {
+        return Err(ParamError::VectorNotFinite {
+            name: "a wire place's origin",
+            components: format!("({}, {}, {})", origin.x, origin.y, origin.z),
+        });
+    }
+    let (length, turned) = V::unit_turn(pose);
+    if (length - 1.0).abs() <= TURN_SLACK {
+        Ok(turned)
+    } else {
+        Err(ParamError::OutOfRange {
+            name: "the length of a wire place's turn",
+            min: 1.0 - TURN_SLACK,
+            max: 1.0 + TURN_SLACK,
+            value: length,
         })
+    }
 }
 
-/// A wire put at its [`WirePlace`], if it has a valid one: its
+/// A wire put at `at` (a place as [`placement`] takes it): its
 /// `transform` written from it and its `pose` there, on its `motion`
-/// about it if it has one; whether it had one. A wire without a valid
-/// place keeps what it has.
+/// about it if it has one.
 pub(crate) fn put_in_place<V: Dimension>(
-    place: Option<&WirePlace<V>>,
+    at: V::Pose,
     motion: Option<&PrescribedMotion<V>>,
     transform: &mut Mut<Transform>,
     pose: &mut Mut<WirePose<V>>,
-) -> bool {
-    let Some(&WirePlace(at)) = place.filter(|p| is_placement::<V>(p.0)) else {
-        return false;
-    };
+) {
     let moved = shown::<V>(transform, at);
     transform.set_if_neq(moved);
     let placed = match motion {
@@ -272,7 +297,6 @@ pub(crate) fn put_in_place<V: Dimension>(
         None => WirePose::on(V::fixed_path(at)),
     };
     pose.set_if_neq(placed);
-    true
 }
 
 /// A point in the frame of `transform`, in the world: `offset` placed by

@@ -20,7 +20,7 @@ pub use bead::{
 pub(crate) use bead::{BeadMotion, BeadMotionItem};
 pub use diagnostics::{BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason};
 pub use dimension::{Dimension, WireRows};
-pub(crate) use dimension::{is_placement, put_in_place, wire_pose};
+pub(crate) use dimension::{placement, put_in_place, wire_pose};
 pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
 pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, NextParams, SimParams, SpaceParams};
 pub use rail::RailOrientation;

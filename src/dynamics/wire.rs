@@ -114,9 +114,12 @@ impl Wire {
 /// A game moves such a wire by writing either: the place (followed
 /// exactly, as a moved `Transform` is followed), or the `Transform` (the
 /// place then follows the `Transform`). On a wire with a
-/// [`PrescribedMotion`] it is the pose the motion is about. A place that
-/// is not finite, or whose turn is not a rotation, is not taken: the
-/// `Transform` places the wire.
+/// [`PrescribedMotion`] it is the pose the motion is about. A turn whose
+/// length is one to within 1e-6 (one read from an `f32` rotation) is
+/// taken as the exact rotation nearest it. A place that is not finite, or
+/// whose turn is not a rotation (a zero quaternion, one of length 2), is
+/// not taken: the `Transform` places the wire, with a one-line warning
+/// each time such a place is written.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 pub struct WirePlace<V: WireSpace = DVec2>(pub V::Pose);
 

@@ -1,6 +1,8 @@
 //! [`RestartPlugin`]: [`Restart`] applies the pending edits and returns
 //! every bead to its initial state, as the assignment's space bar did.
 
+use bevy::ecs::change_detection::Tick;
+use bevy::ecs::system::SystemChangeTick;
 use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 
@@ -11,7 +13,7 @@ use super::wires::prescribed;
 use crate::dynamics::{
     BeadDiagnostics, BeadMotion, BeadMotionItem, BeadParams, Dimension, Diverged, NextBeadParams,
     NextParams, NextWireShape, OnWire, PrescribedMotion, RailOrientation, SimParams, Wire,
-    WireContact, WirePlace, WirePose,
+    WireContact, WirePlace, WirePose, placement, put_in_place,
 };
 use crate::geometry::{MovingTrack, Track, WireSpace};
 use crate::solver::{RowReport, constraint_state_on};
@@ -66,7 +68,7 @@ fn apply_restart(
         &mut WirePose,
         Option<&NextWireShape>,
         Option<&PrescribedMotion>,
-        Option<&WirePlace>,
+        Option<Ref<WirePlace>>,
     )>,
     mut beads: Query<(
         Entity,
@@ -79,6 +81,7 @@ fn apply_restart(
     )>,
     mut islands: ResMut<Islands>,
     mut commands: Commands,
+    ticks: SystemChangeTick,
 ) {
     if restarts.read().count() == 0 {
         return;
@@ -90,7 +93,11 @@ fn apply_restart(
             *wire = wire.reshaped(edit.shape());
             commands.entity(entity).remove::<NextWireShape>();
         }
-        rest_wire((motion, place), &mut transform, &mut pose);
+        rest_wire(
+            (motion, place),
+            (&mut transform, &mut pose),
+            ticks.this_run(),
+        );
     }
     *params = pending.get().clone();
     time.set_timestep_seconds(params.timestep);
@@ -129,20 +136,31 @@ fn apply_restart(
 }
 
 /// A wire back where a run starts: one on a prescribed motion at its
-/// resting pose, one the game moved at rest where it is.
+/// resting pose, one the game moved at rest where it is. A place the game
+/// wrote after the wire's `Transform` (`now` the restart's tick), which no
+/// step has followed yet, is where it rests.
 fn rest_wire<V: Dimension>(
-    (motion, place): (Option<&PrescribedMotion<V>>, Option<&WirePlace<V>>),
-    transform: &mut Transform,
-    pose: &mut WirePose<V>,
+    (motion, place): (Option<&PrescribedMotion<V>>, Option<Ref<WirePlace<V>>>),
+    (transform, pose): (&mut Mut<Transform>, &mut Mut<WirePose<V>>),
+    now: Tick,
 ) {
+    let written = place.as_ref().filter(|place| {
+        place
+            .last_changed()
+            .is_newer_than(transform.last_changed(), now)
+    });
+    if let Some(Ok(at)) = written.map(|place| placement::<V>(place.0)) {
+        put_in_place(at, motion, transform, pose);
+    }
+    let place = place.as_deref();
     match motion {
         Some(motion) => {
-            *pose = prescribed(motion, pose, transform, place);
+            **pose = prescribed(motion, pose, transform, place);
             if let Ok(path) = pose.get() {
                 V::set_pose(transform, V::path_at(&path, 0.0).0);
             }
         }
-        None => *pose = WirePose::placed(transform, place),
+        None => **pose = WirePose::placed(transform, place),
     }
 }
 
@@ -189,7 +207,7 @@ fn restart_in_space(
         &mut Transform,
         &mut WirePose<DVec3>,
         Option<&PrescribedMotion<DVec3>>,
-        Option<&WirePlace<DVec3>>,
+        Option<Ref<WirePlace<DVec3>>>,
     )>,
     mut beads: Query<(
         Entity,
@@ -203,13 +221,18 @@ fn restart_in_space(
     )>,
     mut islands: ResMut<Islands<DVec3>>,
     mut commands: Commands,
+    ticks: SystemChangeTick,
 ) {
     if restarts.read().count() == 0 {
         return;
     }
     islands.mark_dirty();
     for (mut transform, mut pose, motion, place) in &mut wires {
-        rest_wire((motion, place), &mut transform, &mut pose);
+        rest_wire(
+            (motion, place),
+            (&mut transform, &mut pose),
+            ticks.this_run(),
+        );
     }
     let gravity = DVec3::gravity(&params);
     for (entity, mut bead, mut bead_params, edit, diagnostics, contact, on_wire, rail) in &mut beads

@@ -24,7 +24,7 @@ use super::schedule::WireBeadSystems;
 use super::wires::MovingWires;
 use crate::dynamics::{
     BeadDiagnostics, BeadPosition, BeadVelocity, Dimension, Diverged, RailOrientation, SimParams,
-    WireContact, WirePose,
+    WireContact, WirePlace, WirePose,
 };
 
 /// Records every step in the [`Timeline`] and takes the run back to any
@@ -262,10 +262,13 @@ impl Frame {
     }
 }
 
+/// A wire as a frame holds it: its pose, `Transform` and place.
+type WireFrame<V> = (Entity, WirePose<V>, Transform, Option<WirePlace<V>>);
+
 /// One dimension's part of a frame.
 struct Scene<V: Dimension> {
     beads: Vec<BeadFrame<V>>,
-    wires: Vec<(Entity, WirePose<V>, Transform)>,
+    wires: Vec<WireFrame<V>>,
     moving: MovingWires<V>,
     islands: Islands<V>,
 }
@@ -291,7 +294,7 @@ impl<V: Dimension> Scene<V> {
     /// Roughly how much memory it takes.
     fn bytes(&self) -> usize {
         self.beads.len() * size_of::<BeadFrame<V>>()
-            + self.wires.len() * size_of::<(Entity, WirePose<V>, Transform)>()
+            + self.wires.len() * size_of::<WireFrame<V>>()
             + self.islands.bytes()
     }
 }
@@ -342,7 +345,12 @@ struct SceneState<'w, 's, V: Dimension> {
     wires: Query<
         'w,
         's,
-        (Entity, &'static mut WirePose<V>, &'static mut Transform),
+        (
+            Entity,
+            &'static mut WirePose<V>,
+            &'static mut Transform,
+            Option<&'static mut WirePlace<V>>,
+        ),
         (
             With<<V as Dimension>::Wire>,
             Without<<V as Dimension>::Bead>,
@@ -378,7 +386,7 @@ impl<V: Dimension> SceneState<'_, '_, V> {
             wires: self
                 .wires
                 .iter()
-                .map(|(entity, pose, transform)| (entity, *pose, *transform))
+                .map(|(entity, pose, transform, place)| (entity, *pose, *transform, place.copied()))
                 .collect(),
             moving: self.moving.clone(),
             islands: self.islands.clone(),
@@ -424,10 +432,13 @@ impl<V: Dimension> SceneState<'_, '_, V> {
                 _ => {}
             }
         }
-        for (entity, pose, transform) in &scene.wires {
-            if let Ok((_, mut now, mut placed)) = self.wires.get_mut(*entity) {
+        for (entity, pose, transform, place) in &scene.wires {
+            if let Ok((_, mut now, mut shown, placed)) = self.wires.get_mut(*entity) {
                 now.set_if_neq(*pose);
-                placed.set_if_neq(*transform);
+                shown.set_if_neq(*transform);
+                if let (Some(mut placed), Some(place)) = (placed, place) {
+                    placed.set_if_neq(*place);
+                }
             }
         }
         *self.moving = scene.moving.clone();

@@ -14,8 +14,7 @@ use bevy::prelude::*;
 use super::clock::{SimClock, advance_clock};
 use super::schedule::WireBeadSystems;
 use crate::dynamics::{
-    Dimension, PrescribedMotion, SimParams, WirePlace, WirePose, is_placement, put_in_place,
-    wire_pose,
+    Dimension, PrescribedMotion, SimParams, WirePlace, WirePose, placement, put_in_place, wire_pose,
 };
 
 /// Places the wires for each step: a wire's pose when it is added, its
@@ -153,10 +152,11 @@ pub(crate) fn place_wires<V: Dimension>(
 /// one, else where its `Transform` puts it, so that a game moving it from
 /// its first step on moves it from there.
 fn wire_added<V: Dimension>(add: On<Add, V::Wire>, mut wires: Query<PlacedWire<V>>) {
-    if let Ok((place, motion, mut transform, mut pose)) = wires.get_mut(add.entity)
-        && !put_in_place(place, motion, &mut transform, &mut pose)
-    {
-        *pose = WirePose::from_transform(&transform);
+    if let Ok((place, motion, mut transform, mut pose)) = wires.get_mut(add.entity) {
+        match place.and_then(|p| placement::<V>(p.0).ok()) {
+            Some(at) => put_in_place(at, motion, &mut transform, &mut pose),
+            None => *pose = WirePose::from_transform(&transform),
+        }
     }
 }
 
@@ -171,17 +171,24 @@ type PlacedWire<V> = (
 
 /// Puts a wire at the [`WirePlace`] inserted on it.
 fn place_inserted<V: Dimension>(insert: On<Insert, WirePlace<V>>, mut wires: Query<PlacedWire<V>>) {
-    if let Ok((place, motion, mut transform, mut pose)) = wires.get_mut(insert.entity) {
-        put_in_place(place, motion, &mut transform, &mut pose);
+    if let Ok((place, motion, mut transform, mut pose)) = wires.get_mut(insert.entity)
+        && let Some(Ok(at)) = place.map(|p| placement::<V>(p.0))
+    {
+        put_in_place(at, motion, &mut transform, &mut pose);
     }
 }
 
 /// Moves the `Transform` of each wire whose [`WirePlace`] the game wrote
 /// there, so that [`place_wires`] follows it (from the place itself, in
-/// `f64`); a wire on a prescribed motion moves about its new place.
+/// `f64`); a wire on a prescribed motion moves about its new place. A
+/// place that places no wire ([`placement`]), at spawn or written later,
+/// is warned of here, once each time it is written (the observers that
+/// place a wire the moment it or its place is added pass over such a
+/// place without a word).
 fn follow_places<V: Dimension>(
     mut wires: Query<
         (
+            Entity,
             &WirePlace<V>,
             Option<&PrescribedMotion<V>>,
             &mut Transform,
@@ -190,20 +197,21 @@ fn follow_places<V: Dimension>(
         (With<V::Wire>, Changed<WirePlace<V>>),
     >,
 ) {
-    for (place, motion, mut transform, mut pose) in &mut wires {
-        if !is_placement::<V>(place.0) {
-            // Not taken: the `Transform` places the wire.
-            continue;
-        }
+    for (entity, place, motion, mut transform, mut pose) in &mut wires {
+        let at = match placement::<V>(place.0) {
+            Ok(at) => at,
+            Err(why) => {
+                warn!(
+                    "wirebead: wire {entity} was not put at its WirePlace: {why}; its Transform places it"
+                );
+                continue;
+            }
+        };
         match motion {
-            Some(_) => {
-                put_in_place(Some(place), motion, &mut transform, &mut pose);
-            }
-            None => {
-                // Marked changed even where the place moved by less than
-                // the `f32` step of its coordinates, so that it is followed.
-                V::set_pose(&mut transform, place.0);
-            }
+            Some(_) => put_in_place(at, motion, &mut transform, &mut pose),
+            // Marked changed even where the place moved by less than the
+            // `f32` step of its coordinates, so that it is followed.
+            None => V::set_pose(&mut transform, at),
         }
     }
 }

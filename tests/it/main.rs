@@ -20,6 +20,7 @@ mod layout;
 mod marble_run;
 mod parallel;
 mod pendulum;
+mod places;
 mod precision;
 mod presets;
 mod readme;

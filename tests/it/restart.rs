@@ -134,3 +134,42 @@ fn a_restart_keeps_the_state_of_a_bead_whose_params_were_written_invalid() {
     assert_eq!(bead(&app, b).state(), bead(&control, c).state());
     assert!(app.world().get::<Diverged>(b).is_none());
 }
+
+/// A wire's [`WirePlace`](wirebead::WirePlace) written in the frame a
+/// restart is sent, before any step has followed it, is where the
+/// restarted run's wire rests: a bead restarted at rest at the bottom of
+/// the circle about the new place stays there to 1e-12 m over 0.5 s.
+/// Placed from its old `Transform` instead, the wire would be taken to
+/// move 0.5 m in the restarted run's first step, and the bead with it.
+#[test]
+fn a_restart_rests_a_wire_at_the_place_written_with_it() {
+    use wirebead::geometry::Pose;
+    use wirebead::{Restart, WirePlace};
+    let mut app = app(SimParams {
+        method: Method::Rattle,
+        ..SimParams::default()
+    });
+    let wire = app
+        .world_mut()
+        .spawn((Wire::circle(1.0).unwrap(), WirePlace::new(Pose::IDENTITY)))
+        .id();
+    let rider = bead_at_rest_on(&mut app, wire, DVec2::ZERO);
+    run_steps(&mut app, 30);
+    let centre = DVec2::new(0.5, 0.0);
+    let bottom = centre - DVec2::Y;
+    app.world_mut().get_mut::<WirePlace>(wire).unwrap().0 = Pose::new(centre, 0.0);
+    let at_bottom = NextBeadParams::new(BeadParams {
+        mass: 1.0,
+        initial_position: bottom,
+        initial_velocity: DVec2::ZERO,
+    })
+    .unwrap();
+    app.world_mut().entity_mut(rider).insert(at_bottom);
+    app.world_mut().write_message(Restart);
+    let mut moved = 0.0f64;
+    for _ in 0..30 {
+        run_steps(&mut app, 1);
+        moved = moved.max((bead(&app, rider).position - bottom).length());
+    }
+    assert!(moved <= 1e-12, "the bead moved {moved:e} m from the bottom");
+}

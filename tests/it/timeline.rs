@@ -219,3 +219,46 @@ fn b_steps_back_and_n_runs_forward_the_same() {
     assert_eq!(history(&app).matched(), 3);
     assert_eq!(history(&app).at().map(|c| c.steps), Some(39));
 }
+
+/// A wire moved through its [`WirePlace`](wirebead::WirePlace) (at
+/// x = 1000, by 1e-6 m a step, less than the `f32` step of its
+/// `Transform` there) is taken back with its place: back to step 30 the
+/// place is step 30's to the bit, and the run written on from there as
+/// before is the recorded one, bit for bit.
+#[test]
+fn a_wire_moved_by_its_place_runs_on_from_a_step_back_bit_for_bit() {
+    use wirebead::WirePlace;
+    use wirebead::geometry::Pose;
+    let place = |step: u64| Pose::new(DVec2::new(1000.0 + 1e-6 * step as f64, 0.0), 0.0);
+    let params = SimParams {
+        timestep: 1.0 / 240.0,
+        method: Method::new(Integrator::Rattle, None).unwrap(),
+        ..SimParams::default()
+    };
+    let mut app = common::app(params);
+    app.add_plugins(TimelinePlugin);
+    let wire = app
+        .world_mut()
+        .spawn((Wire::circle(1.0).unwrap(), WirePlace::new(place(0))))
+        .id();
+    common::bead_at_rest_on(&mut app, wire, place(0).origin);
+    // The place for the end of the coming step, as a game writes it.
+    let step = |app: &mut App| {
+        let next = app.world().resource::<SimClock>().steps + 1;
+        app.world_mut().get_mut::<WirePlace>(wire).unwrap().0 = place(next);
+        run_steps(app, 1);
+    };
+    let mut run = vec![bits(&mut app)];
+    for _ in 0..60 {
+        step(&mut app);
+        run.push(bits(&mut app));
+    }
+    assert_ne!(run[60], run[0], "the bead rode the moving wire");
+    seek(&mut app, TimelineSeek::To(30));
+    assert_eq!(app.world().get::<WirePlace>(wire).unwrap().0, place(30));
+    assert_eq!(bits(&mut app), run[30], "the step went back");
+    for (k, recorded) in run.iter().enumerate().skip(31) {
+        step(&mut app);
+        assert_eq!(bits(&mut app), *recorded, "step {k} run again differs");
+    }
+}

@@ -1,11 +1,13 @@
 //! Editing the parameters: the selected bead's, its wire's shape, and the
 //! solver's, each through the plugin's validating setters.
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_egui::egui;
 
 use super::keyboard::number_field;
 use super::view::PanelView;
+use crate::dynamics::placement;
 use crate::geometry::{Coordinates, Cycloid};
 use crate::{
     BeadParams, Integrator, NextBeadParams, NextParams, NextWireShape, ParamError,
@@ -122,14 +124,18 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
     let (before, mut draft) = bead_start_editor(ui, "bead", bead, pending_bead);
     let mut outcome = None;
     if let Some(on_wire) = on_wire
-        && let Ok((wire, transform, pending_wire, motion)) = view.wires.get(on_wire.0)
+        && let Ok((wire, transform, pending_wire, motion, place)) = view.wires.get(on_wire.0)
     {
         let shape = pending_wire.map_or_else(|| wire.shape().clone(), |p| p.shape().clone());
         if let Some(edited) = wire_editor(ui, &shape) {
             outcome = Some(NextWireShape::new(edited.clone()).map(|edit| {
                 commands.entity(on_wire.0).insert(edit);
-                // Start the bead at the new wire's lowest point.
-                let pose = pose_of(transform).unwrap_or_default();
+                // Start the bead at the new wire's lowest point, where the
+                // restart rests the wire: at its place, in `f64`.
+                let pose = place
+                    .and_then(|place| placement::<DVec2>(place.0).ok())
+                    .or_else(|| pose_of(transform).ok())
+                    .unwrap_or_default();
                 draft.initial_position = pose.to_world(edited.bottom());
             }));
         }

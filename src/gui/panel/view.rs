@@ -18,7 +18,7 @@ use crate::preset::{ActivePreset, LastExport, LoadPreset};
 use crate::{
     BeadDiagnostics, BeadParams, BeadPosition, ConstraintDiagnostics, Diverged, Islands,
     NextBeadParams, NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, Restart, Rod,
-    SimClock, SimParams, SpaceWire, Wire, WireContact,
+    SimClock, SimParams, SpaceWire, Wire, WireContact, WirePlace,
 };
 
 /// The colour of what went wrong: a refused edit, a divergence, a failed
@@ -61,6 +61,7 @@ pub struct PanelView<'w, 's> {
             &'static Transform,
             Option<&'static NextWireShape>,
             Option<&'static PrescribedMotion>,
+            Option<&'static WirePlace>,
         ),
     >,
     pub(super) space_beads: Query<
