@@ -8,10 +8,7 @@ use bevy::reflect::{GetTypeRegistration, Typed};
 use super::PrescribedMotion;
 use super::wire::{WirePlace, WirePose};
 use super::{Bead, BeadBundle, BeadParams, SimParams, SpaceBead, SpaceBeadBundle, SpaceWire, Wire};
-use crate::geometry::{
-    History, HistoryPose, Placement, Pose, Pose3, PoseHistory, PosePath, SpaceHistory, SpacePath,
-    SpaceShape, Surface, WireSpace,
-};
+use crate::geometry::{Placement, Pose, Pose3, SpaceShape, Surface, WirePath, WireSpace};
 use crate::validate::ParamError;
 
 /// The plane (`DVec2`) or space (`DVec3`) as the plugin keeps them: which
@@ -37,15 +34,6 @@ pub trait Dimension:
     /// A wire's pose from its `Transform`: in the plane its translation's
     /// x and y and its turn about z; in space all of it.
     fn pose_of(transform: &Transform) -> Result<Self::Pose, ParamError>;
-    /// A wire's path after a game moved its `Transform` to `now` over the
-    /// step from `start` to `end = start + h`, and whether it is still
-    /// moving, from its history (so the wire's velocity enters the step).
-    fn followed(
-        path: Option<Self::Path>,
-        now: Self::Pose,
-        start: f64,
-        h: f64,
-    ) -> (Self::Path, bool);
     /// Writes a pose into a `Transform`, in `f32` at this edge.
     fn set_pose(transform: &mut Transform, pose: Self::Pose);
     /// The length of a pose's turn (of `(cos θ, sin θ)` in the plane, of
@@ -110,18 +98,6 @@ impl Dimension for DVec2 {
     fn pose_of(transform: &Transform) -> Result<Pose, ParamError> {
         Pose::from_translation_rotation(transform.translation, transform.rotation)
     }
-    fn followed(path: Option<PosePath>, now: Pose, start: f64, h: f64) -> (PosePath, bool) {
-        let history = match path {
-            Some(PosePath::Fixed(at)) if at == now => return (PosePath::Fixed(now), false),
-            Some(PosePath::Fixed(at)) => PoseHistory::at_rest(f64::NEG_INFINITY, at),
-            Some(PosePath::Followed(history)) => history,
-            Some(path @ PosePath::Prescribed { .. }) => {
-                PoseHistory::at_rest(start, path.pose(start))
-            }
-            None => PoseHistory::at_rest(start, now),
-        };
-        settle(history, now, start, h, PosePath::Fixed, PosePath::Followed)
-    }
     fn unit_turn(pose: Pose) -> (f64, Pose) {
         let length = pose.rotation.length();
         let rotation = pose.rotation / length;
@@ -159,25 +135,6 @@ impl Dimension for DVec3 {
     fn pose_of(transform: &Transform) -> Result<Pose3, ParamError> {
         Pose3::from_translation_rotation(transform.translation, transform.rotation)
     }
-    fn followed(path: Option<SpacePath>, now: Pose3, start: f64, h: f64) -> (SpacePath, bool) {
-        let history = match path {
-            Some(SpacePath::Fixed(at)) if at == now => return (SpacePath::Fixed(now), false),
-            Some(SpacePath::Fixed(at)) => SpaceHistory::at_rest(f64::NEG_INFINITY, at),
-            Some(SpacePath::Followed(history)) => history,
-            Some(path @ SpacePath::Prescribed { .. }) => {
-                SpaceHistory::at_rest(start, path.pose(start))
-            }
-            None => SpaceHistory::at_rest(start, now),
-        };
-        settle(
-            history,
-            now,
-            start,
-            h,
-            SpacePath::Fixed,
-            SpacePath::Followed,
-        )
-    }
     fn unit_turn(pose: Pose3) -> (f64, Pose3) {
         let length = pose.rotation.length();
         let rotation = pose.rotation / length;
@@ -200,25 +157,6 @@ impl Dimension for DVec3 {
     }
 }
 
-/// A followed wire's history after it took in `now` at the end of the step
-/// from `start` (of `h`): fixed there if the last poses are one (`fixed`),
-/// else followed (`followed`), and whether it still moves.
-fn settle<P: HistoryPose, Path>(
-    mut history: History<P>,
-    now: P::Pose,
-    start: f64,
-    h: f64,
-    fixed: impl FnOnce(P::Pose) -> Path,
-    followed: impl FnOnce(History<P>) -> Path,
-) -> (Path, bool) {
-    history.push(start + h, h, now);
-    if history.is_at_rest() {
-        (fixed(now), false)
-    } else {
-        (followed(history), true)
-    }
-}
-
 impl<V: Dimension> WirePose<V> {
     /// The wire held at `transform`, or none if it is not finite.
     pub(crate) fn from_transform(transform: &Transform) -> Self {
@@ -228,7 +166,7 @@ impl<V: Dimension> WirePose<V> {
     /// The wire held where [`wire_pose`] puts it, or none if neither its
     /// place nor its `transform` is finite.
     pub(crate) fn placed(transform: &Transform, place: Option<&WirePlace<V>>) -> Self {
-        Self::new(wire_pose(transform, place).ok().map(V::fixed_path))
+        Self::new(wire_pose(transform, place).ok().map(WirePath::Fixed))
     }
 }
 
@@ -293,8 +231,11 @@ pub(crate) fn put_in_place<V: Dimension>(
     let moved = shown::<V>(transform, at);
     transform.set_if_neq(moved);
     let placed = match motion {
-        Some(motion) => WirePose::on(V::prescribed_path(at, motion.motion())),
-        None => WirePose::on(V::fixed_path(at)),
+        Some(motion) => WirePose::on(WirePath::Prescribed {
+            base: at,
+            motion: motion.motion(),
+        }),
+        None => WirePose::on(WirePath::Fixed(at)),
     };
     pose.set_if_neq(placed);
 }

@@ -9,7 +9,7 @@ use bevy::prelude::*;
 use crate::geometry::not_placeable;
 use crate::geometry::{
     Circle, Coordinates, Ellipse, ImplicitCurve, ImplicitSurface, Line, Parabola, Pose, Pose3,
-    Sine, SpaceCurve, SpaceMotion, SpaceShape, Surface, WireMotion, WireShape, WireSpace,
+    Sine, SpaceCurve, SpaceMotion, SpaceShape, Surface, WireMotion, WirePath, WireShape, WireSpace,
 };
 use crate::solver::{Contact, ContactEvent};
 use crate::validate::ParamError;
@@ -188,32 +188,32 @@ impl<V: WireSpace> PrescribedMotion<V> {
 /// prescribed, or followed from the poses the game writes; none if its
 /// `Transform` is not finite.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
-pub(crate) struct WirePose<V: WireSpace = DVec2>(Option<V::Path>);
+pub(crate) struct WirePose<V: WireSpace = DVec2>(Option<WirePath<V>>);
 
 impl<V: WireSpace> Default for WirePose<V> {
     fn default() -> Self {
-        Self(Some(V::fixed_path(V::Pose::default())))
+        Self(Some(WirePath::Fixed(V::Pose::default())))
     }
 }
 
 impl<V: WireSpace> WirePose<V> {
     /// A wire on `path`, or none if its transform is not finite.
-    pub(crate) fn new(path: Option<V::Path>) -> Self {
+    pub(crate) fn new(path: Option<WirePath<V>>) -> Self {
         Self(path)
     }
 
     /// A wire on `path`.
-    pub(crate) fn on(path: V::Path) -> Self {
+    pub(crate) fn on(path: WirePath<V>) -> Self {
         Self(Some(path))
     }
 
     /// The path, if the wire's transform is finite.
-    pub(crate) fn path(&self) -> Option<V::Path> {
+    pub(crate) fn path(&self) -> Option<WirePath<V>> {
         self.0
     }
 
     /// The path, or the error that the wire's transform is not finite.
-    pub(crate) fn get(&self) -> Result<V::Path, ParamError> {
+    pub(crate) fn get(&self) -> Result<WirePath<V>, ParamError> {
         self.0.ok_or_else(not_placeable)
     }
 }

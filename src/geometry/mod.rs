@@ -27,6 +27,7 @@ mod history;
 mod line;
 mod motion;
 mod parabola;
+mod path;
 mod pose;
 mod shape;
 mod sine;
@@ -46,15 +47,16 @@ pub use cycloid::{Cycloid, CycloidArch};
 pub use ellipse::Ellipse;
 pub use history::{History, HistoryPose, PlanePose, PoseHistory, SpaceHistory, SpacePose};
 pub use line::Line;
-pub use motion::{FixedTrack, MovingTrack, Oscillate, PosePath, Rough, Spin, Track, WireMotion};
+pub use motion::{FixedTrack, Oscillate, Rough, Spin, Track, WireMotion};
 pub use parabola::Parabola;
+pub use path::{MovingSurface, MovingTrack, PosePath, SpacePath, WirePath};
 pub use pose::{Placed, PlacedSurface, Placement, Pose, Pose3};
 pub(crate) use pose::{not_placeable, placed_geometry};
 pub use shape::{WireKind, WireShape};
 pub use sine::Sine;
 pub use space::{
-    Cone, CurveFrame, Cylinder, Extruded, Flat, Helicoid, Helix, ImplicitSurface, MovingSurface,
-    OnPlane, Plane, SpaceCurve, SpaceMotion, SpacePath, Sphere, Torus,
+    Cone, CurveFrame, Cylinder, Extruded, Flat, Helicoid, Helix, ImplicitSurface, OnPlane, Plane,
+    SpaceCurve, SpaceMotion, Sphere, Torus,
 };
 pub use spline::{CubicPath, Spline, SplineKind, SplineSpec};
 pub use surface::{Friction, Side, Surface};

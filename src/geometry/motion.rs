@@ -1,9 +1,8 @@
-//! Wires that move: [`WireMotion`] (a prescribed motion), [`PoseHistory`](super::PoseHistory)
-//! (a motion known only from the poses a game writes), [`PosePath`] (either,
-//! or none) and [`Twist`], a rigid motion's velocity and acceleration at one
-//! instant. [`Track`] is what the solver asks of a wire at a time `t`:
-//! [`FixedTrack`] for a wire that stays put, [`MovingTrack`] for one that
-//! follows a [`PosePath`].
+//! Wires that move: [`WireMotion`] (a prescribed motion) and [`Twist`], a
+//! rigid motion's velocity and acceleration at one instant. [`Track`] is
+//! what the solver asks of a wire at a time `t`: [`FixedTrack`] for a wire
+//! that stays put, [`MovingTrack`](super::MovingTrack) for one that follows
+//! a [`PosePath`](super::PosePath).
 //!
 //! A wire placed by a moving pose has `C(x, t) = C_local(Rᵀ(t)(x − p(t)))`.
 //! Its points move rigidly: the point of the wire at `x` has the velocity
@@ -25,8 +24,7 @@ use bevy::math::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use super::{
-    Coordinates, Geometry, ImplicitCurve, ImplicitSurface, Placed, Placement, Pose, PoseHistory,
-    Surface, Twist,
+    Coordinates, Geometry, ImplicitCurve, ImplicitSurface, Placement, Pose, Surface, Twist,
 };
 use crate::validate::{ParamError, finite, finite_vector, positive};
 
@@ -128,56 +126,6 @@ impl WireMotion {
                 };
                 (pose, twist)
             }
-        }
-    }
-}
-
-/// Where a wire is over time: fixed, prescribed, or followed from the
-/// poses a game wrote.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum PosePath {
-    /// At one pose.
-    Fixed(Pose),
-    /// `motion` about the resting pose `base`.
-    Prescribed {
-        /// The pose at `t = 0`.
-        base: Pose,
-        /// The motion.
-        motion: WireMotion,
-    },
-    /// Interpolated from the last poses.
-    Followed(PoseHistory),
-}
-
-impl PosePath {
-    /// The pose and twist at `t`.
-    #[inline]
-    pub fn at(&self, t: f64) -> (Pose, Twist) {
-        match self {
-            Self::Fixed(pose) => (
-                *pose,
-                Twist {
-                    origin: pose.origin,
-                    ..Twist::default()
-                },
-            ),
-            Self::Prescribed { base, motion } => motion.at(*base, t),
-            Self::Followed(history) => history.at(t),
-        }
-    }
-
-    /// The pose at `t`.
-    pub fn pose(&self, t: f64) -> Pose {
-        self.at(t).0
-    }
-
-    /// The pose if the wire does not move.
-    pub fn fixed(&self) -> Option<Pose> {
-        match self {
-            Self::Fixed(pose) => Some(*pose),
-            Self::Prescribed { base, motion } if !motion.moves() => Some(*base),
-            Self::Followed(history) if history.is_at_rest() => Some(history.newest().1),
-            _ => None,
         }
     }
 }
@@ -309,44 +257,10 @@ impl<C: ImplicitCurve + ?Sized> Track for FixedTrack<'_, C> {
     }
 }
 
-/// A curve in its local frame carried along a [`PosePath`].
-pub struct MovingTrack<'a, C: ImplicitCurve + ?Sized> {
-    /// The curve in its local frame.
-    pub curve: &'a C,
-    /// Where its frame is over time.
-    pub path: &'a PosePath,
-}
-
-impl<C: ImplicitCurve + ?Sized> Track for MovingTrack<'_, C> {
-    const MOVES: bool = true;
-    #[inline]
-    fn geometry(&self, t: f64, x: DVec2) -> Geometry {
-        Placed {
-            curve: self.curve,
-            pose: self.path.pose(t),
-        }
-        .geometry(x)
-    }
-    fn scale(&self) -> f64 {
-        self.curve.scale()
-    }
-    fn twist(&self, t: f64) -> Twist {
-        self.path.at(t).1
-    }
-    fn carry(&self, x: DVec2, from: f64, to: f64) -> DVec2 {
-        carry(&self.path.pose(from), &self.path.pose(to), x)
-    }
-    fn has_ends(&self) -> bool {
-        self.curve.has_ends()
-    }
-    fn past_end(&self, t: f64, x: DVec2) -> f64 {
-        self.curve.past_end(self.path.pose(t).to_local(x))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::PoseHistory;
     use approx::assert_relative_eq;
 
     /// The prescribed motions' velocities and accelerations are the

@@ -1,8 +1,8 @@
 //! [`WireSpace`]: what a wire is in the plane and in space, for the rows
 //! of an island: its shape, where it sits and how it moves. A curve
-//! ([`WireShape`]) placed by a [`Pose`] on a [`PosePath`] in the plane; a
+//! ([`WireShape`]) placed by a [`Pose`] on a [`PosePath`](super::PosePath) in the plane; a
 //! surface or one of a curve's two rows ([`SpaceRow`]) placed by a
-//! [`Pose3`] on a [`SpacePath`] in space.
+//! [`Pose3`] on a [`SpacePath`](super::SpacePath) in space.
 
 use std::fmt::Debug;
 use std::sync::Arc;
@@ -10,8 +10,8 @@ use std::sync::Arc;
 use bevy::math::{DVec2, DVec3};
 
 use super::{
-    Coordinates, Geometry, ImplicitSurface, Placement, Pose, Pose3, PosePath, SpaceCurve,
-    SpaceMotion, SpacePath, Twist, WireMotion, WireShape,
+    Coordinates, Geometry, HistoryPose, ImplicitSurface, Placement, PlanePose, Pose, Pose3,
+    SpaceCurve, SpaceMotion, SpacePose, Twist, WireMotion, WireShape,
 };
 use crate::validate::ParamError;
 
@@ -23,22 +23,18 @@ pub trait WireSpace: Coordinates {
     type Shape: Clone + Debug + Send + Sync + 'static;
     /// Where a wire sits: [`Pose`] or [`Pose3`].
     type Pose: Placement<Self> + Copy + Debug + Default + PartialEq + Send + Sync + 'static;
-    /// Where a wire is over time: [`PosePath`] or [`SpacePath`].
-    type Path: Copy + Debug + PartialEq + Send + Sync + 'static;
+    /// A pose as a wire's [`History`](super::History) keeps it: [`PlanePose`] or
+    /// [`SpacePose`].
+    type Kept: HistoryPose<Pose = Self::Pose, Coords = Self> + Send + Sync + 'static;
     /// A wire's prescribed motion: [`WireMotion`] or [`SpaceMotion`].
     type Motion: Copy + Debug + PartialEq + Send + Sync + 'static;
-    /// A wire resting at `pose`.
-    fn fixed_path(pose: Self::Pose) -> Self::Path;
-    /// A wire moving by `motion` about `base`.
-    fn prescribed_path(base: Self::Pose, motion: Self::Motion) -> Self::Path;
-    /// The resting pose of a prescribed path.
-    fn prescribed_base(path: &Self::Path) -> Option<Self::Pose>;
     /// Whether `motion`'s numbers are valid.
     fn validate_motion(motion: &Self::Motion) -> Result<(), ParamError>;
-    /// The pose and twist of `path` at `t`.
-    fn path_at(path: &Self::Path, t: f64) -> (Self::Pose, Twist<Self>);
-    /// The pose of `path` if it does not move.
-    fn path_fixed(path: &Self::Path) -> Option<Self::Pose>;
+    /// Whether `motion` moves a wire at all.
+    fn motion_moves(motion: &Self::Motion) -> bool;
+    /// The pose at `t` of a wire moving by `motion` about `base`, and its
+    /// twist, exact.
+    fn motion_at(motion: &Self::Motion, base: Self::Pose, t: f64) -> (Self::Pose, Twist<Self>);
     /// `shape`'s geometry at the local point `p`, its nearest point looked
     /// for near the parameter `hint` where there is one (see
     /// [`ImplicitCurve::parameter`](super::ImplicitCurve::parameter)).
@@ -162,29 +158,17 @@ impl Debug for SpaceRow {
 impl WireSpace for DVec2 {
     type Shape = WireShape;
     type Pose = Pose;
-    type Path = PosePath;
+    type Kept = PlanePose;
     type Motion = WireMotion;
-    fn fixed_path(pose: Pose) -> PosePath {
-        PosePath::Fixed(pose)
-    }
-    fn prescribed_path(base: Pose, motion: WireMotion) -> PosePath {
-        PosePath::Prescribed { base, motion }
-    }
-    fn prescribed_base(path: &PosePath) -> Option<Pose> {
-        match path {
-            PosePath::Prescribed { base, .. } => Some(*base),
-            _ => None,
-        }
-    }
     fn validate_motion(motion: &WireMotion) -> Result<(), ParamError> {
         motion.validate()
     }
-    #[inline]
-    fn path_at(path: &PosePath, t: f64) -> (Pose, Twist) {
-        path.at(t)
+    fn motion_moves(motion: &WireMotion) -> bool {
+        motion.moves()
     }
-    fn path_fixed(path: &PosePath) -> Option<Pose> {
-        path.fixed()
+    #[inline]
+    fn motion_at(motion: &WireMotion, base: Pose, t: f64) -> (Pose, Twist) {
+        motion.at(base, t)
     }
     #[inline]
     fn shape_geometry(shape: &WireShape, p: Self, hint: Option<f64>) -> Geometry {
@@ -216,29 +200,17 @@ impl WireSpace for DVec2 {
 impl WireSpace for DVec3 {
     type Shape = SpaceRow;
     type Pose = Pose3;
-    type Path = SpacePath;
+    type Kept = SpacePose;
     type Motion = SpaceMotion;
-    fn fixed_path(pose: Pose3) -> SpacePath {
-        SpacePath::Fixed(pose)
-    }
-    fn prescribed_path(base: Pose3, motion: SpaceMotion) -> SpacePath {
-        SpacePath::Prescribed { base, motion }
-    }
-    fn prescribed_base(path: &SpacePath) -> Option<Pose3> {
-        match path {
-            SpacePath::Prescribed { base, .. } => Some(*base),
-            _ => None,
-        }
-    }
     fn validate_motion(motion: &SpaceMotion) -> Result<(), ParamError> {
         motion.validate()
     }
-    #[inline]
-    fn path_at(path: &SpacePath, t: f64) -> (Pose3, Twist<DVec3>) {
-        path.at(t)
+    fn motion_moves(motion: &SpaceMotion) -> bool {
+        motion.moves()
     }
-    fn path_fixed(path: &SpacePath) -> Option<Pose3> {
-        path.fixed()
+    #[inline]
+    fn motion_at(motion: &SpaceMotion, base: Pose3, t: f64) -> (Pose3, Twist<DVec3>) {
+        motion.at(base, t)
     }
     #[inline]
     fn shape_geometry(shape: &SpaceRow, p: Self, hint: Option<f64>) -> Geometry<DVec3> {

@@ -15,7 +15,7 @@ use crate::dynamics::{
     NextParams, NextWireShape, OnWire, PrescribedMotion, RailOrientation, SimParams, Wire,
     WireContact, WirePlace, WirePose, placement, put_in_place,
 };
-use crate::geometry::{MovingTrack, Track, WireSpace};
+use crate::geometry::{MovingTrack, Track};
 use crate::solver::{RowReport, constraint_state_on};
 
 /// Restarts the run: applies [`NextParams`] and every [`NextBeadParams`],
@@ -157,7 +157,7 @@ fn rest_wire<V: Dimension>(
         Some(motion) => {
             **pose = prescribed(motion, pose, transform, place);
             if let Ok(path) = pose.get() {
-                V::set_pose(transform, V::path_at(&path, 0.0).0);
+                V::set_pose(transform, path.at(0.0).0);
             }
         }
         None => **pose = WirePose::placed(transform, place),
@@ -252,7 +252,7 @@ fn restart_in_space(
         }
         let path = on_wire.and_then(|on| wires.get(on.0).ok()?.1.get().ok());
         if let Some(path) = path {
-            let twist = DVec3::path_at(&path, 0.0).1;
+            let twist = path.at(0.0).1;
             bead.velocity.0 = bead_params.initial_velocity_on(&twist);
         }
         if let Some(mut diagnostics) = diagnostics {

@@ -16,6 +16,7 @@ use super::schedule::WireBeadSystems;
 use crate::dynamics::{
     Dimension, PrescribedMotion, SimParams, WirePlace, WirePose, placement, put_in_place, wire_pose,
 };
+use crate::geometry::WirePath;
 
 /// Places the wires for each step: a wire's pose when it is added, its
 /// prescribed motion, or the motion a game gives it by writing its
@@ -118,7 +119,7 @@ pub(crate) fn place_wires<V: Dimension>(
         let placed = prescribed(motion, &pose, &transform, place);
         pose.set_if_neq(placed);
         if let Some(path) = placed.path() {
-            V::set_pose(&mut transform, V::path_at(&path, start + h).0);
+            V::set_pose(&mut transform, path.at(start + h).0);
         }
     }
     let mut still_moving = EntityHashSet::default();
@@ -139,7 +140,7 @@ pub(crate) fn place_wires<V: Dimension>(
         {
             place.bypass_change_detection().0 = now;
         }
-        let (path, moves) = V::followed(pose.path(), now, start, h);
+        let (path, moves) = WirePath::followed(pose.path(), now, start, h);
         if moves {
             still_moving.insert(entity);
         }
@@ -243,12 +244,15 @@ pub(crate) fn prescribed<V: Dimension>(
     transform: &Transform,
     place: Option<&WirePlace<V>>,
 ) -> WirePose<V> {
-    let base = match pose.path().and_then(|path| V::prescribed_base(&path)) {
+    let base = match pose.path().and_then(|path| path.base()) {
         Some(base) => Ok(base),
         None => wire_pose(transform, place),
     };
     match base {
-        Ok(base) => WirePose::on(V::prescribed_path(base, motion.motion())),
+        Ok(base) => WirePose::on(WirePath::Prescribed {
+            base,
+            motion: motion.motion(),
+        }),
         Err(_) => WirePose::from_transform(transform),
     }
 }

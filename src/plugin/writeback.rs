@@ -15,7 +15,7 @@ use crate::dynamics::{
     Bead, BeadParams, BeadPosition, Dimension, OnWire, RailOrientation, SpaceBead, SpaceWire,
     WirePose,
 };
-use crate::geometry::{SpaceShape, WireSpace};
+use crate::geometry::SpaceShape;
 
 /// Keeps each bead's `Transform` at its position where the step did not
 /// write it itself (a restart, a game's own edit), places it there as
@@ -128,8 +128,8 @@ fn orient_rails(
         let (SpaceShape::Curve(curve), Ok(path)) = (wire.shape(), pose.get()) else {
             continue;
         };
-        let pose = DVec3::path_at(&path, clock.time).0;
-        let start = || (DVec3::path_at(&path, 0.0).0, params.initial_position);
+        let pose = path.at(clock.time).0;
+        let start = || (path.at(0.0).0, params.initial_position);
         if let Some(rotation) = rail.orient(curve.as_ref(), &pose, position.0, start) {
             let rotation = rotation.as_quat();
             if rotation.is_finite() {

@@ -33,7 +33,7 @@ use super::{Coordinates, Geometry};
 
 pub use curve::{CurveFrame, Helix, OnPlane, SpaceCurve};
 pub use helicoid::Helicoid;
-pub use motion::{MovingSurface, SpaceMotion, SpacePath};
+pub use motion::SpaceMotion;
 pub use planar::{Extruded, Flat};
 pub use shapes::{Cone, Cylinder, Plane, Sphere, Torus};
 

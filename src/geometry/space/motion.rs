@@ -1,14 +1,11 @@
-//! Surfaces that move in space: [`SpaceMotion`] (an oscillation of the
-//! origin along a 3D amplitude, or a spin about any axis through it),
-//! [`SpacePath`] (where a surface is over time) and [`MovingSurface`], the
-//! [`Track`] the solver steps a bead on it with. The frame's velocity and
-//! acceleration are exact, and eq. (15) takes them in its 3D form.
+//! Surfaces that move in space: [`SpaceMotion`], an oscillation of the
+//! origin along a 3D amplitude or a spin about any axis through it. The
+//! frame's velocity and acceleration are exact, and eq. (15) takes them in
+//! its 3D form.
 
 use bevy::math::{DQuat, DVec3};
 
-use super::ImplicitSurface;
-use crate::geometry::motion::carry;
-use crate::geometry::{Geometry, Oscillate, PlacedSurface, Pose3, SpaceHistory, Track, Twist};
+use crate::geometry::{Oscillate, Pose3, Twist};
 use crate::validate::{ParamError, finite, positive};
 
 /// A prescribed motion of a surface about its resting pose.
@@ -54,6 +51,17 @@ impl SpaceMotion {
         }
     }
 
+    /// Whether the surface moves at all.
+    pub fn moves(&self) -> bool {
+        match self {
+            Self::Fixed => false,
+            Self::Oscillate(o) => o.amplitude != DVec3::ZERO,
+            Self::Spin {
+                angular_velocity, ..
+            } => *angular_velocity != 0.0,
+        }
+    }
+
     /// The pose at time `t` of a surface resting at `base`, and its twist,
     /// exact.
     pub fn at(&self, base: Pose3, t: f64) -> (Pose3, Twist<DVec3>) {
@@ -94,87 +102,6 @@ impl SpaceMotion {
                 (pose, twist)
             }
         }
-    }
-}
-
-/// Where a wire in space is over time: at one pose, moving by a
-/// prescribed motion about a resting pose, or followed from the poses a
-/// game wrote.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum SpacePath {
-    /// At one pose.
-    Fixed(Pose3),
-    /// `motion` about the resting pose `base`.
-    Prescribed {
-        /// The pose at `t = 0`.
-        base: Pose3,
-        /// The motion.
-        motion: SpaceMotion,
-    },
-    /// Interpolated from the last poses.
-    Followed(SpaceHistory),
-}
-
-impl SpacePath {
-    /// The pose and twist at `t`.
-    pub fn at(&self, t: f64) -> (Pose3, Twist<DVec3>) {
-        match self {
-            Self::Fixed(pose) => SpaceMotion::Fixed.at(*pose, t),
-            Self::Prescribed { base, motion } => motion.at(*base, t),
-            Self::Followed(history) => history.at(t),
-        }
-    }
-
-    /// The pose at `t`.
-    pub fn pose(&self, t: f64) -> Pose3 {
-        self.at(t).0
-    }
-
-    /// The pose if the surface does not move.
-    pub fn fixed(&self) -> Option<Pose3> {
-        match self {
-            Self::Fixed(pose) => Some(*pose),
-            Self::Prescribed {
-                base,
-                motion: SpaceMotion::Fixed,
-            } => Some(*base),
-            Self::Prescribed { .. } | Self::Followed(_) => None,
-        }
-    }
-}
-
-/// A surface in its local frame carried along a [`SpacePath`].
-pub struct MovingSurface<'a, S: ImplicitSurface + ?Sized> {
-    /// The surface in its local frame.
-    pub surface: &'a S,
-    /// Where its frame is over time.
-    pub path: &'a SpacePath,
-}
-
-impl<S: ImplicitSurface + ?Sized> Track<DVec3> for MovingSurface<'_, S> {
-    const MOVES: bool = true;
-    #[inline]
-    fn geometry(&self, t: f64, x: DVec3) -> Geometry<DVec3> {
-        PlacedSurface {
-            surface: self.surface,
-            pose: self.path.pose(t),
-        }
-        .geometry(x)
-    }
-    fn scale(&self) -> f64 {
-        self.surface.scale()
-    }
-    fn twist(&self, t: f64) -> Twist<DVec3> {
-        self.path.at(t).1
-    }
-    fn carry(&self, x: DVec3, from: f64, to: f64) -> DVec3 {
-        carry(&self.path.pose(from), &self.path.pose(to), x)
-    }
-    fn has_ends(&self) -> bool {
-        false
-    }
-    fn past_end(&self, _t: f64, _x: DVec3) -> f64 {
-        f64::NEG_INFINITY
     }
 }
 

@@ -80,7 +80,7 @@ impl WiredRows {
         if !own && surface.side == Side::Both {
             return Ok(());
         }
-        let pose = V::path_at(&path, time).0;
+        let pose = path.at(time).0;
         let shapes = shape.rows();
         // A curve in space: its two rows rub as one (see
         // `Island::pair_rows`).

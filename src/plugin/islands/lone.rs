@@ -8,7 +8,7 @@
 use bevy::prelude::*;
 
 use crate::dynamics::{BeadDiagnostics, Dimension, DivergenceReason};
-use crate::geometry::Track;
+use crate::geometry::{Track, WirePath};
 use crate::plugin::step::{LoneStep, OnTrack};
 use crate::solver::{
     self, BeadState, LinearForce, RowReport, SolveError, StepOutput, StepSettings, TouchBody,
@@ -21,7 +21,7 @@ pub(super) struct LoneTouch<V: Dimension> {
     pub(super) entity: Entity,
     pub(super) wire: Entity,
     /// The wire's path this step.
-    pub(super) path: V::Path,
+    pub(super) path: WirePath<V>,
     pub(super) mass: f64,
     /// Its radius, restitution and friction against another bead,
     /// gathered each step.
@@ -47,7 +47,7 @@ impl<V: Dimension> LoneTouch<V> {
         Self {
             entity,
             wire,
-            path: V::fixed_path(V::Pose::default()),
+            path: WirePath::Fixed(V::Pose::default()),
             mass,
             radius: 0.0,
             restitution: 1.0,

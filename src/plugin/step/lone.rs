@@ -10,7 +10,7 @@ use bevy::math::{DVec2, DVec3};
 use crate::dynamics::Dimension;
 use crate::geometry::{
     FixedTrack, ImplicitSurface, MovingSurface, MovingTrack, Near, Placed, PlacedSurface, Pose,
-    Pose3, PosePath, SpacePath, SpaceShape, Track, WireShape,
+    Pose3, PosePath, SpacePath, SpaceShape, Track, WirePath, WireShape,
 };
 use crate::lane::LaneSpace;
 
@@ -42,15 +42,16 @@ pub(crate) trait LoneStep: Dimension + LaneSpace {
     /// Runs `f` on the shape resting at `pose`, as its concrete type.
     fn fixed<R>(shape: &Self::Lone, pose: Self::Pose, f: impl OnTrack<Self, R>) -> R;
     /// Runs `f` on the shape moving along `path`, as its concrete type.
-    fn moving<R>(shape: &Self::Lone, path: &Self::Path, f: impl OnTrack<Self, R>) -> R;
+    fn moving<R>(shape: &Self::Lone, path: &WirePath<Self>, f: impl OnTrack<Self, R>) -> R;
     /// Runs `f` on the shape along `path`, its nearest point looked for
     /// near the parameter `hint` where it has one.
-    fn near<R>(shape: &Self::Lone, path: &Self::Path, hint: f64, f: impl OnTrack<Self, R>) -> R;
+    fn near<R>(shape: &Self::Lone, path: &WirePath<Self>, hint: f64, f: impl OnTrack<Self, R>)
+    -> R;
     /// Runs `f` on the shape along `path`: resting where the path does
     /// not move, moving otherwise.
     #[inline(always)]
-    fn on_path<R>(shape: &Self::Lone, path: &Self::Path, f: impl OnTrack<Self, R>) -> R {
-        match Self::path_fixed(path) {
+    fn on_path<R>(shape: &Self::Lone, path: &WirePath<Self>, f: impl OnTrack<Self, R>) -> R {
+        match path.fixed() {
             Some(pose) => Self::fixed(shape, pose, f),
             None => Self::moving(shape, path, f),
         }

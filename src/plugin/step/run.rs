@@ -297,7 +297,7 @@ impl<V: LoneStep> StepContext<'_, V> {
         let stepped = V::near(shape, path, hint, on)?;
         if let Some(contact) = contact {
             contact.contact = stepped.contact;
-            let (pose, _) = V::path_at(path, self.time);
+            let (pose, _) = path.at(self.time);
             let local = pose.to_local(stepped.output.state.position);
             contact.along = V::parameter(shape, local, hint) as f32;
         }

@@ -6,7 +6,7 @@ use bevy::prelude::*;
 
 use super::lone::LoneStep;
 use crate::dynamics::{DivergenceReason, OnWire, WirePose, WireRows};
-use crate::geometry::{Placement, Surface};
+use crate::geometry::{Placement, Surface, WirePath};
 
 /// A wire as the step needs it: its shape and, for most wires, where it
 /// stays; a moving wire's path and a one-sided, rough or damped wire's
@@ -16,12 +16,12 @@ pub(crate) struct TableWire<V: LoneStep> {
     /// Where a plain wire that stays put is (when `track` is none).
     pub(super) pose: V::Pose,
     /// The path and surface of the others.
-    pub(super) track: Option<Box<(V::Path, Surface)>>,
+    pub(super) track: Option<Box<(WirePath<V>, Surface)>>,
 }
 
 impl<V: LoneStep> TableWire<V> {
-    fn new(shape: V::Lone, path: V::Path, surface: Surface) -> Self {
-        match V::path_fixed(&path) {
+    fn new(shape: V::Lone, path: WirePath<V>, surface: Surface) -> Self {
+        match path.fixed() {
             Some(pose) if surface.is_plain() => Self {
                 shape,
                 pose,
@@ -37,10 +37,10 @@ impl<V: LoneStep> TableWire<V> {
 
     /// The path (a fixed one for a wire that stays put).
     #[inline]
-    pub(super) fn path(&self) -> V::Path {
+    pub(super) fn path(&self) -> WirePath<V> {
         match &self.track {
             Some(track) => track.0,
-            None => V::fixed_path(self.pose),
+            None => WirePath::Fixed(self.pose),
         }
     }
 

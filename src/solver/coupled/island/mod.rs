@@ -24,7 +24,7 @@ use std::sync::Arc;
 
 use super::constraint::{RowKind, SpringLink};
 use super::normal::NormalMatrix;
-use crate::geometry::{Friction, Side, WireSpace};
+use crate::geometry::{Friction, Side, WirePath, WireSpace};
 use crate::solver::state::BeadState;
 
 mod build;
@@ -104,7 +104,7 @@ pub struct Island<V: WireSpace = DVec2> {
     springs: Vec<SpringLink>,
     normal: Arc<NormalMatrix>,
     /// The path of each wire row that moves (see [`Island::move_wire`]).
-    paths: Vec<Option<V::Path>>,
+    paths: Vec<Option<WirePath<V>>>,
     /// How many rows have a path: with none, a step looks at no path.
     moving: usize,
     /// Each row's side (+1, −1, or 0 for a two-sided row) and restitution
@@ -162,8 +162,8 @@ impl<V: WireSpace> Island<V> {
     /// step: its rows are evaluated where the wire is at each stage's
     /// time, with the terms of eq. (15) (the step's times come from
     /// [`Island::step_at`]). `shape` as for [`Island::place_wire`].
-    pub fn move_wire(&mut self, row: usize, shape: Option<V::Shape>, path: V::Path) {
-        if let Some(pose) = V::path_fixed(&path) {
+    pub fn move_wire(&mut self, row: usize, shape: Option<V::Shape>, path: WirePath<V>) {
+        if let Some(pose) = path.fixed() {
             return self.place_wire(row, shape, pose);
         }
         if matches!(self.rows.get(row), Some(RowKind::Wire { .. })) {

@@ -191,7 +191,7 @@ impl<V: WireSpace> Island<V> {
             return None;
         };
         let (pose, twist) = match &self.paths[r] {
-            Some(path) => V::path_at(path, time),
+            Some(path) => path.at(time),
             None => (*pose, Twist::default()),
         };
         Some((shape, pose, twist))
@@ -319,7 +319,7 @@ impl<V: WireSpace> Island<V> {
                 // Eq. (15): the wire where it is at `time`, seen from its frame.
                 let bead = self.entry_bead[range.start];
                 let (p, u) = (x[bead], v[bead]);
-                let (pose, twist) = V::path_at(path, time);
+                let (pose, twist) = path.at(time);
                 let g = placed_geometry(&pose, p, |local| {
                     V::shape_geometry(shape, local, Some(hint(r)))
                 });
