@@ -177,8 +177,8 @@ pub(crate) fn wire_pose<V: Dimension>(
     transform: &Transform,
     place: Option<&WirePlace<V>>,
 ) -> Result<V::Pose, ParamError> {
-    match place.map(|p| placement::<V>(p.0)) {
-        Some(Ok(pose)) if shown::<V>(transform, pose) == *transform => Ok(pose),
+    match place.and_then(WirePlace::taken) {
+        Some(pose) if shown::<V>(transform, pose) == *transform => Ok(pose),
         _ => V::pose_of(transform),
     }
 }
@@ -216,6 +216,14 @@ pub(crate) fn placement<V: Dimension>(pose: V::Pose) -> Result<V::Pose, ParamErr
             max: 1.0 + TURN_SLACK,
             value: length,
         })
+    }
+}
+
+impl<V: Dimension> WirePlace<V> {
+    /// The pose this place puts its wire at ([`placement`]), if it places
+    /// one.
+    pub(crate) fn taken(&self) -> Option<V::Pose> {
+        placement::<V>(self.0).ok()
     }
 }
 

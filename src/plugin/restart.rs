@@ -13,7 +13,7 @@ use super::wires::prescribed;
 use crate::dynamics::{
     BeadDiagnostics, BeadMotion, BeadMotionItem, BeadParams, Dimension, Diverged, NextBeadParams,
     NextParams, NextWireShape, OnWire, PrescribedMotion, RailOrientation, SimParams, Wire,
-    WireContact, WirePlace, WirePose, placement, put_in_place,
+    WireContact, WirePlace, WirePose, put_in_place,
 };
 use crate::geometry::{MovingTrack, Track};
 use crate::solver::{RowReport, constraint_state_on};
@@ -149,7 +149,7 @@ fn rest_wire<V: Dimension>(
             .last_changed()
             .is_newer_than(transform.last_changed(), now)
     });
-    if let Some(Ok(at)) = written.map(|place| placement::<V>(place.0)) {
+    if let Some(at) = written.and_then(|place| place.taken()) {
         put_in_place(at, motion, transform, pose);
     }
     let place = place.as_deref();

@@ -154,7 +154,7 @@ pub(crate) fn place_wires<V: Dimension>(
 /// its first step on moves it from there.
 fn wire_added<V: Dimension>(add: On<Add, V::Wire>, mut wires: Query<PlacedWire<V>>) {
     if let Ok((place, motion, mut transform, mut pose)) = wires.get_mut(add.entity) {
-        match place.and_then(|p| placement::<V>(p.0).ok()) {
+        match place.and_then(WirePlace::taken) {
             Some(at) => put_in_place(at, motion, &mut transform, &mut pose),
             None => *pose = WirePose::from_transform(&transform),
         }
@@ -173,7 +173,7 @@ type PlacedWire<V> = (
 /// Puts a wire at the [`WirePlace`] inserted on it.
 fn place_inserted<V: Dimension>(insert: On<Insert, WirePlace<V>>, mut wires: Query<PlacedWire<V>>) {
     if let Ok((place, motion, mut transform, mut pose)) = wires.get_mut(insert.entity)
-        && let Some(Ok(at)) = place.map(|p| placement::<V>(p.0))
+        && let Some(at) = place.and_then(WirePlace::taken)
     {
         put_in_place(at, motion, &mut transform, &mut pose);
     }

@@ -1,18 +1,16 @@
 //! Editing the parameters: the selected bead's, its wire's shape, and the
 //! solver's, each through the plugin's validating setters.
 
-use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_egui::egui;
 
 use super::keyboard::number_field;
 use super::view::PanelView;
-use crate::dynamics::placement;
 use crate::geometry::{Coordinates, Cycloid};
 use crate::{
     BeadParams, Integrator, NextBeadParams, NextParams, NextWireShape, ParamError,
     PrescribedMotion, Side, SimClock, Stabilization, Surface, WireContact, WireKind, WireMotion,
-    WireShape, pose_of,
+    WirePlace, WireShape, pose_of,
 };
 
 /// The result of an edit: `None` where nothing was edited.
@@ -133,7 +131,7 @@ pub(super) fn bead_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut C
                 // Start the bead at the new wire's lowest point, where the
                 // restart rests the wire: at its place, in `f64`.
                 let pose = place
-                    .and_then(|place| placement::<DVec2>(place.0).ok())
+                    .and_then(WirePlace::taken)
                     .or_else(|| pose_of(transform).ok())
                     .unwrap_or_default();
                 draft.initial_position = pose.to_world(edited.bottom());
