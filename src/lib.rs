@@ -81,6 +81,8 @@
 
 #[cfg(feature = "avian2d")]
 pub mod avian;
+#[cfg(feature = "avian3d")]
+pub mod avian3d;
 pub mod controls;
 #[cfg(feature = "debug-render")]
 pub mod debug_render;

@@ -17,38 +17,10 @@ pub enum PathRotation {
     Turned,
 }
 
-/// What drives a body along its wire.
-#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
-pub enum PathMotor {
-    /// The anchor's speed along the wire, relative to the wire, brought
-    /// to `speed` (m/s, along the wire's own direction: a line's +x, a
-    /// circle or an ellipse counter-clockwise, a graph's growing x, a
-    /// spline's or a cycloid's parameter) by a force of at most
-    /// `max_force` (N) along it.
-    Velocity {
-        /// The speed the motor holds, m/s.
-        speed: f64,
-        /// The largest force it gives, N.
-        max_force: f64,
-    },
-    /// The anchor drawn along the wire towards `target` (a point of the
-    /// wire, in the wire's frame) as by a spring of `frequency` (Hz) and
-    /// `damping_ratio` (1: critical), by a force of at most `max_force`
-    /// (N). The spring pulls along the wire's tangent at the anchor by the
-    /// target's distance along it, so it draws the anchor to a target
-    /// nearer than a quarter of the wire's turn (a quarter circle on a
-    /// hoop); a farther one is reached by moving it as the anchor goes.
-    Position {
-        /// The point of the wire the anchor is drawn to, wire's frame.
-        target: DVec2,
-        /// The spring's frequency, Hz.
-        frequency: f64,
-        /// Its damping ratio (1: critically damped).
-        damping_ratio: f64,
-        /// The largest force it gives, N.
-        max_force: f64,
-    },
-}
+/// What drives a body along its wire (see
+/// [`PathMotor`](crate::solver::PathMotor)'s variants), its
+/// position target a point of the plane.
+pub type PathMotor = crate::solver::path::PathMotor<DVec2>;
 
 /// Holds a point of the rigid body it is on (the anchor, in the body's
 /// frame from its origin, as avian's joints take theirs) on the wire
@@ -115,16 +87,6 @@ impl PathJoint {
     /// `friction` (N) while no motor drives it.
     pub fn with_friction(self, friction: f64) -> Self {
         Self { friction, ..self }
-    }
-
-    /// The compliance the joint is solved with: its own where that is a
-    /// finite positive number, else 0 (rigid).
-    pub(super) fn yielding(&self) -> f64 {
-        if self.compliance.is_finite() && self.compliance > 0.0 {
-            self.compliance
-        } else {
-            0.0
-        }
     }
 }
 

@@ -17,7 +17,7 @@
 //! | `impact` | `resolve_impacts`: strikes between beads that touch, eq. (18), one pair at a time |
 //! | `touch/` (`group`) | `settle_touches`: where within a step beads meet (broad phase, regula falsi), the step cut there |
 //! | `lanes/` (`circle`) | the batched step: eight beads on circles at once, bit for bit [`step`](fn@step), many such batches in one call; the solves on each lane's circle (crate-private) |
-//! | `path` | a rigid body's anchor held on a wire, and its angle turned with it: the corrections of an engine's substep (a path joint) |
+//! | `path/` (`plane`, `space`, `substep`) | a rigid body's anchor held on a wire, and its orientation turned with it, in the plane and in space: the corrections of an engine's substep (a path joint), and the [`PathMotor`] that drives it |
 //! | `coupled/` (`island/`, `normal/`, …) | [`Island`]: beads joined by rods, pins, wires and springs, eqs. (12)–(14) |
 //!
 //! The equations below are numbered as the code and the tests cite them.
@@ -32,7 +32,7 @@ mod impact;
 mod lanes;
 mod method;
 mod newton;
-#[cfg_attr(not(feature = "avian2d"), allow(dead_code))]
+#[cfg_attr(not(any(feature = "avian2d", feature = "avian3d")), allow(dead_code))]
 pub(crate) mod path;
 mod projection;
 mod rattle;
@@ -54,6 +54,7 @@ pub(crate) use coupled::{pair_gap, pair_speeds};
 pub use euler::{explicit_euler, semi_implicit_euler};
 pub(crate) use lanes::{LANES, RoundLanes, RoundSteps, step_on_round_batches};
 pub use method::{Integrator, Method, Stabilization};
+pub use path::PathMotor;
 pub use projection::project;
 pub use rattle::rattle;
 pub use rk4::rk4;

@@ -26,6 +26,7 @@ const LAYERS: &[&str] = &[
     "dynamics",
     "plugin",
     "avian",
+    "avian3d",
     "controls",
     "preset",
     "headless",

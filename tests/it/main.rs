@@ -5,6 +5,8 @@
 
 #[cfg(feature = "avian2d")]
 mod avian;
+#[cfg(feature = "avian3d")]
+mod avian3d;
 mod bad_input;
 mod baumgarte;
 mod common;

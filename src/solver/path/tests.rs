@@ -12,7 +12,7 @@ fn body(centre: DVec2, angle: f64, arm: DVec2) -> PlaneBody {
     }
 }
 
-fn rows_of(list: &[BodyRow]) -> Rows {
+fn rows_of(list: &[BodyRow<PlaneBody>]) -> Rows<PlaneBody> {
     let mut rows = Rows::default();
     for row in list {
         rows.push(*row);
@@ -32,7 +32,7 @@ fn rows_have_the_gradients_of_their_values() {
     let on = DVec2::new(2.0 * 1.1f64.cos(), 1.1f64.sin());
     let at = |centre: DVec2, angle: f64| body(centre, angle, arm);
     let centre = on - DVec2::from_angle(angle).rotate(arm);
-    let rows: [&dyn Fn(&PlaneBody) -> BodyRow; 2] =
+    let rows: [&dyn Fn(&PlaneBody) -> BodyRow<PlaneBody>; 2] =
         [&|b| on_curve(&curve, b).expect("a row"), &|b| {
             turned_with_curve(&curve, b, 0.3).expect("a row")
         }];
@@ -85,13 +85,13 @@ fn a_projection_puts_the_anchor_on_the_curve_along_the_start_gradient() {
     assert!(off <= 1e-14, "the anchor is {off:e} m off the circle");
     let g = start_rows.iter().next().expect("a row");
     let moved = projected.body.centre - predicted.centre;
-    let expected = g.along_centre * start.inverse_mass * projected.lambda.x;
+    let expected = g.along_centre * start.inverse_mass * projected.lambda[0];
     assert!(
         (moved - expected).length() <= 1e-15,
         "{moved} against {expected}"
     );
     let turned = projected.body.angle - predicted.angle;
-    let expected = g.along_angle * start.inverse_inertia * projected.lambda.x;
+    let expected = g.along_angle * start.inverse_inertia * projected.lambda[0];
     assert!((turned - expected).abs() <= 1e-15);
 }
 
@@ -109,7 +109,7 @@ fn a_compliant_projection_yields_by_its_multiplier() {
     })
     .expect("a projection");
     let c = projected.body.centre.y;
-    assert!((c + compliance * projected.lambda.x).abs() <= 1e-15);
+    assert!((c + compliance * projected.lambda[0]).abs() <= 1e-15);
     // w = 1/2, so C = −0.1 + λ/2 = −2λ: λ = 0.04, C = −0.08.
     assert!((c + 0.08).abs() <= 1e-15, "the row holds at {c}");
 }

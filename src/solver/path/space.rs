@@ -1,0 +1,313 @@
+//! A path joint's rows in space: the body's centre of mass and
+//! orientation `R` are its six coordinates, a turn `δθ` a world rotation
+//! vector applied on the left (`R ← exp(δθ) R`, as avian turns a body).
+//! Its anchor is held on a curve by the curve's two rows, or on a surface
+//! by its one; where the body turns with the wire, an axis `w` of the
+//! body (as it lay along the wire's frame when the joint began) is held
+//! at right angles to a direction `e` of that frame at the anchor: the
+//! row `A = w · e`, whose gradient is
+//!
+//! ```text
+//! ∂A/∂θ = w × e + k (a − c) × t̂,   ∂A/∂c = k t̂,   k = w · (Ω × e)
+//! ```
+//!
+//! with `t̂` the tangent and `Ω` the frame's turn per metre along it (its
+//! Darboux vector: `de/ds = Ω × e`), found from the frame a little either
+//! side of the anchor. The rows hold `w_t` at right angles to `n̂` and
+//! `b̂` (the body turns about the tangent only), and so on for each mode;
+//! with `w_n · b̂` too, the body turns with the frame; against the wire's
+//! own axes (`Ω = 0`) it keeps its orientation to the wire.
+
+use bevy::math::{DMat3, DQuat, DVec3};
+
+use super::{Bend, BodyRow, JointBody, JointWire, Rows};
+use crate::geometry::{Pose3, SpaceShape};
+
+/// A rigid body in space as the joint sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SpaceBody {
+    /// The centre of mass, world frame.
+    pub centre: DVec3,
+    /// The body's orientation.
+    pub rotation: DQuat,
+    /// The anchor from the centre of mass, in the body's frame.
+    pub arm: DVec3,
+    /// `1 / m` along each world axis (0 along a locked one).
+    pub inverse_mass: DVec3,
+    /// `I⁻¹` about the centre of mass, world frame.
+    pub inverse_inertia: DMat3,
+}
+
+impl JointBody for SpaceBody {
+    type V = DVec3;
+    type Turn = DVec3;
+    const COORDINATES: usize = 6;
+
+    fn centre(&self) -> DVec3 {
+        self.centre
+    }
+
+    fn anchor(&self) -> DVec3 {
+        if self.arm == DVec3::ZERO {
+            return self.centre;
+        }
+        self.centre + self.rotation * self.arm
+    }
+
+    fn moment(r: DVec3, d: DVec3) -> DVec3 {
+        r.cross(d)
+    }
+
+    fn inverse_mass(&self, p: DVec3) -> DVec3 {
+        p * self.inverse_mass
+    }
+
+    fn inverse_inertia(&self, tau: DVec3) -> DVec3 {
+        self.inverse_inertia * tau
+    }
+
+    fn displaced(&self, linear: DVec3, turn: DVec3) -> Self {
+        let rotation = if turn == DVec3::ZERO {
+            self.rotation
+        } else {
+            (DQuat::from_scaled_axis(turn) * self.rotation).normalize()
+        };
+        Self {
+            centre: self.centre + linear,
+            rotation,
+            ..*self
+        }
+    }
+}
+
+/// How a body held on a curve in space turns with it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SpaceTurn {
+    /// About the curve's tangent only.
+    AroundTangent,
+    /// About its normal only.
+    AroundNormal,
+    /// About its binormal only.
+    AroundBinormal,
+    /// With the curve's frame.
+    ToPath,
+    /// Not at all, against the wire's own axes.
+    Fixed,
+}
+
+/// How a body turns with its wire, fixed where the joint began: the mode,
+/// and the body's axes that lay along the wire's frame then (tangent,
+/// normal, binormal; the wire's own axes for [`SpaceTurn::Fixed`]), in the
+/// body's frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Alignment {
+    /// The mode.
+    pub turn: SpaceTurn,
+    /// `R₀⁻¹ F₀`: the frame's axes as the body's own.
+    pub axes: DQuat,
+}
+
+impl Alignment {
+    /// The body axis and the frame direction (0 tangent, 1 normal, 2
+    /// binormal) of each row the mode holds.
+    fn pairs(&self) -> &'static [(usize, usize)] {
+        match self.turn {
+            SpaceTurn::AroundTangent => &[(0, 1), (0, 2)],
+            SpaceTurn::AroundNormal => &[(1, 0), (1, 2)],
+            SpaceTurn::AroundBinormal => &[(2, 0), (2, 1)],
+            SpaceTurn::ToPath | SpaceTurn::Fixed => &[(0, 1), (0, 2), (1, 2)],
+        }
+    }
+}
+
+/// A wire in space as a joint holds a body on it, where the wire is at
+/// one instant.
+pub(crate) struct SpaceWireAt<'a> {
+    /// The wire's shape, local frame.
+    pub shape: &'a SpaceShape,
+    /// Where it is.
+    pub pose: Pose3,
+    /// The curve's parameter near the anchor: its branch.
+    pub hint: f64,
+    /// How the body turns with it, once fixed.
+    pub alignment: Option<Alignment>,
+}
+
+/// The columns of a rotation as its three axes.
+fn axes(rotation: DQuat) -> [DVec3; 3] {
+    [
+        rotation * DVec3::X,
+        rotation * DVec3::Y,
+        rotation * DVec3::Z,
+    ]
+}
+
+impl SpaceWireAt<'_> {
+    /// The wire's frame at the local point `local` as a rotation whose
+    /// axes are its tangent, normal and binormal (wire frame); `None` on
+    /// a surface or at a singular point.
+    fn local_frame(&self, local: DVec3) -> Option<DQuat> {
+        let SpaceShape::Curve(curve) = self.shape else {
+            return None;
+        };
+        let frame = curve.frame(local, self.hint);
+        let (t, n) = (frame.tangent, frame.normal);
+        (t != DVec3::ZERO && n != DVec3::ZERO)
+            .then(|| DQuat::from_mat3(&DMat3::from_cols(t, n, t.cross(n))).normalize())
+            .filter(|q| q.is_finite())
+    }
+
+    /// The frame the body turns against at `body`'s anchor, world: the
+    /// curve's for a mode that turns with it, the wire's own axes for
+    /// [`SpaceTurn::Fixed`]. `None` where there is none (a surface, a
+    /// singular point).
+    pub fn frame(&self, body: &SpaceBody, turn: SpaceTurn) -> Option<DQuat> {
+        if turn == SpaceTurn::Fixed {
+            return Some(self.pose.rotation);
+        }
+        Some(self.pose.rotation * self.local_frame(self.pose.to_local(body.anchor()))?)
+    }
+
+    /// The curve's parameter at the body's anchor (NaN on a surface).
+    pub fn parameter(&self, body: &SpaceBody) -> f64 {
+        match self.shape {
+            SpaceShape::Curve(curve) => {
+                curve.parameter(self.pose.to_local(body.anchor()), self.hint)
+            }
+            SpaceShape::Surface(_) => f64::NAN,
+        }
+    }
+
+    /// The frame's turn per metre along the tangent `tangent` at the
+    /// local point `local` (world frame), from the frame a little either
+    /// side.
+    fn frame_rate(&self, local: DVec3, tangent: DVec3) -> Option<DVec3> {
+        let step = 1e-5 * self.shape.scale();
+        let ahead = self.local_frame(local + step * tangent)?;
+        let behind = self.local_frame(local - step * tangent)?;
+        let mut turn = ahead * behind.inverse();
+        if turn.w < 0.0 {
+            turn = -turn;
+        }
+        Some(self.pose.rotation * (turn.to_scaled_axis() / (2.0 * step)))
+    }
+
+    /// The rows that turn the body with the wire (see the module's docs).
+    fn turned(
+        &self,
+        body: &SpaceBody,
+        alignment: &Alignment,
+        local: DVec3,
+        tangent: DVec3,
+    ) -> Option<[BodyRow<SpaceBody>; 3]> {
+        let (frame, rate) = match alignment.turn {
+            SpaceTurn::Fixed => (self.pose.rotation, DVec3::ZERO),
+            _ => (
+                self.pose.rotation * self.local_frame(local)?,
+                self.frame_rate(local, self.pose.rotation.inverse() * tangent)?,
+            ),
+        };
+        let along = BodyRow::at_anchor(body, 0.0, tangent);
+        let body_axes = axes(body.rotation * alignment.axes);
+        let frame_axes = axes(frame);
+        let mut rows = [BodyRow::default(); 3];
+        for (row, &(k, l)) in rows.iter_mut().zip(alignment.pairs()) {
+            let (w, e) = (body_axes[k], frame_axes[l]);
+            let turning = w.dot(rate.cross(e));
+            *row = BodyRow {
+                value: w.dot(e),
+                along_centre: along.along_centre * turning,
+                along_angle: w.cross(e) + along.along_angle * turning,
+            };
+        }
+        Some(rows)
+    }
+}
+
+impl JointWire<SpaceBody> for SpaceWireAt<'_> {
+    fn held(&self, body: &SpaceBody) -> Option<Rows<SpaceBody>> {
+        let local = self.pose.to_local(body.anchor());
+        let geometries = match self.shape {
+            SpaceShape::Curve(curve) => curve.rows(local, self.hint).to_vec(),
+            SpaceShape::Surface(surface) => vec![surface.geometry(local)],
+        };
+        let mut units = Vec::with_capacity(2);
+        for g in &geometries {
+            let length = g.normal.length();
+            if !(length > 0.0 && length.is_finite() && g.c.is_finite()) {
+                return None;
+            }
+            units.push((g.c / length, g.normal / length, length));
+        }
+        // A curve's tangent, and its curvature vector from the rows'
+        // Hessians: κ = −Σ (t̂ᵀ Hᵢ t̂ / |∇Cᵢ|) n̂ᵢ.
+        let bend = if let [(_, a, _), (_, b, _)] = units[..] {
+            let tangent = a.cross(b).normalize_or_zero();
+            let curvature: DVec3 = geometries
+                .iter()
+                .zip(&units)
+                .map(|(g, &(_, n, length))| -n * tangent.dot(g.hessian * tangent) / length)
+                .sum();
+            Bend {
+                tangent: self.pose.rotate(tangent),
+                curvature: curvature.length(),
+            }
+        } else {
+            Bend::default()
+        };
+        let mut rows = Rows::bending(bend);
+        for &(distance, normal, _) in &units {
+            rows.push(BodyRow::at_anchor(body, distance, self.pose.rotate(normal)));
+        }
+        if let Some(alignment) = &self.alignment {
+            let tangent = match alignment.turn {
+                SpaceTurn::Fixed => bend.tangent,
+                _ => self.pose.rotation * self.local_frame(local)?.mul_vec3(DVec3::X),
+            };
+            let turned = self.turned(body, alignment, local, tangent)?;
+            for row in &turned[..alignment.pairs().len()] {
+                rows.push(*row);
+            }
+        }
+        Some(rows)
+    }
+
+    fn past_end(&self, body: &SpaceBody) -> Option<BodyRow<SpaceBody>> {
+        let SpaceShape::Curve(curve) = self.shape else {
+            return None;
+        };
+        if !curve.has_ends() {
+            return None;
+        }
+        let local = self.pose.to_local(body.anchor());
+        let value = curve.past_end(local, self.hint);
+        let tangent = self.local_frame(local)?.mul_vec3(DVec3::X);
+        // Which way is out: past an end the curve goes on along its
+        // tangent, so `past_end` grows by the step along it.
+        let step = 1e-6 * curve.scale();
+        let out = if curve.past_end(local + step * tangent, self.hint)
+            >= curve.past_end(local - step * tangent, self.hint)
+        {
+            tangent
+        } else {
+            -tangent
+        };
+        value
+            .is_finite()
+            .then(|| BodyRow::at_anchor(body, value, self.pose.rotate(out)))
+    }
+
+    fn along(&self, body: &SpaceBody) -> Option<BodyRow<SpaceBody>> {
+        let local = self.pose.to_local(body.anchor());
+        let tangent = self.local_frame(local)?.mul_vec3(DVec3::X);
+        Some(BodyRow::at_anchor(body, 0.0, self.pose.rotate(tangent)))
+    }
+
+    fn to_world(&self, local: DVec3) -> DVec3 {
+        self.pose.to_world(local)
+    }
+
+    fn scale(&self) -> f64 {
+        self.shape.scale()
+    }
+}
