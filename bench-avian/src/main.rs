@@ -8,7 +8,7 @@
 //! cargo run --release -p wirebead-vs-avian -- spheres [--steps 600] [--sizes 1,10000]
 //! cargo run --release -p wirebead-vs-avian -- touch [--dt 0.016667] [--steps 120] [--substeps 50]
 //! cargo run --release -p wirebead-vs-avian -- pile [--beads 1000] [--steps 180] [--piles plane|space|both] [--budget 300]
-//! cargo run --release -p wirebead-vs-avian -- path [--steps 600] [--sizes 1,1000]
+//! cargo run --release -p wirebead-vs-avian -- path [--steps 600] [--sizes 1,1000] [--space]
 //! ```
 //!
 //! - `circle` (the default, also without a subcommand): a bead on a circle
@@ -42,7 +42,8 @@
 //!   the worst overlap of two beads and into the bowl, and how the energy
 //!   rose.
 //! - `path`: N carts on straight rails, each held by our `PathJoint` or by
-//!   avian2d's `PrismaticJoint` (see [`path`]). Prints ms per step, ns per
+//!   avian2d's `PrismaticJoint` (see [`path`]); with `--space`, our
+//!   avian3d `PathJoint` against avian3d's. Prints ms per step, ns per
 //!   cart-step, the rail error and turn, and the time ratio.
 //!
 //! Every job uses Bevy's process-wide task pools with a compute thread per

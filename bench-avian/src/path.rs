@@ -11,6 +11,14 @@
 //!   height (zero compliance, no limits, no motor), the nearest joint
 //!   avian has.
 //!
+//!
+//! With `--space`, the same in space against avian3d: ours a
+//! `wirebead::avian3d::PathJoint` turned with the rail's frame
+//! (`ToPath`) on a straight curve in space (a line in the xy-plane), so
+//! that the anchor is held on it and the cart's orientation to it, as
+//! avian3d's [`PrismaticJoint`](avian3d::prelude::PrismaticJoint) holds
+//! them.
+//!
 //! Both in one kind of app ([`avian_side::physics_app_with`], ours with
 //! wirebead's plugin and the path joint's added), no colliders, sleeping
 //! disabled. Measured per run: wall ms per step and ns per cart-step (the
@@ -61,6 +69,9 @@ pub struct PathArgs {
     /// Numbers of carts.
     #[arg(long, value_delimiter = ',', default_values_t = vec![1, 1000])]
     pub sizes: Vec<usize>,
+    /// In space, against avian3d, instead of in the plane.
+    #[arg(long)]
+    pub space: bool,
 }
 
 /// One run's measurements.
@@ -147,10 +158,96 @@ fn run_side(n: usize, holder: Holder, steps: usize) -> PathRun {
     }
 }
 
+/// N carts in space held by `holder`, stepped `steps` times: the rail
+/// error is the largest distance across the rail, the turn the largest
+/// angle of a cart from where it began.
+fn run_space_side(n: usize, holder: Holder, steps: usize) -> PathRun {
+    use avian3d::prelude as a3;
+    use bevy::math::{DQuat, DVec3};
+    use wirebead::SpaceWire;
+    use wirebead::avian3d::{PathJoint, PathJointPlugin, PathRotation};
+    use wirebead::geometry::{Line, OnPlane};
+    let step = Duration::from_secs_f64(DT);
+    let gravity = DVec3::new(0.0, -GRAVITY, 0.0);
+    let mut app = avian_side::space::physics_app_with(step, None, gravity, None, |app| {
+        if holder == Holder::Path {
+            let params = SimParams {
+                timestep: DT,
+                ..SimParams::default()
+            };
+            app.add_plugins((
+                WireBeadPlugin::new(params).expect("valid parameters"),
+                PathJointPlugin,
+            ));
+        }
+    });
+    let world = app.world_mut();
+    let carts: Vec<(Entity, f64)> = (0..n)
+        .map(|i| {
+            let y = -SPACING * i as f64;
+            let cart = world
+                .spawn((
+                    a3::RigidBody::Dynamic,
+                    a3::Position(DVec3::new(0.0, y, 0.0)),
+                    a3::LinearVelocity(DVec3::new(SPEED, 0.0, 0.0)),
+                    a3::Mass(CART_MASS),
+                    a3::AngularInertia::new(Vec3::splat(0.1)),
+                    a3::SleepingDisabled,
+                ))
+                .id();
+            match holder {
+                Holder::Path => {
+                    let rail = world
+                        .spawn((
+                            SpaceWire::curve(OnPlane(Line)),
+                            Transform::from_xyz(0.0, y as f32, 0.0),
+                        ))
+                        .id();
+                    world
+                        .entity_mut(cart)
+                        .insert(PathJoint::new(rail).with_rotation(PathRotation::ToPath));
+                }
+                Holder::Prismatic => {
+                    let anchor = world
+                        .spawn((a3::RigidBody::Static, a3::Position(DVec3::new(0.0, y, 0.0))))
+                        .id();
+                    world.spawn(a3::PrismaticJoint::new(anchor, cart).with_slider_axis(DVec3::X));
+                }
+            }
+            (cart, y)
+        })
+        .collect();
+    avian_side::space::warm_up(&mut app);
+    let (mut seconds, mut rail_error, mut turn) = (0.0, 0.0f64, 0.0f64);
+    for k in 1..=steps {
+        seconds += avian_side::space::timed_step(&mut app, step, k);
+        for &(cart, y) in &carts {
+            let position = app.world().get::<a3::Position>(cart).expect("a cart").0;
+            let rotation: DQuat = app.world().get::<a3::Rotation>(cart).expect("a cart").0;
+            rail_error = rail_error.max((position.y - y).abs().max(position.z.abs()));
+            turn = turn.max(rotation.angle_between(DQuat::IDENTITY));
+        }
+    }
+    let x = app
+        .world()
+        .get::<a3::Position>(carts[0].0)
+        .expect("a cart")
+        .0
+        .x;
+    PathRun {
+        ms_per_step: seconds * 1e3 / steps as f64,
+        ns_per_cart_step: seconds * 1e9 / (n * steps) as f64,
+        rail_error,
+        turn,
+        along_error: (x - SPEED * DT * steps as f64).abs(),
+    }
+}
+
 /// Runs the path job and prints its table and ratios.
 pub fn run(args: &PathArgs) {
+    let engine = if args.space { "avian3d" } else { "avian2d" };
     println!(
-        "N carts of {CART_MASS} kg, each on its own straight rail ({SPACING} m apart), sent along it at {SPEED} m/s, |g| = {GRAVITY} m/s² across it, dt = 1/60 s, avian2d's {} substeps, {} steps.\n",
+        "N carts of {CART_MASS} kg, each on its own straight rail ({SPACING} m apart), sent along it at {SPEED} m/s, |g| = {GRAVITY} m/s² across it, dt = 1/60 s, {engine}'s {} substeps, {} steps.\n",
         avian_side::default_substeps(),
         args.steps
     );
@@ -162,10 +259,16 @@ pub fn run(args: &PathArgs) {
     for &n in &args.sizes {
         let mut runs = Vec::new();
         for holder in [Holder::Path, Holder::Prismatic] {
-            let run = run_side(n, holder, args.steps);
-            let name = match holder {
-                Holder::Path => "wirebead PathJoint (Turned) on a line",
-                Holder::Prismatic => "avian2d 0.7 PrismaticJoint",
+            let run = if args.space {
+                run_space_side(n, holder, args.steps)
+            } else {
+                run_side(n, holder, args.steps)
+            };
+            let name = match (holder, args.space) {
+                (Holder::Path, false) => "wirebead PathJoint (Turned) on a line",
+                (Holder::Prismatic, false) => "avian2d 0.7 PrismaticJoint",
+                (Holder::Path, true) => "wirebead avian3d PathJoint (ToPath) on a line in space",
+                (Holder::Prismatic, true) => "avian3d 0.7 PrismaticJoint",
             };
             println!(
                 "| {name} | {n} | {:.3} | {:.0} | {:.2e} | {:.2e} | {:.2e} |",

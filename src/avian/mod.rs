@@ -44,6 +44,10 @@
 //!     .update();
 //! ```
 
+// Avian's numbers are `f32` or `f64` as the game builds it: the conversions
+// to `f64` are identities in an `f64` build.
+#![allow(clippy::useless_conversion)]
+
 use avian2d::dynamics::solver::schedule::{SolverSystems, SubstepSchedule, SubstepSolverSystems};
 use avian2d::dynamics::solver::solver_body::{SolverBody, SolverBodyInertia};
 use avian2d::dynamics::solver::xpbd::XpbdSolverSystems;
@@ -292,6 +296,7 @@ fn solve_path_joint(
             spin: twist.angular_velocity,
         },
         h,
+        start: state.0.rows.take(),
     };
     let Some((projected, driven)) = substep.correct(&law(joint)) else {
         return;
@@ -330,6 +335,7 @@ fn project_path_joint_velocity(
 ) {
     let plane = plane_body(state, body, inertia);
     state.0.previous = plane;
+    state.0.rows = None;
     if body.flags.is_kinematic() {
         return;
     }
@@ -355,9 +361,10 @@ fn project_path_joint_velocity(
         spin: twist.angular_velocity,
     };
     let rigid = law(joint).rigid();
-    let Some((v, impulse)) = velocity_on_wire(rigid, &wire, &plane, v, frame) else {
+    let Some((v, impulse, rows)) = velocity_on_wire(rigid, &wire, &plane, v, frame) else {
         return;
     };
+    state.0.rows = rows;
     if v.is_finite() {
         state.0.add_impulse(impulse, 0.0);
         body.linear_velocity = v.linear.adjust_precision();

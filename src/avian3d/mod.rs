@@ -48,6 +48,10 @@
 //!     .update();
 //! ```
 
+// Avian's numbers are `f32` or `f64` as the game builds it: the conversions
+// to `f64` are identities in an `f64` build.
+#![allow(clippy::useless_conversion)]
+
 use avian3d::dynamics::solver::schedule::{SolverSystems, SubstepSchedule, SubstepSolverSystems};
 use avian3d::dynamics::solver::solver_body::{SolverBody, SolverBodyInertia};
 use avian3d::dynamics::solver::xpbd::XpbdSolverSystems;
@@ -323,6 +327,7 @@ fn solve_path_joint(
             spin: twist.angular_velocity,
         },
         h,
+        start: state.rows.take(),
     };
     let Some((projected, driven)) = substep.correct(&law(joint)) else {
         return;
@@ -362,6 +367,7 @@ fn project_path_joint_velocity(
 ) {
     let now = space_body(state.0.start, body, inertia);
     state.0.previous = now;
+    state.0.rows = None;
     if body.flags.is_kinematic() {
         return;
     }
@@ -380,9 +386,11 @@ fn project_path_joint_velocity(
         spin: twist.angular_velocity,
     };
     let rigid = law(joint).rigid();
-    let Some((v, impulse)) = velocity_on_wire(rigid, &wire, &now, velocity_of(body), frame) else {
+    let Some((v, impulse, rows)) = velocity_on_wire(rigid, &wire, &now, velocity_of(body), frame)
+    else {
         return;
     };
+    state.0.rows = rows;
     if v.is_finite() {
         state.0.add_impulse(impulse, 0.0);
         body.linear_velocity = v.linear.adjust_precision();

@@ -28,6 +28,10 @@ impl ImplicitCurve for Circle {
     fn scale(&self) -> f64 {
         self.radius
     }
+    fn travel(&self) -> f64 {
+        // Counter-clockwise: the gradient points out.
+        1.0
+    }
     #[inline]
     fn geometry(&self, p: DVec2) -> Geometry {
         let g = round_geometry::<DVec2, f64>(p.one(), self.radius);

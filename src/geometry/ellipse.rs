@@ -38,4 +38,8 @@ impl ImplicitCurve for Ellipse {
     fn scale(&self) -> f64 {
         self.ell()
     }
+    fn travel(&self) -> f64 {
+        // Counter-clockwise: the gradient points out.
+        1.0
+    }
 }

@@ -104,6 +104,16 @@ pub trait ImplicitCurve {
     fn past_end(&self, _p: DVec2) -> f64 {
         f64::NEG_INFINITY
     }
+    /// Which way the curve's own direction runs against its unit tangent
+    /// `∇C⊥ / |∇C|` (`⊥` a quarter turn counter-clockwise): `−1` unless
+    /// overridden (a line's +x, a graph's growing x, a spline's or a
+    /// cycloid's parameter: the positive side of `C` on the left), `1` for
+    /// a circle and an ellipse (counter-clockwise, their gradient pointing
+    /// out). A motor drives a body along it; a curve in space drawn from
+    /// this one ([`OnPlane`]) runs its frame's tangent along it.
+    fn travel(&self) -> f64 {
+        -1.0
+    }
     /// The curve's own parameter at the point nearest `p`, searched near
     /// `hint` (NaN: anywhere); NaN for a curve with no parameter. A
     /// parametric curve that crosses itself uses it to stay on the branch a
@@ -155,6 +165,9 @@ impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Near<'_, C> {
     }
     fn has_ends(&self) -> bool {
         self.curve.has_ends()
+    }
+    fn travel(&self) -> f64 {
+        self.curve.travel()
     }
     fn past_end(&self, p: DVec2) -> f64 {
         self.curve.past_end_near(p, self.hint)

@@ -335,6 +335,9 @@ impl<C: ImplicitCurve + ?Sized> ImplicitCurve for Placed<'_, C> {
     fn has_ends(&self) -> bool {
         self.curve.has_ends()
     }
+    fn travel(&self) -> f64 {
+        self.curve.travel()
+    }
     fn past_end(&self, p: DVec2) -> f64 {
         self.curve.past_end(self.pose.to_local(p))
     }

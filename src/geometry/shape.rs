@@ -96,17 +96,10 @@ impl WireShape {
     }
 
     /// Which way the wire's own direction runs against its unit tangent
-    /// `∇C⊥ / |∇C|` (`⊥` a quarter turn counter-clockwise): `1` for a
-    /// circle and an ellipse (counter-clockwise, their gradient pointing
-    /// out), `−1` for every other shape (a line's +x, a graph's growing
-    /// x, a spline's or a cycloid's parameter: their positive side is on
-    /// the left), a game's own curve included.
+    /// (see [`ImplicitCurve::travel`]).
     #[cfg_attr(not(feature = "avian2d"), allow(dead_code))]
     pub(crate) fn travel(&self) -> f64 {
-        match self {
-            Self::Circle(_) | Self::Ellipse(_) => 1.0,
-            _ => -1.0,
-        }
+        self.curve().travel()
     }
 
     /// The lowest point of the wire in its local frame (where a bead hangs

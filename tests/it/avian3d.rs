@@ -4,10 +4,13 @@
 
 use avian3d::math::{AdjustPrecision, Vector};
 use avian3d::prelude::*;
+use bevy::math::cubic_splines::{CubicCardinalSpline, CyclicCubicGenerator};
 use bevy::math::{DQuat, DVec3, Vec3};
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
-use wirebead::geometry::{Circle, Helix, Line, OnPlane, SpaceCurve};
+use wirebead::geometry::{
+    Circle, Helix, Line, OnPlane, Plane, SpaceCurve, Spline, SplineKind, SplineSpec,
+};
 use wirebead::prelude::*;
 use wirebead::reference::pendulum_period;
 use wirebead::{Integrator, SpaceWire, avian3d::*};
@@ -292,7 +295,8 @@ fn a_cart_on_a_banked_loop_keeps_the_rails_up() {
 
 /// A velocity motor on a straight rail in space accelerates a body at
 /// `F/m` (to 1 %) until it reaches its speed, then holds it (to 1e-3):
-/// 2 kg, 10 N, 1.5 m/s, no gravity.
+/// 2 kg, 10 N, 1.5 m/s, no gravity; `PathJointForces` says the joint gave
+/// 10 N along the rail (to 1e-3 N) and no torque while accelerating.
 #[test]
 fn a_velocity_motor_in_space_accelerates_at_its_force_over_the_mass() {
     let mut app = physics_app(DT, DVec3::ZERO);
@@ -315,6 +319,15 @@ fn a_velocity_motor_in_space_accelerates_at_its_force_over_the_mass() {
         (accel - 5.0).abs() <= 0.05,
         "accelerated at {accel} m/s², not F/m = 5"
     );
+    // Accelerating, the motor gives its 10 N along the rail, and the joint
+    // nothing else.
+    let pushing = *app.world().get::<PathJointForces>(body).expect("forces");
+    assert!(
+        (pushing.motor_force.abs() - 10.0).abs() <= 1e-3
+            && (pushing.force.length() - 10.0).abs() <= 1e-3
+            && pushing.torque.length() <= 1e-3,
+        "accelerating, the joint gave {pushing:?}"
+    );
     for _ in 0..60 {
         app.update();
     }
@@ -322,4 +335,321 @@ fn a_velocity_motor_in_space_accelerates_at_its_force_over_the_mass() {
     eprintln!("motor in space: {accel:.4} m/s², then {v} at {p}");
     assert!((v.x.abs() - 1.5).abs() <= 1e-3, "holds {v}");
     assert!(v.y.abs().max(v.z.abs()) <= 1e-5 && p.y.abs().max(p.z.abs()) <= 1e-5);
+}
+
+/// A box held 0.2 m off its centre on a vertical unit hoop, kept from
+/// turning against the wire (`Fixed`), only translates: its centre swings
+/// on a unit circle with the point pendulum's period (to 1e-3 at 60 Hz),
+/// its anchor on the hoop to 1e-5 m, and it never turns (1e-5 rad), where
+/// free it would swing about its anchor.
+#[test]
+fn a_fixed_box_held_off_its_centre_only_translates() {
+    let mut app = physics_app(DT, DVec3::new(0.0, -G, 0.0));
+    let hoop = wire(
+        &mut app,
+        OnPlane(Circle { radius: 1.0 }),
+        Transform::IDENTITY,
+    );
+    let theta0 = 60f64.to_radians();
+    let arm = DVec3::new(0.2, 0.1, 0.0);
+    let anchor = DVec3::new(theta0.sin(), -theta0.cos(), 0.0);
+    let joint = PathJoint::new(hoop)
+        .with_anchor(arm)
+        .with_rotation(PathRotation::Fixed);
+    let body = held_body(
+        &mut app,
+        (anchor - arm, DQuat::IDENTITY),
+        DVec3::ZERO,
+        (1.0, Vec3::new(0.3, 0.4, 0.5)),
+        joint,
+    );
+    let exact = pendulum_period(1.0, G, theta0);
+    let (mut off, mut turned, mut crossings, mut last) = (0.0f64, 0.0f64, Vec::new(), anchor);
+    for step in 1..=((3.5 * exact / DT).round() as usize) {
+        app.update();
+        let (c, _, q, _) = body_state(&app, body);
+        let a = c + q * arm;
+        off = off.max((a.length() - 1.0).abs().max(a.z.abs()));
+        turned = turned.max(angle(q, DQuat::IDENTITY));
+        if last.x < 0.0 && a.x >= 0.0 {
+            crossings.push((step as f64 - 1.0 - last.x / (a.x - last.x)) * DT);
+        }
+        last = a;
+    }
+    let n = crossings.len() - 1;
+    let error = ((crossings[n] - crossings[0]) / n as f64 - exact) / exact;
+    eprintln!(
+        "fixed: period error {error:+.2e}, off the wire {off:.2e} m, turned {turned:.2e} rad"
+    );
+    assert!(error.abs() <= 1e-3, "period off by {error:+e}");
+    assert!(off <= 1e-5, "the anchor strayed {off:e} m");
+    assert!(turned <= 1e-5, "the box turned {turned:e} rad");
+}
+
+/// A spline in space closed through a crossing (a figure eight in the
+/// xy-plane, rising and falling in z between its lobes, level where it
+/// crosses itself): a body driven round it at 4 m/s under gravity visits
+/// its lobes in turn (20 crossings, never the same lobe twice in a row)
+/// and stays on it to 1e-5 m.
+#[test]
+fn a_body_keeps_its_branch_where_a_figure_eight_in_space_crosses_itself() {
+    let mut app = physics_app(DT, DVec3::new(0.0, -G, 0.0));
+    let n = 24;
+    let points = (0..n)
+        .map(|i| {
+            let t = std::f64::consts::TAU * i as f64 / n as f64;
+            DVec3::new(2.0 * t.sin(), (2.0 * t).sin(), 0.4 * (2.0 * t).sin())
+        })
+        .collect();
+    let spline = Spline::<DVec3>::new(SplineSpec {
+        kind: SplineKind::CatmullRom,
+        points,
+        closed: true,
+    })
+    .expect("a figure eight");
+    let rail = wire(&mut app, spline.clone(), Transform::IDENTITY);
+    let joint = PathJoint::new(rail).with_motor(PathMotor::Velocity {
+        speed: 4.0,
+        max_force: 200.0,
+    });
+    let body = held_body(
+        &mut app,
+        (DVec3::ZERO, DQuat::IDENTITY),
+        DVec3::ZERO,
+        (1.0, Vec3::splat(0.1)),
+        joint,
+    );
+    let mut lobes: Vec<bool> = Vec::new();
+    let (mut inside, mut off, mut steps, mut hint) = (false, 0.0f64, 0, f64::NAN);
+    while lobes.len() < 21 && steps < 60 * 60 {
+        app.update();
+        steps += 1;
+        let (p, ..) = body_state(&app, body);
+        let rows = spline.rows(p, hint);
+        hint = spline.parameter(p, hint);
+        off = off.max(rows[0].c.abs().max(rows[1].c.abs()));
+        if p.x.abs() > 1.5 && !inside {
+            lobes.push(p.x > 0.0);
+            inside = true;
+        } else if p.x.abs() < 1.0 {
+            inside = false;
+        }
+    }
+    let repeats = lobes.windows(2).filter(|w| w[0] == w[1]).count();
+    eprintln!(
+        "figure eight in space: {} lobe visits in {steps} steps; off the wire by {off:.2e} m",
+        lobes.len()
+    );
+    assert_eq!(repeats, 0, "one lobe twice in a row: {lobes:?}");
+    assert!(
+        lobes.len() >= 21,
+        "only {} lobe visits in a minute",
+        lobes.len()
+    );
+    assert!(off <= 1e-5, "the body strayed {off:e} m from the spline");
+}
+
+/// The end of an open spline in space stops a body sliding down it: it
+/// rests at the end to 1e-5 m and moves at most 1e-3 m/s there.
+#[test]
+fn the_end_of_an_open_curve_in_space_stops_the_body() {
+    let mut app = physics_app(DT, DVec3::new(0.0, -G, 0.0));
+    let end = DVec3::new(2.0, -1.0, 0.6);
+    let spline = Spline::<DVec3>::new(SplineSpec {
+        kind: SplineKind::CatmullRom,
+        points: vec![DVec3::ZERO, DVec3::new(1.0, -0.5, 0.3), end],
+        closed: false,
+    })
+    .expect("a spline");
+    let rail = wire(&mut app, spline, Transform::IDENTITY);
+    let body = held_body(
+        &mut app,
+        (DVec3::ZERO, DQuat::IDENTITY),
+        DVec3::ZERO,
+        (1.0, Vec3::splat(0.1)),
+        PathJoint::new(rail),
+    );
+    for _ in 0..90 {
+        app.update();
+    }
+    let (mut off, mut moving) = (0.0f64, 0.0f64);
+    for _ in 0..60 {
+        app.update();
+        let (p, v, ..) = body_state(&app, body);
+        off = off.max((p - end).length());
+        moving = moving.max(v.length());
+    }
+    eprintln!("end in space: held {off:.2e} m from the end, moving at most {moving:.2e} m/s");
+    assert!(off <= 1e-5, "the body is {off:e} m from the end");
+    assert!(
+        moving <= 1e-3,
+        "the body moves at {moving:e} m/s at the end"
+    );
+}
+
+/// A joint that cannot do all it is asked does what it can and never
+/// writes a number that is not finite: on an entity that is no wire it
+/// holds nothing (the body falls as avian's free body does, to 1e-4 m in
+/// a second); on a surface asked to turn the body with the wire's frame,
+/// which a surface has not, it holds the anchor on the surface (a tilted
+/// plane, to 1e-5 m) and lets the body turn.
+#[test]
+fn a_joint_that_cannot_hold_all_it_is_asked_holds_what_it_can() {
+    let mut app = physics_app(DT, DVec3::new(0.0, -G, 0.0));
+    let not_a_wire = app.world_mut().spawn(Transform::IDENTITY).id();
+    let falling = held_body(
+        &mut app,
+        (DVec3::ZERO, DQuat::IDENTITY),
+        DVec3::ZERO,
+        (1.0, Vec3::splat(0.1)),
+        PathJoint::new(not_a_wire).with_rotation(PathRotation::ToPath),
+    );
+    let tilt = Quat::from_rotation_z(0.3);
+    let slope = app
+        .world_mut()
+        .spawn((SpaceWire::surface_of(Plane), Transform::from_rotation(tilt)))
+        .id();
+    let sliding = held_body(
+        &mut app,
+        (DVec3::new(0.0, 0.0, 0.0), DQuat::IDENTITY),
+        DVec3::new(0.0, 0.0, 1.0),
+        (1.0, Vec3::splat(0.1)),
+        PathJoint::new(slope).with_rotation(PathRotation::AroundTangent),
+    );
+    let normal = DVec3::from(tilt * Vec3::Y);
+    let mut off = 0.0f64;
+    for _ in 0..60 {
+        app.update();
+        let (p, ..) = body_state(&app, sliding);
+        off = off.max(p.dot(normal).abs());
+    }
+    let (p, v, q, w) = body_state(&app, falling);
+    assert!(p.is_finite() && v.is_finite() && q.is_finite() && w.is_finite());
+    let fallen = -0.5 * G * (1.0 + 1.0 / 360.0);
+    assert!(
+        (p.y - fallen).abs() <= 1e-4,
+        "fell to {} m, not {fallen}",
+        p.y
+    );
+    let (p, ..) = body_state(&app, sliding);
+    eprintln!("on a surface: off it by {off:.2e} m, slid to {p}");
+    assert!(off <= 1e-5, "the anchor left the surface by {off:e} m");
+    assert!(p.x < -0.1, "the body did not slide down the slope: {p}");
+}
+
+/// At a sharp corner in space (two straight segments meeting at 45°, the
+/// second rising out of the first's plane), a body coasting at 2 m/s (no
+/// gravity) goes on along the second segment at its speed's part along
+/// it, `2 cos 45°` (to 1e-3), as in the plane, on the wire to 1e-5 m.
+#[test]
+fn a_body_turns_a_sharp_corner_in_space() {
+    let mut app = physics_app(DT, DVec3::ZERO);
+    let bend = DVec3::new(1.0, 0.0, 1.0) * std::f64::consts::FRAC_1_SQRT_2;
+    let spline = Spline::<DVec3>::new(SplineSpec {
+        kind: SplineKind::Segments(vec![
+            [
+                DVec3::new(-2.0, 0.0, 0.0),
+                DVec3::new(2.0, 0.0, 0.0),
+                DVec3::ZERO,
+                DVec3::ZERO,
+            ],
+            [DVec3::ZERO, 2.0 * bend, DVec3::ZERO, DVec3::ZERO],
+        ]),
+        points: Vec::new(),
+        closed: false,
+    })
+    .expect("two segments");
+    let rail = wire(&mut app, spline, Transform::IDENTITY);
+    let body = held_body(
+        &mut app,
+        (DVec3::new(-1.5, 0.0, 0.0), DQuat::IDENTITY),
+        DVec3::new(2.0, 0.0, 0.0),
+        (1.0, Vec3::splat(0.1)),
+        PathJoint::new(rail),
+    );
+    let mut off = 0.0f64;
+    for _ in 0..60 {
+        app.update();
+        let (p, ..) = body_state(&app, body);
+        // The distance from the two segments.
+        let first = DVec3::new(p.x.min(0.0), 0.0, 0.0);
+        let second = bend * p.dot(bend).max(0.0);
+        off = off.max((p - first).length().min((p - second).length()));
+    }
+    let (p, v, ..) = body_state(&app, body);
+    eprintln!("corner in space: off by {off:.2e} m; ends at {p} moving {v}");
+    let expected = 2.0 * bend.x * bend;
+    assert!(
+        (v - expected).length() <= 1e-3,
+        "after the corner it moves at {v}"
+    );
+    assert!(
+        p.x > 0.1 && (p - bend * p.dot(bend)).length() <= 1e-5,
+        "the body is at {p}, not on the second segment"
+    );
+    assert!(off <= 1e-5, "the body strayed {off:e} m from the wire");
+}
+
+/// A cart turned with a game's own Bevy curve in space (a closed
+/// Catmull–Rom loop through six points at several heights, through
+/// `Spline::from_curve`), coasting at 6 m/s with no gravity for 3 s
+/// (more than a lap): its anchor stays on the curve to 1e-5 m, and its
+/// orientation is the curve's rotation-minimizing frame there times the
+/// one it began with, to 1e-4 rad, the frame's turn round the closed
+/// loop included.
+#[test]
+fn a_cart_turned_with_a_bevy_curve_in_space_follows_its_frame() {
+    let mut app = physics_app(DT, DVec3::ZERO);
+    let points = [
+        (4.0, 1.0, 1.0),
+        (6.0, 3.0, 0.0),
+        (4.0, 5.0, -1.0),
+        (0.0, 4.0, -2.0),
+        (-3.0, 2.0, -1.0),
+        (-4.0, 0.5, 1.0),
+    ]
+    .map(|(x, y, z)| Vec3::new(x, y, z));
+    let curve = CubicCardinalSpline::new_catmull_rom(points)
+        .to_curve_cyclic()
+        .expect("a loop");
+    let spline = Spline::<DVec3>::from_curve(&curve);
+    let rail = wire(&mut app, spline.clone(), Transform::IDENTITY);
+    let start = DVec3::new(4.0, 1.0, 1.0);
+    let frame_at = |p: DVec3, hint: f64| {
+        let f = spline.frame(p, hint);
+        DQuat::from_mat3(&bevy::math::DMat3::from_cols(
+            f.tangent,
+            f.normal,
+            f.tangent.cross(f.normal),
+        ))
+    };
+    let begin = frame_at(start, 0.0);
+    let joint = PathJoint::new(rail).with_rotation(PathRotation::ToPath);
+    let body = held_body(
+        &mut app,
+        (start, begin),
+        6.0 * (begin * DVec3::X),
+        (1.0, Vec3::new(0.1, 0.2, 0.15)),
+        joint,
+    );
+    let (mut off, mut turned, mut hint) = (0.0f64, 0.0f64, 0.0);
+    let mut travelled = 0.0;
+    for _ in 0..180 {
+        app.update();
+        let (p, v, q, _) = body_state(&app, body);
+        travelled += v.length() * DT;
+        let rows = spline.rows(p, hint);
+        hint = spline.parameter(p, hint);
+        off = off.max(rows[0].c.abs().max(rows[1].c.abs()));
+        turned = turned.max(angle(q, frame_at(p, hint)));
+    }
+    eprintln!(
+        "bevy curve: {travelled:.1} m travelled, off the curve {off:.2e} m, turned from its frame \
+         {turned:.2e} rad"
+    );
+    assert!(off <= 1e-5, "the anchor strayed {off:e} m");
+    assert!(
+        turned <= 1e-4,
+        "the cart turned {turned:e} rad from the frame"
+    );
 }

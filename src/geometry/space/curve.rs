@@ -75,6 +75,18 @@ pub trait SpaceCurve {
             normal,
         }
     }
+    /// How fast [`SpaceCurve::frame`]'s normal turns about the tangent
+    /// per metre along the curve, beyond the turn that keeps it at right
+    /// angles to the tangent (rad/m): zero for a rotation-minimizing
+    /// frame (a traced curve's or a spline's) and for a planar shape's,
+    /// whose binormal stays the plane's; a helix's torsion for its normal
+    /// out from the axis. A path joint that turns a body with the frame
+    /// takes the frame's turn along the curve as `t̂ × κ + twist · t̂`
+    /// (`κ` the curvature vector from the rows' Hessians); override it
+    /// with `frame` where the frame twists.
+    fn twist(&self, _p: DVec3, _hint: f64) -> f64 {
+        0.0
+    }
     /// Whether the curve ends (an open spline): a bead that passes an end
     /// leaves it there, as on an open curve in the plane.
     fn has_ends(&self) -> bool {
@@ -132,8 +144,9 @@ impl CurveFrame {
 /// A planar shape in space: the curve `C(x, y) = 0` of the wire's local
 /// xy-plane. Rows: the curve drawn out along `z` ([`Extruded`](super::Extruded)), whose
 /// normal lies in the plane, and the plane `z = 0` ([`Flat`]). Its frame's
-/// normal is the shape's own, in the plane; its tangent is the plane's
-/// direction of travel (counter-clockwise round a circle).
+/// normal is the shape's own, in the plane; its tangent runs the shape's
+/// own way ([`ImplicitCurve::travel`]: counter-clockwise round a circle,
+/// along +x on a line).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct OnPlane<C>(pub C);
 
@@ -147,6 +160,13 @@ impl<C: ImplicitCurve> SpaceCurve for OnPlane<C> {
     }
     fn parameter(&self, p: DVec3, hint: f64) -> f64 {
         self.0.parameter(p.truncate(), hint)
+    }
+    fn frame(&self, p: DVec3, hint: f64) -> CurveFrame {
+        let [curve, plane] = self.rows(p, hint);
+        let normal = curve.normal.normalize_or_zero();
+        // ∇C⊥ = ẑ × n̂ in the plane, turned the shape's own way.
+        let tangent = plane.normal.cross(normal).normalize_or_zero() * self.0.travel();
+        CurveFrame { tangent, normal }
     }
 }
 
@@ -180,6 +200,13 @@ impl SpaceCurve for Helix {
     fn parameter(&self, p: DVec3, _hint: f64) -> f64 {
         let above = Helicoid { pitch: self.pitch }.value(p);
         TAU * (p.y - above) / self.pitch
+    }
+    fn twist(&self, _p: DVec3, _hint: f64) -> f64 {
+        // The torsion of (r cos θ, c θ, r sin θ), c the rise per radian:
+        // its normal out from the axis is the principal normal reversed,
+        // and turns with the Frenet frame.
+        let c = self.pitch / TAU;
+        -c / (self.radius * self.radius + c * c)
     }
 }
 
@@ -244,6 +271,21 @@ impl SpaceCurve for Spline<DVec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A planar shape in space runs its frame's tangent the shape's own
+    /// way, as a motor in the plane drives along it: counter-clockwise
+    /// round a circle (at (1, 0, 0): +y), along +x on a line, with the
+    /// shape's normal as the frame's.
+    #[test]
+    fn a_planar_shape_in_space_runs_its_own_way() {
+        use crate::geometry::{Circle, Line};
+        let circle = OnPlane(Circle { radius: 1.0 }).frame(DVec3::X, f64::NAN);
+        assert_eq!(circle.tangent, DVec3::Y);
+        assert_eq!(circle.normal, DVec3::X);
+        let line = OnPlane(Line).frame(DVec3::ZERO, f64::NAN);
+        assert_eq!(line.tangent, DVec3::X);
+        assert_eq!(line.normal, DVec3::Y);
+    }
 
     /// The helix of radius `r` and rise `2π c` per turn as a parametrized
     /// curve, `γ(θ) = (r cos θ, c θ, r sin θ)` over two turns.

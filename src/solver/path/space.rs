@@ -12,8 +12,9 @@
 //! ```
 //!
 //! with `t̂` the tangent and `Ω` the frame's turn per metre along it (its
-//! Darboux vector: `de/ds = Ω × e`), found from the frame a little either
-//! side of the anchor. The rows hold `w_t` at right angles to `n̂` and
+//! Darboux vector: `de/ds = Ω × e`), `Ω = t̂ × κ + τ t̂`: the tangent's own
+//! turn (`κ` the curvature vector, from the rows' Hessians) and the
+//! frame's twist about it ([`SpaceCurve::twist`](crate::geometry::SpaceCurve::twist)). The rows hold `w_t` at right angles to `n̂` and
 //! `b̂` (the body turns about the tangent only), and so on for each mode;
 //! with `w_n · b̂` too, the body turns with the frame; against the wire's
 //! own axes (`Ω = 0`) it keeps its orientation to the wire.
@@ -21,7 +22,7 @@
 use bevy::math::{DMat3, DQuat, DVec3};
 
 use super::{Bend, BodyRow, JointBody, JointWire, Rows};
-use crate::geometry::{Pose3, SpaceShape};
+use crate::geometry::{Geometry, Pose3, SpaceShape};
 
 /// A rigid body in space as the joint sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -143,14 +144,34 @@ fn axes(rotation: DQuat) -> [DVec3; 3] {
 }
 
 impl SpaceWireAt<'_> {
-    /// The wire's frame at the local point `local` as a rotation whose
-    /// axes are its tangent, normal and binormal (wire frame); `None` on
-    /// a surface or at a singular point.
+    /// The wire's frame at the point of the curve nearest the local point
+    /// `local` (see [`Self::frame_near`]).
     fn local_frame(&self, local: DVec3) -> Option<DQuat> {
         let SpaceShape::Curve(curve) = self.shape else {
             return None;
         };
-        let frame = curve.frame(local, self.hint);
+        self.frame_near(local, &curve.rows(local, self.hint))
+    }
+
+    /// The wire's frame at the point of the curve nearest the local point
+    /// `local`, whose rows are `rows` (to second order in its distance:
+    /// one step back along the rows, so that the frame moves only as the
+    /// anchor moves along the curve, whatever the curve's own frame does
+    /// off it), as a rotation whose axes are its tangent, normal and
+    /// binormal (wire frame); `None` on a surface or at a singular point.
+    fn frame_near(&self, local: DVec3, rows: &[Geometry<DVec3>]) -> Option<DQuat> {
+        let SpaceShape::Curve(curve) = self.shape else {
+            return None;
+        };
+        let mut foot = local;
+        for row in rows {
+            let length = row.normal.length_squared();
+            if !(length > 0.0 && length.is_finite()) {
+                return None;
+            }
+            foot -= row.normal * (row.c / length);
+        }
+        let frame = curve.frame(foot, self.hint);
         let (t, n) = (frame.tangent, frame.normal);
         (t != DVec3::ZERO && n != DVec3::ZERO)
             .then(|| DQuat::from_mat3(&DMat3::from_cols(t, n, t.cross(n))).normalize())
@@ -178,35 +199,15 @@ impl SpaceWireAt<'_> {
         }
     }
 
-    /// The frame's turn per metre along the tangent `tangent` at the
-    /// local point `local` (world frame), from the frame a little either
-    /// side.
-    fn frame_rate(&self, local: DVec3, tangent: DVec3) -> Option<DVec3> {
-        let step = 1e-5 * self.shape.scale();
-        let ahead = self.local_frame(local + step * tangent)?;
-        let behind = self.local_frame(local - step * tangent)?;
-        let mut turn = ahead * behind.inverse();
-        if turn.w < 0.0 {
-            turn = -turn;
-        }
-        Some(self.pose.rotation * (turn.to_scaled_axis() / (2.0 * step)))
-    }
-
-    /// The rows that turn the body with the wire (see the module's docs).
+    /// The rows that turn the body with the wire (see the module's docs):
+    /// against `frame` (world), which turns by `rate` per metre along the
+    /// unit tangent `tangent` (world).
     fn turned(
-        &self,
         body: &SpaceBody,
         alignment: &Alignment,
-        local: DVec3,
-        tangent: DVec3,
-    ) -> Option<[BodyRow<SpaceBody>; 3]> {
-        let (frame, rate) = match alignment.turn {
-            SpaceTurn::Fixed => (self.pose.rotation, DVec3::ZERO),
-            _ => (
-                self.pose.rotation * self.local_frame(local)?,
-                self.frame_rate(local, self.pose.rotation.inverse() * tangent)?,
-            ),
-        };
+        frame: DQuat,
+        (tangent, rate): (DVec3, DVec3),
+    ) -> [BodyRow<SpaceBody>; 3] {
         let along = BodyRow::at_anchor(body, 0.0, tangent);
         let body_axes = axes(body.rotation * alignment.axes);
         let frame_axes = axes(frame);
@@ -220,51 +221,74 @@ impl SpaceWireAt<'_> {
                 along_angle: w.cross(e) + along.along_angle * turning,
             };
         }
-        Some(rows)
+        rows
     }
 }
 
 impl JointWire<SpaceBody> for SpaceWireAt<'_> {
     fn held(&self, body: &SpaceBody) -> Option<Rows<SpaceBody>> {
         let local = self.pose.to_local(body.anchor());
-        let geometries = match self.shape {
-            SpaceShape::Curve(curve) => curve.rows(local, self.hint).to_vec(),
-            SpaceShape::Surface(surface) => vec![surface.geometry(local)],
+        // The curve's two rows, or the surface's one.
+        let (all, count) = match self.shape {
+            SpaceShape::Curve(curve) => (curve.rows(local, self.hint), 2),
+            SpaceShape::Surface(surface) => ([surface.geometry(local); 2], 1),
         };
-        let mut units = Vec::with_capacity(2);
-        for g in &geometries {
+        let geometries = &all[..count];
+        let mut units = [(0.0, DVec3::ZERO, 0.0); 2];
+        for (unit, g) in units.iter_mut().zip(geometries) {
             let length = g.normal.length();
             if !(length > 0.0 && length.is_finite() && g.c.is_finite()) {
                 return None;
             }
-            units.push((g.c / length, g.normal / length, length));
+            *unit = (g.c / length, g.normal / length, length);
         }
+        let units = &units[..count];
         // A curve's tangent, and its curvature vector from the rows'
-        // Hessians: κ = −Σ (t̂ᵀ Hᵢ t̂ / |∇Cᵢ|) n̂ᵢ.
-        let bend = if let [(_, a, _), (_, b, _)] = units[..] {
-            let tangent = a.cross(b).normalize_or_zero();
-            let curvature: DVec3 = geometries
+        // Hessians: κ = −Σ (t̂ᵀ Hᵢ t̂ / |∇Cᵢ|) n̂ᵢ (wire frame).
+        let curvature = |tangent: DVec3| -> DVec3 {
+            geometries
                 .iter()
-                .zip(&units)
+                .zip(units)
                 .map(|(g, &(_, n, length))| -n * tangent.dot(g.hessian * tangent) / length)
-                .sum();
+                .sum()
+        };
+        let bend = if let &[(_, a, _), (_, b, _)] = units {
+            let tangent = a.cross(b).normalize_or_zero();
             Bend {
                 tangent: self.pose.rotate(tangent),
-                curvature: curvature.length(),
+                curvature: curvature(tangent).length(),
             }
         } else {
             Bend::default()
         };
         let mut rows = Rows::bending(bend);
-        for &(distance, normal, _) in &units {
+        for &(distance, normal, _) in units {
             rows.push(BodyRow::at_anchor(body, distance, self.pose.rotate(normal)));
         }
         if let Some(alignment) = &self.alignment {
-            let tangent = match alignment.turn {
-                SpaceTurn::Fixed => bend.tangent,
-                _ => self.pose.rotation * self.local_frame(local)?.mul_vec3(DVec3::X),
+            // The frame, and its turn per metre along the tangent: the
+            // tangent's own (t̂ × κ) and the frame's twist about it.
+            let (frame, tangent, rate) = match (alignment.turn, self.shape) {
+                (SpaceTurn::Fixed, _) => (DQuat::IDENTITY, DVec3::X, DVec3::ZERO),
+                (_, SpaceShape::Curve(curve)) => {
+                    let frame = self.frame_near(local, geometries)?;
+                    let tangent = frame * DVec3::X;
+                    let twist = curve.twist(local, self.hint);
+                    (
+                        frame,
+                        tangent,
+                        tangent.cross(curvature(tangent)) + twist * tangent,
+                    )
+                }
+                (_, SpaceShape::Surface(_)) => return None,
             };
-            let turned = self.turned(body, alignment, local, tangent)?;
+            let rotate = |v: DVec3| self.pose.rotate(v);
+            let turned = Self::turned(
+                body,
+                alignment,
+                self.pose.rotation * frame,
+                (rotate(tangent), rotate(rate)),
+            );
             for row in &turned[..alignment.pairs().len()] {
                 rows.push(*row);
             }

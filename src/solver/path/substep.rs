@@ -103,6 +103,10 @@ pub(crate) struct JointState<B: JointBody, T> {
     /// The impulse the joint gave over the step so far: through the
     /// centre of mass, about it, and its drive's along the wire.
     pub impulse: (B::V, B::Turn, f64),
+    /// The rows held where the last substep ended (its velocity step took
+    /// them there): where the next substep begins, with the wire where it
+    /// was then.
+    pub rows: Option<Rows<B>>,
 }
 
 impl<B: JointBody, T> JointState<B, T> {
@@ -116,6 +120,7 @@ impl<B: JointBody, T> JointState<B, T> {
             hint: f64::NAN,
             warned: false,
             impulse: (B::V::ZERO, B::Turn::default(), 0.0),
+            rows: None,
         }
     }
 
@@ -125,6 +130,7 @@ impl<B: JointBody, T> JointState<B, T> {
         self.previous = body;
         self.time = (time, 0.0);
         self.impulse = (B::V::ZERO, B::Turn::default(), 0.0);
+        self.rows = None;
     }
 
     /// Adds a substep's impulse: `(p, τ)` and the drive's.
@@ -163,6 +169,8 @@ pub(crate) struct Substep<'w, B: JointBody, W> {
     pub frame: BodyVelocity<B>,
     /// The substep, s.
     pub h: f64,
+    /// The rows held at `previous` on `before`, where known.
+    pub start: Option<Rows<B>>,
 }
 
 impl<B: JointBody, W: JointWire<B>> Substep<'_, B, W> {
@@ -184,7 +192,10 @@ impl<B: JointBody, W: JointWire<B>> Substep<'_, B, W> {
             }
             Some(rows)
         };
-        let start = with_end(before, &self.previous)?;
+        let start = match self.start {
+            Some(rows) if !end => rows,
+            _ => with_end(before, &self.previous)?,
+        };
         let tolerance = 1e-12 * after.scale().max(1.0);
         let compliance = law.compliance / (self.h * self.h);
         let rows_at = |b: &B| with_end(after, b);
@@ -261,28 +272,35 @@ impl<B: JointBody, W: JointWire<B>> Substep<'_, B, W> {
     }
 }
 
+/// What RATTLE's velocity step left: the body's velocity, the
+/// generalized impulse that gave it, and the rows held where the body is
+/// (for the next substep to begin from).
+pub(crate) type OnWire<B> = (
+    BodyVelocity<B>,
+    (<B as JointBody>::V, <B as JointBody>::Turn),
+    Option<Rows<B>>,
+);
+
 /// RATTLE's velocity step: the velocity a joint leaves its body with, on
 /// its rows where the substep ends (a compliant joint, met in position
 /// only, keeps its velocity), stopped at an end of an open wire it would
-/// pass; and the generalized impulse that did it. `None` where the rows
-/// are singular.
+/// pass; the generalized impulse that did it; and the rows it held.
+/// `None` where the rows are singular.
 pub(crate) fn velocity_on_wire<B: JointBody>(
     rigid: bool,
     wire: &impl JointWire<B>,
     body: &B,
     v: BodyVelocity<B>,
     frame: BodyVelocity<B>,
-) -> Option<(BodyVelocity<B>, (B::V, B::Turn))> {
-    let mut rows = if rigid {
-        wire.held(body)?
-    } else {
-        Rows::default()
-    };
+) -> Option<OnWire<B>> {
+    let held = if rigid { Some(wire.held(body)?) } else { None };
+    let mut rows = held.unwrap_or_default();
     if let Some(end) = wire.past_end(body)
         && end.value > -1e-9 * wire.scale()
         && end.rate(v) > end.rate(frame)
     {
         rows.push(BodyRow { value: 0.0, ..end });
     }
-    project_velocity(&rows, body, v, frame)
+    let (v, impulse) = project_velocity(&rows, body, v, frame)?;
+    Some((v, impulse, held))
 }
