@@ -110,16 +110,42 @@ pub fn wire_pose(transform: &Transform) -> Pose {
     pose_of(transform).unwrap_or_default()
 }
 
+/// What a wire rides: the body of its `WireOnBody`, with the avian
+/// features.
+#[cfg(any(feature = "avian2d", feature = "avian3d"))]
+type Riding = Option<&'static crate::dynamics::WireOnBody>;
+/// What a wire rides: nothing, without the avian features.
+#[cfg(not(any(feature = "avian2d", feature = "avian3d")))]
+type Riding = ();
+
+/// Where the body a wire rides puts the wire's frame (the identity for a
+/// wire that rides none).
+#[cfg(any(feature = "avian2d", feature = "avian3d"))]
+fn carrier_pose(riding: Option<&crate::dynamics::WireOnBody>, bodies: &Query<&Transform>) -> Pose {
+    riding
+        .and_then(|on| bodies.get(on.0).ok())
+        .map_or(Pose::IDENTITY, wire_pose)
+}
+
+/// Where the body a wire rides puts the wire's frame: no wire rides one
+/// without the avian features.
+#[cfg(not(any(feature = "avian2d", feature = "avian3d")))]
+fn carrier_pose(_: (), _: &Query<&Transform>) -> Pose {
+    Pose::IDENTITY
+}
+
 /// Draws every wire as a gizmo stroke, a one-sided one hatched on its
-/// closed side.
+/// closed side; a wire that rides a body (`WireOnBody`) where the body
+/// carries it.
 pub fn draw_wires(
-    wires: Query<(&Wire, &Transform)>,
+    wires: Query<(&Wire, &Transform, Riding)>,
+    bodies: Query<&Transform>,
     style: Res<DebugRenderStyle>,
     mut gizmos: Gizmos,
 ) {
     let (lo, hi) = style.bounds;
-    for (wire, transform) in &wires {
-        let pose = wire_pose(transform);
+    for (wire, transform, riding) in &wires {
+        let pose = carrier_pose(riding, &bodies).compose(&wire_pose(transform));
         match wire.shape() {
             WireShape::Custom(curve) => {
                 // A game's own curve: traced where it crosses the bounds.

@@ -83,6 +83,8 @@
 pub mod avian;
 #[cfg(feature = "avian3d")]
 pub mod avian3d;
+#[cfg(any(feature = "avian2d", feature = "avian3d"))]
+mod carrier;
 pub mod controls;
 #[cfg(feature = "debug-render")]
 pub mod debug_render;

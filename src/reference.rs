@@ -10,7 +10,7 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use bevy::math::DVec2;
+use bevy::math::{DQuat, DVec2, DVec3};
 
 /// The complete elliptic integral of the first kind `K(m)`, parameter `m`
 /// (not modulus), for `0 ≤ m < 1`. Returns NaN outside that range.
@@ -163,11 +163,54 @@ pub fn period_from_crossings(samples: &[(f64, f64)]) -> Option<f64> {
         .then(|| (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64)
 }
 
+/// A bead of mass `m` on a hoop centred on a free body of mass `big_m`
+/// (no gravity, frictionless; ../shared/PHYSICS.md, "Bodies beside
+/// beads"): where the bead and the body's centre are at time `t`, from the
+/// bead at `bead` moving at `bead_v` and the body's centre at `body` moving
+/// at `body_v`, the bead's velocity relative to the body across the line
+/// between them. The hoop's push passes through the body's centre, so the
+/// body never turns; the two turn about their common centre of mass, which
+/// drifts at the pair's mean velocity, at `Ω = (r × u) / |r|²` (`r` the
+/// bead less the body's centre, `u` its relative velocity), the bead
+/// `M/(m+M)` of `r` from it and the body `m/(m+M)` on the other side.
+pub fn bead_on_a_free_hoop(
+    (m, big_m): (f64, f64),
+    (bead, bead_v): (DVec3, DVec3),
+    (body, body_v): (DVec3, DVec3),
+    t: f64,
+) -> (DVec3, DVec3) {
+    let total = m + big_m;
+    let centre = (m * bead + big_m * body) / total + (m * bead_v + big_m * body_v) / total * t;
+    let r = bead - body;
+    let turn = r.cross(bead_v - body_v) / r.length_squared();
+    let r = DQuat::from_scaled_axis(turn * t) * r;
+    (centre + big_m / total * r, centre - m / total * r)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
     use std::f64::consts::PI;
+
+    /// The two-body answer keeps the hoop's radius between the two and
+    /// moves their centre of mass uniformly, to 1e-14; a quarter of the
+    /// relative turn (`Ω = u / R`) puts the bead a quarter round.
+    #[test]
+    fn a_bead_on_a_free_hoop_turns_about_the_pairs_centre_of_mass() {
+        let (m, big_m) = (1.0, 3.0);
+        let bead = (DVec3::X, DVec3::new(0.0, 1.5, 0.0));
+        let body = (DVec3::ZERO, DVec3::ZERO);
+        for t in [0.0, 0.7, 3.1] {
+            let (b, c) = bead_on_a_free_hoop((m, big_m), bead, body, t);
+            assert_relative_eq!((b - c).length(), 1.0, epsilon = 1e-14);
+            let centre = (m * b + big_m * c) / (m + big_m);
+            let expected = (m * bead.0 + m * bead.1 * t) / (m + big_m);
+            assert!((centre - expected).length() <= 1e-14);
+        }
+        let (b, c) = bead_on_a_free_hoop((m, big_m), bead, body, FRAC_PI_2 / 1.5);
+        assert!((b - c - DVec3::Y).length() <= 1e-14, "{}", b - c);
+    }
 
     #[test]
     fn elliptic_k_matches_known_values() {

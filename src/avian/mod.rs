@@ -48,6 +48,7 @@
 // to `f64` are identities in an `f64` build.
 #![allow(clippy::useless_conversion)]
 
+use avian2d::dynamics::solver::islands::WakeBody;
 use avian2d::dynamics::solver::schedule::{SolverSystems, SubstepSchedule, SubstepSolverSystems};
 use avian2d::dynamics::solver::solver_body::{SolverBody, SolverBodyInertia};
 use avian2d::dynamics::solver::xpbd::XpbdSolverSystems;
@@ -59,30 +60,42 @@ use bevy::prelude::*;
 use crate::dynamics::{Wire, WirePose};
 use crate::geometry::{Near, Placed, PosePath, WireShape};
 use crate::solver::path::{
-    JointBody, JointState, Law, PlaneBody, PlaneVelocity, PlaneWire, Substep, turn_offset,
-    velocity_on_wire,
+    Held, JointBody, JointState, JointWire, Law, PlaneBody, PlaneVelocity, PlaneWire, Substep,
+    turn_offset, velocity_on_wire,
 };
 use crate::{SimClock, SimParams};
+use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
 
+mod carried;
 mod joint;
 
+pub use crate::dynamics::WireOnBody;
 pub use joint::{PathJoint, PathJointForces, PathMotor, PathRotation};
 
 /// What a path joint holds from one substep to the next (the body's
 /// angle less the wire's tangent angle at the anchor, once set, for a
-/// body turned with its wire).
+/// body turned with its wire), and the body its wire rides, if any.
 #[derive(Component, Clone, Debug)]
-struct PathJointState(JointState<PlaneBody, f64>);
+struct PathJointState(JointState<PlaneBody, f64>, Option<Entity>);
 
 impl Default for PathJointState {
     fn default() -> Self {
-        Self(JointState::new(PlaneBody {
-            centre: DVec2::ZERO,
-            angle: 0.0,
-            arm: DVec2::ZERO,
-            inverse_mass: DVec2::ZERO,
-            inverse_inertia: 0.0,
-        }))
+        Self(
+            JointState::new(at_rest(DVec2::ZERO, 0.0, DVec2::ZERO)),
+            None,
+        )
+    }
+}
+
+/// A body at `centre` turned by `angle`, its anchor `arm` from its centre
+/// of mass, not yet given its masses.
+fn at_rest(centre: DVec2, angle: f64, arm: DVec2) -> PlaneBody {
+    PlaneBody {
+        centre,
+        angle,
+        arm,
+        inverse_mass: DVec2::ZERO,
+        inverse_inertia: 0.0,
     }
 }
 
@@ -95,6 +108,7 @@ impl Plugin for PathJointPlugin {
     fn build(&self, app: &mut App) {
         app.register_type::<PathJoint>()
             .register_type::<PathJointForces>()
+            .register_type::<WireOnBody>()
             .add_systems(
                 PhysicsSchedule,
                 (
@@ -105,10 +119,16 @@ impl Plugin for PathJointPlugin {
             .add_systems(
                 SubstepSchedule,
                 (
-                    solve_path_joints.in_set(XpbdSolverSystems::SolveUserConstraints),
+                    (solve_path_joints, solve_carried_path_joints)
+                        .chain()
+                        .in_set(XpbdSolverSystems::SolveUserConstraints),
                     // After avian turns the substep's corrections into
                     // velocity, before it damps it.
-                    project_path_joint_velocities
+                    (
+                        project_path_joint_velocities,
+                        project_carried_path_joint_velocities,
+                    )
+                        .chain()
                         .after(XpbdSolverSystems::VelocityProjection)
                         .before(SubstepSolverSystems::Damping),
                 ),
@@ -116,57 +136,120 @@ impl Plugin for PathJointPlugin {
     }
 }
 
-/// Reads each joint's body where the step begins; says once of a joint
-/// whose wire is missing that it holds nothing.
+/// The wires of path joints: each one's shape, where it is over time and
+/// the body it rides, if any.
+type Wires<'w, 's> = Query<
+    'w,
+    's,
+    (
+        &'static Wire,
+        &'static WirePose<DVec2>,
+        Option<&'static WireOnBody>,
+    ),
+>;
+
+/// Where a rigid body is: its origin, its turn and its centre of mass.
+type Placing<'a> = (&'a Position, &'a Rotation, &'a ComputedCenterOfMass);
+
+/// A body placed as avian has it, its anchor at `anchor` from its origin
+/// (in its frame).
+fn placed_body((position, rotation, centre): Placing, anchor: DVec2) -> PlaneBody {
+    let origin = DVec2::from(position.0);
+    let angle = f64::from(rotation.as_radians());
+    let local_centre = DVec2::from(centre.0);
+    at_rest(
+        origin + DVec2::from_angle(angle).rotate(local_centre),
+        angle,
+        anchor - local_centre,
+    )
+}
+
+/// Reads each joint's body, and the body its wire rides, where the step
+/// begins; says once of a joint whose wire is missing that it holds
+/// nothing, and of a wire on an entity that is no rigid body that it
+/// stays where its place puts it.
 fn prepare_path_joints(
-    mut joints: Query<(
-        Entity,
-        &PathJoint,
-        &mut PathJointState,
-        &Position,
-        &Rotation,
-        &ComputedCenterOfMass,
-    )>,
-    wires: Query<(&Wire, &WirePose<DVec2>)>,
+    mut joints: Query<(Entity, &PathJoint, &mut PathJointState, Placing)>,
+    bodies: Query<Placing, With<RigidBody>>,
+    sleeping: Query<(), With<Sleeping>>,
+    wires: Wires,
     clock: Res<SimClock>,
     params: Res<SimParams>,
+    mut commands: Commands,
 ) {
-    for (entity, joint, mut state, position, rotation, centre) in &mut joints {
-        let origin = DVec2::from(position.0);
-        let angle = f64::from(rotation.as_radians());
-        let local_centre = DVec2::from(centre.0);
-        let body = PlaneBody {
-            centre: origin + DVec2::from_angle(angle).rotate(local_centre),
-            angle,
-            arm: joint.anchor - local_centre,
-            ..state.0.start
+    for (entity, joint, mut state, placing) in &mut joints {
+        let body = placed_body(placing, joint.anchor);
+        let (placed, rides) = match wires.get(joint.wire) {
+            Ok((_, pose, on)) => (pose.path().is_some(), on.map(|on| on.0)),
+            Err(_) => (false, None),
         };
-        state.0.begin(body, clock.time - params.timestep);
-        let placed = wires
-            .get(joint.wire)
-            .is_ok_and(|(_, pose)| pose.path().is_some());
-        if !placed && !state.0.warned {
-            warn!(
-                "wirebead: the path joint of body {entity} holds nothing: entity {} is not a wire \
-                 with a finite pose",
+        // A carrier's anchor is its origin; a body carries no wire that
+        // holds it.
+        let carrier = rides
+            .filter(|&e| e != entity)
+            .and_then(|e| bodies.get(e).ok().map(|b| (e, placed_body(b, DVec2::ZERO))));
+        state.1 = carrier.map(|(e, _)| e);
+        // Avian sleeps each body on its own: one of a pair asleep while
+        // the other moves is woken, so the joint holds them together.
+        if let Some((e, _)) = carrier
+            && sleeping.contains(e) != sleeping.contains(entity)
+        {
+            let asleep = if sleeping.contains(e) { e } else { entity };
+            commands.queue(WakeBody(asleep));
+        }
+        let at = Held {
+            body,
+            carrier: carrier.map(|(_, b)| b),
+        };
+        state.0.begin(at, clock.time - params.timestep);
+        if state.0.warned {
+            continue;
+        }
+        let why = if !placed {
+            Some(format!(
+                "holds nothing: entity {} is not a wire with a finite pose",
                 joint.wire
-            );
+            ))
+        } else if let (Some(rides), None) = (rides, carrier) {
+            Some(format!(
+                "its wire rides entity {rides}, which is no other rigid body: the wire stays \
+                 where its place puts it"
+            ))
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            warn!("wirebead: the path joint of body {entity} {why}");
             state.0.warned = true;
         }
     }
 }
 
-/// The body as the joint sees it: where the step began, moved by the
-/// substep's `delta`.
-fn plane_body(state: &PathJointState, body: &SolverBody, inertia: &SolverBodyInertia) -> PlaneBody {
-    let start = state.0.start;
+/// A body as the joint sees it: where the step began (`start`), moved by
+/// the substep's `delta`; one with no solver body (a static carrier)
+/// stays where it began.
+fn plane_body(start: PlaneBody, solver: Option<(&SolverBody, &SolverBodyInertia)>) -> PlaneBody {
+    let Some((body, inertia)) = solver else {
+        return start;
+    };
+    // A kinematic body goes where the game sends it: no joint moves it.
+    let movable = if body.flags.is_kinematic() { 0.0 } else { 1.0 };
     PlaneBody {
         centre: start.centre + DVec2::from(body.delta_position),
         angle: start.angle + f64::from(body.delta_rotation.as_radians()),
-        inverse_mass: DVec2::from(inertia.effective_inv_mass()),
-        inverse_inertia: f64::from(inertia.effective_inv_angular_inertia()),
+        inverse_mass: DVec2::from(inertia.effective_inv_mass()) * movable,
+        inverse_inertia: f64::from(inertia.effective_inv_angular_inertia()) * movable,
         ..start
     }
+}
+
+/// A body's velocity as avian's solver has it (at rest without a solver
+/// body).
+fn velocity_of(solver: Option<&SolverBody>) -> PlaneVelocity {
+    solver.map_or_else(PlaneVelocity::default, |body| PlaneVelocity {
+        linear: DVec2::from(body.linear_velocity),
+        spin: f64::from(body.angular_velocity),
+    })
 }
 
 /// Each joint's impulses over the step, as its mean forces.
@@ -182,15 +265,13 @@ fn write_path_joint_forces(mut joints: Query<(&PathJointState, &mut PathJointFor
     }
 }
 
-/// The wire of a joint: its shape and where it is over time.
-fn wire_of<'a>(
-    wires: &'a Query<(&Wire, &WirePose<DVec2>)>,
-    joint: &PathJoint,
-) -> Option<(&'a WireShape, PosePath)> {
+/// The wire of a joint: its shape and where it is over time (in its
+/// carrier's frame, where it rides one).
+fn wire_of<'a>(wires: &'a Wires, joint: &PathJoint) -> Option<(&'a WireShape, PosePath)> {
     wires
         .get(joint.wire)
         .ok()
-        .and_then(|(wire, pose)| Some((wire.shape(), pose.path()?)))
+        .and_then(|(wire, pose, _)| Some((wire.shape(), pose.path()?)))
 }
 
 /// What the joint asks beside holding its body.
@@ -219,14 +300,10 @@ type JointBodies<'w, 's> = Query<
     ),
 >;
 
-/// SHAKE's step for each joint in the substep: the body, moved freely by
-/// avian's substep, put back on its rows along their gradients where the
-/// substep began, to rounding.
-fn solve_path_joints(
-    mut joints: JointBodies,
-    wires: Query<(&Wire, &WirePose<DVec2>)>,
-    time: Res<Time>,
-) {
+/// SHAKE's step for each joint on a wire that rides no body, in the
+/// substep: the body, moved freely by avian's substep, put back on its
+/// rows along their gradients where the substep began, to rounding.
+fn solve_path_joints(mut joints: JointBodies, wires: Wires, time: Res<Time>) {
     let h = time.delta_secs_f64();
     if h.is_nan() || h <= 0.0 {
         return;
@@ -235,7 +312,9 @@ fn solve_path_joints(
     joints
         .par_iter_mut()
         .for_each(|(joint, mut state, mut body, inertia)| {
-            solve_path_joint(joint, &mut state, &mut body, inertia, &wires, h);
+            if state.1.is_none() {
+                solve_path_joint(joint, &mut state, ((&mut *body, inertia), None), &wires, h);
+            }
         });
 }
 
@@ -243,9 +322,8 @@ fn solve_path_joints(
 fn solve_path_joint(
     joint: &PathJoint,
     state: &mut PathJointState,
-    body: &mut SolverBody,
-    inertia: &SolverBodyInertia,
-    wires: &Query<(&Wire, &WirePose<DVec2>)>,
+    ((body, inertia), carried): Solved,
+    wires: &Wires,
     h: f64,
 ) {
     state.0.time.1 += h;
@@ -262,39 +340,67 @@ fn solve_path_joint(
         curve: shape.curve(),
         hint: state.0.hint,
     };
-    let predicted = plane_body(state, body, inertia);
-    let previous = PlaneBody {
-        centre: state.0.previous.centre,
-        angle: state.0.previous.angle,
-        ..predicted
+    let (start, previous) = (state.0.start, state.0.previous);
+    let carrier_solver = carried.as_ref().map(|(b, i)| (&**b, *i));
+    let predicted = Held {
+        body: plane_body(start.body, Some((&*body, inertia))),
+        carrier: start.carrier.map(|c| plane_body(c, carrier_solver)),
     };
-    if !(predicted.anchor().is_finite() && predicted.angle.is_finite()) {
+    // Where the substep began, as hard to move as now.
+    let began = |was: PlaneBody, now: PlaneBody| PlaneBody {
+        centre: was.centre,
+        angle: was.angle,
+        ..now
+    };
+    let previous = Held {
+        body: began(previous.body, predicted.body),
+        carrier: previous
+            .carrier
+            .zip(predicted.carrier)
+            .map(|(was, now)| began(was, now)),
+    };
+    if !(predicted.body.anchor().is_finite() && predicted.body.angle.is_finite()) {
         return;
     }
-    let placed = |pose| Placed { curve: &near, pose };
-    if joint.rotation == PathRotation::Turned && state.0.turn.is_none() {
-        state.0.turn = turn_offset(&placed(path.pose(now - h)), &previous);
-    }
-    let wire_at = |pose| PlaneWire {
-        curve: placed(pose),
-        turned: turned(joint, state),
+    let wire_at = |pose, turned| PlaneWire {
+        curve: Placed { curve: &near, pose },
+        turned,
         travel: shape.travel(),
     };
-    let (before, after) = (wire_at(path.pose(now - h)), wire_at(path.pose(now)));
-    let (_, twist) = path.at(now - h);
+    if joint.rotation == PathRotation::Turned && state.0.turn.is_none() {
+        let wire = wire_at(path.pose(now - h), None).carried_by(previous.carrier.as_ref());
+        state.0.turn = turn_offset(&wire.curve, &previous.body);
+    }
+    let turned = turned(joint, state);
+    let (before, after) = (
+        wire_at(path.pose(now - h), turned),
+        wire_at(path.pose(now), turned),
+    );
+    // The velocity the body would have riding rigidly with the wire:
+    // with its carrier, or as the game moves it.
+    let frame = match previous.carrier {
+        Some(carrier) => {
+            let v = velocity_of(carrier_solver.map(|(b, _)| b));
+            PlaneVelocity {
+                linear: v.linear + perp(previous.body.centre - carrier.centre) * v.spin,
+                spin: v.spin,
+            }
+        }
+        None => {
+            let (_, twist) = path.at(now - h);
+            PlaneVelocity {
+                linear: twist.velocity_at(previous.body.centre),
+                spin: twist.angular_velocity,
+            }
+        }
+    };
     let substep = Substep {
         before: &before,
         after: &after,
         previous,
         predicted,
-        v: PlaneVelocity {
-            linear: DVec2::from(body.linear_velocity),
-            spin: f64::from(body.angular_velocity),
-        },
-        frame: PlaneVelocity {
-            linear: twist.velocity_at(previous.centre),
-            spin: twist.angular_velocity,
-        },
+        v: velocity_of(Some(&*body)),
+        frame,
         h,
         start: state.0.rows.take(),
     };
@@ -302,25 +408,48 @@ fn solve_path_joint(
         return;
     };
     // The move is the impulse over the substep: Δq = h M⁻¹ p.
-    let (p, tau) = projected.impulse;
+    let (p, tau) = projected.impulse.body;
     state.0.add_impulse((p / h, tau / h), driven / h);
     let moved = projected.body;
-    state.0.hint = shape
-        .curve()
-        .parameter(after.curve.pose.to_local(moved.anchor()), state.0.hint);
-    body.delta_position += (moved.centre - predicted.centre).adjust_precision();
-    body.delta_rotation = Rotation::radians((moved.angle - state.0.start.angle).adjust_precision());
+    let placed = after.carried_by(moved.carrier.as_ref());
+    state.0.hint = shape.curve().parameter(
+        placed.curve.pose.to_local(moved.body.anchor()),
+        state.0.hint,
+    );
+    body.delta_position += (moved.body.centre - predicted.body.centre).adjust_precision();
+    body.delta_rotation =
+        Rotation::radians((moved.body.angle - start.body.angle).adjust_precision());
+    if let (Some((carrier, _)), Some(moved), Some(predicted), Some(start)) =
+        (carried, moved.carrier, predicted.carrier, start.carrier)
+    {
+        carrier.delta_position += (moved.centre - predicted.centre).adjust_precision();
+        carrier.delta_rotation = Rotation::radians((moved.angle - start.angle).adjust_precision());
+    }
 }
 
-/// RATTLE's velocity step for each joint, after avian has turned the
-/// substep's corrections into velocity: the velocity onto the rows where
-/// the substep ends, the end of an open wire stopping an anchor that
-/// would pass it (the motor and friction act in the position step).
-fn project_path_joint_velocities(mut joints: JointBodies, wires: Query<(&Wire, &WirePose<DVec2>)>) {
+/// `v` turned a quarter counter-clockwise: `ω × r` for `ω` one radian a
+/// second.
+fn perp(v: DVec2) -> DVec2 {
+    DVec2::new(-v.y, v.x)
+}
+
+/// RATTLE's velocity step for each joint on a wire that rides no body,
+/// after avian has turned the substep's corrections into velocity: the
+/// velocity onto the rows where the substep ends, the end of an open wire
+/// stopping an anchor that would pass it (the motor and friction act in
+/// the position step).
+fn project_path_joint_velocities(mut joints: JointBodies, wires: Wires) {
     joints
         .par_iter_mut()
         .for_each(|(joint, mut state, mut body, inertia)| {
-            project_path_joint_velocity(joint, &mut state, &mut body, inertia, &wires);
+            if state.1.is_none() {
+                project_path_joint_velocity(
+                    joint,
+                    &mut state,
+                    ((&mut *body, inertia), None),
+                    &wires,
+                );
+            }
         });
 }
 
@@ -329,12 +458,16 @@ fn project_path_joint_velocities(mut joints: JointBodies, wires: Query<(&Wire, &
 fn project_path_joint_velocity(
     joint: &PathJoint,
     state: &mut PathJointState,
-    body: &mut SolverBody,
-    inertia: &SolverBodyInertia,
-    wires: &Query<(&Wire, &WirePose<DVec2>)>,
+    ((body, inertia), carried): Solved,
+    wires: &Wires,
 ) {
-    let plane = plane_body(state, body, inertia);
-    state.0.previous = plane;
+    let start = state.0.start;
+    let carrier_solver = carried.as_ref().map(|(b, i)| (&**b, *i));
+    let now = Held {
+        body: plane_body(start.body, Some((&*body, inertia))),
+        carrier: start.carrier.map(|c| plane_body(c, carrier_solver)),
+    };
+    state.0.previous = now;
     state.0.rows = None;
     if body.flags.is_kinematic() {
         return;
@@ -352,22 +485,34 @@ fn project_path_joint_velocity(
         turned: turned(joint, state),
         travel: shape.travel(),
     };
-    let v = PlaneVelocity {
-        linear: DVec2::from(body.linear_velocity),
-        spin: f64::from(body.angular_velocity),
+    let v = Held {
+        body: velocity_of(Some(&*body)),
+        carrier: now
+            .carrier
+            .map(|_| velocity_of(carrier_solver.map(|(b, _)| b))),
     };
-    let frame = PlaneVelocity {
-        linear: twist.velocity_at(plane.centre),
-        spin: twist.angular_velocity,
+    // A carrier's velocity is the joint's to keep; a wire the game moves
+    // is followed.
+    let frame = if now.carrier.is_some() {
+        PlaneVelocity::default()
+    } else {
+        PlaneVelocity {
+            linear: twist.velocity_at(now.body.centre),
+            spin: twist.angular_velocity,
+        }
     };
     let rigid = law(joint).rigid();
-    let Some((v, impulse, rows)) = velocity_on_wire(rigid, &wire, &plane, v, frame) else {
+    let Some((v, impulse, rows)) = velocity_on_wire(rigid, &wire, &now, v, frame) else {
         return;
     };
     state.0.rows = rows;
     if v.is_finite() {
-        state.0.add_impulse(impulse, 0.0);
-        body.linear_velocity = v.linear.adjust_precision();
-        body.angular_velocity = v.spin.adjust_precision();
+        state.0.add_impulse(impulse.body, 0.0);
+        body.linear_velocity = v.body.linear.adjust_precision();
+        body.angular_velocity = v.body.spin.adjust_precision();
+        if let (Some((carrier, _)), Some(v)) = (carried, v.carrier) {
+            carrier.linear_velocity = v.linear.adjust_precision();
+            carrier.angular_velocity = v.spin.adjust_precision();
+        }
     }
 }

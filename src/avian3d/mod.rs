@@ -52,6 +52,7 @@
 // to `f64` are identities in an `f64` build.
 #![allow(clippy::useless_conversion)]
 
+use avian3d::dynamics::solver::islands::WakeBody;
 use avian3d::dynamics::solver::schedule::{SolverSystems, SubstepSchedule, SubstepSolverSystems};
 use avian3d::dynamics::solver::solver_body::{SolverBody, SolverBodyInertia};
 use avian3d::dynamics::solver::xpbd::XpbdSolverSystems;
@@ -63,29 +64,42 @@ use bevy::prelude::*;
 use crate::dynamics::{SpaceWire, WirePose};
 use crate::geometry::{SpacePath, SpaceShape};
 use crate::solver::path::{
-    Alignment, BodyVelocity, JointBody, JointState, Law, SpaceBody, SpaceWireAt, Substep,
-    velocity_on_wire,
+    Alignment, BodyVelocity, Held, JointBody, JointState, JointWire, Law, SpaceBody, SpaceWireAt,
+    Substep, velocity_on_wire,
 };
 use crate::{SimClock, SimParams};
+use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
 
+mod carried;
 mod joint;
 
+pub use crate::dynamics::WireOnBody;
 pub use joint::{PathJoint, PathJointForces, PathMotor, PathRotation};
 
 /// What a path joint in space holds from one substep to the next (how
-/// the body turns with its wire, once fixed).
+/// the body turns with its wire, once fixed), and the body its wire
+/// rides, if any.
 #[derive(Component, Clone, Debug)]
-struct PathJointState(JointState<SpaceBody, Alignment>);
+struct PathJointState(JointState<SpaceBody, Alignment>, Option<Entity>);
 
 impl Default for PathJointState {
     fn default() -> Self {
-        Self(JointState::new(SpaceBody {
-            centre: DVec3::ZERO,
-            rotation: DQuat::IDENTITY,
-            arm: DVec3::ZERO,
-            inverse_mass: DVec3::ZERO,
-            inverse_inertia: DMat3::ZERO,
-        }))
+        Self(
+            JointState::new(at_rest(DVec3::ZERO, DQuat::IDENTITY, DVec3::ZERO)),
+            None,
+        )
+    }
+}
+
+/// A body at `centre` turned by `rotation`, its anchor `arm` from its
+/// centre of mass (in its frame), not yet given its masses.
+fn at_rest(centre: DVec3, rotation: DQuat, arm: DVec3) -> SpaceBody {
+    SpaceBody {
+        centre,
+        rotation,
+        arm,
+        inverse_mass: DVec3::ZERO,
+        inverse_inertia: DMat3::ZERO,
     }
 }
 
@@ -98,6 +112,7 @@ impl Plugin for PathJointPlugin {
     fn build(&self, app: &mut App) {
         app.register_type::<PathJoint>()
             .register_type::<PathJointForces>()
+            .register_type::<WireOnBody>()
             .add_systems(
                 PhysicsSchedule,
                 (
@@ -108,10 +123,16 @@ impl Plugin for PathJointPlugin {
             .add_systems(
                 SubstepSchedule,
                 (
-                    solve_path_joints.in_set(XpbdSolverSystems::SolveUserConstraints),
+                    (solve_path_joints, solve_carried_path_joints)
+                        .chain()
+                        .in_set(XpbdSolverSystems::SolveUserConstraints),
                     // After avian turns the substep's corrections into
                     // velocity, before it damps it.
-                    project_path_joint_velocities
+                    (
+                        project_path_joint_velocities,
+                        project_carried_path_joint_velocities,
+                    )
+                        .chain()
                         .after(XpbdSolverSystems::VelocityProjection)
                         .before(SubstepSolverSystems::Damping),
                 ),
@@ -134,48 +155,96 @@ fn vector_of(v: Vector) -> DVec3 {
     DVec3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z))
 }
 
-/// The wires in space with their poses.
-type Wires<'w, 's> = Query<'w, 's, (&'static SpaceWire, &'static WirePose<DVec3>)>;
+/// The wires in space of path joints: each one's shape, where it is over
+/// time and the body it rides, if any.
+type Wires<'w, 's> = Query<
+    'w,
+    's,
+    (
+        &'static SpaceWire,
+        &'static WirePose<DVec3>,
+        Option<&'static WireOnBody>,
+    ),
+>;
 
-/// Reads each joint's body where the step begins; says once of a joint
-/// whose wire is missing, or cannot turn the body as asked, that it holds
-/// nothing, or only its anchor.
+/// Where a rigid body is: its origin, its turn and its centre of mass.
+type Placing<'a> = (&'a Position, &'a Rotation, &'a ComputedCenterOfMass);
+
+/// A body placed as avian has it, its anchor at `anchor` from its origin
+/// (in its frame).
+fn placed_body((position, rotation, centre): Placing, anchor: DVec3) -> SpaceBody {
+    let rotation = rotation_of(rotation.0).normalize();
+    let local_centre = vector_of(centre.0);
+    at_rest(
+        vector_of(position.0) + rotation * local_centre,
+        rotation,
+        anchor - local_centre,
+    )
+}
+
+/// Reads each joint's body, and the body its wire rides, where the step
+/// begins; says once of a joint whose wire is missing, or cannot turn the
+/// body as asked, that it holds nothing, or only its anchor, and of a
+/// wire on an entity that is no rigid body that it stays where its place
+/// puts it.
 fn prepare_path_joints(
-    mut joints: Query<(
-        Entity,
-        &PathJoint,
-        &mut PathJointState,
-        &Position,
-        &Rotation,
-        &ComputedCenterOfMass,
-    )>,
+    mut joints: Query<(Entity, &PathJoint, &mut PathJointState, Placing)>,
+    bodies: Query<Placing, With<RigidBody>>,
+    sleeping: Query<(), With<Sleeping>>,
     wires: Wires,
     clock: Res<SimClock>,
     params: Res<SimParams>,
+    mut commands: Commands,
 ) {
-    for (entity, joint, mut state, position, rotation, centre) in &mut joints {
-        let rotation = rotation_of(rotation.0).normalize();
-        let local_centre = vector_of(centre.0);
-        let body = SpaceBody {
-            centre: vector_of(position.0) + rotation * local_centre,
-            rotation,
-            arm: joint.anchor - local_centre,
-            ..state.0.start
+    for (entity, joint, mut state, placing) in &mut joints {
+        let body = placed_body(placing, joint.anchor);
+        let rides = wires
+            .get(joint.wire)
+            .ok()
+            .and_then(|(_, _, on)| on.map(|on| on.0));
+        // A carrier's anchor is its origin; a body carries no wire that
+        // holds it.
+        let carrier = rides
+            .filter(|&e| e != entity)
+            .and_then(|e| bodies.get(e).ok().map(|b| (e, placed_body(b, DVec3::ZERO))));
+        state.1 = carrier.map(|(e, _)| e);
+        // Avian sleeps each body on its own: one of a pair asleep while
+        // the other moves is woken, so the joint holds them together.
+        if let Some((e, _)) = carrier
+            && sleeping.contains(e) != sleeping.contains(entity)
+        {
+            let asleep = if sleeping.contains(e) { e } else { entity };
+            commands.queue(WakeBody(asleep));
+        }
+        let at = Held {
+            body,
+            carrier: carrier.map(|(_, b)| b),
         };
-        state.0.begin(body, clock.time - params.timestep);
+        state.0.begin(at, clock.time - params.timestep);
         if state.0.warned {
             continue;
         }
         let why = match wires.get(joint.wire) {
-            Ok((_, pose)) if pose.path().is_none() => Some("its wire has no finite pose"),
-            Ok((wire, _))
+            Ok((_, pose, _)) if pose.path().is_none() => {
+                Some("its wire has no finite pose".to_string())
+            }
+            Ok((wire, _, _))
                 if matches!(wire.shape(), SpaceShape::Surface(_))
                     && !matches!(joint.rotation, PathRotation::Free | PathRotation::Fixed) =>
             {
-                Some("a surface has no tangent to turn it with, so it holds the anchor only")
+                Some(
+                    "a surface has no tangent to turn it with, so it holds the anchor only"
+                        .to_string(),
+                )
             }
-            Ok(_) => None,
-            Err(_) => Some("its wire is not a wire in space"),
+            Ok(_) => match (rides, carrier) {
+                (Some(rides), None) => Some(format!(
+                    "its wire rides entity {rides}, which is no other rigid body: the wire \
+                     stays where its place puts it"
+                )),
+                _ => None,
+            },
+            Err(_) => Some("its wire is not a wire in space".to_string()),
         };
         if let Some(why) = why {
             warn!(
@@ -187,21 +256,27 @@ fn prepare_path_joints(
     }
 }
 
-/// The body as the joint sees it: where the step began, moved by the
-/// substep's `delta`.
-fn space_body(start: SpaceBody, body: &SolverBody, inertia: &SolverBodyInertia) -> SpaceBody {
+/// A body as the joint sees it: where the step began (`start`), moved by
+/// the substep's `delta`; one with no solver body (a static carrier)
+/// stays where it began.
+fn space_body(start: SpaceBody, solver: Option<(&SolverBody, &SolverBodyInertia)>) -> SpaceBody {
+    let Some((body, inertia)) = solver else {
+        return start;
+    };
     let m = inertia.effective_inv_angular_inertia();
     let column =
         |x: Scalar, y: Scalar, z: Scalar| DVec3::new(f64::from(x), f64::from(y), f64::from(z));
+    // A kinematic body goes where the game sends it: no joint moves it.
+    let movable = if body.flags.is_kinematic() { 0.0 } else { 1.0 };
     SpaceBody {
         centre: start.centre + vector_of(body.delta_position),
         rotation: (rotation_of(body.delta_rotation.0) * start.rotation).normalize(),
-        inverse_mass: vector_of(inertia.effective_inv_mass()),
+        inverse_mass: vector_of(inertia.effective_inv_mass()) * movable,
         inverse_inertia: DMat3::from_cols(
             column(m.m00, m.m01, m.m02),
             column(m.m01, m.m11, m.m12),
             column(m.m02, m.m12, m.m22),
-        ),
+        ) * movable,
         ..start
     }
 }
@@ -219,12 +294,13 @@ fn write_path_joint_forces(mut joints: Query<(&PathJointState, &mut PathJointFor
     }
 }
 
-/// The wire of a joint: its shape and where it is over time.
+/// The wire of a joint: its shape and where it is over time (in its
+/// carrier's frame, where it rides one).
 fn wire_of<'a>(wires: &'a Wires, joint: &PathJoint) -> Option<(&'a SpaceShape, SpacePath)> {
     wires
         .get(joint.wire)
         .ok()
-        .and_then(|(wire, pose)| Some((wire.shape(), pose.path()?)))
+        .and_then(|(wire, pose, _)| Some((wire.shape(), pose.path()?)))
 }
 
 /// What the joint asks beside holding its body.
@@ -244,9 +320,9 @@ type JointBodies<'w, 's> = Query<
     ),
 >;
 
-/// SHAKE's step for each joint in the substep: the body, moved freely by
-/// avian's substep, put back on its rows along their gradients where the
-/// substep began, to rounding.
+/// SHAKE's step for each joint on a wire that rides no body, in the
+/// substep: the body, moved freely by avian's substep, put back on its
+/// rows along their gradients where the substep began, to rounding.
 fn solve_path_joints(mut joints: JointBodies, wires: Wires, time: Res<Time>) {
     let h = time.delta_secs_f64();
     if h.is_nan() || h <= 0.0 {
@@ -256,24 +332,26 @@ fn solve_path_joints(mut joints: JointBodies, wires: Wires, time: Res<Time>) {
     joints
         .par_iter_mut()
         .for_each(|(joint, mut state, mut body, inertia)| {
-            solve_path_joint(joint, &mut state, &mut body, inertia, &wires, h);
+            if state.1.is_none() {
+                solve_path_joint(joint, &mut state, ((&mut *body, inertia), None), &wires, h);
+            }
         });
 }
 
-/// The body's velocity as avian's solver has it.
-fn velocity_of(body: &SolverBody) -> BodyVelocity<SpaceBody> {
-    BodyVelocity {
+/// The body's velocity as avian's solver has it (at rest without a solver
+/// body).
+fn velocity_of(solver: Option<&SolverBody>) -> BodyVelocity<SpaceBody> {
+    solver.map_or_else(BodyVelocity::default, |body| BodyVelocity {
         linear: vector_of(body.linear_velocity),
         spin: vector_of(body.angular_velocity),
-    }
+    })
 }
 
 /// SHAKE's step for one joint (see [`solve_path_joints`]).
 fn solve_path_joint(
     joint: &PathJoint,
     state: &mut PathJointState,
-    body: &mut SolverBody,
-    inertia: &SolverBodyInertia,
+    ((body, inertia), carried): Solved,
     wires: &Wires,
     h: f64,
 ) {
@@ -286,29 +364,43 @@ fn solve_path_joint(
         return;
     };
     let now = state.time.0 + state.time.1;
-    let predicted = space_body(state.start, body, inertia);
-    let previous = SpaceBody {
-        centre: state.previous.centre,
-        rotation: state.previous.rotation,
-        ..predicted
+    let carrier_solver = carried.as_ref().map(|(b, i)| (&**b, *i));
+    let predicted = Held {
+        body: space_body(state.start.body, Some((&*body, inertia))),
+        carrier: state.start.carrier.map(|c| space_body(c, carrier_solver)),
     };
-    if !(predicted.anchor().is_finite() && predicted.rotation.is_finite()) {
+    // Where the substep began, as hard to move as now.
+    let began = |was: SpaceBody, now: SpaceBody| SpaceBody {
+        centre: was.centre,
+        rotation: was.rotation,
+        ..now
+    };
+    let previous = Held {
+        body: began(state.previous.body, predicted.body),
+        carrier: state
+            .previous
+            .carrier
+            .zip(predicted.carrier)
+            .map(|(was, now)| began(was, now)),
+    };
+    if !(predicted.body.anchor().is_finite() && predicted.body.rotation.is_finite()) {
         return;
     }
-    let (pose, twist) = path.at(now - h);
     let mut before = SpaceWireAt {
         shape,
-        pose,
+        pose: path.pose(now - h),
         hint: state.hint,
         alignment: None,
     };
     if let Some(turn) = joint.rotation.turn()
         && state.turn.is_none()
-        && let Some(frame) = before.frame(&previous, turn)
+        && let Some(frame) = before
+            .carried_by(previous.carrier.as_ref())
+            .frame(&previous.body, turn)
     {
         state.turn = Some(Alignment {
             turn,
-            axes: (previous.rotation.inverse() * frame).normalize(),
+            axes: (previous.body.rotation.inverse() * frame).normalize(),
         });
     }
     before.alignment = state.turn;
@@ -316,43 +408,78 @@ fn solve_path_joint(
         pose: path.pose(now),
         ..before
     };
+    // The velocity the body would have riding rigidly with the wire:
+    // with its carrier, or as the game moves it.
+    let frame = match previous.carrier {
+        Some(carrier) => {
+            let v = velocity_of(carrier_solver.map(|(b, _)| b));
+            BodyVelocity {
+                linear: v.linear + v.spin.cross(previous.body.centre - carrier.centre),
+                spin: v.spin,
+            }
+        }
+        None => {
+            let (_, twist) = path.at(now - h);
+            BodyVelocity {
+                linear: twist.velocity_at(previous.body.centre),
+                spin: twist.angular_velocity,
+            }
+        }
+    };
     let substep = Substep {
         before: &before,
         after: &after,
         previous,
         predicted,
-        v: velocity_of(body),
-        frame: BodyVelocity {
-            linear: twist.velocity_at(previous.centre),
-            spin: twist.angular_velocity,
-        },
+        v: velocity_of(Some(&*body)),
+        frame,
         h,
         start: state.rows.take(),
     };
     let Some((projected, driven)) = substep.correct(&law(joint)) else {
         return;
     };
-    let (p, tau) = projected.impulse;
+    let (p, tau) = projected.impulse.body;
     state.add_impulse((p / h, tau / h), driven / h);
     let moved = projected.body;
-    state.hint = after.parameter(&moved);
-    body.delta_position += (moved.centre - predicted.centre).adjust_precision();
-    body.delta_rotation = Rotation(
-        (moved.rotation * state.start.rotation.inverse())
-            .normalize()
-            .adjust_precision(),
-    );
+    state.hint = after
+        .carried_by(moved.carrier.as_ref())
+        .parameter(&moved.body);
+    let start = state.start;
+    let write =
+        |solver: &mut SolverBody, moved: SpaceBody, predicted: SpaceBody, start: SpaceBody| {
+            solver.delta_position += (moved.centre - predicted.centre).adjust_precision();
+            solver.delta_rotation = Rotation(
+                (moved.rotation * start.rotation.inverse())
+                    .normalize()
+                    .adjust_precision(),
+            );
+        };
+    write(body, moved.body, predicted.body, start.body);
+    if let (Some((carrier, _)), Some(moved), Some(predicted), Some(start)) =
+        (carried, moved.carrier, predicted.carrier, start.carrier)
+    {
+        write(carrier, moved, predicted, start);
+    }
 }
 
-/// RATTLE's velocity step for each joint, after avian has turned the
-/// substep's corrections into velocity: the velocity onto the rows where
-/// the substep ends, the end of an open wire stopping an anchor that
-/// would pass it (the motor and friction act in the position step).
+/// RATTLE's velocity step for each joint on a wire that rides no body,
+/// after avian has turned the substep's corrections into velocity: the
+/// velocity onto the rows where the substep ends, the end of an open wire
+/// stopping an anchor that would pass it (the motor and friction act in
+/// the position step).
 fn project_path_joint_velocities(mut joints: JointBodies, wires: Wires) {
     joints
         .par_iter_mut()
         .for_each(|(joint, mut state, mut body, inertia)| {
-            project_path_joint_velocity(joint, &mut state, &mut body, inertia, &wires);
+            if state.1.is_none() {
+                project_path_joint_velocity(
+                    joint,
+                    &mut state,
+                    ((&mut *body, inertia), None),
+                    &wires,
+                );
+            }
         });
 }
 
@@ -361,11 +488,14 @@ fn project_path_joint_velocities(mut joints: JointBodies, wires: Wires) {
 fn project_path_joint_velocity(
     joint: &PathJoint,
     state: &mut PathJointState,
-    body: &mut SolverBody,
-    inertia: &SolverBodyInertia,
+    ((body, inertia), carried): Solved,
     wires: &Wires,
 ) {
-    let now = space_body(state.0.start, body, inertia);
+    let carrier_solver = carried.as_ref().map(|(b, i)| (&**b, *i));
+    let now = Held {
+        body: space_body(state.0.start.body, Some((&*body, inertia))),
+        carrier: state.0.start.carrier.map(|c| space_body(c, carrier_solver)),
+    };
     state.0.previous = now;
     state.0.rows = None;
     if body.flags.is_kinematic() {
@@ -381,19 +511,34 @@ fn project_path_joint_velocity(
         hint: state.0.hint,
         alignment: state.0.turn,
     };
-    let frame = BodyVelocity {
-        linear: twist.velocity_at(now.centre),
-        spin: twist.angular_velocity,
+    let v = Held {
+        body: velocity_of(Some(&*body)),
+        carrier: now
+            .carrier
+            .map(|_| velocity_of(carrier_solver.map(|(b, _)| b))),
+    };
+    // A carrier's velocity is the joint's to keep; a wire the game moves
+    // is followed.
+    let frame = if now.carrier.is_some() {
+        BodyVelocity::default()
+    } else {
+        BodyVelocity {
+            linear: twist.velocity_at(now.body.centre),
+            spin: twist.angular_velocity,
+        }
     };
     let rigid = law(joint).rigid();
-    let Some((v, impulse, rows)) = velocity_on_wire(rigid, &wire, &now, velocity_of(body), frame)
-    else {
+    let Some((v, impulse, rows)) = velocity_on_wire(rigid, &wire, &now, v, frame) else {
         return;
     };
     state.0.rows = rows;
     if v.is_finite() {
-        state.0.add_impulse(impulse, 0.0);
-        body.linear_velocity = v.linear.adjust_precision();
-        body.angular_velocity = v.spin.adjust_precision();
+        state.0.add_impulse(impulse.body, 0.0);
+        body.linear_velocity = v.body.linear.adjust_precision();
+        body.angular_velocity = v.body.spin.adjust_precision();
+        if let (Some((carrier, _)), Some(v)) = (carried, v.carrier) {
+            carrier.linear_velocity = v.linear.adjust_precision();
+            carrier.angular_velocity = v.spin.adjust_precision();
+        }
     }
 }

@@ -27,6 +27,8 @@ pub use rail::RailOrientation;
 pub use touch::{
     BeadRadius, BeadSentBack, BeadsStruck, CatchesBeads, Contacts, Restitution, SendsBeadsBack,
 };
+#[cfg(any(feature = "avian2d", feature = "avian3d"))]
+pub use wire::WireOnBody;
 pub(crate) use wire::WirePose;
 pub use wire::{
     ContactChanged, NextWireShape, OnWire, PrescribedMotion, SpaceWire, Wire, WireBeads,

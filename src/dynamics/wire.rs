@@ -380,6 +380,29 @@ pub struct ContactChanged<V: Coordinates = DVec2> {
 #[relationship_target(relationship = OnWire, linked_spawn)]
 pub struct WireBeads(Vec<Entity>);
 
+/// Fixes the wire it is on to the rigid body `0` (a door, a cart, a free
+/// body): the wire's place (its `Transform`, or its
+/// [`WirePlace`]) is then in the body's frame, from the
+/// body's origin, and the wire moves and turns with the body. A
+/// path joint on it (`wirebead::avian::PathJoint`,
+/// `wirebead::avian3d::PathJoint`) holds its own body against the carrier: the
+/// joint's push, its motor, its friction and its ends act on both, so the
+/// pair keeps its momentum and its angular momentum, and a body held on a
+/// hoop fixed to a free body swings the two about their common centre of
+/// mass. Joints on one carrier are solved one after another each
+/// substep, as avian solves its own joints. The place is read each
+/// substep: a place that moves on the body moves the wire there, but only
+/// the body's own motion counts in the wire's velocity (put a moving
+/// track on a body of its own). A carrier that is no other rigid body
+/// (or the joint's own body) leaves the wire where its place puts it, in
+/// the world, and the joint says so once in the log. Avian sleeps bodies
+/// one by one: where one of a carrier and a body held on its wire sleeps
+/// while the other moves, the sleeper is woken.
+#[cfg(any(feature = "avian2d", feature = "avian3d"))]
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq, Reflect)]
+#[reflect(Component)]
+pub struct WireOnBody(#[entities] pub Entity);
+
 #[cfg(test)]
 mod tests {
     use bevy::math::DVec2;

@@ -131,6 +131,15 @@ impl Pose {
     pub fn rotate(&self, d: DVec2) -> DVec2 {
         self.matrix() * d
     }
+
+    /// The pose in world coordinates of `inner`, a pose in this one's
+    /// frame (a wire placed on a body that sits at `self`).
+    pub fn compose(&self, inner: &Pose) -> Pose {
+        Pose {
+            origin: self.to_world(inner.origin),
+            rotation: self.rotate(inner.rotation),
+        }
+    }
 }
 
 impl Placement<DVec2> for Pose {
@@ -245,6 +254,15 @@ impl Pose3 {
     /// A local direction in world coordinates.
     pub fn rotate(&self, d: DVec3) -> DVec3 {
         self.matrix() * d
+    }
+
+    /// The pose in world coordinates of `inner`, a pose in this one's
+    /// frame (a wire placed on a body that sits at `self`).
+    pub fn compose(&self, inner: &Pose3) -> Pose3 {
+        Pose3 {
+            origin: self.to_world(inner.origin),
+            rotation: (self.rotation * inner.rotation).normalize(),
+        }
     }
 }
 

@@ -25,6 +25,7 @@ const LAYERS: &[&str] = &[
     "solver",
     "dynamics",
     "plugin",
+    "carrier",
     "avian",
     "avian3d",
     "controls",

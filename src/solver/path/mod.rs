@@ -29,6 +29,7 @@ use crate::lane::Vector;
 
 #[cfg_attr(not(feature = "avian2d"), allow(dead_code))]
 mod plane;
+mod rows;
 #[cfg_attr(not(feature = "avian3d"), allow(dead_code))]
 mod space;
 mod substep;
@@ -37,6 +38,8 @@ mod substep;
 pub(crate) use plane::{PlaneBody, PlaneVelocity, PlaneWire, turn_offset};
 #[cfg(test)]
 use plane::{along_curve, on_curve, past_end, turned_with_curve};
+use rows::{Bend, solve};
+pub(crate) use rows::{BodyRow, BodyVelocity, Held, Impulse, Rows};
 #[cfg_attr(not(feature = "avian3d"), allow(unused_imports))]
 pub(crate) use space::{Alignment, SpaceBody, SpaceTurn, SpaceWireAt};
 pub use substep::PathMotor;
@@ -122,229 +125,9 @@ pub(crate) trait JointBody: Copy + Debug + PartialEq + Send + Sync {
     fn lever(&self) -> Self::V {
         self.anchor() - self.centre()
     }
-}
-
-/// A body's velocity: its centre's, and its spin.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct BodyVelocity<B: JointBody> {
-    /// `ċ`.
-    pub linear: B::V,
-    /// `ω` (`θ̇` in the plane).
-    pub spin: B::Turn,
-}
-
-impl<B: JointBody> Default for BodyVelocity<B> {
-    fn default() -> Self {
-        Self {
-            linear: B::V::ZERO,
-            spin: B::Turn::default(),
-        }
-    }
-}
-
-impl<B: JointBody> BodyVelocity<B> {
-    /// The velocity changed by the generalized impulse `(p, τ)`.
-    fn kicked(self, body: &B, (p, tau): (B::V, B::Turn)) -> Self {
-        Self {
-            linear: self.linear + body.inverse_mass(p),
-            spin: self.spin + body.inverse_inertia(tau),
-        }
-    }
-
-    /// Whether every component is finite.
-    pub fn is_finite(&self) -> bool {
-        self.linear.is_finite() && self.spin.finite()
-    }
-}
-
-/// One row of a body's constraint: its value and its gradient with
-/// respect to the centre of mass and the orientation.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct BodyRow<B: JointBody> {
-    /// `C`.
-    pub value: f64,
-    /// `∂C/∂c`.
-    pub along_centre: B::V,
-    /// `∂C/∂θ` (in space, for a rotation vector `δθ` applied on the left).
-    pub along_angle: B::Turn,
-}
-
-impl<B: JointBody> Default for BodyRow<B> {
-    fn default() -> Self {
-        Self {
-            value: 0.0,
-            along_centre: B::V::ZERO,
-            along_angle: B::Turn::default(),
-        }
-    }
-}
-
-impl<B: JointBody> BodyRow<B> {
-    /// A row of value `value` whose gradient is the direction `d` at the
-    /// anchor of `body`: `∂C/∂c = d`, `∂C/∂θ = (a − c) × d`.
-    pub fn at_anchor(body: &B, value: f64, d: B::V) -> Self {
-        Self {
-            value,
-            along_centre: d,
-            along_angle: B::moment(body.lever(), d),
-        }
-    }
-
-    /// `Ċ = J q̇` at the velocity `v`.
-    pub fn rate(&self, v: BodyVelocity<B>) -> f64 {
-        self.along_centre.dot(v.linear) + self.along_angle.dot(v.spin)
-    }
-
-    /// `Jᵢ M⁻¹ Jⱼᵀ`: how far this row moves as `other`'s multiplier does.
-    fn coupling(&self, other: &Self, body: &B) -> f64 {
-        self.along_centre.dot(body.inverse_mass(other.along_centre))
-            + self
-                .along_angle
-                .dot(body.inverse_inertia(other.along_angle))
-    }
-}
-
-/// The rows of one joint, at most as many as the body has coordinates;
-/// and how the wire bends at the anchor they were taken at.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Rows<B: JointBody> {
-    rows: [BodyRow<B>; MAX_ROWS],
-    len: usize,
-    bend: Bend<B::V>,
-}
-
-/// How a wire bends at an anchor: its unit tangent there and how fast
-/// that turns along it (the curvature), for [`turns_a_corner`].
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct Bend<V> {
-    /// The unit tangent.
-    pub tangent: V,
-    /// The curvature, 1/m.
-    pub curvature: f64,
-}
-
-impl<B: JointBody> Default for Rows<B> {
-    fn default() -> Self {
-        Self {
-            rows: [BodyRow::default(); MAX_ROWS],
-            len: 0,
-            bend: Bend {
-                tangent: B::V::ZERO,
-                curvature: 0.0,
-            },
-        }
-    }
-}
-
-impl<B: JointBody> Rows<B> {
-    /// No rows yet, on a wire that bends as `bend` says.
-    pub fn bending(bend: Bend<B::V>) -> Self {
-        Self {
-            bend,
-            ..Self::default()
-        }
-    }
-
-    /// Adds `row`; a row past the body's coordinates is dropped (they
-    /// fix it already).
-    pub fn push(&mut self, row: BodyRow<B>) {
-        if self.len < B::COORDINATES {
-            self.rows[self.len] = row;
-            self.len += 1;
-        }
-    }
-
-    /// How many rows there are.
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// The rows.
-    pub fn iter(&self) -> impl Iterator<Item = &BodyRow<B>> {
-        self.rows[..self.len].iter()
-    }
-
-    /// The rows' values, zero past the last.
-    fn values(&self) -> Multipliers {
-        std::array::from_fn(|i| {
-            if i < self.len {
-                self.rows[i].value
-            } else {
-                0.0
-            }
-        })
-    }
-
-    /// `J q̇` at `v`, zero past the last row.
-    fn rates(&self, v: BodyVelocity<B>) -> Multipliers {
-        std::array::from_fn(|i| {
-            if i < self.len {
-                self.rows[i].rate(v)
-            } else {
-                0.0
-            }
-        })
-    }
-
-    /// `Gᵀ λ`: the generalized impulse of the multipliers `lambda` along
-    /// the rows.
-    pub fn impulse(&self, lambda: &Multipliers) -> (B::V, B::Turn) {
-        self.iter()
-            .zip(lambda)
-            .fold((B::V::ZERO, B::Turn::default()), |(p, tau), (row, &l)| {
-                (p + row.along_centre * l, tau + row.along_angle * l)
-            })
-    }
-
-    /// `A = J M⁻¹ Gᵀ` for the rows `J` (self) and `G` (`along`), with
-    /// `compliance` added to the diagonal.
-    fn matrix(&self, along: &Self, body: &B, compliance: f64) -> Matrix {
-        let mut a = [[0.0; MAX_ROWS]; MAX_ROWS];
-        for (i, row) in self.iter().enumerate() {
-            for (j, other) in along.iter().enumerate() {
-                a[i][j] = row.coupling(other, body) + if i == j { compliance } else { 0.0 };
-            }
-        }
-        a
-    }
-}
-
-/// A square matrix of rows, row-major.
-type Matrix = [[f64; MAX_ROWS]; MAX_ROWS];
-
-/// `A x = b` for the leading `n` rows and columns of `A` (the rest
-/// ignored, zero in `x`), by Gauss elimination with partial pivoting; or
-/// `None` where they are singular (a pivot at most 1e-13 of `A`'s largest
-/// entry) or the answer not finite. The matrix `J M⁻¹ Gᵀ` of SHAKE's step
-/// is not symmetric, so it takes no Cholesky factor.
-fn solve(mut a: Matrix, b: Multipliers, n: usize) -> Option<Multipliers> {
-    let mut x = b;
-    let size = a[..n]
-        .iter()
-        .flat_map(|row| row[..n].iter())
-        .fold(0.0f64, |m, v| m.max(v.abs()));
-    for k in 0..n {
-        let pivot = (k..n).max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))?;
-        if a[pivot][k].is_nan() || a[pivot][k].abs() <= 1e-13 * size {
-            return None;
-        }
-        a.swap(k, pivot);
-        x.swap(k, pivot);
-        let (above, below) = a.split_at_mut(k + 1);
-        let pivot_row = &above[k];
-        for (i, row) in below[..n - k - 1].iter_mut().enumerate() {
-            let factor = row[k] / pivot_row[k];
-            for (entry, &p) in row[k..n].iter_mut().zip(&pivot_row[k..n]) {
-                *entry -= factor * p;
-            }
-            x[k + 1 + i] -= factor * x[k];
-        }
-    }
-    for k in (0..n).rev() {
-        let sum: f64 = (k + 1..n).map(|j| a[k][j] * x[j]).sum();
-        x[k] = (x[k] - sum) / a[k][k];
-    }
-    x.iter().all(|v| v.is_finite()).then_some(x)
+    /// The point `p` and the direction `d`, fixed to the body where it was
+    /// at `was`, where the body's motion from there to here takes them.
+    fn carry(&self, was: &Self, p: Self::V, d: Self::V) -> (Self::V, Self::V);
 }
 
 /// The angle between two unit vectors, `2 atan2(|a − b|, |a + b|)`,
@@ -363,21 +146,31 @@ const CORNER_SLACK: f64 = 0.02;
 /// between them by more than twice what its curvature at the two turns
 /// it over the distance, and [`CORNER_SLACK`] beside. On a smooth wire
 /// the tangent turns by the curvature times the distance, to second
-/// order.
+/// order. On a wire that rides a body, the tangent and the anchor are
+/// compared in the carrier's frame, so the carrier's own turn is none of
+/// the wire's.
 pub(crate) fn turns_a_corner<B: JointBody>(
-    (from, at_from): (&B, &Rows<B>),
-    (to, at_to): (&B, &Rows<B>),
+    (from, at_from): (&Held<B>, &Rows<B>),
+    (to, at_to): (&Held<B>, &Rows<B>),
 ) -> bool {
     let (a, b) = (at_from.bend, at_to.bend);
-    let turn = angle_between(a.tangent, b.tangent);
-    let moved = to.anchor() - from.anchor();
+    let (anchor, tangent) = match (from.carrier, to.carrier) {
+        (Some(was), Some(now)) => now.carry(&was, from.body.anchor(), a.tangent),
+        _ => (from.body.anchor(), a.tangent),
+    };
+    let turn = angle_between(tangent, b.tangent);
+    let moved = to.body.anchor() - anchor;
     let bend = (a.curvature + b.curvature) * moved.dot(moved).sqrt();
     turn > bend + CORNER_SLACK
 }
 
 /// A wire as a joint holds a body on it, where the wire is at one
 /// instant: the rows it holds, its end, its own direction.
-pub(crate) trait JointWire<B: JointBody> {
+pub(crate) trait JointWire<B: JointBody>: Sized {
+    /// The wire where it is while it rides `carrier` (its place then in
+    /// the carrier's frame, from the carrier's origin); itself where it
+    /// rides nothing.
+    fn carried_by(&self, carrier: Option<&B>) -> Self;
     /// The rows the joint holds at `body`: its anchor on the wire and,
     /// as the joint asks, its orientation turned with it. `None` at a
     /// singular point.
@@ -396,6 +189,25 @@ pub(crate) trait JointWire<B: JointBody> {
     fn to_world(&self, local: B::V) -> B::V;
     /// The wire's characteristic length: tolerances scale with it.
     fn scale(&self) -> f64;
+    /// The rows the joint holds at the bodies `at`, the wire where their
+    /// carrier has it (see [`JointWire::held`]).
+    #[inline]
+    fn held_at(&self, at: &Held<B>) -> Option<Rows<B>> {
+        self.on(at.carrier.as_ref(), |wire| {
+            let mut rows = wire.held(&at.body)?;
+            rows.ride(at);
+            Some(rows)
+        })
+    }
+    /// `f` of the wire where `carrier` has it: of the wire itself, not
+    /// copied, where it rides nothing.
+    #[inline]
+    fn on<T>(&self, carrier: Option<&B>, f: impl FnOnce(&Self) -> T) -> T {
+        match carrier {
+            Some(_) => f(&self.carried_by(carrier)),
+            None => f(self),
+        }
+    }
 }
 
 /// What [`project`] found: the body on its rows, the multipliers that put
@@ -403,12 +215,13 @@ pub(crate) trait JointWire<B: JointBody> {
 /// method met the tolerance.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Projected<B: JointBody> {
-    /// The body moved onto its rows.
-    pub body: B,
+    /// The body (and the carrier) moved onto its rows.
+    pub body: Held<B>,
     /// `λ`, one per row.
     pub lambda: Multipliers,
-    /// The generalized impulse `Gᵀ λ` that moved it (times the substep).
-    pub impulse: (B::V, B::Turn),
+    /// The generalized impulse `Gᵀ λ` that moved it, and the carrier's
+    /// (times the substep).
+    pub impulse: Held<Impulse<B>>,
     /// The rows where the body is, unless that is a singular point.
     pub rows: Option<Rows<B>>,
     /// Whether every row met the tolerance.
@@ -435,14 +248,15 @@ fn largest(r: &Multipliers) -> f64 {
 /// rows of `start`; in space the turn applied to the predicted
 /// orientation), meets its rows `C(q) + α̃ λ = 0` (`rows_at` gives them,
 /// the same rows in the same order; `compliance` is `α̃ = α / h²`), by
-/// Newton's method to `tolerance`. `None` where a row is singular or the
-/// step is not finite.
+/// Newton's method to `tolerance`. Where the wire rides a carrier, the
+/// carrier moves too, by its own part of `Gᵀ λ`. `None` where a row is
+/// singular or the step is not finite.
 pub(crate) fn project<B: JointBody>(
     start: &Rows<B>,
-    predicted: B,
+    predicted: Held<B>,
     compliance: f64,
     tolerance: f64,
-    rows_at: impl Fn(&B) -> Option<Rows<B>>,
+    rows_at: impl Fn(&Held<B>) -> Option<Rows<B>>,
 ) -> Option<Projected<B>> {
     let mut lambda = [0.0; MAX_ROWS];
     let mut body = predicted;
@@ -466,7 +280,7 @@ pub(crate) fn project<B: JointBody>(
         for (l, s) in lambda.iter_mut().zip(step) {
             *l += s;
         }
-        body = predicted.moved(start.impulse(&lambda));
+        body = predicted.moved(start, &lambda);
     }
     let rows = rows_at(&body);
     let converged =
@@ -480,50 +294,62 @@ pub(crate) fn project<B: JointBody>(
     })
 }
 
-/// RATTLE's velocity step: the velocity `v` less the part along the rows'
-/// gradients that moves them against the wire's own motion `frame` (the
-/// velocity the body would have riding rigidly with the wire, along which
-/// every row is unchanged), `v − M⁻¹ Jᵀ (J M⁻¹ Jᵀ)⁻¹ J (v − frame)`; and
-/// the generalized impulse that took it off. `None` where the rows are
-/// singular.
+/// RATTLE's velocity step: the velocities `v` less the part along the
+/// rows' gradients that moves them against the wire's own motion `frame`
+/// (the velocity the body would have riding rigidly with a wire that
+/// moves as the game moves it, along which every row is unchanged; zero
+/// for a wire that rides a carrier, whose velocity is in `v`),
+/// `v − M⁻¹ Jᵀ (J M⁻¹ Jᵀ)⁻¹ J (v − frame)`; and the generalized impulses
+/// that took it off. `None` where the rows are singular.
 pub(crate) fn project_velocity<B: JointBody>(
     rows: &Rows<B>,
-    body: &B,
-    v: BodyVelocity<B>,
+    bodies: &Held<B>,
+    v: Held<BodyVelocity<B>>,
     frame: BodyVelocity<B>,
-) -> Option<(BodyVelocity<B>, (B::V, B::Turn))> {
+) -> Option<(Held<BodyVelocity<B>>, Held<Impulse<B>>)> {
     if rows.len() == 0 {
-        return Some((v, (B::V::ZERO, B::Turn::default())));
+        return Some((v, rows.impulse(&[0.0; MAX_ROWS])));
     }
-    let (now, riding) = (rows.rates(v), rows.rates(frame));
+    let (now, riding) = (rows.rates(&v), rows.rates(&Held::alone(frame)));
     let excess: Multipliers = std::array::from_fn(|i| riding[i] - now[i]);
-    let lambda = solve(rows.matrix(rows, body, 0.0), excess, rows.len())?;
+    let lambda = solve(rows.matrix(rows, bodies, 0.0), excess, rows.len())?;
     let impulse = rows.impulse(&lambda);
-    Some((v.kicked(body, impulse), impulse))
+    Some((v.kicked(bodies, &impulse), impulse))
 }
 
 /// A motor (or friction: a motor holding the anchor where it is on the
 /// wire) as one more row of the position step: the anchor's displacement
 /// over the substep along the wire's direction `direction` where it began
 /// (from `from`) brought to `shift`, by a multiplier of at most `bound`
-/// either way (the force limit times the substep squared).
+/// either way (the force limit times the substep squared). On a wire that
+/// rides a body, `direction` and `from` are fixed to the carrier as it was
+/// where the substep began, and move with it: the displacement is the
+/// anchor's against the wire.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Drive<V> {
+pub(crate) struct Drive<B: JointBody> {
     /// The wire's unit tangent where the substep began, its own way.
-    pub direction: V,
+    pub direction: B::V,
     /// The anchor where the substep began.
-    pub from: V,
+    pub from: B::V,
     /// The displacement along `direction` the drive asks for, m.
     pub shift: f64,
     /// The largest multiplier it gives, `F h²`.
     pub bound: f64,
+    /// The carrier of the wire where the substep began, if any.
+    pub carrier: Option<B>,
 }
 
-impl<V: Coordinates> Drive<V> {
-    /// The drive's row at `body`: `d · (a − from) − shift`.
-    pub fn row<B: JointBody<V = V>>(&self, body: &B) -> BodyRow<B> {
-        let value = self.direction.dot(body.anchor() - self.from) - self.shift;
-        BodyRow::at_anchor(body, value, self.direction)
+impl<B: JointBody> Drive<B> {
+    /// The drive's row at `at`: `d · (a − from) − shift`, `d` and `from`
+    /// carried with the carrier to where it is.
+    pub fn row(&self, at: &Held<B>) -> BodyRow<B> {
+        let (from, direction) = match (self.carrier, at.carrier) {
+            (Some(was), Some(now)) => now.carry(&was, self.from, self.direction),
+            _ => (self.from, self.direction),
+        };
+        let body = &at.body;
+        let value = direction.dot(body.anchor() - from) - self.shift;
+        BodyRow::at_anchor(body, value, direction)
     }
 }
 
@@ -535,12 +361,12 @@ impl<V: Coordinates> Drive<V> {
 /// together) and the drive's multiplier.
 pub(crate) fn project_driven<B: JointBody>(
     start: &Rows<B>,
-    previous: &B,
-    drive: &Drive<B::V>,
-    predicted: B,
+    previous: &Held<B>,
+    drive: &Drive<B>,
+    predicted: Held<B>,
     compliance: f64,
     tolerance: f64,
-    rows_at: impl Fn(&B) -> Option<Rows<B>>,
+    rows_at: impl Fn(&Held<B>) -> Option<Rows<B>>,
 ) -> Option<(Projected<B>, f64)> {
     if start.len() >= B::COORDINATES {
         // Held in every coordinate: nothing left to drive.
@@ -562,19 +388,30 @@ pub(crate) fn project_driven<B: JointBody>(
         return Some((together, multiplier));
     }
     let bounded = multiplier.clamp(-drive.bound, drive.bound);
-    let mut alone = Rows::default();
+    // The drive alone, carried to the carrier as the rows are.
+    let mut alone = Rows {
+        carrier: start.carrier,
+        ..Rows::default()
+    };
     alone.push(drive.row(previous));
     let mut lambda = [0.0; MAX_ROWS];
     lambda[0] = bounded;
     let pushing = alone.impulse(&lambda);
     let mut beside = project(
         start,
-        predicted.moved(pushing),
+        predicted.moved(&alone, &lambda),
         compliance,
         tolerance,
         rows_at,
     )?;
-    beside.impulse = (beside.impulse.0 + pushing.0, beside.impulse.1 + pushing.1);
+    let add = |(p, tau): Impulse<B>, (q, sigma): Impulse<B>| (p + q, tau + sigma);
+    beside.impulse = Held {
+        body: add(beside.impulse.body, pushing.body),
+        carrier: match (beside.impulse.carrier, pushing.carrier) {
+            (Some(a), Some(b)) => Some(add(a, b)),
+            (a, _) => a,
+        },
+    };
     Some((beside, bounded))
 }
 

@@ -7,7 +7,7 @@
 use bevy::math::DVec2;
 
 use super::{Bend, BodyRow, BodyVelocity, JointBody, JointWire, Rows};
-use crate::geometry::{ImplicitCurve, Placed};
+use crate::geometry::{ImplicitCurve, Placed, Pose};
 
 /// A rigid body in the plane as the joint sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,6 +61,11 @@ impl JointBody for PlaneBody {
             ..*self
         }
     }
+
+    fn carry(&self, was: &Self, p: DVec2, d: DVec2) -> (DVec2, DVec2) {
+        let turn = DVec2::from_angle(self.angle - was.angle);
+        (self.centre + turn.rotate(p - was.centre), turn.rotate(d))
+    }
 }
 
 /// A body's velocity in the plane.
@@ -85,6 +90,23 @@ pub(crate) struct PlaneWire<'a, C: ImplicitCurve + ?Sized> {
 }
 
 impl<C: ImplicitCurve + ?Sized> JointWire<PlaneBody> for PlaneWire<'_, C> {
+    fn carried_by(&self, carrier: Option<&PlaneBody>) -> Self {
+        // A carrier's arm is its origin from its centre of mass: its
+        // anchor is its origin.
+        let pose = match carrier {
+            Some(carrier) => Pose::new(carrier.anchor(), carrier.angle).compose(&self.curve.pose),
+            None => self.curve.pose,
+        };
+        Self {
+            curve: Placed {
+                curve: self.curve.curve,
+                pose,
+            },
+            turned: self.turned,
+            travel: self.travel,
+        }
+    }
+
     fn held(&self, body: &PlaneBody) -> Option<Rows<PlaneBody>> {
         held(&self.curve, body, self.turned)
     }

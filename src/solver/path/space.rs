@@ -79,6 +79,11 @@ impl JointBody for SpaceBody {
             ..*self
         }
     }
+
+    fn carry(&self, was: &Self, p: DVec3, d: DVec3) -> (DVec3, DVec3) {
+        let turn = self.rotation * was.rotation.inverse();
+        (self.centre + turn * (p - was.centre), turn * d)
+    }
 }
 
 /// How a body held on a curve in space turns with it.
@@ -123,6 +128,7 @@ impl Alignment {
 
 /// A wire in space as a joint holds a body on it, where the wire is at
 /// one instant.
+#[derive(Clone, Copy)]
 pub(crate) struct SpaceWireAt<'a> {
     /// The wire's shape, local frame.
     pub shape: &'a SpaceShape,
@@ -226,6 +232,20 @@ impl SpaceWireAt<'_> {
 }
 
 impl JointWire<SpaceBody> for SpaceWireAt<'_> {
+    fn carried_by(&self, carrier: Option<&SpaceBody>) -> Self {
+        // A carrier's arm is its origin from its centre of mass: its
+        // anchor is its origin.
+        let pose = match carrier {
+            Some(carrier) => Pose3 {
+                origin: carrier.anchor(),
+                rotation: carrier.rotation,
+            }
+            .compose(&self.pose),
+            None => self.pose,
+        };
+        Self { pose, ..*self }
+    }
+
     fn held(&self, body: &SpaceBody) -> Option<Rows<SpaceBody>> {
         let local = self.pose.to_local(body.anchor());
         // The curve's two rows, or the surface's one.

@@ -9,8 +9,8 @@ use bevy::math::DVec2;
 use bevy::reflect::Reflect;
 
 use super::{
-    BodyRow, BodyVelocity, Drive, JointBody, JointWire, Projected, Rows, Turn, project,
-    project_driven, project_velocity, turns_a_corner,
+    BodyRow, BodyVelocity, Drive, Held, Impulse, JointBody, JointWire, Projected, Rows, Turn,
+    project, project_driven, project_velocity, turns_a_corner,
 };
 use crate::geometry::Coordinates;
 use crate::lane::Vector;
@@ -89,10 +89,10 @@ impl<V> Law<V> {
 pub(crate) struct JointState<B: JointBody, T> {
     /// The time the step began at, and how far into it the substeps are.
     pub time: (f64, f64),
-    /// The body where the step began.
-    pub start: B,
-    /// The body where the substep began.
-    pub previous: B,
+    /// The body (and the carrier of its wire) where the step began.
+    pub start: Held<B>,
+    /// The body (and the carrier) where the substep began.
+    pub previous: Held<B>,
     /// How the body turns with the wire, once fixed.
     pub turn: Option<T>,
     /// The wire's parameter at the anchor: its branch where it crosses
@@ -114,8 +114,8 @@ impl<B: JointBody, T> JointState<B, T> {
     pub fn new(body: B) -> Self {
         Self {
             time: (0.0, 0.0),
-            start: body,
-            previous: body,
+            start: Held::alone(body),
+            previous: Held::alone(body),
             turn: None,
             hint: f64::NAN,
             warned: false,
@@ -124,8 +124,9 @@ impl<B: JointBody, T> JointState<B, T> {
         }
     }
 
-    /// The step begins with the body at `body`, at time `time`.
-    pub fn begin(&mut self, body: B, time: f64) {
+    /// The step begins with the body (and the carrier) at `body`, at time
+    /// `time`.
+    pub fn begin(&mut self, body: Held<B>, time: f64) {
         self.start = body;
         self.previous = body;
         self.time = (time, 0.0);
@@ -151,21 +152,22 @@ impl<B: JointBody, T> JointState<B, T> {
 }
 
 /// One substep of a joint: the wire where the substep begins and where
-/// it ends, the body where it began and where the engine moved it, its
-/// velocity and the wire's where it began.
+/// it ends (in its carrier's frame, where it rides one), the body (and the
+/// carrier) where it began and where the engine moved it, its velocity
+/// and the wire's where it began.
 pub(crate) struct Substep<'w, B: JointBody, W> {
     /// The wire where the substep begins.
     pub before: &'w W,
     /// The wire where it ends.
     pub after: &'w W,
-    /// The body where it began.
-    pub previous: B,
-    /// The body as the engine moved it, freely.
-    pub predicted: B,
+    /// The body (and the carrier) where it began.
+    pub previous: Held<B>,
+    /// The body (and the carrier) as the engine moved it, freely.
+    pub predicted: Held<B>,
     /// The body's velocity.
     pub v: BodyVelocity<B>,
     /// The velocity the body would have riding rigidly with the wire,
-    /// where the substep began.
+    /// where the substep began (with its carrier, where it rides one).
     pub frame: BodyVelocity<B>,
     /// The substep, s.
     pub h: f64,
@@ -182,15 +184,21 @@ impl<B: JointBody, W: JointWire<B>> Substep<'_, B, W> {
     /// singular at the body.
     pub fn correct(&self, law: &Law<B::V>) -> Option<(Projected<B>, f64)> {
         let (before, after) = (self.before, self.after);
+        let predicted = &self.predicted;
         let end = after
-            .past_end(&self.predicted)
+            .on(predicted.carrier.as_ref(), |wire| {
+                wire.past_end(&predicted.body)
+            })
             .is_some_and(|row| row.value > 0.0);
-        let with_end = |wire: &W, b: &B| {
-            let mut rows = wire.held(b)?;
-            if end {
-                rows.push(wire.past_end(b)?);
-            }
-            Some(rows)
+        let with_end = |wire: &W, at: &Held<B>| {
+            wire.on(at.carrier.as_ref(), |wire| {
+                let mut rows = wire.held(&at.body)?;
+                if end {
+                    rows.push(wire.past_end(&at.body)?);
+                }
+                rows.ride(at);
+                Some(rows)
+            })
         };
         let start = match self.start {
             Some(rows) if !end => rows,
@@ -198,10 +206,10 @@ impl<B: JointBody, W: JointWire<B>> Substep<'_, B, W> {
         };
         let tolerance = 1e-12 * after.scale().max(1.0);
         let compliance = law.compliance / (self.h * self.h);
-        let rows_at = |b: &B| with_end(after, b);
+        let rows_at = |at: &Held<B>| with_end(after, at);
         // At an end the buffer holds the anchor, whatever drives it.
         let drive = if end { None } else { self.drive(law) };
-        let put_back = |start: &Rows<B>, from: &B| match drive {
+        let put_back = |start: &Rows<B>, from: &Held<B>| match drive {
             Some(drive) => project_driven(
                 start,
                 from,
@@ -232,75 +240,93 @@ impl<B: JointBody, W: JointWire<B>> Substep<'_, B, W> {
     /// The joint's motor, or its friction while no motor drives it, as a
     /// displacement along the wire and a bound; `None` for a joint that
     /// neither drives nor holds.
-    fn drive(&self, law: &Law<B::V>) -> Option<Drive<B::V>> {
+    fn drive(&self, law: &Law<B::V>) -> Option<Drive<B>> {
         // A joint that neither drives nor holds costs no evaluation of
         // the wire.
         if law.motor.is_none() && law.friction <= 0.0 {
             return None;
         }
-        let previous = &self.previous;
-        let along = self.before.along(previous)?;
-        let relative = along.rate(self.v) - along.rate(self.frame);
-        let (speed, max_force) = match law.motor {
-            Some(PathMotor::Velocity { speed, max_force }) => (speed, max_force),
-            Some(PathMotor::Position {
-                target,
-                frequency,
-                damping_ratio,
-                max_force,
-            }) => {
-                // The spring–damper's implicit step, as avian's motors take it.
-                let error = along
-                    .along_centre
-                    .dot(self.before.to_world(target) - previous.anchor());
-                let omega = std::f64::consts::TAU * frequency;
-                let damping = 2.0 * damping_ratio * omega;
-                let h = self.h;
-                let change = (omega * omega * error - damping * relative) * h
-                    / (1.0 + damping * h + omega * omega * h * h);
-                (relative + change, max_force)
-            }
-            None => (0.0, law.friction),
-        };
-        let (speed, max_force) = (speed + along.rate(self.frame), max_force.max(0.0));
-        (speed.is_finite() && !max_force.is_nan()).then(|| Drive {
-            direction: along.along_centre,
-            from: previous.anchor(),
-            shift: speed * self.h,
-            bound: max_force * self.h * self.h,
+        self.before.on(self.previous.carrier.as_ref(), |before| {
+            let previous = &self.previous.body;
+            let along = before.along(previous)?;
+            let relative = along.rate(self.v) - along.rate(self.frame);
+            let (speed, max_force) = match law.motor {
+                Some(PathMotor::Velocity { speed, max_force }) => (speed, max_force),
+                Some(PathMotor::Position {
+                    target,
+                    frequency,
+                    damping_ratio,
+                    max_force,
+                }) => {
+                    // The spring–damper's implicit step, as avian's motors take it.
+                    let error = along
+                        .along_centre
+                        .dot(before.to_world(target) - previous.anchor());
+                    let omega = std::f64::consts::TAU * frequency;
+                    let damping = 2.0 * damping_ratio * omega;
+                    let h = self.h;
+                    let change = (omega * omega * error - damping * relative) * h
+                        / (1.0 + damping * h + omega * omega * h * h);
+                    (relative + change, max_force)
+                }
+                None => (0.0, law.friction),
+            };
+            // Along a wire the game moves the anchor goes with the wire too; on
+            // a wire that rides a body the drive moves with the carrier.
+            let carried = self.previous.carrier;
+            let riding = if carried.is_some() {
+                0.0
+            } else {
+                along.rate(self.frame)
+            };
+            let (speed, max_force) = (speed + riding, max_force.max(0.0));
+            (speed.is_finite() && !max_force.is_nan()).then(|| Drive {
+                direction: along.along_centre,
+                from: previous.anchor(),
+                shift: speed * self.h,
+                bound: max_force * self.h * self.h,
+                carrier: carried,
+            })
         })
     }
 }
 
-/// What RATTLE's velocity step left: the body's velocity, the
-/// generalized impulse that gave it, and the rows held where the body is
-/// (for the next substep to begin from).
-pub(crate) type OnWire<B> = (
-    BodyVelocity<B>,
-    (<B as JointBody>::V, <B as JointBody>::Turn),
-    Option<Rows<B>>,
-);
+/// What RATTLE's velocity step left: the velocities of the body (and
+/// the carrier), the generalized impulses that gave them, and the rows
+/// held where the body is (for the next substep to begin from).
+pub(crate) type OnWire<B> = (Held<BodyVelocity<B>>, Held<Impulse<B>>, Option<Rows<B>>);
 
-/// RATTLE's velocity step: the velocity a joint leaves its body with, on
-/// its rows where the substep ends (a compliant joint, met in position
-/// only, keeps its velocity), stopped at an end of an open wire it would
-/// pass; the generalized impulse that did it; and the rows it held.
-/// `None` where the rows are singular.
+/// RATTLE's velocity step: the velocity a joint leaves its body (and the
+/// carrier of its wire) with, on its rows where the substep ends (a
+/// compliant joint, met in position only, keeps its velocity), stopped
+/// at an end of an open wire it would pass; the generalized impulses that
+/// did it; and the rows it held. `frame` is the velocity riding rigidly
+/// with a wire the game moves (zero for one that rides a carrier). `None`
+/// where the rows are singular.
 pub(crate) fn velocity_on_wire<B: JointBody>(
     rigid: bool,
     wire: &impl JointWire<B>,
-    body: &B,
-    v: BodyVelocity<B>,
+    bodies: &Held<B>,
+    v: Held<BodyVelocity<B>>,
     frame: BodyVelocity<B>,
 ) -> Option<OnWire<B>> {
-    let held = if rigid { Some(wire.held(body)?) } else { None };
+    let held = if rigid {
+        Some(wire.held_at(bodies)?)
+    } else {
+        None
+    };
+    let body = &bodies.body;
     let mut rows = held.unwrap_or_default();
-    if let Some(end) = wire.past_end(body)
-        && end.value > -1e-9 * wire.scale()
-        && end.rate(v) > end.rate(frame)
+    rows.ride(bodies);
+    let end = wire.on(bodies.carrier.as_ref(), |wire| {
+        wire.past_end(body)
+            .filter(|end| end.value > -1e-9 * wire.scale())
+    });
+    if let Some(end) = end
+        && end.rate_of(rows.carrier, &v) > end.rate(frame)
     {
         rows.push(BodyRow { value: 0.0, ..end });
     }
-    let (v, impulse) = project_velocity(&rows, body, v, frame)?;
+    let (v, impulse) = project_velocity(&rows, bodies, v, frame)?;
     Some((v, impulse, held))
 }

@@ -1,6 +1,7 @@
 use super::*;
 use crate::geometry::{
-    Circle, Ellipse, Helix, Line, Pose3, SpaceShape, Spline, SplineKind, SplineSpec,
+    Circle, Ellipse, Helix, ImplicitCurve, Line, Placed, Pose, Pose3, SpaceShape, Spline,
+    SplineKind, SplineSpec,
 };
 use bevy::math::{DMat3, DQuat, DVec2, DVec3};
 
@@ -38,28 +39,31 @@ fn rows_have_the_gradients_of_their_values() {
         [&|b| on_curve(&curve, b).expect("a row"), &|b| {
             turned_with_curve(&curve, b, 0.3).expect("a row")
         }];
-    let e = 1e-6;
     for row in rows {
         let exact = row(&at(centre, angle));
-        for axis in [DVec2::X, DVec2::Y] {
-            let plus = row(&at(centre + e * axis, angle)).value;
-            let minus = row(&at(centre - e * axis, angle)).value;
-            let numeric = (plus - minus) / (2.0 * e);
-            assert!(
-                (numeric - exact.along_centre.dot(axis)).abs() <= 1e-7,
-                "∂C/∂c along {axis}: {numeric} against {}",
-                exact.along_centre.dot(axis)
-            );
-        }
-        let plus = row(&at(centre, angle + e)).value;
-        let minus = row(&at(centre, angle - e)).value;
-        let numeric = (plus - minus) / (2.0 * e);
+        assert_plane_gradient(&exact, |dc, da| row(&at(centre + dc, angle + da)).value);
+    }
+}
+
+/// Asserts that central differences of `value` (a row's value with the
+/// body's centre moved by `dc` and its angle by `da`) agree with `row`'s
+/// gradient to 1e-7, along each axis and the angle.
+fn assert_plane_gradient(row: &BodyRow<PlaneBody>, value: impl Fn(DVec2, f64) -> f64) {
+    let e = 1e-6;
+    for axis in [DVec2::X, DVec2::Y] {
+        let numeric = (value(e * axis, 0.0) - value(-e * axis, 0.0)) / (2.0 * e);
+        let exact = row.along_centre.dot(axis);
         assert!(
-            (numeric - exact.along_angle).abs() <= 1e-7,
-            "∂C/∂θ: {numeric} against {}",
-            exact.along_angle
+            (numeric - exact).abs() <= 1e-7,
+            "∂C/∂c along {axis}: {numeric} against {exact}"
         );
     }
+    let numeric = (value(DVec2::ZERO, e) - value(DVec2::ZERO, -e)) / (2.0 * e);
+    assert!(
+        (numeric - row.along_angle).abs() <= 1e-7,
+        "∂C/∂θ: {numeric} against {}",
+        row.along_angle
+    );
 }
 
 /// SHAKE's step: a body off a unit circle, its anchor off its centre, is
@@ -78,21 +82,22 @@ fn a_projection_puts_the_anchor_on_the_curve_along_the_start_gradient() {
         angle: 0.02,
         ..start
     };
-    let projected = project(&start_rows, predicted, 0.0, 1e-15, |b| {
-        Some(rows_of(&[on_curve(&curve, b)?]))
+    let projected = project(&start_rows, Held::alone(predicted), 0.0, 1e-15, |b| {
+        Some(rows_of(&[on_curve(&curve, &b.body)?]))
     })
     .expect("a projection");
     assert!(projected.converged);
-    let off = (projected.body.anchor().length() - 1.0).abs();
+    let projected_body = projected.body.body;
+    let off = (projected_body.anchor().length() - 1.0).abs();
     assert!(off <= 1e-14, "the anchor is {off:e} m off the circle");
     let g = start_rows.iter().next().expect("a row");
-    let moved = projected.body.centre - predicted.centre;
+    let moved = projected_body.centre - predicted.centre;
     let expected = g.along_centre * start.inverse_mass * projected.lambda[0];
     assert!(
         (moved - expected).length() <= 1e-15,
         "{moved} against {expected}"
     );
-    let turned = projected.body.angle - predicted.angle;
+    let turned = projected_body.angle - predicted.angle;
     let expected = g.along_angle * start.inverse_inertia * projected.lambda[0];
     assert!((turned - expected).abs() <= 1e-15);
 }
@@ -106,11 +111,15 @@ fn a_compliant_projection_yields_by_its_multiplier() {
     let start_rows = rows_of(&[on_curve(&curve, &start).expect("a row")]);
     let predicted = body(DVec2::new(0.3, -0.1), 0.0, DVec2::ZERO);
     let compliance = 2.0;
-    let projected = project(&start_rows, predicted, compliance, 1e-15, |b| {
-        Some(rows_of(&[on_curve(&curve, b)?]))
-    })
+    let projected = project(
+        &start_rows,
+        Held::alone(predicted),
+        compliance,
+        1e-15,
+        |b| Some(rows_of(&[on_curve(&curve, &b.body)?])),
+    )
     .expect("a projection");
-    let c = projected.body.centre.y;
+    let c = projected.body.body.centre.y;
     assert!((c + compliance * projected.lambda[0]).abs() <= 1e-15);
     // w = 1/2, so C = −0.1 + λ/2 = −2λ: λ = 0.04, C = −0.08.
     assert!((c + 0.08).abs() <= 1e-15, "the row holds at {c}");
@@ -132,8 +141,14 @@ fn a_velocity_projection_takes_off_the_normal_part() {
     let energy = |v: PlaneVelocity| {
         0.5 * (v.linear.length_squared() / 0.5 + v.spin * v.spin / b.inverse_inertia)
     };
-    let (after, _) =
-        project_velocity(&rows, &b, v, PlaneVelocity::default()).expect("a projection");
+    let (after, _) = project_velocity(
+        &rows,
+        &Held::alone(b),
+        Held::alone(v),
+        PlaneVelocity::default(),
+    )
+    .expect("a projection");
+    let after = after.body;
     let rate = rows.iter().next().expect("a row").rate(after);
     assert!(
         rate.abs() <= 1e-15,
@@ -160,19 +175,20 @@ fn a_drive_moves_by_its_shift_or_gives_its_bound() {
         from: previous.anchor(),
         shift: 0.3,
         bound,
+        carrier: None,
     };
-    let rows_at = |b: &PlaneBody| Some(rows_of(&[on_curve(&curve, b)?]));
+    let rows_at = |b: &Held<PlaneBody>| Some(rows_of(&[on_curve(&curve, &b.body)?]));
     let (free, multiplier) = project_driven(
         &start,
-        &previous,
+        &Held::alone(previous),
         &drive(1.0),
-        predicted,
+        Held::alone(predicted),
         0.0,
         1e-15,
         rows_at,
     )
     .expect("a projection");
-    assert!((free.body.centre - DVec2::new(0.3, 0.0)).length() <= 1e-15);
+    assert!((free.body.body.centre - DVec2::new(0.3, 0.0)).length() <= 1e-15);
     // The body moved 0.2 m along at 1/m = 1/2: λ = 0.4.
     assert!(
         (multiplier - 0.4).abs() <= 1e-15,
@@ -180,16 +196,16 @@ fn a_drive_moves_by_its_shift_or_gives_its_bound() {
     );
     let (bounded, multiplier) = project_driven(
         &start,
-        &previous,
+        &Held::alone(previous),
         &drive(0.1),
-        predicted,
+        Held::alone(predicted),
         0.0,
         1e-15,
         rows_at,
     )
     .expect("a projection");
     assert_eq!(multiplier, 0.1);
-    assert!((bounded.body.centre - DVec2::new(0.15, 0.0)).length() <= 1e-15);
+    assert!((bounded.body.body.centre - DVec2::new(0.15, 0.0)).length() <= 1e-15);
 }
 
 /// Past the end of an open curve the end row is positive and points out:
@@ -244,6 +260,69 @@ fn space_body(centre: DVec3, rotation: DQuat, arm: DVec3) -> SpaceBody {
     }
 }
 
+/// No rotation held, and each of the modes.
+const EVERY_TURN: [Option<SpaceTurn>; 6] = [
+    None,
+    Some(SpaceTurn::AroundTangent),
+    Some(SpaceTurn::AroundNormal),
+    Some(SpaceTurn::AroundBinormal),
+    Some(SpaceTurn::ToPath),
+    Some(SpaceTurn::Fixed),
+];
+
+/// A helix of radius 1.5 m and pitch 2 m, and a pose turning it off every
+/// axis.
+fn helix_on_a_slant() -> (SpaceShape, Pose3) {
+    let helix = SpaceShape::curve(Helix {
+        radius: 1.5,
+        pitch: 2.0,
+    });
+    let pose = Pose3::from_axis_angle(DVec3::new(0.1, -0.2, 0.3), DVec3::new(1.0, 2.0, 0.5), 0.7)
+        .expect("a pose");
+    (helix, pose)
+}
+
+/// The point of [`helix_on_a_slant`]'s helix at 0.9 rad, placed by `pose`.
+fn on_the_helix(pose: &Pose3) -> DVec3 {
+    let theta: f64 = 0.9;
+    pose.to_world(DVec3::new(
+        1.5 * theta.cos(),
+        2.0 * theta / std::f64::consts::TAU,
+        1.5 * theta.sin(),
+    ))
+}
+
+/// `shape` at `pose` (on `carrier`, if any) holding `start` turned as
+/// `turn` says, its alignment 0.2 rad about y from the frame where it is,
+/// so the rows are not zero.
+fn turned_off_its_frame<'a>(
+    shape: &'a SpaceShape,
+    pose: Pose3,
+    turn: Option<SpaceTurn>,
+    start: &SpaceBody,
+    carrier: Option<&SpaceBody>,
+) -> SpaceWireAt<'a> {
+    let wire = SpaceWireAt {
+        shape,
+        pose,
+        hint: f64::NAN,
+        alignment: None,
+    };
+    let frame = |turn| {
+        wire.carried_by(carrier)
+            .frame(start, turn)
+            .expect("a frame")
+    };
+    SpaceWireAt {
+        alignment: turn.map(|turn| Alignment {
+            turn,
+            axes: (start.rotation.inverse() * frame(turn) * DQuat::from_rotation_y(0.2))
+                .normalize(),
+        }),
+        ..wire
+    }
+}
+
 /// The rows in space have the gradients of their values where the anchor
 /// is on the curve: central differences over the centre (the anchor
 /// moving with it) and over a turn of the body about each world axis
@@ -252,70 +331,50 @@ fn space_body(centre: DVec3, rotation: DQuat, arm: DVec3) -> SpaceBody {
 /// (whose gradients carry the frame's turn along the curve).
 #[test]
 fn space_rows_have_the_gradients_of_their_values() {
-    let helix = SpaceShape::curve(Helix {
-        radius: 1.5,
-        pitch: 2.0,
-    });
-    let pose = Pose3::from_axis_angle(DVec3::new(0.1, -0.2, 0.3), DVec3::new(1.0, 2.0, 0.5), 0.7)
-        .expect("a pose");
-    let theta: f64 = 0.9;
-    let on = pose.to_world(DVec3::new(
-        1.5 * theta.cos(),
-        2.0 * theta / std::f64::consts::TAU,
-        1.5 * theta.sin(),
-    ));
+    let (helix, pose) = helix_on_a_slant();
     let arm = DVec3::new(0.2, -0.3, 0.1);
     let rotation = DQuat::from_euler(bevy::math::EulerRot::XYZ, 0.3, -0.5, 1.1);
     let at = |centre: DVec3, rotation: DQuat| space_body(centre, rotation, arm);
-    let centre = on - rotation * arm;
+    let centre = on_the_helix(&pose) - rotation * arm;
     let start = at(centre, rotation);
-    for turn in [
-        None,
-        Some(SpaceTurn::AroundTangent),
-        Some(SpaceTurn::AroundNormal),
-        Some(SpaceTurn::AroundBinormal),
-        Some(SpaceTurn::ToPath),
-        Some(SpaceTurn::Fixed),
-    ] {
-        let mut wire = SpaceWireAt {
-            shape: &helix,
-            pose,
-            hint: f64::NAN,
-            alignment: None,
-        };
-        // Turned from where the joint began, so the rows are not zero.
-        wire.alignment = turn.map(|turn| Alignment {
-            turn,
-            axes: (rotation.inverse()
-                * wire.frame(&start, turn).expect("a frame")
-                * DQuat::from_rotation_y(0.2))
-            .normalize(),
-        });
+    for turn in EVERY_TURN {
+        let wire = turned_off_its_frame(&helix, pose, turn, &start, None);
         let rows = wire.held(&start).expect("rows");
         let value = |b: &SpaceBody, i: usize| wire.held(b).expect("rows").rows[i].value;
-        let e = 1e-6;
         for (i, row) in rows.iter().enumerate() {
-            for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
-                let numeric = (value(&at(centre + e * axis, rotation), i)
-                    - value(&at(centre - e * axis, rotation), i))
-                    / (2.0 * e);
-                let exact = row.along_centre.dot(axis);
-                assert!(
-                    (numeric - exact).abs() <= 1e-6,
-                    "{turn:?}, row {i}: ∂C/∂c along {axis}: {numeric} against {exact}"
-                );
-                let turned = |s: f64| {
-                    let q = DQuat::from_scaled_axis(s * e * axis) * rotation;
-                    value(&at(centre, q), i)
-                };
-                let numeric = (turned(1.0) - turned(-1.0)) / (2.0 * e);
-                let exact = row.along_angle.dot(axis);
-                assert!(
-                    (numeric - exact).abs() <= 1e-6,
-                    "{turn:?}, row {i}: ∂C/∂θ about {axis}: {numeric} against {exact}"
-                );
-            }
+            assert_space_gradient(row, &format!("{turn:?}, row {i}"), |dc, turn| {
+                value(
+                    &at(centre + dc, DQuat::from_scaled_axis(turn) * rotation),
+                    i,
+                )
+            });
         }
+    }
+}
+
+/// Asserts that central differences of `value` (a row's value with the
+/// body's centre moved by `dc` and the body turned by the world rotation
+/// vector `turn`, on the left) agree with `row`'s gradient to 1e-6, along
+/// and about each axis; `what` names the row.
+fn assert_space_gradient(
+    row: &BodyRow<SpaceBody>,
+    what: &str,
+    value: impl Fn(DVec3, DVec3) -> f64,
+) {
+    let e = 1e-6;
+    for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+        let numeric = (value(e * axis, DVec3::ZERO) - value(-e * axis, DVec3::ZERO)) / (2.0 * e);
+        let exact = row.along_centre.dot(axis);
+        assert!(
+            (numeric - exact).abs() <= 1e-6,
+            "{what}: ∂C/∂c along {axis}: {numeric} against {exact}"
+        );
+        let numeric = (value(DVec3::ZERO, e * axis) - value(DVec3::ZERO, -e * axis)) / (2.0 * e);
+        let exact = row.along_angle.dot(axis);
+        assert!(
+            (numeric - exact).abs() <= 1e-6,
+            "{what}: ∂C/∂θ about {axis}: {numeric} against {exact}"
+        );
     }
 }
 
@@ -347,17 +406,23 @@ fn a_projection_in_space_meets_every_row() {
     assert_eq!(rows.len(), 5);
     assert!(rows.iter().all(|r| r.value.abs() <= 1e-12));
     let predicted = start.displaced(DVec3::new(0.02, 0.05, -0.03), DVec3::new(0.01, -0.02, 0.03));
-    let projected = project(&rows, predicted, 0.0, 1e-12, |b| wire.held(b)).expect("a projection");
+    let projected = project(&rows, Held::alone(predicted), 0.0, 1e-12, |b| {
+        wire.held(&b.body)
+    })
+    .expect("a projection");
     assert!(projected.converged);
-    let after = wire.held(&projected.body).expect("rows");
+    let moved_body = projected.body.body;
+    let after = wire.held(&moved_body).expect("rows");
     let worst = after.iter().fold(0.0f64, |m, r| m.max(r.value.abs()));
     assert!(worst <= 1e-12, "a row is {worst:e} off");
     // Moved along the start gradients: Δc = M⁻¹ Gᵀ λ.
-    let (p, _) = rows.impulse(&projected.lambda);
-    let moved = projected.body.centre - predicted.centre;
+    let (p, _) = rows.impulse(&projected.lambda).body;
+    let moved = moved_body.centre - predicted.centre;
     assert!(
         (moved - 0.5 * p).length() <= 1e-14,
         "{moved} against {}",
         0.5 * p
     );
 }
+
+mod carried;
