@@ -6,6 +6,9 @@
 use bevy::ecs::component::Mutable;
 use bevy::prelude::*;
 
+use crate::dynamics::{Diverged, DivergenceReason, WireBeads, WireOnBody};
+use crate::plugin::{Divergences, SimClock, WireBeadSystems};
+
 /// A joint's body in the substep's solver (`S` avian's solver body, `I`
 /// its inertia), and its carrier's where the carrier has one.
 pub(crate) type Solved<'a, S, I> = ((&'a mut S, &'a I), Option<(&'a mut S, &'a I)>);
@@ -41,4 +44,45 @@ pub(crate) fn each_carried<J, T, S, I>(
             solve(joint, &mut state, ((&mut *body, inertia), None));
         }
     }
+}
+
+/// Stops each bead of ours on a wire that rides a body, before the step,
+/// and says why in one line: a wire that rides a body is placed in the
+/// body's frame, which our beads do not follow yet (a path joint's body
+/// does), so stepping the bead would put it on the wire as if its place
+/// were in the world. The bead is [`Diverged`] with
+/// [`DivergenceReason::InvalidWire`] until a restart, as a bead on a wire
+/// that cannot be placed is.
+fn stop_beads_on_carried_wires(
+    wires: Query<(Entity, &WireOnBody, &WireBeads)>,
+    stopped: Query<(), With<Diverged>>,
+    clock: Res<SimClock>,
+    mut divergences: Divergences,
+) {
+    for (wire, on, beads) in &wires {
+        for bead in beads.iter().filter(|&bead| !stopped.contains(bead)) {
+            let why = format!(
+                "wire {wire} rides body {}, which beads do not ride yet (a PathJoint's body does)",
+                on.0
+            );
+            divergences.report(bead, DivergenceReason::InvalidWire(why), clock.time);
+        }
+    }
+}
+
+/// Whether [`stop_beads_on_carried_wires`] is scheduled: either avian
+/// plugin schedules it, once.
+#[derive(Resource)]
+struct CarriedWiresWatched;
+
+/// Schedules what both avian plugins share, once however many of them
+/// the game adds.
+pub(crate) fn share(app: &mut App) {
+    if app.world().contains_resource::<CarriedWiresWatched>() {
+        return;
+    }
+    app.insert_resource(CarriedWiresWatched).add_systems(
+        FixedUpdate,
+        stop_beads_on_carried_wires.in_set(WireBeadSystems::Prepare),
+    );
 }

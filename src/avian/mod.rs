@@ -106,6 +106,7 @@ pub struct PathJointPlugin;
 
 impl Plugin for PathJointPlugin {
     fn build(&self, app: &mut App) {
+        crate::carrier::share(app);
         app.register_type::<PathJoint>()
             .register_type::<PathJointForces>()
             .register_type::<WireOnBody>()

@@ -110,6 +110,7 @@ pub struct PathJointPlugin;
 
 impl Plugin for PathJointPlugin {
     fn build(&self, app: &mut App) {
+        crate::carrier::share(app);
         app.register_type::<PathJoint>()
             .register_type::<PathJointForces>()
             .register_type::<WireOnBody>()

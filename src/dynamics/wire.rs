@@ -395,7 +395,9 @@ pub struct WireBeads(Vec<Entity>);
 /// the body's own motion counts in the wire's velocity (put a moving
 /// track on a body of its own). A carrier that is no other rigid body
 /// (or the joint's own body) leaves the wire where its place puts it, in
-/// the world, and the joint says so once in the log. Avian sleeps bodies
+/// the world, and the joint says so once in the log. Beads of ours do not
+/// ride a carried wire yet: one on it is stopped before the step
+/// ([`Diverged`](crate::Diverged), its wire invalid). Avian sleeps bodies
 /// one by one: where one of a carrier and a body held on its wire sleeps
 /// while the other moves, the sleeper is woken.
 #[cfg(any(feature = "avian2d", feature = "avian3d"))]

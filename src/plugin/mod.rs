@@ -40,6 +40,8 @@ pub use forces::SpringAnchorPlugin;
 pub use islands::{IslandPlugin, IslandReport, Islands, PressedPair};
 pub use parallel::{ParallelStep, StepSplit, compute_on_all_cores, use_single_threaded_executors};
 pub use params::ParamsPlugin;
+#[cfg(any(feature = "avian2d", feature = "avian3d"))]
+pub(crate) use report::Divergences;
 pub use restart::{Restart, RestartPlugin};
 pub use schedule::WireBeadSystems;
 pub use step::BeadStepPlugin;

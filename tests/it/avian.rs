@@ -6,13 +6,13 @@ use avian2d::prelude::*;
 use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
-use wirebead::Integrator;
 use wirebead::avian::{
     PathJoint, PathJointForces, PathJointPlugin, PathMotor, PathRotation, WireOnBody,
 };
 use wirebead::geometry::{ImplicitCurve, Spline, SplineKind, SplineSpec, WireShape};
 use wirebead::prelude::*;
 use wirebead::reference::{bead_on_a_free_hoop, pendulum_period};
+use wirebead::{DivergenceReason, Integrator};
 
 const G: f64 = 9.81;
 const DT: f64 = 1.0 / 60.0;
@@ -973,4 +973,39 @@ fn a_motor_on_a_carried_hoop_drives_the_body_against_its_carrier() {
         worst_l <= 1e-4,
         "the pair's angular momentum reached {worst_l:e}"
     );
+}
+
+/// A bead of ours on a wire that rides a body is stopped before the step
+/// and said to be on an invalid wire (beads do not ride bodies yet): it
+/// stays where it was put, and a restart stops it again.
+#[test]
+fn a_bead_on_a_carried_wire_is_stopped_and_says_why() {
+    let mut app = physics_app(SUBSTEPS);
+    let (carrier, hoop, _) = hoop_on_a_free_body(
+        &mut app,
+        DVec2::ZERO,
+        DVec2::new(0.0, 1.5),
+        PathJoint::new(Entity::PLACEHOLDER),
+    );
+    let start = DVec2::new(0.6, -0.8);
+    let bead = app
+        .world_mut()
+        .spawn((Bead::at_rest(1.0, start).expect("a bead"), OnWire(hoop)))
+        .id();
+    for _ in 0..3 {
+        app.update();
+    }
+    let world = app.world();
+    let diverged = world.get::<Diverged>(bead).expect("the bead is stopped");
+    let said = diverged.reason.to_string();
+    assert!(
+        matches!(diverged.reason, DivergenceReason::InvalidWire(_))
+            && said.contains(&format!("rides body {carrier}")),
+        "{said}"
+    );
+    let at = world.get::<BeadPosition>(bead).expect("a bead").0;
+    assert_eq!(at, start, "the stopped bead moved to {at}");
+    app.world_mut().write_message(Restart);
+    app.update();
+    assert!(app.world().get::<Diverged>(bead).is_some());
 }
