@@ -380,13 +380,8 @@ fn solve_path_joint(
     // The velocity the body would have riding rigidly with the wire:
     // with its carrier, or as the game moves it.
     let frame = match previous.carrier {
-        Some(carrier) => {
-            let v = velocity_of(carrier_solver.map(|(b, _)| b));
-            PlaneVelocity {
-                linear: v.linear + perp(previous.body.centre - carrier.centre) * v.spin,
-                spin: v.spin,
-            }
-        }
+        Some(carrier) => velocity_of(carrier_solver.map(|(b, _)| b))
+            .carried_to(carrier.centre, previous.body.centre),
         None => {
             let (_, twist) = path.at(now - h);
             PlaneVelocity {
@@ -426,12 +421,6 @@ fn solve_path_joint(
         carrier.delta_position += (moved.centre - predicted.centre).adjust_precision();
         carrier.delta_rotation = Rotation::radians((moved.angle - start.angle).adjust_precision());
     }
-}
-
-/// `v` turned a quarter counter-clockwise: `ω × r` for `ω` one radian a
-/// second.
-fn perp(v: DVec2) -> DVec2 {
-    DVec2::new(-v.y, v.x)
 }
 
 /// RATTLE's velocity step for each joint on a wire that rides no body,

@@ -412,13 +412,8 @@ fn solve_path_joint(
     // The velocity the body would have riding rigidly with the wire:
     // with its carrier, or as the game moves it.
     let frame = match previous.carrier {
-        Some(carrier) => {
-            let v = velocity_of(carrier_solver.map(|(b, _)| b));
-            BodyVelocity {
-                linear: v.linear + v.spin.cross(previous.body.centre - carrier.centre),
-                spin: v.spin,
-            }
-        }
+        Some(carrier) => velocity_of(carrier_solver.map(|(b, _)| b))
+            .carried_to(carrier.centre, previous.body.centre),
         None => {
             let (_, twist) = path.at(now - h);
             BodyVelocity {

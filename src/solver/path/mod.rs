@@ -98,7 +98,7 @@ impl Turn for DVec3 {
 /// it, and how hard it is to move ([`PlaneBody`], [`SpaceBody`]).
 pub(crate) trait JointBody: Copy + Debug + PartialEq + Send + Sync {
     /// Its position's coordinates: `DVec2` or `DVec3`.
-    type V: Coordinates;
+    type V: Coordinates<Angular = Self::Turn>;
     /// A change of its orientation: `f64` or a `DVec3` rotation vector.
     type Turn: Turn;
     /// How many coordinates it has (3 or 6): as many rows fix it.

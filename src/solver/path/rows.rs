@@ -38,6 +38,16 @@ impl<B: JointBody> BodyVelocity<B> {
     pub fn is_finite(&self) -> bool {
         self.linear.is_finite() && self.spin.finite()
     }
+
+    /// The velocity a body whose centre is at `at` would have riding
+    /// rigidly with one whose centre is at `centre` and that moves at
+    /// `self`: `v + ω × (at − centre)`, the same spin.
+    pub fn carried_to(self, centre: B::V, at: B::V) -> Self {
+        Self {
+            linear: self.linear + B::V::turn(self.spin, at - centre),
+            spin: self.spin,
+        }
+    }
 }
 
 /// What a joint moves: the body it holds and, where its wire rides a
