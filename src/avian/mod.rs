@@ -382,13 +382,7 @@ fn solve_path_joint(
     let frame = match previous.carrier {
         Some(carrier) => velocity_of(carrier_solver.map(|(b, _)| b))
             .carried_to(carrier.centre, previous.body.centre),
-        None => {
-            let (_, twist) = path.at(now - h);
-            PlaneVelocity {
-                linear: twist.velocity_at(previous.body.centre),
-                spin: twist.angular_velocity,
-            }
-        }
+        None => PlaneVelocity::riding(&path.at(now - h).1, previous.body.centre),
     };
     let substep = Substep {
         before: &before,
@@ -486,10 +480,7 @@ fn project_path_joint_velocity(
     let frame = if now.carrier.is_some() {
         PlaneVelocity::default()
     } else {
-        PlaneVelocity {
-            linear: twist.velocity_at(now.body.centre),
-            spin: twist.angular_velocity,
-        }
+        PlaneVelocity::riding(&twist, now.body.centre)
     };
     let rigid = law(joint).rigid();
     let Some((v, impulse, rows)) = velocity_on_wire(rigid, &wire, &now, v, frame) else {

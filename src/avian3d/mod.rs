@@ -414,13 +414,7 @@ fn solve_path_joint(
     let frame = match previous.carrier {
         Some(carrier) => velocity_of(carrier_solver.map(|(b, _)| b))
             .carried_to(carrier.centre, previous.body.centre),
-        None => {
-            let (_, twist) = path.at(now - h);
-            BodyVelocity {
-                linear: twist.velocity_at(previous.body.centre),
-                spin: twist.angular_velocity,
-            }
-        }
+        None => BodyVelocity::riding(&path.at(now - h).1, previous.body.centre),
     };
     let substep = Substep {
         before: &before,
@@ -518,10 +512,7 @@ fn project_path_joint_velocity(
     let frame = if now.carrier.is_some() {
         BodyVelocity::default()
     } else {
-        BodyVelocity {
-            linear: twist.velocity_at(now.body.centre),
-            spin: twist.angular_velocity,
-        }
+        BodyVelocity::riding(&twist, now.body.centre)
     };
     let rigid = law(joint).rigid();
     let Some((v, impulse, rows)) = velocity_on_wire(rigid, &wire, &now, v, frame) else {

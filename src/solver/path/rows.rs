@@ -4,7 +4,7 @@
 //! ([`Rows`]) and the small dense solve of their matrix.
 
 use super::{JointBody, MAX_ROWS, Multipliers, Turn};
-use crate::geometry::Coordinates;
+use crate::geometry::{Coordinates, Twist};
 use crate::lane::Vector;
 
 /// A body's velocity: its centre's, and its spin.
@@ -37,6 +37,15 @@ impl<B: JointBody> BodyVelocity<B> {
     /// Whether every component is finite.
     pub fn is_finite(&self) -> bool {
         self.linear.is_finite() && self.spin.finite()
+    }
+
+    /// The velocity a body whose centre is at `at` would have riding
+    /// rigidly with a wire the game moves by `twist`.
+    pub fn riding(twist: &Twist<B::V>, at: B::V) -> Self {
+        Self {
+            linear: twist.velocity_at(at),
+            spin: twist.angular_velocity,
+        }
     }
 
     /// The velocity a body whose centre is at `at` would have riding
