@@ -57,15 +57,18 @@ use avian2d::prelude::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use crate::carrier::{Boarding, board_beads, hand_over_forces, read_back_beads};
 use crate::dynamics::{Wire, WirePose};
 use crate::geometry::{Near, Placed, PosePath, WireShape};
 use crate::solver::path::{
     Held, JointBody, JointState, JointWire, Law, PlaneBody, PlaneVelocity, PlaneWire, Substep,
     turn_offset, velocity_on_wire,
 };
-use crate::{SimClock, SimParams};
+use crate::{SimClock, SimParams, WireBeadSystems};
+use beads::Avian2d;
 use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
 
+mod beads;
 mod carried;
 mod joint;
 
@@ -100,7 +103,8 @@ fn at_rest(centre: DVec2, angle: f64, arm: DVec2) -> PlaneBody {
 }
 
 /// Solves [`PathJoint`]s in avian's substep loop. Add it after avian's
-/// `PhysicsPlugins`.
+/// `PhysicsPlugins`. It also carries our beads on wires that ride
+/// bodies ([`WireOnBody`]), each as a point body on a path joint.
 #[derive(Default)]
 pub struct PathJointPlugin;
 
@@ -111,10 +115,18 @@ impl Plugin for PathJointPlugin {
             .register_type::<PathJointForces>()
             .register_type::<WireOnBody>()
             .add_systems(
+                FixedUpdate,
+                (
+                    board_beads::<Avian2d>.in_set(Boarding),
+                    hand_over_forces::<Avian2d>.in_set(WireBeadSystems::Step),
+                ),
+            )
+            .add_systems(
                 PhysicsSchedule,
                 (
                     prepare_path_joints.in_set(SolverSystems::PrepareJoints),
                     write_path_joint_forces.in_set(SolverSystems::Finalize),
+                    read_back_beads::<Avian2d>.in_set(PhysicsStepSystems::Last),
                 ),
             )
             .add_systems(

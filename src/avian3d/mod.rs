@@ -61,15 +61,18 @@ use avian3d::prelude::*;
 use bevy::math::{DMat3, DQuat, DVec3};
 use bevy::prelude::*;
 
+use crate::carrier::{Boarding, board_beads, hand_over_forces, read_back_beads};
 use crate::dynamics::{SpaceWire, WirePose};
 use crate::geometry::{SpacePath, SpaceShape};
 use crate::solver::path::{
     Alignment, BodyVelocity, Held, JointBody, JointState, JointWire, Law, SpaceBody, SpaceWireAt,
     Substep, velocity_on_wire,
 };
-use crate::{SimClock, SimParams};
+use crate::{SimClock, SimParams, WireBeadSystems};
+use beads::Avian3d;
 use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
 
+mod beads;
 mod carried;
 mod joint;
 
@@ -104,7 +107,8 @@ fn at_rest(centre: DVec3, rotation: DQuat, arm: DVec3) -> SpaceBody {
 }
 
 /// Solves [`PathJoint`]s in avian3d's substep loop. Add it after avian's
-/// `PhysicsPlugins`.
+/// `PhysicsPlugins`. It also carries our beads on wires that ride
+/// bodies ([`WireOnBody`]), each as a point body on a path joint.
 #[derive(Default)]
 pub struct PathJointPlugin;
 
@@ -115,10 +119,18 @@ impl Plugin for PathJointPlugin {
             .register_type::<PathJointForces>()
             .register_type::<WireOnBody>()
             .add_systems(
+                FixedUpdate,
+                (
+                    board_beads::<Avian3d>.in_set(Boarding),
+                    hand_over_forces::<Avian3d>.in_set(WireBeadSystems::Step),
+                ),
+            )
+            .add_systems(
                 PhysicsSchedule,
                 (
                     prepare_path_joints.in_set(SolverSystems::PrepareJoints),
                     write_path_joint_forces.in_set(SolverSystems::Finalize),
+                    read_back_beads::<Avian3d>.in_set(PhysicsStepSystems::Last),
                 ),
             )
             .add_systems(

@@ -29,7 +29,7 @@ pub use touch::{
 };
 #[cfg(any(feature = "avian2d", feature = "avian3d"))]
 pub use wire::WireOnBody;
-pub(crate) use wire::WirePose;
+pub(crate) use wire::{Boarded, RidingBody, WirePose};
 pub use wire::{
     ContactChanged, NextWireShape, OnWire, PrescribedMotion, SpaceWire, Wire, WireBeads,
     WireContact, WirePlace, pose_of,

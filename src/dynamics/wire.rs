@@ -395,15 +395,42 @@ pub struct WireBeads(Vec<Entity>);
 /// the body's own motion counts in the wire's velocity (put a moving
 /// track on a body of its own). A carrier that is no other rigid body
 /// (or the joint's own body) leaves the wire where its place puts it, in
-/// the world, and the joint says so once in the log. Beads of ours do not
-/// ride a carried wire yet: one on it is stopped before the step
-/// ([`Diverged`](crate::Diverged), its wire invalid). Avian sleeps bodies
+/// the world, and the joint says so once in the log.
+///
+/// A bead of ours on a carried wire rides it the same way: the avian
+/// plugin of its dimension makes it a point body of avian (its mass, its
+/// rotation locked, no collider), held on the wire by a path joint, as
+/// soon as it is on the wire (and again at each restart). Its initial
+/// velocity is relative to the carrier's point where it starts, as on any
+/// moving wire; gravity is the plugin's ([`SimParams`](crate::SimParams))
+/// and the forces of [`WireBeadSystems::Forces`](crate::WireBeadSystems::Forces)
+/// act on it for the step. Avian steps it with its carrier; after avian's
+/// step its [`BeadPosition`](crate::BeadPosition),
+/// [`BeadVelocity`](crate::BeadVelocity) and
+/// [`BeadDiagnostics`](crate::BeadDiagnostics) are avian's (move such a
+/// bead through its body's `Position` and `LinearVelocity`; the
+/// timeline does not take avian's bodies back). A bead that cannot ride
+/// this way is stopped before the step ([`Diverged`](crate::Diverged),
+/// its wire invalid) and says why in words: one joined to other beads or
+/// with a radius, one on a one-sided, rough or damped wire, one whose
+/// wire rides an entity that is no rigid body. Avian sleeps bodies
 /// one by one: where one of a carrier and a body held on its wire sleeps
 /// while the other moves, the sleeper is woken.
 #[cfg(any(feature = "avian2d", feature = "avian3d"))]
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq, Reflect)]
 #[reflect(Component)]
 pub struct WireOnBody(#[entities] pub Entity);
+
+/// Marks a bead of ours on a wire carried by a body (see `WireOnBody`):
+/// avian steps it, and the plugin's own step and islands leave it alone.
+/// Kept by the avian plugins as beads and wires come and go.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub(crate) struct RidingBody;
+
+/// Marks a bead riding a body that has been made a body of avian's, from
+/// where it was then: taken off by a restart, which boards it afresh.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub(crate) struct Boarded;
 
 #[cfg(test)]
 mod tests {

@@ -11,9 +11,9 @@ use super::islands::Islands;
 use super::schedule::WireBeadSystems;
 use super::wires::prescribed;
 use crate::dynamics::{
-    BeadDiagnostics, BeadMotion, BeadMotionItem, BeadParams, Dimension, Diverged, NextBeadParams,
-    NextParams, NextWireShape, OnWire, PrescribedMotion, RailOrientation, SimParams, Wire,
-    WireContact, WirePlace, WirePose, put_in_place,
+    BeadDiagnostics, BeadMotion, BeadMotionItem, BeadParams, Boarded, Dimension, Diverged,
+    NextBeadParams, NextParams, NextWireShape, OnWire, PrescribedMotion, RailOrientation,
+    SimParams, Wire, WireContact, WirePlace, WirePose, put_in_place,
 };
 use crate::geometry::{MovingTrack, Track};
 use crate::solver::{RowReport, constraint_state_on};
@@ -190,7 +190,7 @@ fn reset_bead<V: Dimension>(
     if let Some(mut contact) = contact {
         contact.set_if_neq(WireContact::default());
     }
-    commands.entity(entity).remove::<Diverged>();
+    commands.entity(entity).remove::<(Diverged, Boarded)>();
     true
 }
 

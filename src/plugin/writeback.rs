@@ -12,8 +12,8 @@ use super::energy::{SceneEnergy, measure_scene_energy};
 use super::parallel::ParallelStep;
 use super::schedule::WireBeadSystems;
 use crate::dynamics::{
-    Bead, BeadParams, BeadPosition, Dimension, OnWire, RailOrientation, SpaceBead, SpaceWire,
-    WirePose,
+    Bead, BeadParams, BeadPosition, Dimension, OnWire, RailOrientation, RidingBody, SpaceBead,
+    SpaceWire, WirePose,
 };
 use crate::geometry::SpaceShape;
 
@@ -80,7 +80,10 @@ impl<V> LastStep<V> {
 fn write_transforms<V: Dimension>(
     parallel: Res<ParallelStep>,
     stepped: Res<LastStep<V>>,
-    mut beads: Query<(Ref<BeadPosition<V>>, &mut Transform), Changed<BeadPosition<V>>>,
+    mut beads: Query<
+        (Ref<BeadPosition<V>>, &mut Transform),
+        (Changed<BeadPosition<V>>, Without<RidingBody>),
+    >,
 ) {
     let write = |(position, mut transform): (Ref<BeadPosition<V>>, Mut<Transform>)| {
         // The step wrote the ones it changed last (without reading them
@@ -109,16 +112,20 @@ fn place_spawned<B: Component, V: Dimension>(
 
 /// Turns each bead with a [`RailOrientation`] on a curve in space with its
 /// track, where it is after the step (see [`RailOrientation`]); a
-/// rotation that is not finite is never written.
+/// rotation that is not finite is never written. A bead riding a body is
+/// avian's, and keeps the turn it had.
 fn orient_rails(
     clock: Res<SimClock>,
-    mut beads: Query<(
-        &BeadPosition<DVec3>,
-        &BeadParams<DVec3>,
-        &OnWire,
-        &mut RailOrientation,
-        &mut Transform,
-    )>,
+    mut beads: Query<
+        (
+            &BeadPosition<DVec3>,
+            &BeadParams<DVec3>,
+            &OnWire,
+            &mut RailOrientation,
+            &mut Transform,
+        ),
+        Without<RidingBody>,
+    >,
     wires: Query<(&SpaceWire, &WirePose<DVec3>)>,
 ) {
     for (position, params, on, mut rail, mut transform) in &mut beads {

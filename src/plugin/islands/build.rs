@@ -14,7 +14,7 @@ use super::touch::Rider;
 use super::{CachedIsland, ContactRow, InIsland, IslandReport, Islands, LinkRows, WireRow, touch};
 use crate::dynamics::{
     Bead, CatchesBeads, Contacts, Dimension, DivergenceReason, Joint, OnWire, Pin, Restitution,
-    Rod, SimParams, SpaceBead, Spring, WirePose, WireRows,
+    RidingBody, Rod, SimParams, SpaceBead, Spring, WirePose, WireRows,
 };
 use crate::geometry::{Friction, Side, Surface};
 use crate::plugin::clock::SimClock;
@@ -130,6 +130,7 @@ pub(super) fn prepare_islands<V: LoneStep>(
     catching: Query<Entity, (With<CatchesBeads>, With<V::Wire>)>,
     restitutions: Query<&Restitution>,
     transforms: Query<&Transform>,
+    riding: Query<(), With<RidingBody>>,
     mut commands: Commands,
     mut divergences: Divergences,
     clock: Res<SimClock>,
@@ -330,8 +331,9 @@ pub(super) fn prepare_islands<V: LoneStep>(
     }
     // The beads in islands: every bead a link names, every bead on no
     // wire, every bead on a wire without a step of its own (a curve in
-    // space), and every bead with a radius that does not ride its wire
-    // alone (its step may be cut where it meets another).
+    // space) unless the wire rides a body (avian steps the bead), and
+    // every bead with a radius that does not ride its wire alone (its step
+    // may be cut where it meets another).
     let mut index: HashMap<Entity, usize> = HashMap::new();
     let mut members: Vec<Entity> = Vec::new();
     let mut join = |bead: Entity, members: &mut Vec<Entity>| {
@@ -357,7 +359,8 @@ pub(super) fn prepare_islands<V: LoneStep>(
         .collect();
     alone.sort_unstable();
     for (entity, _, on_wire, _, radius, _) in &beads {
-        let lone = on_wire.is_some_and(|on| wires.get(on.0).map_or(true, |(w, _)| w.lone()));
+        let lone = on_wire.is_some_and(|on| wires.get(on.0).map_or(true, |(w, _)| w.lone()))
+            || riding.contains(entity);
         let touches = radius.is_some() && alone.binary_search(&entity).is_err();
         if !lone || touches {
             join(entity, &mut members);

@@ -34,7 +34,7 @@ use super::step::LoneStep;
 use super::wires::place_wires;
 use crate::dynamics::{
     BeadRadius, BeadSentBack, CatchesBeads, ConstraintDiagnostics, Dimension, Joint, OnWire, Pin,
-    Rod, SendsBeadsBack, Spring,
+    RidingBody, Rod, SendsBeadsBack, Spring,
 };
 use crate::solver::{BeadState, Island, IslandMark, IslandWork, LinearForce, SolveError};
 
@@ -83,6 +83,8 @@ fn add_islands<V: LoneStep>(app: &mut App) {
         .add_observer(topology_changed::<Remove, BeadRadius, V>)
         .add_observer(topology_changed::<Insert, CatchesBeads, V>)
         .add_observer(topology_changed::<Remove, CatchesBeads, V>)
+        .add_observer(topology_changed::<Insert, RidingBody, V>)
+        .add_observer(topology_changed::<Remove, RidingBody, V>)
         .add_systems(
             PreUpdate,
             build::prepare_islands::<V>

@@ -9,7 +9,7 @@ use super::{CachedIsland, InIsland, Islands, LinkRows, PressedPair, touch};
 use crate::dynamics::{
     BeadDiagnostics, BeadForce, BeadMotion, BeadPosition, BeadRadius, BeadVelocity, BeadsStruck,
     ConstraintDiagnostics, Contacts, Dimension, Diverged, DivergenceReason, Pin, Restitution,
-    SimParams, WireContact, WirePose, WireRows,
+    RidingBody, SimParams, WireContact, WirePose, WireRows,
 };
 use crate::plugin::clock::SimClock;
 use crate::plugin::parallel::{ParallelStep, StepSplit};
@@ -18,8 +18,8 @@ use crate::plugin::step::LoneStep;
 use crate::solver::{BeadState, Contact, RowReport, StepSettings};
 
 /// The beads [`step_islands`] steps: those in an island (or riding a
-/// wire alone with a radius) that have not stopped.
-type Stepped = (With<InIsland>, Without<Diverged>);
+/// wire alone with a radius) that have not stopped and ride no body.
+type Stepped = (With<InIsland>, Without<Diverged>, Without<RidingBody>);
 
 /// What a step gathers of each bead: its state, the force on it, its
 /// radius and restitution.

@@ -26,7 +26,7 @@ use super::schedule::WireBeadSystems;
 use super::writeback::LastStep;
 use crate::dynamics::{
     Bead, BeadDiagnostics, BeadForce, BeadMass, BeadPosition, BeadVelocity, Diverged, OnWire,
-    SimParams, SpaceBead, WireContact, WirePose,
+    RidingBody, SimParams, SpaceBead, WireContact, WirePose,
 };
 pub(crate) use lone::{LoneStep, OnTrack};
 use run::{StepContext, split_table};
@@ -76,7 +76,7 @@ fn step_beads<V: LoneStep>(
             Option<&mut Transform>,
             Option<&mut WireContact>,
         ),
-        (Without<Diverged>, Without<InIsland>),
+        (Without<Diverged>, Without<InIsland>, Without<RidingBody>),
     >,
     mut found: Local<FoundDivergences>,
     mut events: Local<FoundEvents<V>>,

@@ -6,6 +6,7 @@
 use super::{JointBody, MAX_ROWS, Multipliers, Turn};
 use crate::geometry::{Coordinates, Twist};
 use crate::lane::Vector;
+use crate::solver::RowReport;
 
 /// A body's velocity: its centre's, and its spin.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -278,6 +279,31 @@ impl<B: JointBody> Rows<B> {
                 0.0
             }
         })
+    }
+
+    /// What the rows say of a body held by them, as a bead's diagnostics
+    /// report a wire's row: the row furthest from met (its `C`), its rate
+    /// `Ċ` at the velocities `v`, and `λ` of the mean force `force` on the
+    /// body's centre along its gradient, `force · ∇C / |∇C|²` (the force
+    /// is then `λ ∇C` where it is normal to the wire). All zero with no
+    /// rows.
+    pub fn report(&self, v: &Held<BodyVelocity<B>>, force: B::V) -> RowReport {
+        let Some(row) = self
+            .iter()
+            .max_by(|a, b| a.value.abs().total_cmp(&b.value.abs()))
+        else {
+            return RowReport::default();
+        };
+        let normal = row.along_centre.dot(row.along_centre);
+        RowReport {
+            c: row.value,
+            c_dot: row.rate_of(self.carrier, v),
+            lambda: if normal > 0.0 {
+                force.dot(row.along_centre) / normal
+            } else {
+                0.0
+            },
+        }
     }
 
     /// `Gᵀ λ`: the generalized impulse of the multipliers `lambda` along
