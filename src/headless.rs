@@ -38,6 +38,7 @@ pub struct Headless {
     single_threaded: bool,
     parallel: Option<ParallelStep>,
     assets: Option<PathBuf>,
+    bodies: Option<bool>,
 }
 
 impl Headless {
@@ -52,6 +53,7 @@ impl Headless {
             single_threaded: false,
             parallel: None,
             assets: None,
+            bodies: None,
         }
     }
 
@@ -81,6 +83,17 @@ impl Headless {
         }
     }
 
+    /// Avian's physics for a scene's rigid bodies, in the plane or
+    /// (`in_space`) in space: avian's `PhysicsPlugins` and our
+    /// `PathJointPlugin` of that dimension, where the build has its avian
+    /// (see [`runs_bodies`]).
+    pub fn bodies(self, in_space: bool) -> Self {
+        Self {
+            bodies: Some(in_space),
+            ..self
+        }
+    }
+
     /// The app, after its first update (which starts the clocks and runs
     /// `Startup`, but no fixed step). Each later `app.update()` runs one
     /// fixed step until [`run_steps`] says otherwise.
@@ -102,6 +115,28 @@ impl Headless {
         if let Some(parallel) = self.parallel {
             app.insert_resource(parallel);
         }
+        match self.bodies {
+            #[cfg(feature = "avian2d")]
+            Some(false) => {
+                app.add_plugins((
+                    avian2d::prelude::PhysicsPlugins::default(),
+                    crate::avian::PathJointPlugin,
+                ));
+            }
+            #[cfg(feature = "avian3d")]
+            Some(true) => {
+                app.add_plugins((
+                    avian3d::prelude::PhysicsPlugins::default(),
+                    crate::avian3d::PathJointPlugin,
+                ));
+            }
+            _ => {}
+        }
+        if self.bodies.is_some() {
+            // As `App::run` does: avian's plugins finish their set-up.
+            app.finish();
+            app.cleanup();
+        }
         app.insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
         // Enough for any batch of steps `run_steps` asks for at once.
         app.world_mut()
@@ -113,6 +148,12 @@ impl Headless {
         app.update();
         app
     }
+}
+
+/// Whether this build runs rigid bodies in the plane or (`in_space`) in
+/// space: whether it has the feature `avian2d` or `avian3d`.
+pub fn runs_bodies(in_space: bool) -> bool {
+    (in_space && cfg!(feature = "avian3d")) || (!in_space && cfg!(feature = "avian2d"))
 }
 
 /// Runs exactly `n` fixed steps in one update (and `n` per update after

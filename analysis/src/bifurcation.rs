@@ -93,6 +93,8 @@ impl HoopSweep {
             dimension: 3,
             params: wirebead::SpaceParams(params),
             wires: vec![SpaceWirePreset {
+                name: String::new(),
+                body: String::new(),
                 shape: SpaceShapePreset::Circle(Hoop {
                     radius: self.radius,
                 }),
@@ -121,6 +123,7 @@ impl HoopSweep {
             constraints: Vec::new(),
             springs: Vec::new(),
             contacts: Default::default(),
+            bodies: Vec::new(),
         }
     }
 

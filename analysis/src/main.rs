@@ -32,8 +32,12 @@ enum Command {
     /// Run one simulation and write a CSV (`t,x,y,vx,vy,c,c_dot,lambda,energy`);
     /// with `--scene`, any scene file (`t`, then
     /// `<bead>.x,<bead>.y,<bead>.vx,<bead>.vy,<bead>.on` for each bead, `on` 1
-    /// while held on its wire, then `energy,max_abs_c`; in space
-    /// `<bead>.x,<bead>.y,<bead>.z,<bead>.vx,<bead>.vy,<bead>.vz,<bead>.on`).
+    /// while held on its wire, then
+    /// `<body>.x,<body>.y,<body>.angle,<body>.vx,<body>.vy,<body>.w` for each
+    /// dynamic or kinematic body, then `energy,max_abs_c`; in space
+    /// `<bead>.x,<bead>.y,<bead>.z,<bead>.vx,<bead>.vy,<bead>.vz,<bead>.on`
+    /// and `<body>.x,…,<body>.qx,<body>.qy,<body>.qz,<body>.qw,<body>.vx,…,<body>.wz`).
+    /// A scene with bodies needs the tool built with `--features avian`.
     Simulate(SimulateArgs),
     /// Reproduce the assignment's three studies: trajectory, drift and energy PNGs,
     /// the CSV behind each, and summary.md.

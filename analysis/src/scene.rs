@@ -6,13 +6,14 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
-use bevy::prelude::{Entity, FixedUpdate, IntoScheduleConfigs, Query, Res, ResMut, Resource};
-use wirebead::headless::{Headless, idle, run_steps};
+use bevy::prelude::{Entity, FixedLast, Mut, Query, QueryState, Resource, World};
+use wirebead::geometry::Coordinates;
+use wirebead::headless::{Headless, idle, run_steps, runs_bodies};
 use wirebead::preset::table;
 pub use wirebead::preset::table::{Measure, Scene, SceneRow, SceneRun, SceneSpace};
 use wirebead::{
     BeadPosition, BeadVelocity, Diverged, Method, ParamError, SceneFile, ScenePreset, SimClock,
-    SimParams, WireBeadPlugin, WireBeadSystems, WireContact,
+    SimParams, WireBeadPlugin, WireContact,
 };
 
 use crate::AnalysisResult;
@@ -33,15 +34,27 @@ pub fn load_scene_file(path: &Path) -> AnalysisResult<SceneFile> {
 #[derive(Resource)]
 struct Recorder<V: SceneSpace> {
     beads: Vec<Entity>,
+    /// The dynamic and kinematic bodies, in the file's order.
+    bodies: Vec<Entity>,
     measure: Measure<V>,
     rows: Vec<SceneRow<V>>,
     stopped: bool,
 }
 
 impl<V: SceneSpace> Recorder<V> {
-    fn record(&mut self, t: f64, beads: &Query<BeadRecord<V>>) {
+    fn record(&mut self, t: f64, beads: &Query<BeadRecord<V>>, world: &World) {
         if self.stopped {
             return;
+        }
+        let mut bodies = Vec::with_capacity(self.bodies.len());
+        for &body in &self.bodies {
+            match V::body(world, body) {
+                Some(state) => bodies.push(state),
+                None => {
+                    self.stopped = true;
+                    return;
+                }
+            }
         }
         let mut x = Vec::with_capacity(self.beads.len());
         let mut v = Vec::with_capacity(self.beads.len());
@@ -59,7 +72,7 @@ impl<V: SceneSpace> Recorder<V> {
                 }
             }
         }
-        self.rows.push(self.measure.row(t, x, v, on));
+        self.rows.push(self.measure.row(t, (x, v, on), bodies));
     }
 }
 
@@ -71,29 +84,50 @@ type BeadRecord<V> = (
     Option<&'static Diverged>,
 );
 
-fn record_scene<V: SceneSpace>(
-    clock: Res<SimClock>,
-    beads: Query<BeadRecord<V>>,
-    mut recorder: ResMut<Recorder<V>>,
-) {
-    recorder.record(clock.time, &beads);
+fn record_scene<V: SceneSpace>(world: &mut World, beads: &mut QueryState<BeadRecord<V>>) {
+    let time = world.resource::<SimClock>().time;
+    world.resource_scope(|world, mut recorder: Mut<Recorder<V>>| {
+        let query = beads.query(world);
+        recorder.record(time, &query, world);
+    });
 }
 
-/// A headless app running `preset` with `params`, and its beads in the
-/// file's order.
+/// A headless app running `preset` with `params` (with avian's physics
+/// where it has bodies), its beads and its recorded bodies in the file's
+/// order; an error in words for a scene with bodies in a build without
+/// the avian of its dimension.
 fn scene_app<S: Scene>(
     preset: &S,
     params: SimParams,
-) -> Result<(bevy::app::App, Vec<Entity>), ParamError> {
+) -> AnalysisResult<(bevy::app::App, Vec<Entity>, Vec<Entity>)> {
     let plugin = WireBeadPlugin::new(params)?;
-    let mut app = Headless::new(plugin).single_threaded().build();
-    let beads = preset.spawn(&mut app.world_mut().commands());
+    let mut headless = Headless::new(plugin).single_threaded();
+    let named = preset.body_names();
+    if !named.is_empty() {
+        let in_space = S::V::DIMENSION == 3;
+        if !runs_bodies(in_space) {
+            let feature = if in_space { "avian3d" } else { "avian2d" };
+            return Err(format!(
+                "scene {:?} has rigid bodies, which this build of the tool cannot run: build it with --features {feature}",
+                preset.name()
+            )
+            .into());
+        }
+        headless = headless.bodies(in_space);
+    }
+    let mut app = headless.build();
+    let (beads, bodies) = preset.spawn_all(&mut app.world_mut().commands());
+    let bodies = bodies
+        .into_iter()
+        .zip(&named)
+        .filter_map(|(body, (_, recorded))| recorded.then_some(body))
+        .collect();
     app.world_mut().flush();
     // One update with no step: the islands are built and their initial
     // velocities projected onto their constraints, so row 0 is the state
     // the first step starts from.
     idle(&mut app);
-    Ok((app, beads))
+    Ok((app, beads, bodies))
 }
 
 /// Runs `preset` headless for `duration` seconds with `params` (the
@@ -112,17 +146,16 @@ pub fn simulate_scene<S: Scene>(
     }
     let steps = (duration / params.timestep).round() as u32;
     let measure = preset.measure()?;
-    let (mut app, beads) = scene_app(preset, params)?;
+    let (mut app, beads, bodies) = scene_app(preset, params)?;
     app.insert_resource(Recorder {
         beads: beads.clone(),
+        bodies,
         measure,
         rows: Vec::new(),
         stopped: false,
     })
-    .add_systems(
-        FixedUpdate,
-        record_scene::<S::V>.after(WireBeadSystems::Writeback),
-    );
+    // When the whole step is done: the plugin's, and avian's after it.
+    .add_systems(FixedLast, record_scene::<S::V>);
     app.world_mut().run_system_cached(record_scene::<S::V>).ok();
     let bar = crate::run::progress(u64::from(steps), "steps");
     let mut done = 0;
@@ -139,8 +172,12 @@ pub fn simulate_scene<S: Scene>(
             .map(|d| (d.time, d.reason.to_string()))
     });
     let rows = std::mem::take(&mut app.world_mut().resource_mut::<Recorder<S::V>>().rows);
+    let body_names = preset.body_names().into_iter();
     Ok(SceneRun {
         names: preset.bead_names(),
+        body_names: body_names
+            .filter_map(|(n, recorded)| recorded.then_some(n))
+            .collect(),
         rows,
         diverged,
     })
@@ -209,7 +246,7 @@ pub fn compare_scene<S: Scene>(
 /// Microseconds per step of the plugin on `preset` (no recording), from
 /// 300 steps after 30 to warm up.
 fn time_scene<S: Scene>(preset: &S, params: SimParams) -> AnalysisResult<f64> {
-    let (mut app, _) = scene_app(preset, params)?;
+    let (mut app, ..) = scene_app(preset, params)?;
     run_steps(&mut app, 30);
     let steps = 300;
     let clock = Instant::now();

@@ -154,7 +154,7 @@ impl Plugin for PathJointPlugin {
 }
 
 /// A rotation of avian's, in `f64`.
-fn rotation_of(q: Quaternion) -> DQuat {
+pub(crate) fn rotation_of(q: Quaternion) -> DQuat {
     DQuat::from_xyzw(
         f64::from(q.x),
         f64::from(q.y),
@@ -164,7 +164,7 @@ fn rotation_of(q: Quaternion) -> DQuat {
 }
 
 /// A vector of avian's, in `f64`.
-fn vector_of(v: Vector) -> DVec3 {
+pub(crate) fn vector_of(v: Vector) -> DVec3 {
     DVec3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z))
 }
 

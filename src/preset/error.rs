@@ -126,6 +126,22 @@ pub enum PresetError {
     /// Two beads have one name.
     #[error("two beads are named {0:?}")]
     DuplicateName(String),
+    /// Two bodies have one name.
+    #[error("two bodies are named {0:?}")]
+    DuplicateBody(String),
+    /// Two wires have one name.
+    #[error("two wires are named {0:?}")]
+    DuplicateWire(String),
+    /// A body is invalid.
+    #[error("body {index} ({name:?}): {source}")]
+    Body {
+        /// Its index in `bodies`.
+        index: usize,
+        /// Its name.
+        name: String,
+        /// What is wrong.
+        source: ParamError,
+    },
     /// The contacts' parameters are invalid.
     #[error("contacts: {0}")]
     Contacts(ParamError),
@@ -149,8 +165,8 @@ pub enum PresetError {
         /// What is wrong.
         problem: String,
     },
-    /// The scene has no bead.
-    #[error("the scene has no bead")]
+    /// The scene has no bead and no body.
+    #[error("the scene has no bead and no body")]
     Empty,
     /// A scene in space where one in the plane was asked for.
     #[error("the scene is in space (dimension: 3); this takes scenes in the plane")]

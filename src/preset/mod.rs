@@ -25,6 +25,12 @@
 //! `file_watcher`), and on a malformed file keeps the running scene and
 //! records the error in [`ActivePreset::error`].
 
+#[cfg(feature = "avian2d")]
+mod bodies_plane;
+#[cfg(feature = "avian3d")]
+mod bodies_space;
+#[cfg(test)]
+mod body_tests;
 mod error;
 mod export;
 mod format;
@@ -44,8 +50,11 @@ pub use error::PresetError;
 pub(crate) use export::{BeadEdits, WireEdits, edited_scene};
 pub use export::{ExportDir, ExportPlugin, LastExport, scene_ron, scene_stem, with_edits};
 pub use format::{
-    BeadPreset, ConstraintPreset, ContactsPreset, PinPreset, RodPreset, SceneLink, ScenePreset,
-    SendBackPreset, SpringPreset, WirePreset,
+    ANCHOR_TOLERANCE, BallShape, BeadPreset, BodyKind, BodyPreset, BodyShape, BoxShape,
+    CapsuleShape, ConstraintPreset, ContactsPreset, MotorPreset, PathPreset, PathRotationPreset,
+    PinPreset, PositionMotorPreset, RodPreset, RotationPreset, SceneBody, SceneLink, ScenePath,
+    ScenePreset, SendBackPreset, SpaceBodyPreset, SpringPreset, VelocityMotorPreset, WirePreset,
+    plane_inertia, space_inertia,
 };
 pub use hourglass::{GRAIN_RADIUS, Hourglass};
 pub use marble_run::{MARBLE_BOWL, MarbleRun};
@@ -55,8 +64,8 @@ pub use plugin::{
     load_requested_preset, report_preset_errors,
 };
 pub use space::{
-    ConePreset, RailPreset, RotationPreset, SpaceMotionPreset, SpaceScene, SpaceShapePreset,
-    SpaceWirePreset, SpinPreset,
+    ConePreset, RailPreset, SpaceMotionPreset, SpaceScene, SpaceShapePreset, SpaceWirePreset,
+    SpinPreset,
 };
 pub use spawn::FromPreset;
 

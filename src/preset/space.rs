@@ -2,14 +2,15 @@
 //! with three components, wires that are curves or surfaces placed by a
 //! position and a rotation about any axis.
 
-use bevy::math::{DQuat, DVec3};
+use bevy::math::DVec3;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::error::PresetError;
 use super::format::{
-    BeadPreset, ConstraintPreset, ContactsPreset, SceneLink, SendBackPreset, SpringPreset,
-    catching_and_sending, check_beads_and_links, given_some, is_false, names_of, written_some,
+    BeadPreset, ConstraintPreset, ContactsPreset, NamedWire, RotationPreset, SceneLink, ScenePath,
+    SendBackPreset, SpaceBodyPreset, SpringPreset, catching_and_sending, check_beads_and_links,
+    check_bodies, checked_bodies, given_some, is_false, names_of, with_bodies, written_some,
 };
 use super::spawn::{FromPreset, spawn_beads_and_links};
 use crate::dynamics::{
@@ -128,45 +129,6 @@ impl SpaceShapePreset {
     }
 }
 
-/// A turn about `axis` (through the wire's origin) by `angle_degrees`,
-/// right-handed: `rotation: (axis: (0.0, 1.0, 0.0), angle_degrees: 30.0)`.
-/// None by default.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-#[serde(default)]
-pub struct RotationPreset {
-    /// The axis, not zero (its length does not matter).
-    pub axis: DVec3,
-    /// The angle in degrees.
-    pub angle_degrees: f64,
-}
-
-impl Default for RotationPreset {
-    fn default() -> Self {
-        Self {
-            axis: DVec3::Z,
-            angle_degrees: 0.0,
-        }
-    }
-}
-
-impl RotationPreset {
-    /// The rotation as a unit quaternion, if the axis is not zero and
-    /// everything is finite.
-    pub fn quaternion(&self) -> Result<DQuat, ParamError> {
-        finite_vector("rotation axis", self.axis)?;
-        finite("rotation angle", self.angle_degrees)?;
-        let axis = self
-            .axis
-            .try_normalize()
-            .ok_or(ParamError::Incompatible("a rotation axis must not be zero"))?;
-        Ok(DQuat::from_axis_angle(
-            axis,
-            self.angle_degrees.to_radians(),
-        ))
-    }
-}
-
 /// A spin as a scene file in space gives it:
 /// `Spin((angular_velocity: w, axis: (0.0, 1.0, 0.0)))`, right-handed
 /// about `axis` (by default `(0, 0, 1)`, the plane's counter-clockwise
@@ -215,6 +177,13 @@ impl SpaceMotionPreset {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpaceWirePreset {
+    /// The name path joints refer to it by (empty, the default, for none).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub name: String,
+    /// The body it rides, by name (empty, the default, for none): its
+    /// `position` and `rotation` are then in the body's frame.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub body: String,
     /// The shape, in the wire's frame.
     pub shape: SpaceShapePreset,
     /// Where the wire's origin sits.
@@ -345,6 +314,9 @@ pub struct SpaceScene {
     /// How beads with radii strike.
     #[serde(default, skip_serializing_if = "ContactsPreset::is_default")]
     pub contacts: ContactsPreset,
+    /// Rigid bodies, run by avian (feature `avian3d`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<SpaceBodyPreset>,
 }
 
 impl SpaceScene {
@@ -364,7 +336,27 @@ impl SpaceScene {
         }
         let wires: Vec<&[BeadPreset<DVec3>]> =
             self.wires.iter().map(|w| w.beads.as_slice()).collect();
-        check_beads_and_links(&wires, &self.beads, &self.constraints, &self.springs).map(drop)
+        let beads = check_beads_and_links(&wires, &self.beads, &self.constraints, &self.springs);
+        with_bodies(beads, self.bodies.is_empty())?;
+        self.paths().map(drop)
+    }
+
+    /// The path joints with their bodies and wires found (see
+    /// [`ScenePreset::paths`](super::ScenePreset::paths)).
+    pub fn paths(&self) -> Result<Vec<ScenePath<DVec3>>, PresetError> {
+        let bodies = checked_bodies(&self.bodies)?;
+        let mut wires = Vec::new();
+        for (index, wire) in self.wires.iter().enumerate() {
+            wires.push(NamedWire {
+                name: &wire.name,
+                body: &wire.body,
+                place: wire
+                    .pose()
+                    .map_err(|source| PresetError::Wire { index, source })?,
+                rows: wire.shape.shape().rows(),
+            });
+        }
+        check_bodies(&bodies, &wires, &self.constraints)
     }
 
     /// Every bead of the file in order: the wires' beads, then the free
@@ -387,6 +379,13 @@ impl SpaceScene {
     /// Spawns the scene: its wires, beads (named) and links, each marked
     /// [`FromPreset`]. The beads in the file's order.
     pub fn spawn(&self, commands: &mut Commands) -> Vec<Entity> {
+        self.spawn_all(commands).0
+    }
+
+    /// [`SpaceScene::spawn`], and the bodies in avian3d (feature
+    /// `avian3d`; without it they are left out, with a warning): the beads
+    /// and the bodies in the file's order.
+    pub fn spawn_all(&self, commands: &mut Commands) -> (Vec<Entity>, Vec<Entity>) {
         let mut wires = Vec::new();
         for wire in &self.wires {
             let Ok(pose) = wire.pose() else { continue };
@@ -415,6 +414,8 @@ impl SpaceScene {
         if let Ok(contacts) = self.contacts.contacts() {
             commands.insert_resource(contacts);
         }
+        let spawned: Vec<Option<Entity>> = wires.iter().map(|w| w.0).collect();
+        let bodies = self.spawn_bodies(&spawned, commands);
         let beads = spawn_beads_and_links(&wires, &self.beads, links, self.bead_names(), commands);
         // The beads of a rail turn with it.
         let mut first = 0;
@@ -428,6 +429,36 @@ impl SpaceScene {
                 commands.entity(bead).insert(rail);
             }
         }
-        beads
+        (beads, bodies)
+    }
+
+    /// Spawns the bodies in avian3d, puts the wires that ride them on
+    /// them (`wires` the spawned wires) and the path joints on them, and
+    /// sets avian's gravity to the scene's.
+    #[cfg(feature = "avian3d")]
+    fn spawn_bodies(&self, wires: &[Option<Entity>], commands: &mut Commands) -> Vec<Entity> {
+        if self.bodies.is_empty() {
+            return Vec::new();
+        }
+        use avian3d::math::AdjustPrecision;
+        commands.insert_resource(avian3d::prelude::Gravity(
+            self.params.0.gravity_in_space().adjust_precision(),
+        ));
+        let bodies = super::bodies_space::spawn_bodies(&self.bodies, commands);
+        let names: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
+        super::spawn::join_bodies(
+            (wires, &bodies),
+            (self.wires.iter().map(|w| w.body.as_str()), &names),
+            &self.paths().unwrap_or_default(),
+            super::bodies_space::joint,
+            commands,
+        );
+        bodies
+    }
+
+    /// Says that the bodies are left out: this build has no avian3d.
+    #[cfg(not(feature = "avian3d"))]
+    fn spawn_bodies(&self, _: &[Option<Entity>], _: &mut Commands) -> Vec<Entity> {
+        super::spawn::bodies_left_out(&self.name, self.bodies.len(), "avian3d")
     }
 }

@@ -20,6 +20,13 @@ impl ScenePreset {
     /// each tagged [`FromPreset`]; returns the beads in the file's order.
     /// Call on a validated preset: anything invalid is left out.
     pub fn spawn(&self, commands: &mut Commands) -> Vec<Entity> {
+        self.spawn_all(commands).0
+    }
+
+    /// [`ScenePreset::spawn`], and the bodies in avian2d (feature
+    /// `avian2d`; without it they are left out, with a warning): the
+    /// beads and the bodies in the file's order.
+    pub fn spawn_all(&self, commands: &mut Commands) -> (Vec<Entity>, Vec<Entity>) {
         let mut wires = Vec::new();
         for wire in &self.wires {
             // In `f64` to the solver; the plugin writes the `Transform`.
@@ -47,7 +54,84 @@ impl ScenePreset {
         if let Ok(contacts) = self.contacts.contacts() {
             commands.insert_resource(contacts);
         }
-        spawn_beads_and_links(&wires, &self.beads, links, self.bead_names(), commands)
+        let spawned: Vec<Option<Entity>> = wires.iter().map(|w| w.0).collect();
+        let bodies = self.spawn_bodies(&spawned, commands);
+        let beads = spawn_beads_and_links(&wires, &self.beads, links, self.bead_names(), commands);
+        (beads, bodies)
+    }
+
+    /// Spawns the bodies in avian2d, puts the wires that ride them on
+    /// them (`wires` the spawned wires) and the path joints on them, and
+    /// sets avian's gravity to the scene's.
+    #[cfg(feature = "avian2d")]
+    fn spawn_bodies(&self, wires: &[Option<Entity>], commands: &mut Commands) -> Vec<Entity> {
+        if self.bodies.is_empty() {
+            return Vec::new();
+        }
+        use avian2d::math::AdjustPrecision;
+        commands.insert_resource(avian2d::prelude::Gravity(
+            self.params.gravity.adjust_precision(),
+        ));
+        let bodies = super::bodies_plane::spawn_bodies(&self.bodies, commands);
+        let names: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
+        join_bodies(
+            (wires, &bodies),
+            (self.wires.iter().map(|w| w.body.as_str()), &names),
+            &self.paths().unwrap_or_default(),
+            super::bodies_plane::joint,
+            commands,
+        );
+        bodies
+    }
+
+    /// Says that the bodies are left out: this build has no avian2d.
+    #[cfg(not(feature = "avian2d"))]
+    fn spawn_bodies(&self, _: &[Option<Entity>], _: &mut Commands) -> Vec<Entity> {
+        bodies_left_out(&self.name, self.bodies.len(), "avian2d")
+    }
+}
+
+/// Says once, where a scene has bodies, that this build leaves them out
+/// for want of `feature`; no bodies.
+#[cfg(not(all(feature = "avian2d", feature = "avian3d")))]
+pub(super) fn bodies_left_out(scene: &str, count: usize, feature: &str) -> Vec<Entity> {
+    if count > 0 {
+        warn!(
+            "wirebead: scene {scene:?} has {count} bodies, which this build cannot run (build with the {feature} feature); they are left out"
+        );
+    }
+    Vec::new()
+}
+
+/// Joins a scene's spawned bodies to the rest of it: each wire whose
+/// body is named (`wire_bodies`, each wire's; `names`, each body's) rides
+/// that body, each path joint is put on its body (`joint` making it from
+/// its wire's entity), and each body is named and marked [`FromPreset`].
+#[cfg(any(feature = "avian2d", feature = "avian3d"))]
+pub(super) fn join_bodies<'a, V: crate::geometry::Coordinates, J: Bundle>(
+    (wires, bodies): (&[Option<Entity>], &[Entity]),
+    (wire_bodies, names): (impl Iterator<Item = &'a str>, &[&str]),
+    paths: &[super::ScenePath<V>],
+    joint: impl Fn(Entity, &super::ScenePath<V>) -> J,
+    commands: &mut Commands,
+) {
+    for (wire, body) in wires.iter().zip(wire_bodies) {
+        let carrier = names.iter().position(|n| !body.is_empty() && *n == body);
+        if let (Some(wire), Some(carrier)) = (wire, carrier) {
+            commands
+                .entity(*wire)
+                .insert(crate::dynamics::WireOnBody(bodies[carrier]));
+        }
+    }
+    for path in paths {
+        if let Some(wire) = wires[path.wire] {
+            commands.entity(bodies[path.body]).insert(joint(wire, path));
+        }
+    }
+    for (&body, name) in bodies.iter().zip(names) {
+        commands
+            .entity(body)
+            .insert((Name::new((*name).to_owned()), FromPreset));
     }
 }
 

@@ -5,10 +5,10 @@
 
 use std::io::Write;
 
-use bevy::math::{DVec2, DVec3};
-use bevy::prelude::{Commands, Entity};
+use bevy::math::{DQuat, DVec2, DVec3};
+use bevy::prelude::{Commands, Entity, World};
 
-use super::{SceneFile, SceneLink, ScenePreset, SpaceScene};
+use super::{BodyKind, SceneBody, SceneFile, SceneLink, ScenePreset, SpaceScene};
 use crate::dynamics::{Dimension, SimParams};
 use crate::geometry::{
     ImplicitCurve, Placed, Pose, Pose3, SpaceMotion, SpaceShape, WireMotion, WireShape, WireSpace,
@@ -16,10 +16,28 @@ use crate::geometry::{
 use crate::plugin::{RecordedBead, Timeline};
 
 /// The plane or space as a scene's run is measured in it: how far a bead
-/// is off its wire.
+/// is off its wire, and a rigid body's state as a row writes it.
 pub trait SceneSpace: Dimension {
     /// A wire as measured: its shape, resting pose and motion.
     type WireCheck: Clone + std::fmt::Debug + Send + Sync + 'static;
+    /// A body's turn: its angle (rad, counter-clockwise) in the plane, its
+    /// unit quaternion in space.
+    type Turn: Copy + std::fmt::Debug + PartialEq + Send + Sync + 'static;
+    /// A body's principal moments of inertia: one in the plane, three
+    /// (about its own x, y and z) in space.
+    type Inertia: Copy + std::fmt::Debug + PartialEq + Send + Sync + 'static;
+    /// The names of a body's turn's columns: `angle`, or `qx, qy, qz, qw`.
+    const TURN_COLUMNS: &'static [&'static str];
+    /// The names of its spin's: `w`, or `wx, wy, wz`.
+    const SPIN_COLUMNS: &'static [&'static str];
+    /// A turn's and a spin's values, in their columns' order.
+    fn turn_and_spin(turn: Self::Turn, spin: Self::Angular) -> Vec<f64>;
+    /// `½ ωᵀ I ω` of a body turned by `turn` spinning at `spin` (world
+    /// frame), its principal moments `inertia`.
+    fn spin_energy(inertia: Self::Inertia, turn: Self::Turn, spin: Self::Angular) -> f64;
+    /// The state of the rigid body `body` in `world`; `None` where it is
+    /// none (or the build has no avian of this dimension).
+    fn body(world: &World, body: Entity) -> Option<BodyState<Self>>;
     /// `|C|` of a bead at `x` on `wire` at time `t`: in space, over a
     /// curve's two rows, the length of its offset.
     fn drift(wire: &Self::WireCheck, t: f64, x: Self) -> f64;
@@ -29,6 +47,24 @@ pub trait SceneSpace: Dimension {
 
 impl SceneSpace for DVec2 {
     type WireCheck = (WireShape, Pose, WireMotion);
+    type Turn = f64;
+    type Inertia = f64;
+    const TURN_COLUMNS: &'static [&'static str] = &["angle"];
+    const SPIN_COLUMNS: &'static [&'static str] = &["w"];
+    fn turn_and_spin(turn: f64, spin: f64) -> Vec<f64> {
+        vec![turn, spin]
+    }
+    fn spin_energy(inertia: f64, _: f64, spin: f64) -> f64 {
+        0.5 * inertia * spin * spin
+    }
+    #[cfg(feature = "avian2d")]
+    fn body(world: &World, body: Entity) -> Option<BodyState<Self>> {
+        super::bodies_plane::body_state(world, body).map(BodyState::from)
+    }
+    #[cfg(not(feature = "avian2d"))]
+    fn body(_: &World, _: Entity) -> Option<BodyState<Self>> {
+        None
+    }
     fn drift((shape, pose, motion): &Self::WireCheck, t: f64, x: Self) -> f64 {
         Placed {
             curve: shape.curve(),
@@ -44,6 +80,27 @@ impl SceneSpace for DVec2 {
 
 impl SceneSpace for DVec3 {
     type WireCheck = (SpaceShape, Pose3, SpaceMotion);
+    type Turn = DQuat;
+    type Inertia = DVec3;
+    const TURN_COLUMNS: &'static [&'static str] = &["qx", "qy", "qz", "qw"];
+    const SPIN_COLUMNS: &'static [&'static str] = &["wx", "wy", "wz"];
+    fn turn_and_spin(turn: DQuat, spin: DVec3) -> Vec<f64> {
+        let mut values = turn.to_array().to_vec();
+        values.extend(spin.to_array());
+        values
+    }
+    fn spin_energy(inertia: DVec3, turn: DQuat, spin: DVec3) -> f64 {
+        let own = turn.inverse() * spin;
+        0.5 * inertia.dot(own * own)
+    }
+    #[cfg(feature = "avian3d")]
+    fn body(world: &World, body: Entity) -> Option<BodyState<Self>> {
+        super::bodies_space::body_state(world, body).map(BodyState::from)
+    }
+    #[cfg(not(feature = "avian3d"))]
+    fn body(_: &World, _: Entity) -> Option<BodyState<Self>> {
+        None
+    }
     fn drift((shape, pose, motion): &Self::WireCheck, t: f64, x: Self) -> f64 {
         let local = motion.at(*pose, t).0.to_local(x);
         shape.rows().iter().fold(0.0, |offset, row| {
@@ -67,8 +124,13 @@ pub trait Scene {
     fn bead_names(&self) -> Vec<String>;
     /// Spawns it; its beads in the file's order.
     fn spawn(&self, commands: &mut Commands) -> Vec<Entity>;
+    /// Spawns it; its beads and its bodies in the file's order.
+    fn spawn_all(&self, commands: &mut Commands) -> (Vec<Entity>, Vec<Entity>);
     /// Each bead's wire, mass, and the links.
     fn measure(&self) -> Result<Measure<Self::V>, String>;
+    /// Each rigid body's name, in the file's order, and whether a run
+    /// records it (a dynamic or kinematic body; a static one never moves).
+    fn body_names(&self) -> Vec<(String, bool)>;
 }
 
 impl Scene for ScenePreset {
@@ -85,17 +147,24 @@ impl Scene for ScenePreset {
     fn spawn(&self, commands: &mut Commands) -> Vec<Entity> {
         ScenePreset::spawn(self, commands)
     }
+    fn spawn_all(&self, commands: &mut Commands) -> (Vec<Entity>, Vec<Entity>) {
+        ScenePreset::spawn_all(self, commands)
+    }
+    fn body_names(&self) -> Vec<(String, bool)> {
+        recorded(&self.bodies)
+    }
     fn measure(&self) -> Result<Measure<DVec2>, String> {
         let wires = self.wires.iter().map(|wire| {
             let pose = Pose::new(wire.position, wire.angle_degrees.to_radians());
             ((wire.shape.clone(), pose, wire.motion), wire.beads.len())
         });
-        Ok(Measure::new(
+        let measure = Measure::new(
             wires,
             self.links().map_err(|e| e.to_string())?,
             self.all_beads().map(|b| b.mass).collect(),
             self.params.gravity,
-        ))
+        );
+        Ok(measure.with_bodies(masses(&self.bodies)))
     }
 }
 
@@ -113,6 +182,12 @@ impl Scene for SpaceScene {
     fn spawn(&self, commands: &mut Commands) -> Vec<Entity> {
         SpaceScene::spawn(self, commands)
     }
+    fn spawn_all(&self, commands: &mut Commands) -> (Vec<Entity>, Vec<Entity>) {
+        SpaceScene::spawn_all(self, commands)
+    }
+    fn body_names(&self) -> Vec<(String, bool)> {
+        recorded(&self.bodies)
+    }
     fn measure(&self) -> Result<Measure<DVec3>, String> {
         let mut wires = Vec::new();
         for wire in &self.wires {
@@ -120,13 +195,32 @@ impl Scene for SpaceScene {
             let check = (wire.shape.shape(), pose, wire.motion.motion());
             wires.push((check, wire.beads.len()));
         }
-        Ok(Measure::new(
+        let measure = Measure::new(
             wires.into_iter(),
             self.links().map_err(|e| e.to_string())?,
             self.all_beads().map(|b| b.mass).collect(),
             self.params.0.gravity_in_space(),
-        ))
+        );
+        Ok(measure.with_bodies(masses(&self.bodies)))
     }
+}
+
+/// Each body's name, and whether a run records it (a dynamic or kinematic
+/// body; a static one never moves).
+fn recorded<B: SceneBody>(bodies: &[B]) -> Vec<(String, bool)> {
+    bodies
+        .iter()
+        .map(|b| (b.name().to_owned(), b.kind() != BodyKind::Static))
+        .collect()
+}
+
+/// Each recorded body's mass and principal moments.
+fn masses<B: SceneBody>(bodies: &[B]) -> Vec<Option<(f64, B::Inertia)>> {
+    bodies
+        .iter()
+        .filter(|b| b.kind() != BodyKind::Static)
+        .map(SceneBody::mass_properties)
+        .collect()
 }
 
 /// One constraint to measure, with beads as indices in the file's order.
@@ -146,6 +240,34 @@ pub struct Measure<V: SceneSpace> {
     springs: Vec<(usize, usize, f64, f64)>,
     masses: Vec<f64>,
     gravity: V,
+    /// Each recorded body's mass and principal moments (none for a
+    /// kinematic body given no mass).
+    bodies: Vec<Option<(f64, V::Inertia)>>,
+}
+
+/// A rigid body's state in a row of a scene's run: its origin, its turn,
+/// its velocity and its spin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyState<V: SceneSpace> {
+    /// Where its origin is.
+    pub position: V,
+    /// How it is turned.
+    pub turn: V::Turn,
+    /// Its velocity.
+    pub velocity: V,
+    /// Its spin (counter-clockwise in the plane; right-handed in space).
+    pub spin: V::Angular,
+}
+
+impl<V: SceneSpace> From<(V, V::Turn, V, V::Angular)> for BodyState<V> {
+    fn from((position, turn, velocity, spin): (V, V::Turn, V, V::Angular)) -> Self {
+        Self {
+            position,
+            turn,
+            velocity,
+            spin,
+        }
+    }
 }
 
 /// `|v|`.
@@ -186,7 +308,29 @@ impl<V: SceneSpace> Measure<V> {
             springs,
             masses,
             gravity,
+            bodies: Vec::new(),
         }
+    }
+
+    /// The measure with the recorded bodies' masses and moments.
+    pub(crate) fn with_bodies(self, bodies: Vec<Option<(f64, V::Inertia)>>) -> Self {
+        Self { bodies, ..self }
+    }
+
+    /// Kinetic plus gravitational energy of the bodies at `states`.
+    pub fn body_energy(&self, states: &[BodyState<V>]) -> f64 {
+        self.bodies
+            .iter()
+            .zip(states)
+            .filter_map(|(mass, state)| {
+                let (m, inertia) = (*mass)?;
+                let (x, v) = (state.position, state.velocity);
+                Some(
+                    0.5 * m * v.dot(v) - m * self.gravity.dot(x)
+                        + V::spin_energy(inertia, state.turn, state.spin),
+                )
+            })
+            .sum()
     }
 
     /// The largest `|C|` at time `t` of every constraint, wires included
@@ -212,18 +356,24 @@ impl<V: SceneSpace> Measure<V> {
             .sum()
     }
 
-    /// The row of the beads' state at time `t`: every bead's position
-    /// and velocity in the file's order, and whether each is held on its
-    /// wire.
-    pub fn row(&self, t: f64, positions: Vec<V>, velocities: Vec<V>, on: Vec<bool>) -> SceneRow<V> {
+    /// The row of the scene's state at time `t`: every bead's position
+    /// and velocity in the file's order, whether each is held on its wire,
+    /// and each recorded body's state.
+    pub fn row(
+        &self,
+        t: f64,
+        (positions, velocities, on): (Vec<V>, Vec<V>, Vec<bool>),
+        bodies: Vec<BodyState<V>>,
+    ) -> SceneRow<V> {
         SceneRow {
             t,
-            energy: self.energy(&positions, &velocities),
+            energy: self.energy(&positions, &velocities) + self.body_energy(&bodies),
             spring_energy: self.spring_energy(&positions),
             max_abs_c: self.max_abs_c(t, &positions, &on),
             positions,
             velocities,
             on,
+            bodies,
         }
     }
 
@@ -241,7 +391,7 @@ impl<V: SceneSpace> Measure<V> {
 
 /// One row of a scene run: after a step, or at t = 0.
 #[derive(Clone, Debug, PartialEq)]
-pub struct SceneRow<V = DVec2> {
+pub struct SceneRow<V: SceneSpace = DVec2> {
     /// Time.
     pub t: f64,
     /// Every bead's position, in the file's order.
@@ -251,7 +401,10 @@ pub struct SceneRow<V = DVec2> {
     /// Whether each bead is held on its wire (false in flight off a
     /// one-sided wire, and for a bead on no wire).
     pub on: Vec<bool>,
-    /// Kinetic plus gravitational energy of all beads.
+    /// Each recorded body's state (a dynamic or kinematic body), in the
+    /// file's order.
+    pub bodies: Vec<BodyState<V>>,
+    /// Kinetic plus gravitational energy of all beads and bodies.
     pub energy: f64,
     /// The energy stored in the springs (not a CSV column; the analysis
     /// tool's `compare` adds it to `energy`).
@@ -262,9 +415,11 @@ pub struct SceneRow<V = DVec2> {
 
 /// What a scene run produced.
 #[derive(Clone, Debug, Default)]
-pub struct SceneRun<V = DVec2> {
+pub struct SceneRun<V: SceneSpace = DVec2> {
     /// Every bead's name, in the file's order.
     pub names: Vec<String>,
+    /// Every recorded body's name, in the file's order.
+    pub body_names: Vec<String>,
     /// One row per step from t = 0, up to a divergence.
     pub rows: Vec<SceneRow<V>>,
     /// When a bead diverged, and why, if one did.
@@ -275,7 +430,12 @@ pub struct SceneRun<V = DVec2> {
 /// `<name>.x,<name>.y,<name>.vx,<name>.vy,<name>.on` in the plane, or
 /// `<name>.x,<name>.y,<name>.z,<name>.vx,<name>.vy,<name>.vz,<name>.on` in
 /// space (`on` 1 while held on its wire, 0 in flight off a one-sided wire
-/// or on no wire), then `energy,max_abs_c`.
+/// or on no wire), then for each dynamic or kinematic body
+/// `<name>.x,<name>.y,<name>.angle,<name>.vx,<name>.vy,<name>.w` (the
+/// angle in radians, counter-clockwise) in the plane, or
+/// `<name>.x,<name>.y,<name>.z,<name>.qx,<name>.qy,<name>.qz,<name>.qw,<name>.vx,<name>.vy,<name>.vz,<name>.wx,<name>.wy,<name>.wz`
+/// in space, then `energy,max_abs_c` (the energy the beads' and the
+/// bodies' kinetic and gravitational energy).
 pub fn write_scene_csv<V: SceneSpace>(out: impl Write, run: &SceneRun<V>) -> csv::Result<()> {
     let mut writer = csv::Writer::from_writer(out);
     let axes = &["x", "y", "z"][..V::DIMENSION];
@@ -288,6 +448,15 @@ pub fn write_scene_csv<V: SceneSpace>(out: impl Write, run: &SceneRun<V>) -> csv
             .chain(["on".to_owned()]);
         header.extend(columns.map(|c| format!("{name}.{c}")));
     }
+    for name in &run.body_names {
+        let columns = axes
+            .iter()
+            .map(|a| a.to_string())
+            .chain(V::TURN_COLUMNS.iter().map(|c| c.to_string()))
+            .chain(axes.iter().map(|a| format!("v{a}")))
+            .chain(V::SPIN_COLUMNS.iter().map(|c| c.to_string()));
+        header.extend(columns.map(|c| format!("{name}.{c}")));
+    }
     header.extend(["energy".to_owned(), "max_abs_c".to_owned()]);
     writer.write_record(&header)?;
     for row in &run.rows {
@@ -296,6 +465,14 @@ pub fn write_scene_csv<V: SceneSpace>(out: impl Write, run: &SceneRun<V>) -> csv
             record.extend(&x.xyz().to_array()[..V::DIMENSION]);
             record.extend(&v.xyz().to_array()[..V::DIMENSION]);
             record.push(f64::from(u8::from(*on)));
+        }
+        for body in &row.bodies {
+            let values = V::turn_and_spin(body.turn, body.spin);
+            let (turn, spin) = values.split_at(V::TURN_COLUMNS.len());
+            record.extend(&body.position.xyz().to_array()[..V::DIMENSION]);
+            record.extend(turn);
+            record.extend(&body.velocity.xyz().to_array()[..V::DIMENSION]);
+            record.extend(spin);
         }
         record.extend([row.energy, row.max_abs_c]);
         writer.write_record(record.iter().map(|v| format!("{v:e}")))?;
@@ -335,10 +512,11 @@ pub fn recorded_run<S: Scene>(
             v.push(recorded.velocity);
             on.push(recorded.on_wire);
         }
-        rows.push(measure.row(t, x, v, on));
+        rows.push(measure.row(t, (x, v, on), Vec::new()));
     }
     (!rows.is_empty()).then(|| SceneRun {
         names: scene.bead_names(),
+        body_names: Vec::new(),
         rows,
         diverged,
     })

@@ -74,7 +74,10 @@ fn an_unknown_field_is_refused_in_one_line_naming_it_and_its_item() {
         err.starts_with("unknown field `restitutoin` in wires[0] at line 5, column "),
         "{err}"
     );
-    assert!(err.contains("known fields: shape, position,"), "{err}");
+    assert!(
+        err.contains("known fields: name, body, shape, position,"),
+        "{err}"
+    );
     assert!(!err.contains('\n'), "{err}");
     let err = refuse("mass: 1.0", "mas: 1.0");
     assert!(

@@ -140,6 +140,8 @@ pub(in crate::preset) fn resolve_links<V: Coordinates>(
                 finite_vector("pin point", pin.at).map_err(problem(item()))?;
                 SceneLink::Pin { bead, at: pin.at }
             }
+            // A body's, not a bead's: see `check_bodies`.
+            ConstraintPreset::Path(_) => continue,
         });
     }
     for (index, spring) in springs.iter().enumerate() {

@@ -1,18 +1,29 @@
 //! The scene file's format: the serde types of `*.scene.ron`, the checks
 //! of every value in them, and the links with their beads resolved.
 
+mod bodies;
 mod links;
+mod paths;
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
+pub use bodies::{
+    BallShape, BodyKind, BodyPreset, BodyShape, BoxShape, CapsuleShape, RotationPreset, SceneBody,
+    SpaceBodyPreset, plane_inertia, space_inertia,
+};
 pub use links::SceneLink;
 pub(super) use links::{check_beads_and_links, names_of, resolve_links};
+pub use paths::{
+    ANCHOR_TOLERANCE, MotorPreset, PathPreset, PathRotationPreset, PositionMotorPreset, ScenePath,
+    VelocityMotorPreset,
+};
+pub(super) use paths::{NamedWire, check_bodies, checked_bodies};
 
 use super::error::PresetError;
 use crate::dynamics::{BeadParams, BeadRadius, Contacts, SendsBeadsBack, SimParams};
-use crate::geometry::{Coordinates, Friction, Side, Surface, WireMotion, WireShape};
+use crate::geometry::{Coordinates, Friction, Pose, Side, Surface, WireMotion, WireShape};
 use crate::validate::{ParamError, finite, finite_vector};
 
 /// A bead of a scene file: its name (optional) and its parameters.
@@ -134,19 +145,26 @@ pub struct PinPreset<V = DVec2> {
 
 /// A constraint of a scene file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum ConstraintPreset<V = DVec2> {
+#[serde(bound(
+    serialize = "V: Coordinates + Serialize",
+    deserialize = "V: Coordinates + Deserialize<'de>"
+))]
+pub enum ConstraintPreset<V: Coordinates = DVec2> {
     /// See [`Rod`](crate::Rod).
     Rod(RodPreset),
     /// See [`Pin`](crate::Pin).
     Pin(PinPreset<V>),
+    /// A body's point held on a wire (see [`PathPreset`]).
+    Path(PathPreset<V>),
 }
 
-impl<V> ConstraintPreset<V> {
-    /// `rod` or `pin`.
+impl<V: Coordinates> ConstraintPreset<V> {
+    /// `rod`, `pin` or `path`.
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Rod(_) => "rod",
             Self::Pin(_) => "pin",
+            Self::Path(_) => "path",
         }
     }
 }
@@ -172,6 +190,13 @@ pub struct SpringPreset {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WirePreset {
+    /// The name path joints refer to it by (empty, the default, for none).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub name: String,
+    /// The body it rides, by name (empty, the default, for none): its
+    /// `position` and `angle_degrees` are then in the body's frame.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub body: String,
     /// The shape, in the wire's frame.
     pub shape: WireShape,
     /// Where the wire's origin sits.
@@ -324,6 +349,9 @@ pub struct ScenePreset {
     /// How beads with radii strike.
     #[serde(default, skip_serializing_if = "ContactsPreset::is_default")]
     pub contacts: ContactsPreset,
+    /// Rigid bodies, run by avian (features `avian2d`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<BodyPreset>,
 }
 
 impl ScenePreset {
@@ -362,7 +390,26 @@ impl ScenePreset {
                 .map_err(|source| PresetError::Wire { index, source })?;
         }
         let wires: Vec<&[BeadPreset]> = self.wires.iter().map(|w| w.beads.as_slice()).collect();
-        check_beads_and_links(&wires, &self.beads, &self.constraints, &self.springs).map(drop)
+        let beads = check_beads_and_links(&wires, &self.beads, &self.constraints, &self.springs);
+        with_bodies(beads, self.bodies.is_empty())?;
+        self.paths().map(drop)
+    }
+
+    /// The path joints with their bodies and wires found, each body, wire
+    /// name and anchor checked.
+    pub fn paths(&self) -> Result<Vec<ScenePath>, PresetError> {
+        let bodies = checked_bodies(&self.bodies)?;
+        let wires: Vec<NamedWire<DVec2>> = self
+            .wires
+            .iter()
+            .map(|wire| NamedWire {
+                name: &wire.name,
+                body: &wire.body,
+                place: Pose::new(wire.position, wire.angle_degrees.to_radians()),
+                rows: vec![wire.shape.clone()],
+            })
+            .collect();
+        check_bodies(&bodies, &wires, &self.constraints)
     }
 
     /// Every bead of the file in order: the wires' beads, then the free
@@ -380,6 +427,18 @@ impl ScenePreset {
     /// indices into [`ScenePreset::all_beads`], every value checked.
     pub fn links(&self) -> Result<Vec<SceneLink>, PresetError> {
         resolve_links(&self.constraints, &self.springs, &self.bead_names())
+    }
+}
+
+/// A scene's beads and links checked, where a scene with bodies may have
+/// no bead (`no_bodies` false).
+pub(super) fn with_bodies<T>(
+    checked: Result<T, PresetError>,
+    no_bodies: bool,
+) -> Result<(), PresetError> {
+    match checked {
+        Err(PresetError::Empty) if !no_bodies => Ok(()),
+        checked => checked.map(drop),
     }
 }
 

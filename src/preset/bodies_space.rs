@@ -1,0 +1,95 @@
+//! A scene file's rigid bodies in avian3d: each body spawned as an avian
+//! body (its collider, mass, principal moments, pose, velocity and
+//! contact materials), and each path joint of the file.
+
+use avian3d::math::{AdjustPrecision, Scalar};
+use avian3d::prelude::*;
+use bevy::math::{DQuat, DVec3};
+use bevy::prelude::*;
+
+use super::{BodyKind, BodyShape, PathRotationPreset, SceneBody, ScenePath, SpaceBodyPreset};
+use crate::avian3d::{PathJoint, PathRotation, rotation_of, vector_of};
+
+/// Avian's kind of body for a scene's.
+fn rigid_body(kind: BodyKind) -> RigidBody {
+    match kind {
+        BodyKind::Dynamic => RigidBody::Dynamic,
+        BodyKind::Static => RigidBody::Static,
+        BodyKind::Kinematic => RigidBody::Kinematic,
+    }
+}
+
+/// The collider of a body's shape.
+fn collider(shape: &BodyShape<DVec3>) -> Collider {
+    let size = |x: f64| x as Scalar;
+    match shape {
+        BodyShape::Box(b) => {
+            let full = b.half_extents * 2.0;
+            Collider::cuboid(size(full.x), size(full.y), size(full.z))
+        }
+        BodyShape::Ball(b) => Collider::sphere(size(b.radius)),
+        BodyShape::Capsule(c) => Collider::capsule(size(c.radius), size(2.0 * c.half_length)),
+    }
+}
+
+/// Spawns a scene's bodies, each marked [`FromPreset`] and named; the
+/// bodies in the file's order. Call on a validated scene.
+pub(crate) fn spawn_bodies(bodies: &[SpaceBodyPreset], commands: &mut Commands) -> Vec<Entity> {
+    bodies
+        .iter()
+        .map(|body| {
+            let mut entity = commands.spawn((
+                (
+                    rigid_body(body.kind),
+                    collider(&body.shape),
+                    Position(body.position.adjust_precision()),
+                    Rotation(body.pose().rotation.adjust_precision()),
+                    LinearVelocity(body.velocity.adjust_precision()),
+                    AngularVelocity(body.angular_velocity.adjust_precision()),
+                ),
+                Restitution::new(body.restitution as Scalar),
+                Friction::new(body.friction as Scalar),
+            ));
+            if let Some((mass, moments)) = body.mass_properties() {
+                entity.insert((Mass(mass as f32), AngularInertia::new(moments.as_vec3())));
+            }
+            entity.id()
+        })
+        .collect()
+}
+
+/// The path joint of a scene's `path` on the wire `wire`.
+pub(super) fn joint(wire: Entity, path: &ScenePath<DVec3>) -> PathJoint {
+    let rotation = match path.rotation {
+        PathRotationPreset::AroundTangent => PathRotation::AroundTangent,
+        PathRotationPreset::AroundNormal => PathRotation::AroundNormal,
+        PathRotationPreset::AroundBinormal => PathRotation::AroundBinormal,
+        PathRotationPreset::ToPath => PathRotation::ToPath,
+        PathRotationPreset::Fixed => PathRotation::Fixed,
+        PathRotationPreset::Free | PathRotationPreset::Tangent => PathRotation::Free,
+    };
+    let joint = PathJoint::new(wire)
+        .with_anchor(path.anchor)
+        .with_friction(path.friction)
+        .with_rotation(rotation);
+    match path.motor {
+        Some(motor) => joint.with_motor(motor),
+        None => joint,
+    }
+}
+
+/// The state of the rigid body `body` as a scene's run records it: its
+/// origin, its rotation, its velocity and spin; `None` where it is no
+/// avian3d body.
+pub(crate) fn body_state(world: &World, body: Entity) -> Option<(DVec3, DQuat, DVec3, DVec3)> {
+    let position = world.get::<Position>(body)?;
+    let rotation = world.get::<Rotation>(body)?;
+    let velocity = world.get::<LinearVelocity>(body)?;
+    let spin = world.get::<AngularVelocity>(body)?;
+    Some((
+        vector_of(position.0),
+        rotation_of(rotation.0),
+        vector_of(velocity.0),
+        vector_of(spin.0),
+    ))
+}
