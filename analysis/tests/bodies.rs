@@ -58,7 +58,8 @@ fn a_scene_with_bodies_is_refused_by_a_build_without_avian() {
 }
 
 /// The box's columns follow the beads' (there are none), in the format's
-/// order; it stays on its hoop (1e-5 m) and never turns (1e-5 rad), and
+/// order; it stays on its hoop (1e-5 m, as `max_abs_c` says of its
+/// joint) and never turns (1e-5 rad), and
 /// the energy, the body's kinetic and gravitational, stays within 1e-2 J
 /// (5e-4 of `m g r`) of its start over 2 s: avian's substeps turn the
 /// joint's corrections into velocity to first order in the substep.
@@ -83,6 +84,8 @@ fn a_scene_with_a_body_writes_its_columns_and_its_energy() {
         off = off.max((row[1].hypot(row[2]) - 1.0).abs());
         turned = turned.max(row[3].abs());
         energy = energy.max(row[7].abs());
+        // The joint's anchor measured on its wire, as the column says.
+        assert!((row[8] - (row[1].hypot(row[2]) - 1.0).abs()).abs() < 1e-12);
     }
     println!("off the hoop {off:.2e} m, turned {turned:.2e} rad, energy within {energy:.2e} J");
     assert!(off <= 1e-5, "{off:e} m off the hoop");
@@ -130,6 +133,11 @@ fn a_scene_in_space_with_a_body_writes_its_quaternion_and_spin() {
         across = across.max((row[1] - 2.3).abs());
         turned = turned.max((row[7].abs() - 1.0).abs());
         energy = energy.max((row[14] - rows[0][14]).abs());
+        assert!(
+            row[15] <= 1e-5,
+            "the joint's anchor is {} m off the hoop",
+            row[15]
+        );
     }
     println!("across the door {across:.2e} m, turned {turned:.2e}, energy within {energy:.2e} J");
     assert!(across <= 1e-5, "left the door's plane by {across:e} m");
@@ -139,4 +147,59 @@ fn a_scene_in_space_with_a_body_writes_its_quaternion_and_spin() {
         rows.iter().any(|r| r[2] < -0.49),
         "never reached the bottom"
     );
+}
+
+/// A bead of a scene on a hoop that rides a free body (no gravity, 60 Hz):
+/// the bead rides the hoop and pushes its hub, and the CSV's columns turn
+/// the pair as the two-body answer says, to 1e-4 m over 5 s; their
+/// momentum stays to 1e-5 of itself, the hub never spins (1e-5 rad/s),
+/// and `max_abs_c` measures the bead against the hoop where the hub has
+/// it (1e-5 m). Neither sleeps: the hub slows to 0.012 m/s near 4.2 s,
+/// where avian would put it to sleep alone and lose the pair's momentum.
+#[cfg(feature = "avian2d")]
+#[test]
+fn a_scene_beads_on_a_hoop_on_a_free_body_turn_the_pair_as_two_bodies_do() {
+    use bevy::math::DVec3;
+    let text = r#"(
+        name: "A bead on a hoop on a free hub",
+        params: (integrator: Rattle, timestep: 0.016666666666666666, gravity: (0.0, 0.0)),
+        bodies: [(name: "hub", shape: Ball((radius: 0.1)), mass: 3.0, inertia: 0.5, position: (0.0, 0.0))],
+        wires: [(name: "hoop", body: "hub", shape: Circle((radius: 1.0)), beads: [
+            (name: "b", mass: 1.0, initial_position: (1.0, 0.0), initial_velocity: (0.0, 1.5)),
+        ])],
+    )"#;
+    let wirebead::SceneFile::Plane(scene) = scene_file("hub", text) else {
+        panic!("a scene in the plane");
+    };
+    let run = analysis::simulate_scene(&scene, scene.params.clone(), 5.0).unwrap();
+    assert!(run.diverged.is_none(), "{:?}", run.diverged);
+    let (header, rows) = csv_of(&run);
+    assert_eq!(
+        header.join(","),
+        "t,b.x,b.y,b.vx,b.vy,b.on,hub.x,hub.y,hub.angle,hub.vx,hub.vy,hub.w,energy,max_abs_c"
+    );
+    assert_eq!(rows.len(), 301, "t = 0 and 300 steps");
+    let (mut off, mut drift, mut spin, mut c) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for row in &rows {
+        let (bead_at, hub_at) = wirebead::reference::bead_on_a_free_hoop(
+            (1.0, 3.0),
+            (DVec3::X, DVec3::new(0.0, 1.5, 0.0)),
+            (DVec3::ZERO, DVec3::ZERO),
+            row[0],
+        );
+        off = off
+            .max((DVec3::new(row[1], row[2], 0.0) - bead_at).length())
+            .max((DVec3::new(row[6], row[7], 0.0) - hub_at).length());
+        let momentum = (row[3] + 3.0 * row[9]).hypot(row[4] + 3.0 * row[10] - 1.5);
+        drift = drift.max(momentum / 1.5);
+        spin = spin.max(row[11].abs());
+        c = c.max(row[13]);
+    }
+    println!(
+        "off the two-body answer {off:.2e} m, momentum {drift:.2e}, spin {spin:.2e} rad/s, max |C| {c:.2e} m"
+    );
+    assert!(off <= 1e-4, "{off:e} m off the two-body answer");
+    assert!(drift <= 1e-5, "the momentum changed by {drift:e} of itself");
+    assert!(spin <= 1e-5, "the hub spins at {spin:e} rad/s");
+    assert!(c <= 1e-5, "the bead is {c:e} m off its hoop");
 }

@@ -203,7 +203,7 @@ fn placed_body((position, rotation, centre): Placing, anchor: DVec3) -> SpaceBod
 fn prepare_path_joints(
     mut joints: Query<(Entity, &PathJoint, &mut PathJointState, Placing)>,
     bodies: Query<Placing, With<RigidBody>>,
-    sleeping: Query<(), With<Sleeping>>,
+    sleeping: Query<(Has<Sleeping>, Has<SleepingDisabled>)>,
     wires: Wires,
     clock: Res<SimClock>,
     params: Res<SimParams>,
@@ -221,13 +221,9 @@ fn prepare_path_joints(
             .filter(|&e| e != entity)
             .and_then(|e| bodies.get(e).ok().map(|b| (e, placed_body(b, DVec3::ZERO))));
         state.1 = carrier.map(|(e, _)| e);
-        // Avian sleeps each body on its own: one of a pair asleep while
-        // the other moves is woken, so the joint holds them together.
-        if let Some((e, _)) = carrier
-            && sleeping.contains(e) != sleeping.contains(entity)
-        {
-            let asleep = if sleeping.contains(e) { e } else { entity };
-            commands.queue(WakeBody(asleep));
+        if let Some((e, _)) = carrier {
+            let never = (SleepingDisabled, WakeBody);
+            crate::carrier::keep_awake([e, entity], &sleeping, never, &mut commands);
         }
         let at = Held {
             body,

@@ -55,6 +55,30 @@ pub(crate) fn each_carried<J, T, S, I>(
     }
 }
 
+/// Keeps a body held on a carried wire and its carrier (`pair`) awake
+/// for good: avian sleeps bodies one by one and a body asleep keeps no
+/// velocity, so one of the pair falling asleep while the other moves
+/// would take the pair's momentum with it. `S` is avian's `Sleeping`, `D`
+/// its `SleepingDisabled` (`never`), `wake` its `WakeBody`.
+pub(crate) fn keep_awake<S: Component, D: Component + Copy, W: Command>(
+    pair: [Entity; 2],
+    states: &Query<(Has<S>, Has<D>)>,
+    (never, wake): (D, impl Fn(Entity) -> W),
+    commands: &mut Commands,
+) {
+    for body in pair {
+        let Ok((asleep, kept)) = states.get(body) else {
+            continue;
+        };
+        if !kept {
+            commands.entity(body).try_insert(never);
+        }
+        if asleep {
+            commands.queue(wake(body));
+        }
+    }
+}
+
 /// Stops each bead of ours on a wire that rides a body that no avian
 /// plugin boarded (none of its dimension was added), before the step, and
 /// says why in one line: the wire is placed in the body's frame, which the

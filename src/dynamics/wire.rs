@@ -414,8 +414,10 @@ pub struct WireBeads(Vec<Entity>);
 /// its wire invalid) and says why in words: one joined to other beads or
 /// with a radius, one on a one-sided, rough or damped wire, one whose
 /// wire rides an entity that is no rigid body. Avian sleeps bodies
-/// one by one: where one of a carrier and a body held on its wire sleeps
-/// while the other moves, the sleeper is woken.
+/// one by one, and a body asleep keeps no velocity: a carrier and each
+/// body (or bead) held on its wire are given `SleepingDisabled`, so that
+/// neither falls asleep while the other moves and takes the pair's
+/// momentum with it.
 #[cfg(any(feature = "avian2d", feature = "avian3d"))]
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq, Reflect)]
 #[reflect(Component)]

@@ -8,12 +8,17 @@ use std::io::Write;
 use bevy::math::{DQuat, DVec2, DVec3};
 use bevy::prelude::{Commands, Entity, World};
 
-use super::{BodyKind, SceneBody, SceneFile, SceneLink, ScenePreset, SpaceScene};
+use super::{SceneFile, ScenePreset, SpaceScene};
 use crate::dynamics::{Dimension, SimParams};
 use crate::geometry::{
     ImplicitCurve, Placed, Pose, Pose3, SpaceMotion, SpaceShape, WireMotion, WireShape, WireSpace,
 };
 use crate::plugin::{RecordedBead, Timeline};
+
+mod measure;
+
+pub use measure::{BodyState, Measure};
+use measure::{carried_by, joints, masses, recorded};
 
 /// The plane or space as a scene's run is measured in it: how far a bead
 /// is off its wire, and a rigid body's state as a row writes it.
@@ -38,6 +43,11 @@ pub trait SceneSpace: Dimension {
     /// The state of the rigid body `body` in `world`; `None` where it is
     /// none (or the build has no avian of this dimension).
     fn body(world: &World, body: Entity) -> Option<BodyState<Self>>;
+    /// Where a body of a row is.
+    fn body_pose(body: &BodyState<Self>) -> Self::Pose;
+    /// The wire of `check` on a body at `on` (its own place then in the
+    /// body's frame).
+    fn carried(check: &Self::WireCheck, on: &Self::Pose) -> Self::WireCheck;
     /// `|C|` of a bead at `x` on `wire` at time `t`: in space, over a
     /// curve's two rows, the length of its offset.
     fn drift(wire: &Self::WireCheck, t: f64, x: Self) -> f64;
@@ -64,6 +74,12 @@ impl SceneSpace for DVec2 {
     #[cfg(not(feature = "avian2d"))]
     fn body(_: &World, _: Entity) -> Option<BodyState<Self>> {
         None
+    }
+    fn body_pose(body: &BodyState<Self>) -> Pose {
+        Pose::new(body.position, body.turn)
+    }
+    fn carried((shape, pose, motion): &Self::WireCheck, on: &Pose) -> Self::WireCheck {
+        (shape.clone(), on.compose(pose), *motion)
     }
     fn drift((shape, pose, motion): &Self::WireCheck, t: f64, x: Self) -> f64 {
         Placed {
@@ -100,6 +116,15 @@ impl SceneSpace for DVec3 {
     #[cfg(not(feature = "avian3d"))]
     fn body(_: &World, _: Entity) -> Option<BodyState<Self>> {
         None
+    }
+    fn body_pose(body: &BodyState<Self>) -> Pose3 {
+        Pose3 {
+            origin: body.position,
+            rotation: body.turn,
+        }
+    }
+    fn carried((shape, pose, motion): &Self::WireCheck, on: &Pose3) -> Self::WireCheck {
+        (shape.clone(), on.compose(pose), *motion)
     }
     fn drift((shape, pose, motion): &Self::WireCheck, t: f64, x: Self) -> f64 {
         let local = motion.at(*pose, t).0.to_local(x);
@@ -156,15 +181,23 @@ impl Scene for ScenePreset {
     fn measure(&self) -> Result<Measure<DVec2>, String> {
         let wires = self.wires.iter().map(|wire| {
             let pose = Pose::new(wire.position, wire.angle_degrees.to_radians());
-            ((wire.shape.clone(), pose, wire.motion), wire.beads.len())
+            let check = (wire.shape.clone(), pose, wire.motion);
+            let (check, carrier) = carried_by::<DVec2, _>(check, &self.bodies, &wire.body);
+            (check, carrier, wire.beads.len())
         });
         let measure = Measure::new(
-            wires,
+            wires.clone(),
             self.links().map_err(|e| e.to_string())?,
             self.all_beads().map(|b| b.mass).collect(),
             self.params.gravity,
         );
-        Ok(measure.with_bodies(masses(&self.bodies)))
+        let wires: Vec<_> = wires.map(|(check, carrier, _)| (check, carrier)).collect();
+        let paths = self.paths().map_err(|e| e.to_string())?;
+        Ok(measure.with_bodies(masses(&self.bodies)).with_paths(joints(
+            &paths,
+            &wires,
+            &self.bodies,
+        )))
     }
 }
 
@@ -193,199 +226,25 @@ impl Scene for SpaceScene {
         for wire in &self.wires {
             let pose = wire.pose().map_err(|e| e.to_string())?;
             let check = (wire.shape.shape(), pose, wire.motion.motion());
-            wires.push((check, wire.beads.len()));
+            let (check, carrier) = carried_by::<DVec3, _>(check, &self.bodies, &wire.body);
+            wires.push((check, carrier, wire.beads.len()));
         }
         let measure = Measure::new(
-            wires.into_iter(),
+            wires.clone().into_iter(),
             self.links().map_err(|e| e.to_string())?,
             self.all_beads().map(|b| b.mass).collect(),
             self.params.0.gravity_in_space(),
         );
-        Ok(measure.with_bodies(masses(&self.bodies)))
-    }
-}
-
-/// Each body's name, and whether a run records it (a dynamic or kinematic
-/// body; a static one never moves).
-fn recorded<B: SceneBody>(bodies: &[B]) -> Vec<(String, bool)> {
-    bodies
-        .iter()
-        .map(|b| (b.name().to_owned(), b.kind() != BodyKind::Static))
-        .collect()
-}
-
-/// Each recorded body's mass and principal moments.
-fn masses<B: SceneBody>(bodies: &[B]) -> Vec<Option<(f64, B::Inertia)>> {
-    bodies
-        .iter()
-        .filter(|b| b.kind() != BodyKind::Static)
-        .map(SceneBody::mass_properties)
-        .collect()
-}
-
-/// One constraint to measure, with beads as indices in the file's order.
-#[derive(Clone, Debug)]
-enum Check<V: SceneSpace> {
-    /// A bead on a wire.
-    Wire(usize, V::WireCheck),
-    Rod(usize, usize, f64),
-    Pin(usize, V),
-}
-
-/// What a scene's rows are measured against: its constraints, springs and
-/// masses.
-#[derive(Clone, Debug)]
-pub struct Measure<V: SceneSpace> {
-    checks: Vec<Check<V>>,
-    springs: Vec<(usize, usize, f64, f64)>,
-    masses: Vec<f64>,
-    gravity: V,
-    /// Each recorded body's mass and principal moments (none for a
-    /// kinematic body given no mass).
-    bodies: Vec<Option<(f64, V::Inertia)>>,
-}
-
-/// A rigid body's state in a row of a scene's run: its origin, its turn,
-/// its velocity and its spin.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BodyState<V: SceneSpace> {
-    /// Where its origin is.
-    pub position: V,
-    /// How it is turned.
-    pub turn: V::Turn,
-    /// Its velocity.
-    pub velocity: V,
-    /// Its spin (counter-clockwise in the plane; right-handed in space).
-    pub spin: V::Angular,
-}
-
-impl<V: SceneSpace> From<(V, V::Turn, V, V::Angular)> for BodyState<V> {
-    fn from((position, turn, velocity, spin): (V, V::Turn, V, V::Angular)) -> Self {
-        Self {
-            position,
-            turn,
-            velocity,
-            spin,
-        }
-    }
-}
-
-/// `|v|`.
-fn length<V: SceneSpace>(v: V) -> f64 {
-    v.dot(v).sqrt()
-}
-
-impl<V: SceneSpace> Measure<V> {
-    /// A scene's measure: each wire with its number of beads (the wires'
-    /// beads come first in the file's order), the links, every bead's
-    /// mass and gravity.
-    pub(crate) fn new(
-        wires: impl Iterator<Item = (V::WireCheck, usize)>,
-        links: Vec<SceneLink<V>>,
-        masses: Vec<f64>,
-        gravity: V,
-    ) -> Self {
-        let mut checks = Vec::new();
-        let mut bead = 0;
-        for (wire, count) in wires {
-            for _ in 0..count {
-                checks.push(Check::Wire(bead, wire.clone()));
-                bead += 1;
-            }
-        }
-        let mut springs = Vec::new();
-        for link in links {
-            match link {
-                SceneLink::Rod { a, b, length } => checks.push(Check::Rod(a, b, length)),
-                SceneLink::Pin { bead, at } => checks.push(Check::Pin(bead, at)),
-                SceneLink::Spring { a, b, spring } => {
-                    springs.push((a, b, spring.rest_length, spring.stiffness))
-                }
-            }
-        }
-        Self {
-            checks,
-            springs,
-            masses,
-            gravity,
-            bodies: Vec::new(),
-        }
-    }
-
-    /// The measure with the recorded bodies' masses and moments.
-    pub(crate) fn with_bodies(self, bodies: Vec<Option<(f64, V::Inertia)>>) -> Self {
-        Self { bodies, ..self }
-    }
-
-    /// Kinetic plus gravitational energy of the bodies at `states`.
-    pub fn body_energy(&self, states: &[BodyState<V>]) -> f64 {
-        self.bodies
-            .iter()
-            .zip(states)
-            .filter_map(|(mass, state)| {
-                let (m, inertia) = (*mass)?;
-                let (x, v) = (state.position, state.velocity);
-                Some(
-                    0.5 * m * v.dot(v) - m * self.gravity.dot(x)
-                        + V::spin_energy(inertia, state.turn, state.spin),
-                )
-            })
-            .sum()
-    }
-
-    /// The largest `|C|` at time `t` of every constraint, wires included
-    /// (a bead in flight off its wire left out).
-    pub fn max_abs_c(&self, t: f64, x: &[V], on: &[bool]) -> f64 {
-        self.checks
-            .iter()
-            .map(|check| match check {
-                Check::Wire(b, _) if !on[*b] => 0.0,
-                Check::Wire(b, wire) => V::drift(wire, t, x[*b]),
-                Check::Rod(a, b, rod) => (length(x[*a] - x[*b]) - rod).abs(),
-                Check::Pin(b, at) => length(x[*b] - *at),
-            })
-            .fold(0.0, f64::max)
-    }
-
-    /// Kinetic plus gravitational energy of every bead.
-    pub fn energy(&self, x: &[V], v: &[V]) -> f64 {
-        self.masses
-            .iter()
-            .zip(x.iter().zip(v))
-            .map(|(m, (x, v))| 0.5 * m * v.dot(*v) - m * self.gravity.dot(*x))
-            .sum()
-    }
-
-    /// The row of the scene's state at time `t`: every bead's position
-    /// and velocity in the file's order, whether each is held on its wire,
-    /// and each recorded body's state.
-    pub fn row(
-        &self,
-        t: f64,
-        (positions, velocities, on): (Vec<V>, Vec<V>, Vec<bool>),
-        bodies: Vec<BodyState<V>>,
-    ) -> SceneRow<V> {
-        SceneRow {
-            t,
-            energy: self.energy(&positions, &velocities) + self.body_energy(&bodies),
-            spring_energy: self.spring_energy(&positions),
-            max_abs_c: self.max_abs_c(t, &positions, &on),
-            positions,
-            velocities,
-            on,
-            bodies,
-        }
-    }
-
-    /// The energy stored in the springs.
-    pub fn spring_energy(&self, x: &[V]) -> f64 {
-        self.springs
-            .iter()
-            .map(|&(a, b, rest, k)| {
-                let stretch = length(x[a] - x[b]) - rest;
-                0.5 * k * stretch * stretch
-            })
-            .sum()
+        let wires: Vec<_> = wires
+            .into_iter()
+            .map(|(check, carrier, _)| (check, carrier))
+            .collect();
+        let paths = self.paths().map_err(|e| e.to_string())?;
+        Ok(measure.with_bodies(masses(&self.bodies)).with_paths(joints(
+            &paths,
+            &wires,
+            &self.bodies,
+        )))
     }
 }
 
