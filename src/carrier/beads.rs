@@ -64,8 +64,9 @@ pub(crate) trait PointBodies: Send + Sync + 'static {
     fn point_body(bead: Boarder<Self::V>, gravity: Self::V) -> impl Bundle;
 }
 
-/// The beads are boarded in this set (before the plugin's step, after its
-/// islands are built), and the beads left on carried wires stopped after
+/// The beads are boarded in this set, in
+/// [`WireBeadSystems::Prepare`](crate::WireBeadSystems::Prepare) before
+/// the plugin's step; the beads left on carried wires are stopped after
 /// it.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct Boarding;
