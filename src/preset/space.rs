@@ -445,10 +445,9 @@ impl SpaceScene {
             self.params.0.gravity_in_space().adjust_precision(),
         ));
         let bodies = super::bodies_space::spawn_bodies(&self.bodies, commands);
-        let names: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
         super::spawn::join_bodies(
             (wires, &bodies),
-            (self.wires.iter().map(|w| w.body.as_str()), &names),
+            (self.wires.iter().map(|w| w.body.as_str()), &self.bodies),
             &self.paths().unwrap_or_default(),
             super::bodies_space::joint,
             commands,

@@ -73,10 +73,9 @@ impl ScenePreset {
             self.params.gravity.adjust_precision(),
         ));
         let bodies = super::bodies_plane::spawn_bodies(&self.bodies, commands);
-        let names: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
         join_bodies(
             (wires, &bodies),
-            (self.wires.iter().map(|w| w.body.as_str()), &names),
+            (self.wires.iter().map(|w| w.body.as_str()), &self.bodies),
             &self.paths().unwrap_or_default(),
             super::bodies_plane::joint,
             commands,
@@ -103,20 +102,27 @@ pub(super) fn bodies_left_out(scene: &str, count: usize, feature: &str) -> Vec<E
     Vec::new()
 }
 
-/// Joins a scene's spawned bodies to the rest of it: each wire whose
-/// body is named (`wire_bodies`, each wire's; `names`, each body's) rides
-/// that body, each path joint is put on its body (`joint` making it from
-/// its wire's entity), and each body is named and marked [`FromPreset`].
+/// Joins a scene's spawned `bodies` (of the file's `presets`, in order)
+/// to the rest of it: each wire whose body is named (`wire_bodies`, each
+/// wire's) rides that body, each path joint is put on its body (`joint`
+/// making it from its wire's entity), and each body is named and marked
+/// [`FromPreset`].
 #[cfg(any(feature = "avian2d", feature = "avian3d"))]
-pub(super) fn join_bodies<'a, V: crate::geometry::Coordinates, J: Bundle>(
+pub(super) fn join_bodies<'a, V, B, J>(
     (wires, bodies): (&[Option<Entity>], &[Entity]),
-    (wire_bodies, names): (impl Iterator<Item = &'a str>, &[&str]),
+    (wire_bodies, presets): (impl Iterator<Item = &'a str>, &[B]),
     paths: &[super::ScenePath<V>],
     joint: impl Fn(Entity, &super::ScenePath<V>) -> J,
     commands: &mut Commands,
-) {
+) where
+    V: crate::geometry::Coordinates,
+    B: super::SceneBody,
+    J: Bundle,
+{
     for (wire, body) in wires.iter().zip(wire_bodies) {
-        let carrier = names.iter().position(|n| !body.is_empty() && *n == body);
+        let carrier = presets
+            .iter()
+            .position(|b| !body.is_empty() && b.name() == body);
         if let (Some(wire), Some(carrier)) = (wire, carrier) {
             commands
                 .entity(*wire)
@@ -128,10 +134,10 @@ pub(super) fn join_bodies<'a, V: crate::geometry::Coordinates, J: Bundle>(
             commands.entity(bodies[path.body]).insert(joint(wire, path));
         }
     }
-    for (&body, name) in bodies.iter().zip(names) {
+    for (&body, preset) in bodies.iter().zip(presets) {
         commands
             .entity(body)
-            .insert((Name::new((*name).to_owned()), FromPreset));
+            .insert((Name::new(preset.name().to_owned()), FromPreset));
     }
 }
 

@@ -6,21 +6,23 @@ use super::{SceneRow, SceneSpace};
 use crate::geometry::Placement;
 use crate::preset::{BodyKind, SceneBody, SceneLink, ScenePath};
 
-/// Each body's name, and whether a run records it (a dynamic or kinematic
-/// body; a static one never moves).
+/// Whether a run records a body: a dynamic or kinematic one (a static
+/// one never moves).
+fn moves<B: SceneBody>(body: &B) -> bool {
+    body.kind() != BodyKind::Static
+}
+
+/// The index among the recorded bodies of `bodies[index]`, if a run
+/// records it.
+fn recorded_index<B: SceneBody>(bodies: &[B], index: usize) -> Option<usize> {
+    moves(&bodies[index]).then(|| bodies[..index].iter().filter(|b| moves(*b)).count())
+}
+
+/// Each body's name, and whether a run records it.
 pub(super) fn recorded<B: SceneBody>(bodies: &[B]) -> Vec<(String, bool)> {
     bodies
         .iter()
-        .map(|b| (b.name().to_owned(), b.kind() != BodyKind::Static))
-        .collect()
-}
-
-/// Each recorded body's mass and principal moments.
-pub(super) fn masses<B: SceneBody>(bodies: &[B]) -> Vec<Option<(f64, B::Inertia)>> {
-    bodies
-        .iter()
-        .filter(|b| b.kind() != BodyKind::Static)
-        .map(SceneBody::mass_properties)
+        .map(|b| (b.name().to_owned(), moves(b)))
         .collect()
 }
 
@@ -33,37 +35,16 @@ pub(super) fn carried_by<V: SceneSpace, B: SceneBody<Pose = V::Pose>>(
     bodies: &[B],
     body: &str,
 ) -> (V::WireCheck, Option<usize>) {
-    let recorded = bodies.iter().filter(|b| b.kind() != BodyKind::Static);
-    match bodies.iter().find(|b| !body.is_empty() && b.name() == body) {
-        Some(b) if b.kind() == BodyKind::Static => (V::carried(&check, &b.pose()), None),
-        Some(_) => (check, recorded.clone().position(|b| b.name() == body)),
-        None => (check, None),
-    }
-}
-
-/// The path joints of recorded bodies as measured: each body's index
-/// among the recorded ones, its anchor, and its wire (`wires`, each with
-/// the recorded body it rides).
-pub(super) fn joints<V: SceneSpace, B: SceneBody>(
-    paths: &[ScenePath<V>],
-    wires: &[(V::WireCheck, Option<usize>)],
-    bodies: &[B],
-) -> Vec<(usize, V, V::WireCheck, Option<usize>)> {
-    let recorded = |index: usize| {
-        (bodies[index].kind() != BodyKind::Static).then(|| {
-            bodies[..index]
-                .iter()
-                .filter(|b| b.kind() != BodyKind::Static)
-                .count()
-        })
-    };
-    paths
+    let Some(index) = bodies
         .iter()
-        .filter_map(|path| {
-            let (wire, carrier) = wires.get(path.wire)?.clone();
-            Some((recorded(path.body)?, path.anchor, wire, carrier))
-        })
-        .collect()
+        .position(|b| !body.is_empty() && b.name() == body)
+    else {
+        return (check, None);
+    };
+    match recorded_index(bodies, index) {
+        Some(recorded) => (check, Some(recorded)),
+        None => (V::carried(&check, &bodies[index].pose()), None),
+    }
 }
 
 /// One constraint to measure, with beads as indices in the file's order.
@@ -128,7 +109,7 @@ impl<V: SceneSpace> Measure<V> {
     /// beads come first in the file's order), the links, every bead's
     /// mass and gravity.
     pub(crate) fn new(
-        wires: impl Iterator<Item = (V::WireCheck, Option<usize>, usize)>,
+        wires: &[(V::WireCheck, Option<usize>, usize)],
         links: Vec<SceneLink<V>>,
         masses: Vec<f64>,
         gravity: V,
@@ -136,8 +117,8 @@ impl<V: SceneSpace> Measure<V> {
         let mut checks = Vec::new();
         let mut bead = 0;
         for (wire, carrier, count) in wires {
-            for _ in 0..count {
-                checks.push(Check::Wire(bead, wire.clone(), carrier));
+            for _ in 0..*count {
+                checks.push(Check::Wire(bead, wire.clone(), *carrier));
                 bead += 1;
             }
         }
@@ -160,21 +141,27 @@ impl<V: SceneSpace> Measure<V> {
         }
     }
 
-    /// The measure with the recorded bodies' masses and moments.
-    pub(crate) fn with_bodies(self, bodies: Vec<Option<(f64, V::Inertia)>>) -> Self {
-        Self { bodies, ..self }
-    }
-
-    /// The measure with path joints to measure: each a recorded body, its
-    /// anchor and its wire (see [`joints`]).
-    pub(super) fn with_paths(
+    /// The measure with a scene's bodies: each recorded body's mass and
+    /// principal moments, and each path joint of a recorded body (its
+    /// anchor on its wire, `wires` as [`Measure::new`] took them).
+    pub(super) fn with_scene_bodies<B: SceneBody<Inertia = V::Inertia>>(
         mut self,
-        paths: Vec<(usize, V, V::WireCheck, Option<usize>)>,
+        wires: &[(V::WireCheck, Option<usize>, usize)],
+        paths: &[ScenePath<V>],
+        bodies: &[B],
     ) -> Self {
-        let joints = paths
-            .into_iter()
-            .map(|(body, anchor, wire, carrier)| Check::Path(body, anchor, wire, carrier));
-        self.checks.extend(joints);
+        self.bodies = bodies
+            .iter()
+            .filter(|b| moves(*b))
+            .map(SceneBody::mass_properties)
+            .collect();
+        for path in paths {
+            let body = recorded_index(bodies, path.body);
+            if let (Some(body), Some((wire, carrier, _))) = (body, wires.get(path.wire)) {
+                let check = Check::Path(body, path.anchor, wire.clone(), *carrier);
+                self.checks.push(check);
+            }
+        }
         self
     }
 

@@ -18,7 +18,7 @@ use crate::plugin::{RecordedBead, Timeline};
 mod measure;
 
 pub use measure::{BodyState, Measure};
-use measure::{carried_by, joints, masses, recorded};
+use measure::{carried_by, recorded};
 
 /// The plane or space as a scene's run is measured in it: how far a bead
 /// is off its wire, and a rigid body's state as a row writes it.
@@ -179,25 +179,24 @@ impl Scene for ScenePreset {
         recorded(&self.bodies)
     }
     fn measure(&self) -> Result<Measure<DVec2>, String> {
-        let wires = self.wires.iter().map(|wire| {
-            let pose = Pose::new(wire.position, wire.angle_degrees.to_radians());
-            let check = (wire.shape.clone(), pose, wire.motion);
-            let (check, carrier) = carried_by::<DVec2, _>(check, &self.bodies, &wire.body);
-            (check, carrier, wire.beads.len())
-        });
+        let wires: Vec<_> = self
+            .wires
+            .iter()
+            .map(|wire| {
+                let pose = Pose::new(wire.position, wire.angle_degrees.to_radians());
+                let check = (wire.shape.clone(), pose, wire.motion);
+                let (check, carrier) = carried_by::<DVec2, _>(check, &self.bodies, &wire.body);
+                (check, carrier, wire.beads.len())
+            })
+            .collect();
         let measure = Measure::new(
-            wires.clone(),
+            &wires,
             self.links().map_err(|e| e.to_string())?,
             self.all_beads().map(|b| b.mass).collect(),
             self.params.gravity,
         );
-        let wires: Vec<_> = wires.map(|(check, carrier, _)| (check, carrier)).collect();
         let paths = self.paths().map_err(|e| e.to_string())?;
-        Ok(measure.with_bodies(masses(&self.bodies)).with_paths(joints(
-            &paths,
-            &wires,
-            &self.bodies,
-        )))
+        Ok(measure.with_scene_bodies(&wires, &paths, &self.bodies))
     }
 }
 
@@ -230,21 +229,13 @@ impl Scene for SpaceScene {
             wires.push((check, carrier, wire.beads.len()));
         }
         let measure = Measure::new(
-            wires.clone().into_iter(),
+            &wires,
             self.links().map_err(|e| e.to_string())?,
             self.all_beads().map(|b| b.mass).collect(),
             self.params.0.gravity_in_space(),
         );
-        let wires: Vec<_> = wires
-            .into_iter()
-            .map(|(check, carrier, _)| (check, carrier))
-            .collect();
         let paths = self.paths().map_err(|e| e.to_string())?;
-        Ok(measure.with_bodies(masses(&self.bodies)).with_paths(joints(
-            &paths,
-            &wires,
-            &self.bodies,
-        )))
+        Ok(measure.with_scene_bodies(&wires, &paths, &self.bodies))
     }
 }
 
