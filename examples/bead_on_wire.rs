@@ -65,34 +65,56 @@ struct Args {
 fn main() -> AppExit {
     let args = Args::parse();
     let preset = args.preset.clone();
-    App::new()
-        .add_plugins(
-            DefaultPlugins
-                .set(WindowPlugin {
-                    primary_window: Some(Window {
-                        title: "wirebead: a bead on a wire".into(),
-                        resolution: WindowResolution::new(args.width, args.height),
-                        ..default()
-                    }),
-                    ..default()
-                })
-                .set(AssetPlugin {
-                    watch_for_changes_override: Some(true),
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(WindowPlugin {
+                primary_window: Some(Window {
+                    title: "wirebead: a bead on a wire".into(),
+                    resolution: WindowResolution::new(args.width, args.height),
                     ..default()
                 }),
-        )
-        .add_plugins((WireBeadPlugin::default(), WireBeadGuiPlugin))
-        .insert_resource(ExportDir(args.export_dir))
-        .insert_resource(Presentation(args.present))
-        .add_plugins(AutomationPlugin {
-            frames: args.frames,
-            screenshot: args.screenshot,
-            ready: args.ready,
-            report: args.report,
-            finish_when: args.finish_when,
-        })
-        .add_systems(Startup, move |mut loads: MessageWriter<LoadPreset>| {
-            loads.write(LoadPreset(preset.clone()));
-        })
-        .run()
+                ..default()
+            })
+            .set(AssetPlugin {
+                watch_for_changes_override: Some(true),
+                ..default()
+            }),
+    )
+    .add_plugins((WireBeadPlugin::default(), WireBeadGuiPlugin))
+    .insert_resource(ExportDir(args.export_dir))
+    .insert_resource(Presentation(args.present))
+    .add_plugins(AutomationPlugin {
+        frames: args.frames,
+        screenshot: args.screenshot,
+        ready: args.ready,
+        report: args.report,
+        finish_when: args.finish_when,
+    })
+    .add_systems(Startup, move |mut loads: MessageWriter<LoadPreset>| {
+        loads.write(LoadPreset(preset.clone()));
+    });
+    add_rigid_bodies(&mut app);
+    app.run()
+}
+
+/// Avian's physics of each dimension the build has (features `avian2d`,
+/// `avian3d`), for scenes with rigid bodies; a build with neither runs
+/// such scenes with their bodies left out, and says so.
+fn add_rigid_bodies(_app: &mut App) {
+    #[cfg(feature = "avian2d")]
+    _app.add_plugins((
+        avian2d::prelude::PhysicsPlugins::default(),
+        wirebead::avian::PathJointPlugin,
+    ));
+    #[cfg(feature = "avian3d")]
+    {
+        use bevy::app::PluginGroup as _;
+        let physics = avian3d::prelude::PhysicsPlugins::default().build();
+        // Each avian's interpolation adds the one plugin an app takes once
+        // (`bevy_transform_interpolation`'s): avian2d's has added it.
+        #[cfg(feature = "avian2d")]
+        let physics = physics.disable::<avian3d::prelude::PhysicsInterpolationPlugin>();
+        _app.add_plugins((physics, wirebead::avian3d::PathJointPlugin));
+    }
 }

@@ -43,6 +43,7 @@
 //! | [`Method`] | an [`Integrator`] with its [`Stabilization`] (RATTLE takes none) |
 //! | [`KeyboardControlsPlugin`] | Space restarts, P pauses, N steps once: headless-testable |
 //! | [`SpringAnchor`] | a point a spring `k (anchor - x)` pulls a bead toward (the assignment's mouse drag) |
+//! | [`GrabPoint`] | the point of an avian body a [`SpringAnchor`] on it pulls (the scene's drag of a body) |
 //! | [`BeadDiagnostics`], [`Diverged`], [`BeadDiverged`] | `C`, `Ċ`, λ and energy each step; divergence reports |
 //! | [`SimClock`], [`ParallelStep`] | steps and seconds since the last restart; when the step splits over threads |
 //! | [`SceneEnergy`] | the whole scene's energy after each step, for a plot that jumps only where energy is taken or given |
@@ -106,10 +107,10 @@ pub use dynamics::{
     Bead, BeadBundle, BeadDiagnostics, BeadDiverged, BeadForce, BeadForces, BeadForcesItem,
     BeadMass, BeadParams, BeadPosition, BeadRadius, BeadSentBack, BeadVelocity, BeadsStruck,
     CatchesBeads, ConstraintDiagnostics, ContactChanged, Contacts, Dimension, Diverged,
-    DivergenceReason, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams, NextParams, NextWireShape,
-    OnWire, Pin, PrescribedMotion, RailOrientation, Restitution, Rod, SendsBeadsBack, SimParams,
-    SpaceBead, SpaceBeadBundle, SpaceParams, SpaceWire, Spring, SpringAnchor, Wire, WireBeads,
-    WireContact, WirePlace, WireRows, pose_of,
+    DivergenceReason, GrabPoint, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams, NextParams,
+    NextWireShape, OnWire, Pin, PrescribedMotion, RailOrientation, Restitution, Rod,
+    SendsBeadsBack, SimParams, SpaceBead, SpaceBeadBundle, SpaceParams, SpaceWire, Spring,
+    SpringAnchor, Wire, WireBeads, WireContact, WirePlace, WireRows, pose_of,
 };
 pub use geometry::{
     Friction, ImplicitCurve, Oscillate, Side, Spin, Surface, WireKind, WireMotion, WireShape,

@@ -57,14 +57,16 @@ use avian2d::prelude::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::carrier::{Boarding, board_beads, hand_over_forces, read_back_beads};
+use crate::carrier::{
+    Boarding, board_beads, body_start, hand_over_forces, pull_bodies, read_back_beads,
+};
 use crate::dynamics::{Wire, WirePose};
 use crate::geometry::{Near, Placed, PosePath, WireShape};
 use crate::solver::path::{
     Held, JointBody, JointState, JointWire, Law, PlaneBody, PlaneVelocity, PlaneWire, Substep,
     turn_offset, velocity_on_wire,
 };
-use crate::{SimClock, SimParams, WireBeadSystems};
+use crate::{GrabPoint, SimClock, SimParams, SpringAnchor, WireBeadSystems};
 use beads::Avian2d;
 use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
 
@@ -102,6 +104,8 @@ fn at_rest(centre: DVec2, angle: f64, arm: DVec2) -> PlaneBody {
     }
 }
 
+body_start!(avian2d);
+
 /// Solves [`PathJoint`]s in avian's substep loop. Add it after avian's
 /// `PhysicsPlugins`. It also carries our beads on wires that ride
 /// bodies ([`WireOnBody`]), each as a point body on a path joint.
@@ -114,13 +118,18 @@ impl Plugin for PathJointPlugin {
         app.register_type::<PathJoint>()
             .register_type::<PathJointForces>()
             .register_type::<WireOnBody>()
+            .register_type::<GrabPoint<DVec2>>()
             .add_systems(
                 FixedUpdate,
                 (
                     board_beads::<Avian2d>.in_set(Boarding),
                     hand_over_forces::<Avian2d>.in_set(WireBeadSystems::Step),
+                    pull_bodies::<Avian2d>
+                        .in_set(WireBeadSystems::Forces)
+                        .run_if(any_with_component::<SpringAnchor<DVec2>>),
                 ),
             )
+            .add_systems(PreUpdate, restart_bodies.in_set(WireBeadSystems::Restart))
             .add_systems(
                 PhysicsSchedule,
                 (

@@ -61,14 +61,16 @@ use avian3d::prelude::*;
 use bevy::math::{DMat3, DQuat, DVec3};
 use bevy::prelude::*;
 
-use crate::carrier::{Boarding, board_beads, hand_over_forces, read_back_beads};
+use crate::carrier::{
+    Boarding, board_beads, body_start, hand_over_forces, pull_bodies, read_back_beads,
+};
 use crate::dynamics::{SpaceWire, WirePose};
 use crate::geometry::{SpacePath, SpaceShape};
 use crate::solver::path::{
     Alignment, BodyVelocity, Held, JointBody, JointState, JointWire, Law, SpaceBody, SpaceWireAt,
     Substep, velocity_on_wire,
 };
-use crate::{SimClock, SimParams, WireBeadSystems};
+use crate::{GrabPoint, SimClock, SimParams, SpringAnchor, WireBeadSystems};
 use beads::Avian3d;
 use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
 
@@ -106,6 +108,8 @@ fn at_rest(centre: DVec3, rotation: DQuat, arm: DVec3) -> SpaceBody {
     }
 }
 
+body_start!(avian3d);
+
 /// Solves [`PathJoint`]s in avian3d's substep loop. Add it after avian's
 /// `PhysicsPlugins`. It also carries our beads on wires that ride
 /// bodies ([`WireOnBody`]), each as a point body on a path joint.
@@ -118,13 +122,18 @@ impl Plugin for PathJointPlugin {
         app.register_type::<PathJoint>()
             .register_type::<PathJointForces>()
             .register_type::<WireOnBody>()
+            .register_type::<GrabPoint<DVec3>>()
             .add_systems(
                 FixedUpdate,
                 (
                     board_beads::<Avian3d>.in_set(Boarding),
                     hand_over_forces::<Avian3d>.in_set(WireBeadSystems::Step),
+                    pull_bodies::<Avian3d>
+                        .in_set(WireBeadSystems::Forces)
+                        .run_if(any_with_component::<SpringAnchor<DVec3>>),
                 ),
             )
+            .add_systems(PreUpdate, restart_bodies.in_set(WireBeadSystems::Restart))
             .add_systems(
                 PhysicsSchedule,
                 (

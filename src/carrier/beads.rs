@@ -6,7 +6,7 @@
 //! and says why.
 
 use bevy::ecs::component::Mutable;
-use bevy::ecs::query::{ROQueryItem, ReadOnlyQueryData};
+use bevy::ecs::query::{IterQueryData, QueryItem, ROQueryItem, ReadOnlyQueryData};
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
@@ -62,6 +62,16 @@ pub(crate) trait PointBodies: Send + Sync + 'static {
     /// mass, its rotation locked, no collider, `gravity` in place of
     /// avian's, and the joint afresh.
     fn point_body(bead: Boarder<Self::V>, gravity: Self::V) -> impl Bundle;
+    /// A rigid body a spring pulls: where it is, and what takes the force.
+    type Pulled: IterQueryData;
+    /// Applies to `body` for the step the spring `k (target - p)` at its
+    /// point `p`, `grab` in its frame; the spring's force.
+    fn pull(
+        body: QueryItem<'_, '_, Self::Pulled>,
+        grab: Self::V,
+        target: Self::V,
+        k: f64,
+    ) -> Self::V;
 }
 
 /// The beads are boarded in this set, in
@@ -389,6 +399,23 @@ macro_rules! point_bodies {
                         PathJointState::default(),
                     ),
                 )
+            }
+
+            type Pulled = (Placing<'static>, $avian::prelude::Forces);
+
+            fn pull(
+                (placing, mut forces): bevy::ecs::query::QueryItem<'_, '_, Self::Pulled>,
+                grab: $v,
+                target: $v,
+                k: f64,
+            ) -> $v {
+                use $avian::math::AdjustPrecision as _;
+                use $avian::prelude::WriteRigidBodyForces as _;
+                use $crate::solver::path::JointBody as _;
+                let at = placed_body(placing, grab).anchor();
+                let force = k * (target - at);
+                forces.apply_force_at_point(force.adjust_precision(), at.adjust_precision());
+                force
             }
         }
     };

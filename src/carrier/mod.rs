@@ -13,10 +13,14 @@ use crate::dynamics::{
 use crate::plugin::{Divergences, SimClock, WireBeadSystems};
 
 mod beads;
+mod pull;
+mod restart;
 
 pub(crate) use beads::{
     Boarder, Boarding, PointBodies, board_beads, hand_over_forces, point_bodies, read_back_beads,
 };
+pub(crate) use pull::pull_bodies;
+pub(crate) use restart::body_start;
 
 /// A joint's body in the substep's solver (`S` avian's solver body, `I`
 /// its inertia), and its carrier's where the carrier has one.

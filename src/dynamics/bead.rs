@@ -401,9 +401,32 @@ impl<V: Coordinates + Reflect + TypePath> NextBeadParams<V> {
 /// with the cursor, removes it on release); a game may pull a bead anywhere
 /// with one. `SpringAnchor` pulls a bead in the plane,
 /// `SpringAnchor<DVec3>` one in space.
+///
+/// On an avian rigid body (features `avian2d`, `avian3d`, with the
+/// `PathJointPlugin` of its dimension) the same spring pulls the body's
+/// [`GrabPoint`] (its origin without one), as a force at that point: the
+/// scene's mouse drag of a body.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
 #[reflect(Component)]
 pub struct SpringAnchor<V: Coordinates + Reflect + TypePath = DVec2>(V);
+
+/// The point of a rigid body, in the body's frame, that its
+/// [`SpringAnchor`] pulls: where the mouse took hold of it.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
+#[reflect(Component)]
+pub struct GrabPoint<V: Coordinates + Reflect + TypePath = DVec2>(V);
+
+impl<V: Coordinates + Reflect + TypePath> GrabPoint<V> {
+    /// The point `local` of the body (its frame), if it is finite.
+    pub fn new(local: V) -> Result<Self, ParamError> {
+        finite_vector("grab point", local).map(Self)
+    }
+
+    /// The point, in the body's frame.
+    pub fn get(&self) -> V {
+        self.0
+    }
+}
 
 impl<V: Coordinates + Reflect + TypePath> SpringAnchor<V> {
     /// An anchor at `point`, if it is finite.

@@ -15,7 +15,7 @@ mod wire;
 
 pub use bead::{
     Bead, BeadBundle, BeadForce, BeadForces, BeadForcesItem, BeadMass, BeadParams, BeadPosition,
-    BeadVelocity, NextBeadParams, SpaceBead, SpaceBeadBundle, SpringAnchor,
+    BeadVelocity, GrabPoint, NextBeadParams, SpaceBead, SpaceBeadBundle, SpringAnchor,
 };
 pub(crate) use bead::{BeadMotion, BeadMotionItem};
 pub use diagnostics::{BeadDiagnostics, BeadDiverged, Diverged, DivergenceReason};

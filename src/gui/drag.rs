@@ -12,11 +12,11 @@
 //! moves in the arrows' direction at a quarter of the view's height a second, a
 //! cursor moved by the keys; letting go of the arrows lets go of the bead.
 
-use bevy::math::DVec3;
+use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 
 use crate::gui::render::{SceneCamera, screen_to_world};
-use crate::{BeadPosition, SpringAnchor};
+use crate::{BeadPosition, GrabPoint, SpringAnchor};
 
 /// The bead the panel shows: the last one grabbed, or the first one.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -42,10 +42,12 @@ impl Plugin for BeadDragPlugin {
     }
 }
 
-type SceneCameras<'w, 's> =
+/// The plane's camera.
+pub(crate) type SceneCameras<'w, 's> =
     Query<'w, 's, (&'static Camera, &'static GlobalTransform), With<SceneCamera>>;
 
-fn cursor_world(
+/// Where the pointer is in the plane, as a spring's anchor.
+pub(crate) fn cursor_world(
     location: &bevy::picking::pointer::Location,
     cameras: &SceneCameras,
 ) -> Option<SpringAnchor> {
@@ -77,25 +79,27 @@ pub fn start_drag(
         // as an egui window: never grab a bead through it.
         None
     } else {
-        // The press missed every bead mesh: take the nearest bead whose
-        // drawn disc (scale = radius) is under the cursor, with some slack.
-        beads
-            .iter()
-            .map(|(e, b, t)| {
-                (
-                    e,
-                    (b.0 - target.get()).length() / f64::from(t.scale.x.max(1e-6)),
-                )
-            })
-            .filter(|(_, d)| *d <= 1.5)
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(e, _)| e)
+        bead_under(&beads, target.get())
     };
     let Some(bead) = bead else { return };
     debug!("wirebead: grabbed bead {bead}");
     grabbed.0 = Some(bead);
     selected.0 = Some(bead);
     commands.entity(bead).insert(target);
+}
+
+/// The bead a press at `at` that missed every bead mesh takes: the
+/// nearest whose drawn disc (scale = radius) is under it, with some slack.
+pub(crate) fn bead_under(
+    beads: &Query<(Entity, &BeadPosition, &Transform)>,
+    at: DVec2,
+) -> Option<Entity> {
+    beads
+        .iter()
+        .map(|(e, b, t)| (e, (b.0 - at).length() / f64::from(t.scale.x.max(1e-6))))
+        .filter(|(_, d)| *d <= 1.5)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(e, _)| e)
 }
 
 /// Moves the drag target with the cursor.
@@ -123,7 +127,12 @@ pub fn end_drag(
     if let Some(bead) = grabbed.0.take()
         && let Ok(mut entity) = commands.get_entity(bead)
     {
-        entity.remove::<(SpringAnchor, SpringAnchor<DVec3>)>();
+        entity.remove::<(
+            SpringAnchor,
+            SpringAnchor<DVec3>,
+            GrabPoint,
+            GrabPoint<DVec3>,
+        )>();
     }
 }
 

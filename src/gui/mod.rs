@@ -8,6 +8,7 @@
 //! | [`SceneRenderPlugin`] | camera framing, wire gizmos, bead meshes, trails, force arrows |
 //! | [`SpaceViewPlugin`] | the 3D view of scenes in space: orbit camera, wires as lines and translucent surfaces, beads as spheres to drag |
 //! | [`BeadDragPlugin`] | mesh picking: drag a bead with the mouse (the assignment's spring) |
+//! | [`BodyViewPlugin`] | avian's rigid bodies (features `avian2d`, `avian3d`) drawn, and dragged by the point taken |
 //! | [`PanelPlugin`] | the egui panel and plots |
 //! | [`AutomationPlugin`] | run N frames, screenshot, reports, exit status |
 //!
@@ -16,6 +17,7 @@
 //! `MeshPickingPlugin` if they are missing.
 
 pub mod automation;
+pub mod bodies;
 pub mod drag;
 pub mod ghost;
 pub mod panel;
@@ -26,7 +28,10 @@ use bevy::picking::mesh_picking::MeshPickingPlugin;
 use bevy::prelude::*;
 use bevy_egui::{EguiGlobalSettings, EguiPlugin};
 
-pub use automation::{AutomationPlugin, FrameReport, GhostBeadReport, PlotReport, TimelineReport};
+pub use automation::{
+    AutomationPlugin, BodyReport, FrameReport, GhostBeadReport, PlotReport, TimelineReport,
+};
+pub use bodies::BodyViewPlugin;
 pub use drag::BeadDragPlugin;
 pub use panel::{PanelPlugin, PresetCatalog};
 pub use render::{SceneCamera, SceneRenderPlugin, SceneStyle};
@@ -78,6 +83,7 @@ impl Plugin for WireBeadGuiPlugin {
             SceneRenderPlugin,
             SpaceViewPlugin,
             BeadDragPlugin,
+            BodyViewPlugin,
             PanelPlugin,
         ));
     }

@@ -15,6 +15,7 @@ use crate::debug_render::{
     DebugRenderStyle, DebugRenderSystems, WireBeadDebugPlugin, wire_points, wire_pose,
 };
 use crate::geometry::{Pose, WireShape};
+use crate::gui::bodies::BodyVisual;
 use crate::{
     Bead, BeadParams, BeadPosition, BeadRadius, BeadSentBack, OnWire, Restart, Rod, Wire,
     WireBeadSystems, WireContact,
@@ -31,6 +32,10 @@ pub struct SceneStyle {
     pub hatch: Color,
     /// Beads.
     pub bead: Color,
+    /// Dynamic rigid bodies (features `avian2d`, `avian3d`).
+    pub body: Color,
+    /// Static and kinematic rigid bodies.
+    pub fixed_body: Color,
     /// A diverged bead.
     pub diverged: Color,
     /// Trails (faded toward the background with age).
@@ -94,6 +99,8 @@ impl Default for SceneStyle {
             wire: Color::srgb(0.35, 0.80, 1.0),
             hatch: Color::srgb(0.24, 0.52, 0.66),
             bead: Color::srgb(1.0, 0.55, 0.10),
+            body: Color::srgb(0.45, 0.62, 0.50),
+            fixed_body: Color::srgb(0.30, 0.32, 0.36),
             diverged: Color::srgb(0.9, 0.1, 0.1),
             trail: Color::srgb(1.0, 0.85, 0.3),
             flight: Color::srgb(0.95, 0.35, 1.0),
@@ -340,11 +347,12 @@ fn longest_chain<'a>(rods: impl Iterator<Item = &'a Rod>) -> f64 {
     lengths.into_iter().fold(0.0, f64::max)
 }
 
-/// Frames every wire (and every bead's start) in the part of the window
-/// left of the panel, whatever their size.
+/// Frames every wire (and every bead's and body's start) in the part of
+/// the window left of the panel, whatever their size.
 pub fn frame_camera(
     wires: Query<(&Wire, &Transform)>,
     beads: Query<&BeadParams>,
+    bodies: Query<&BodyVisual>,
     rods: Query<&Rod>,
     on_wire: Query<(), With<OnWire>>,
     windows: Query<&Window>,
@@ -363,6 +371,11 @@ pub fn frame_camera(
     for bead in &beads {
         lo = lo.min(bead.initial_position);
         hi = hi.max(bead.initial_position);
+    }
+    for body in &bodies {
+        let [a, b] = body.bounds();
+        lo = lo.min(a.truncate().as_dvec2());
+        hi = hi.max(b.truncate().as_dvec2());
     }
     // Beads hanging on rods swing out as far as the rods reach: the
     // longest chain of rods with a bead on no wire widens the view by its
@@ -489,6 +502,12 @@ impl SceneStyle {
     /// How many points of a trail are kept: its seconds at `timestep`.
     pub fn trail_points(&self, timestep: f64) -> usize {
         (self.trail_seconds / timestep).ceil() as usize
+    }
+
+    /// A rigid body's colour: a dynamic body's, or a static or kinematic
+    /// one's.
+    pub fn body_colour(&self, dynamic: bool) -> Color {
+        if dynamic { self.body } else { self.fixed_body }
     }
 
     /// A bead's colour: diverged, in flight off its one-sided wire, or on

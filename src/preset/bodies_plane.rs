@@ -11,7 +11,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::{BodyKind, BodyPreset, BodyShape, PathRotationPreset, SceneBody, ScenePath};
-use crate::avian::{PathJoint, PathRotation};
+use crate::avian::{BodyStart, PathJoint, PathRotation};
 
 /// Avian's kind of body for a scene's.
 fn rigid_body(kind: BodyKind) -> RigidBody {
@@ -34,21 +34,22 @@ fn collider(shape: &BodyShape<DVec2>) -> Collider {
     }
 }
 
-/// Spawns a scene's bodies, each marked [`FromPreset`] and named; the
-/// bodies in the file's order. Call on a validated scene.
+/// Spawns a scene's bodies, each marked [`FromPreset`] and named, with
+/// its [`BodyStart`] for a restart; the bodies in the file's order. Call
+/// on a validated scene.
 pub(crate) fn spawn_bodies(bodies: &[BodyPreset], commands: &mut Commands) -> Vec<Entity> {
     bodies
         .iter()
         .map(|body| {
+            let start = BodyStart {
+                position: Position(body.position.adjust_precision()),
+                rotation: Rotation::radians(body.angle_degrees.to_radians() as Scalar),
+                linear: LinearVelocity(body.velocity.adjust_precision()),
+                angular: AngularVelocity(body.angular_velocity as Scalar),
+            };
             let mut entity = commands.spawn((
-                (
-                    rigid_body(body.kind),
-                    collider(&body.shape),
-                    Position(body.position.adjust_precision()),
-                    Rotation::radians(body.angle_degrees.to_radians() as Scalar),
-                    LinearVelocity(body.velocity.adjust_precision()),
-                    AngularVelocity(body.angular_velocity as Scalar),
-                ),
+                (rigid_body(body.kind), collider(&body.shape), start),
+                (start.position, start.rotation, start.linear, start.angular),
                 Restitution::new(body.restitution as Scalar),
                 Friction::new(body.friction as Scalar),
             ));

@@ -8,7 +8,7 @@ use bevy::math::{DQuat, DVec3};
 use bevy::prelude::*;
 
 use super::{BodyKind, BodyShape, PathRotationPreset, SceneBody, ScenePath, SpaceBodyPreset};
-use crate::avian3d::{PathJoint, PathRotation, rotation_of, vector_of};
+use crate::avian3d::{BodyStart, PathJoint, PathRotation, rotation_of, vector_of};
 
 /// Avian's kind of body for a scene's.
 fn rigid_body(kind: BodyKind) -> RigidBody {
@@ -32,21 +32,22 @@ fn collider(shape: &BodyShape<DVec3>) -> Collider {
     }
 }
 
-/// Spawns a scene's bodies, each marked [`FromPreset`] and named; the
-/// bodies in the file's order. Call on a validated scene.
+/// Spawns a scene's bodies, each marked [`FromPreset`] and named, with
+/// its [`BodyStart`] for a restart; the bodies in the file's order. Call
+/// on a validated scene.
 pub(crate) fn spawn_bodies(bodies: &[SpaceBodyPreset], commands: &mut Commands) -> Vec<Entity> {
     bodies
         .iter()
         .map(|body| {
+            let start = BodyStart {
+                position: Position(body.position.adjust_precision()),
+                rotation: Rotation(body.pose().rotation.adjust_precision()),
+                linear: LinearVelocity(body.velocity.adjust_precision()),
+                angular: AngularVelocity(body.angular_velocity.adjust_precision()),
+            };
             let mut entity = commands.spawn((
-                (
-                    rigid_body(body.kind),
-                    collider(&body.shape),
-                    Position(body.position.adjust_precision()),
-                    Rotation(body.pose().rotation.adjust_precision()),
-                    LinearVelocity(body.velocity.adjust_precision()),
-                    AngularVelocity(body.angular_velocity.adjust_precision()),
-                ),
+                (rigid_body(body.kind), collider(&body.shape), start),
+                (start.position, start.rotation, start.linear, start.angular),
                 Restitution::new(body.restitution as Scalar),
                 Friction::new(body.friction as Scalar),
             ));

@@ -13,7 +13,7 @@ use wirebead::geometry::{ImplicitCurve, Side, Spline, SplineKind, SplineSpec, Su
 use wirebead::headless::{Headless, run_steps};
 use wirebead::prelude::*;
 use wirebead::reference::{bead_on_a_free_hoop, pendulum_period};
-use wirebead::{DivergenceReason, Integrator, NextParams, ScenePreset};
+use wirebead::{DivergenceReason, GrabPoint, Integrator, NextParams, ScenePreset, SpringAnchor};
 
 const G: f64 = 9.81;
 const DT: f64 = 1.0 / 60.0;
@@ -36,7 +36,10 @@ fn physics_app_at(dt: f64, substeps: u32) -> App {
     };
     let mut app = App::new();
     app.add_plugins((
-        MinimalPlugins,
+        // The process's task pools as every other test app asks for them.
+        MinimalPlugins.set(TaskPoolPlugin {
+            task_pool_options: wirebead::plugin::compute_on_all_cores(),
+        }),
         WireBeadPlugin::new(params).expect("valid parameters"),
         PhysicsPlugins::default(),
         PathJointPlugin,
@@ -1290,13 +1293,9 @@ fn a_bead_that_cannot_ride_a_body_is_stopped_and_says_why() {
 /// joint at its centre, released level with the hoop's centre, at 1 ms.
 const CART_SCENE: &str = include_str!("../scenes/cart_on_hoop.scene.ron");
 
-/// The period of the body of `scene` (a scene file of bodies on a unit
-/// hoop about the origin, released level with its centre), from two
-/// crossings of the bottom moving right, the farthest it strayed off the
-/// hoop, and the most it turned.
-fn scene_swing(scene: &str) -> (f64, f64, f64) {
-    let scene = ScenePreset::from_ron(scene).expect("the scene reads");
-    let dt = scene.params.timestep;
+/// A headless app running `scene` with its bodies in avian2d, and its
+/// bodies.
+fn scene_app(scene: &ScenePreset) -> (App, Vec<Entity>) {
     let plugin = WireBeadPlugin::new(scene.params.clone()).expect("valid parameters");
     let mut app = Headless::new(plugin)
         .single_threaded()
@@ -1304,6 +1303,17 @@ fn scene_swing(scene: &str) -> (f64, f64, f64) {
         .build();
     let (_, bodies) = scene.spawn_all(&mut app.world_mut().commands());
     app.world_mut().flush();
+    (app, bodies)
+}
+
+/// The period of the body of `scene` (a scene file of bodies on a unit
+/// hoop about the origin, released level with its centre), from two
+/// crossings of the bottom moving right, the farthest it strayed off the
+/// hoop, and the most it turned.
+fn scene_swing(scene: &str) -> (f64, f64, f64) {
+    let scene = ScenePreset::from_ron(scene).expect("the scene reads");
+    let dt = scene.params.timestep;
+    let (mut app, bodies) = scene_app(&scene);
     let cart = bodies[0];
     let (mut crossings, mut off, mut turned) = (Vec::new(), 0.0f64, 0.0f64);
     let (mut last, _, _, _) = body_state(&app, cart);
@@ -1357,4 +1367,87 @@ fn a_scene_files_box_on_a_hoop_swings_with_the_exact_period() {
         "period {period} s against {exact} s"
     );
     assert!(off <= 1e-5, "strayed {off:e} m off the hoop");
+}
+
+/// A spring anchor pulls a free body at its grab point, as the scene's
+/// mouse drag does: over one step the force `k (anchor - p)` moves the
+/// body by `F/m` and turns it by `(r × F)/I` (to 1e-5 relative, f32);
+/// once the anchor goes, the body coasts (1e-6).
+#[test]
+fn a_spring_anchor_pulls_a_body_by_its_grab_point() {
+    let mut app = physics_app(SUBSTEPS);
+    without_gravity(&mut app);
+    let (mass, inertia) = (2.0, 0.5);
+    let body = app
+        .world_mut()
+        .spawn((
+            RigidBody::Dynamic,
+            Position(Vector::ZERO),
+            Mass(mass),
+            AngularInertia(inertia),
+            SpringAnchor::new(DVec2::new(0.5, 1.0)).expect("finite"),
+            GrabPoint::new(DVec2::new(0.5, 0.0)).expect("finite"),
+        ))
+        .id();
+    run_steps(&mut app, 1);
+    let k = app.world().resource::<SimParams>().drag_stiffness;
+    let (_, velocity, _, spin) = body_state(&app, body);
+    let (v, w) = (k / f64::from(mass) * DT, 0.5 * k / f64::from(inertia) * DT);
+    println!("pulled: v {velocity} (expected (0, {v})), w {spin} (expected {w})");
+    assert!(velocity.x.abs() <= 1e-5 * v, "{velocity}");
+    assert!((velocity.y - v).abs() <= 1e-5 * v, "{velocity} against {v}");
+    assert!((spin - w).abs() <= 1e-5 * w, "{spin} against {w}");
+    app.world_mut().entity_mut(body).remove::<SpringAnchor>();
+    run_steps(&mut app, 1);
+    let (_, coasting, _, spun) = body_state(&app, body);
+    assert!(
+        (coasting - velocity).length() <= 1e-6,
+        "{coasting} after {velocity}"
+    );
+    assert!((spun - spin).abs() <= 1e-6, "{spun} after {spin}");
+}
+
+/// A restart puts a scene's bodies back where the file starts them, a
+/// path joint met afresh: the run after it repeats the run before it (the
+/// box's state 0.2 s in, turned with its hoop, the same to 1e-6), and a
+/// restart as the scene starts (as the window's loading of a scene sends)
+/// changes nothing, its static floor included.
+#[test]
+fn a_restart_puts_a_scenes_bodies_back_at_their_start() {
+    let floor = r#"    ), (name: "floor", kind: Static, shape: Box((half_extents: (2.0, 0.1))), position: (0.0, -1.5))],
+    wires"#;
+    let text = CART_SCENE
+        .replace("rotation: Free", "rotation: Tangent")
+        .replace("    )],\n    wires", floor);
+    let scene = ScenePreset::from_ron(&text).expect("the scene reads");
+    assert_eq!(scene.bodies.len(), 2, "{text}");
+    let steps = (0.2 / scene.params.timestep).round() as u32;
+    let (mut app, bodies) = scene_app(&scene);
+    app.world_mut().write_message(Restart);
+    let cart = bodies[0];
+    let start = body_state(&app, cart);
+    run_steps(&mut app, steps);
+    let first = body_state(&app, cart);
+    run_steps(&mut app, 2 * steps);
+    app.world_mut().write_message(Restart);
+    run_steps(&mut app, steps);
+    let again = body_state(&app, cart);
+    println!("restarted: {first:?} then {again:?} (from {start:?})");
+    assert!((first.0 - start.0).length() > 0.1, "the box never swung");
+    assert!(
+        (again.0 - first.0).length() <= 1e-6,
+        "{again:?} against {first:?}"
+    );
+    assert!(
+        (again.1 - first.1).length() <= 1e-6,
+        "{again:?} against {first:?}"
+    );
+    assert!(
+        (again.2 - first.2).abs() <= 1e-6,
+        "{again:?} against {first:?}"
+    );
+    assert!(
+        (again.3 - first.3).abs() <= 1e-6,
+        "{again:?} against {first:?}"
+    );
 }

@@ -13,7 +13,7 @@ use wirebead::geometry::{
 };
 use wirebead::prelude::*;
 use wirebead::reference::{bead_on_a_free_hoop, pendulum_period};
-use wirebead::{Integrator, SpaceBead, SpaceWire, avian3d::*};
+use wirebead::{GrabPoint, Integrator, SpaceBead, SpaceWire, SpringAnchor, avian3d::*};
 
 const G: f64 = 9.81;
 const DT: f64 = 1.0 / 60.0;
@@ -32,7 +32,10 @@ fn physics_app(dt: f64, gravity: DVec3) -> App {
     };
     let mut app = App::new();
     app.add_plugins((
-        MinimalPlugins,
+        // The process's task pools as every other test app asks for them.
+        MinimalPlugins.set(TaskPoolPlugin {
+            task_pool_options: wirebead::plugin::compute_on_all_cores(),
+        }),
         WireBeadPlugin::new(params).expect("valid parameters"),
         PhysicsPlugins::default(),
         PathJointPlugin,
@@ -782,4 +785,38 @@ fn a_body_on_a_hoop_fixed_to_a_free_body_in_space_turns_the_pair_as_two_bodies_d
     assert!(off <= 1e-4, "{off:e} m off the two-body answer");
     assert!(drift <= 1e-5, "the momentum changed by {drift:e} of itself");
     assert!(spin <= 1e-4, "the carrier spins at {spin:e} rad/s");
+}
+
+/// A spring anchor pulls a free body in space at its grab point: over one
+/// step the force `k (anchor - p)` moves it by `F/m` and turns it by
+/// `I⁻¹ (r × F)` (to 1e-5 relative, f32).
+#[test]
+fn a_spring_anchor_pulls_a_body_in_space_by_its_grab_point() {
+    let mut app = physics_app(DT, DVec3::ZERO);
+    let (mass, inertia) = (2.0, 0.5);
+    let body = app
+        .world_mut()
+        .spawn((
+            RigidBody::Dynamic,
+            Position(Vector::ZERO),
+            Mass(mass),
+            AngularInertia::new(Vec3::splat(inertia)),
+            SpringAnchor::new(DVec3::new(0.5, 1.0, 0.0)).expect("finite"),
+            GrabPoint::new(DVec3::new(0.5, 0.0, 0.0)).expect("finite"),
+        ))
+        .id();
+    app.update();
+    let k = app.world().resource::<SimParams>().drag_stiffness;
+    let (_, velocity, _, spin) = body_state(&app, body);
+    let v = DVec3::new(0.0, k / f64::from(mass) * DT, 0.0);
+    let w = DVec3::new(0.0, 0.0, 0.5 * k / f64::from(inertia) * DT);
+    println!("pulled in space: v {velocity} (expected {v}), w {spin} (expected {w})");
+    assert!(
+        (velocity - v).length() <= 1e-5 * v.length(),
+        "{velocity} against {v}"
+    );
+    assert!(
+        (spin - w).length() <= 1e-5 * w.length(),
+        "{spin} against {w}"
+    );
 }

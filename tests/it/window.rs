@@ -35,16 +35,8 @@ fn close(a: Rgb<u8>, b: Rgb<u8>, tolerance: i32) -> bool {
 
 /// Whether a pixel of `colour` lies within `radius` pixels of `at`.
 fn colour_near(image: &RgbImage, at: [f32; 2], radius: i32, colour: Rgb<u8>) -> bool {
-    let (x0, y0) = (at[0].round() as i32, at[1].round() as i32);
-    (-radius..=radius).any(|dy| {
-        (-radius..=radius).any(|dx| {
-            let (x, y) = (x0 + dx, y0 + dy);
-            x >= 0
-                && y >= 0
-                && (x as u32) < image.width()
-                && (y as u32) < image.height()
-                && close(*image.get_pixel(x as u32, y as u32), colour, 40)
-        })
+    hue_near(image, at, radius, |rgb| {
+        close(Rgb(rgb.map(|v| v as u8)), colour, 40)
     })
 }
 
@@ -272,20 +264,28 @@ fn screenshot_of_the_roller_coaster_hatches_the_closed_side_of_its_track() {
     );
 }
 
-/// Whether a pixel within `radius` of `at` has the bead's hue: orange
-/// (the bead is lit, so its brightness varies across it; the trail's
-/// yellow has too much green).
-fn bead_hue_near(image: &RgbImage, at: [f32; 2], radius: i32) -> bool {
+/// Whether a pixel within `radius` of `at` has the hue `hue` says of its
+/// red, green and blue.
+fn hue_near(image: &RgbImage, at: [f32; 2], radius: i32, hue: impl Fn([f32; 3]) -> bool) -> bool {
     let (x0, y0) = (at[0].round() as i32, at[1].round() as i32);
     (-radius..=radius).any(|dy| {
         (-radius..=radius).any(|dx| {
             let (x, y) = (x0 + dx, y0 + dy);
-            if x < 0 || y < 0 || x as u32 >= image.width() || y as u32 >= image.height() {
-                return false;
-            }
-            let [r, g, b] = image.get_pixel(x as u32, y as u32).0.map(f32::from);
-            r >= 80.0 && (0.3..0.75).contains(&(g / r)) && b / r < 0.35
+            x >= 0
+                && y >= 0
+                && (x as u32) < image.width()
+                && (y as u32) < image.height()
+                && hue(image.get_pixel(x as u32, y as u32).0.map(f32::from))
         })
+    })
+}
+
+/// Whether a pixel within `radius` of `at` has the bead's hue: orange
+/// (the bead is lit, so its brightness varies across it; the trail's
+/// yellow has too much green).
+fn bead_hue_near(image: &RgbImage, at: [f32; 2], radius: i32) -> bool {
+    hue_near(image, at, radius, |[r, g, b]| {
+        r >= 80.0 && (0.3..0.75).contains(&(g / r)) && b / r < 0.35
     })
 }
 
@@ -626,4 +626,117 @@ fn a_mass_typed_with_the_keyboard_alone_applies_with_space() {
     );
     // A bead's mass changes only when Space applies the pending edits.
     assert_eq!(after.beads[0].mass, 0.25);
+}
+
+/// Whether a pixel within `radius` of `at` has a dynamic body's hue:
+/// green over red and blue (lit in space, so its brightness varies).
+fn body_hue_near(image: &RgbImage, at: [f32; 2], radius: i32) -> bool {
+    hue_near(image, at, radius, |[r, g, b]| {
+        g >= 50.0 && g > 1.15 * r && g > 1.08 * b
+    })
+}
+
+/// The body named `name` of a report.
+fn body<'a>(report: &'a FrameReport, name: &str) -> &'a wirebead::gui::BodyReport {
+    report
+        .bodies
+        .iter()
+        .find(|b| b.name == name)
+        .unwrap_or_else(|| panic!("no body {name:?} in {:?}", report.bodies))
+}
+
+#[test]
+#[ignore = "needs the screenshot .ci/run makes under Xvfb"]
+fn screenshot_of_rigid_bodies_shows_each_where_avian_has_it() {
+    let (image, report) = screenshot("bodies");
+    assert_eq!(report.preset.as_deref(), Some("Cart on a hoop"));
+    assert_eq!(report.bodies.len(), 3, "{:?}", report.bodies);
+    let style = wirebead::gui::SceneStyle::default();
+    // The cart at rest at the bottom of its hoop, the ball come to rest on
+    // the floor (its top at y = -1.5) beside it.
+    let (cart, ball, floor) = (
+        body(&report, "cart"),
+        body(&report, "ball"),
+        body(&report, "floor"),
+    );
+    assert!(
+        cart.world[0].abs() < 1e-3 && (cart.world[1] + 1.0).abs() < 1e-3,
+        "the cart at {:?}",
+        cart.world
+    );
+    assert!(
+        (ball.world[1] + 1.35).abs() < 0.02,
+        "the ball at {:?}",
+        ball.world
+    );
+    for (what, at, colour) in [
+        ("cart", cart.pixel, style.body),
+        ("ball", ball.pixel, style.body),
+        ("floor", floor.pixel, style.fixed_body),
+    ] {
+        assert!(
+            colour_near(&image, at, 4, rgb(colour)),
+            "no {what} colour at {at:?}"
+        );
+    }
+    // Nothing of the bodies' colour far from them: 60 px above the cart
+    // is the hoop's inside.
+    let above = [cart.pixel[0], cart.pixel[1] - 60.0];
+    assert!(
+        !colour_near(&image, above, 2, rgb(style.body)),
+        "body colour at {above:?}, above the cart"
+    );
+}
+
+#[test]
+#[ignore = "needs the screenshot .ci/run makes under Xvfb"]
+fn screenshot_of_rigid_bodies_in_space_shows_them_in_the_3d_view() {
+    let (image, report) = screenshot("bodies_space");
+    assert_eq!(report.preset.as_deref(), Some("Cart on a loop in space"));
+    assert_eq!(report.bodies.len(), 3, "{:?}", report.bodies);
+    for name in ["cart", "ball"] {
+        let at = body(&report, name).pixel;
+        assert!(body_hue_near(&image, at, 3), "no {name} at {at:?}");
+    }
+    // The loop is drawn where it is.
+    let [hoop] = report.space_curves.as_slice() else {
+        panic!("one curve in space, got {}", report.space_curves.len());
+    };
+    let wire_colour = rgb(wirebead::gui::SceneStyle::default().wire);
+    let on = hoop
+        .iter()
+        .filter(|p| colour_near(&image, **p, 3, wire_colour))
+        .count();
+    assert!(
+        on as f64 > 0.5 * hoop.len() as f64 && hoop.len() > 50,
+        "the loop's colour at {on} of its {} points",
+        hoop.len()
+    );
+}
+
+#[test]
+#[ignore = "needs the xdotool drag .ci/run makes under Xvfb"]
+fn a_real_mouse_drag_pulls_a_rigid_body_by_the_point_taken() {
+    let ready = report("body_drag_ready.ron");
+    assert_eq!(ready.preset.as_deref(), Some("Cart on a hoop"));
+    let drag = report("body_drag.ron")
+        .drag
+        .expect("the drag never took the cart through picking");
+    // The cart, taken at its centre, is held on its unit hoop about the
+    // origin: the nearest it can come to the cursor is the hoop's point
+    // nearest it.
+    let [x, y, _] = drag.bead_start;
+    assert!(
+        (x.hypot(y) - 1.0).abs() < 0.05,
+        "the point taken, {:?}, is not the cart's centre on its hoop",
+        drag.bead_start
+    );
+    let [x, y, _] = drag.target;
+    let nearest = (x.hypot(y) - 1.0).abs();
+    assert!(
+        drag.closest_distance < nearest + 0.05 && drag.closest_distance < drag.start_distance - 0.5,
+        "the cart came no closer than {:.3} to the cursor (from {:.3}; the hoop's nearest point is {nearest:.3} from it)",
+        drag.closest_distance,
+        drag.start_distance
+    );
 }

@@ -14,13 +14,14 @@ mod report;
 
 use report::write_report;
 pub use report::{
-    BeadReport, DragReport, FrameReport, GhostBeadReport, PlotReport, SpaceBeadReport,
+    BeadReport, BodyReport, DragReport, FrameReport, GhostBeadReport, PlotReport, SpaceBeadReport,
     TimelineReport, WireReport,
 };
 
 use crate::debug_render::{hatch_point, wire_points};
 use crate::geometry::Placed;
 use crate::ghost::Ghosts;
+use crate::gui::bodies::BodyVisual;
 use crate::gui::ghost::ghost_beads;
 use crate::gui::panel::{FocusTrail, PhasePlotFrame, PlotsShown};
 use crate::gui::render::{FramedView, SceneCamera, hatch_length};
@@ -28,8 +29,8 @@ use crate::gui::space::{SpaceCamera, WireDrawing};
 use crate::plugin::Timeline;
 use crate::preset::ActivePreset;
 use crate::{
-    BeadParams, BeadPosition, BeadVelocity, Diverged, Pin, Rod, SimClock, SpringAnchor, Wire,
-    WireContact, pose_of,
+    BeadParams, BeadPosition, BeadVelocity, Diverged, GrabPoint, Pin, Rod, SimClock, SpringAnchor,
+    Wire, WireContact, pose_of,
 };
 
 /// Run `frames` frames, optionally screenshot, report and exit.
@@ -106,6 +107,17 @@ struct ReportView<'w, 's> {
         ),
     >,
     space_wires: Query<'w, 's, (&'static WireDrawing, &'static Transform)>,
+    bodies: Query<'w, 's, (Option<&'static Name>, &'static GlobalTransform), With<BodyVisual>>,
+    dragged_bodies: Query<
+        'w,
+        's,
+        (
+            &'static GlobalTransform,
+            AnyOf<(&'static GrabPoint, &'static GrabPoint<DVec3>)>,
+            AnyOf<(&'static SpringAnchor, &'static SpringAnchor<DVec3>)>,
+        ),
+        With<BodyVisual>,
+    >,
     rods: Query<'w, 's, &'static Rod>,
     pins: Query<'w, 's, &'static Pin>,
     transforms: Query<'w, 's, &'static Transform>,
@@ -218,6 +230,7 @@ impl ReportView<'_, '_> {
                 .filter_map(|pin| to_pixel(pin.locate(&self.transforms)?))
                 .collect(),
             space_beads: self.space_beads(scale),
+            bodies: self.bodies(scale, &to_pixel),
             space_curves: self.space_curves(scale, in_window),
             drag,
             preset: self.active.running.clone(),
@@ -325,6 +338,47 @@ impl ReportView<'_, '_> {
         Some(camera.world_to_viewport(transform, p).ok()? * scale)
     }
 
+    /// Where each rigid body shows.
+    fn bodies(&self, scale: f32, to_pixel: &dyn Fn(DVec2) -> Option<[f32; 2]>) -> Vec<BodyReport> {
+        self.bodies
+            .iter()
+            .filter_map(|(name, transform)| {
+                let at = transform.translation();
+                let pixel = if self.active.in_space {
+                    self.space_pixel(scale, at)?.to_array()
+                } else {
+                    to_pixel(at.truncate().as_dvec2())?
+                };
+                Some(BodyReport {
+                    name: name.map(|n| n.as_str().to_owned()).unwrap_or_default(),
+                    world: at.as_dvec3().to_array(),
+                    pixel,
+                })
+            })
+            .collect()
+    }
+
+    /// Each body being dragged: the point taken, where it is now, and the
+    /// spring's anchor.
+    fn dragged_bodies(&self) -> impl Iterator<Item = (DVec3, DVec3)> + '_ {
+        self.dragged_bodies
+            .iter()
+            .filter_map(|(transform, grabs, anchors)| {
+                let grab = match grabs {
+                    (Some(g), _) => g.get().extend(0.0),
+                    (_, Some(g)) => g.get(),
+                    _ => return None,
+                };
+                let target = match anchors {
+                    (Some(a), _) => a.get().extend(0.0),
+                    (_, Some(a)) => a.get(),
+                    _ => return None,
+                };
+                let at = transform.transform_point(grab.as_vec3()).as_dvec3();
+                Some((at, target))
+            })
+    }
+
     /// Where each bead in space shows, and how large.
     fn space_beads(&self, scale: f32) -> Vec<SpaceBeadReport> {
         let right = self
@@ -405,9 +459,9 @@ impl AutomationState {
             let failure = format!("the scene preset {} never ran", active.path);
             self.failures.push(failure);
         }
-        if last.beads.is_empty() && last.space_beads.is_empty() {
+        if last.beads.is_empty() && last.space_beads.is_empty() && last.bodies.is_empty() {
             self.failures
-                .push("there was no bead in the scene".to_owned());
+                .push("there was no bead or body in the scene".to_owned());
         }
     }
 }
@@ -436,7 +490,7 @@ fn automation(
         .space_beads
         .iter()
         .filter_map(|(bead, _, _, target)| Some((bead.0, target?.get())));
-    state.follow_drag(in_plane.chain(in_space));
+    state.follow_drag(in_plane.chain(in_space).chain(scene.dragged_bodies()));
     let report =
         |state: &AutomationState| scene.report(frame, state.drag_report(), state.mean_frame_ms());
 

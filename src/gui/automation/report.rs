@@ -38,6 +38,18 @@ pub struct SpaceBeadReport {
     pub diverged: Option<String>,
 }
 
+/// Where one rigid body is (features `avian2d`, `avian3d`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BodyReport {
+    /// Its name, if it has one.
+    pub name: String,
+    /// Its origin (`z` zero in the plane).
+    pub world: [f64; 3],
+    /// Its origin's window position in physical pixels, from the top
+    /// left, through the camera of the view shown.
+    pub pixel: [f32; 2],
+}
+
 /// Where one wire is drawn.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WireReport {
@@ -55,16 +67,18 @@ pub struct WireReport {
     pub open_side: Vec<[f32; 2]>,
 }
 
-/// What a mouse drag did, in the plane (`z = 0`) or in space.
+/// What a mouse drag did, in the plane (`z = 0`) or in space, to a bead
+/// or to the point of a body it took.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DragReport {
-    /// The bead's position when the drag began.
+    /// The bead's position (or the point taken) when the drag began.
     pub bead_start: [f64; 3],
     /// The last drag target (where the cursor was released).
     pub target: [f64; 3],
     /// The distance from the bead's start to that target.
     pub start_distance: f64,
-    /// The bead's closest approach to that target while dragged.
+    /// The bead's (or point's) closest approach to that target while
+    /// dragged.
     pub closest_distance: f64,
 }
 
@@ -88,6 +102,9 @@ pub struct FrameReport {
     /// The beads in space.
     #[serde(default)]
     pub space_beads: Vec<SpaceBeadReport>,
+    /// The rigid bodies drawn.
+    #[serde(default)]
+    pub bodies: Vec<BodyReport>,
     /// Each curve in space: its drawn points inside the window, in
     /// physical pixels.
     #[serde(default)]

@@ -35,6 +35,21 @@ pub use window::panel;
 use crate::gui::drag::SelectedBead;
 use crate::{Bead, WireBeadSystems};
 
+/// The presets with rigid bodies the build can run: those of each avian
+/// it has (features `avian2d`, `avian3d`).
+const WITH_BODIES: &[(&str, &str)] = &[
+    #[cfg(feature = "avian2d")]
+    (
+        "With avian: cart on a hoop",
+        "scenes/avian/cart_on_hoop.scene.ron",
+    ),
+    #[cfg(feature = "avian3d")]
+    (
+        "With avian, in space: cart on a loop",
+        "scenes/avian/cart_on_loop_in_space.scene.ron",
+    ),
+];
+
 /// The presets the panel offers: `(label, asset path)`.
 #[derive(Resource, Clone, Debug)]
 pub struct PresetCatalog(pub Vec<(String, String)>);
@@ -95,6 +110,7 @@ impl Default for PresetCatalog {
                 ),
             ]
             .into_iter()
+            .chain(WITH_BODIES.iter().copied())
             .map(|(a, b)| (a.to_owned(), b.to_owned()))
             .collect(),
         )

@@ -15,6 +15,7 @@ use super::{Orbit, SPACE_LAYER, SpaceGizmos};
 use crate::controls::Presentation;
 use crate::debug_render::{DebugRenderStyle, force_unit};
 use crate::geometry::{Side, SpaceShape};
+use crate::gui::bodies::BodyVisual;
 use crate::gui::render::{BeadSizes, SceneStyle, Trail};
 use crate::{
     BeadDiagnostics, BeadMass, BeadParams, BeadPosition, BeadRadius, Diverged, OnWire, Pin,
@@ -158,14 +159,16 @@ pub fn add_bead_visuals(
     }
 }
 
-/// Frames the scene when its wires or beads change: the camera looks at
-/// the middle of everything drawn and every bead's start, from far
+/// Frames the scene when its wires, beads or bodies change: the camera
+/// looks at the middle of everything drawn and every bead's and body's
+/// start, from far
 /// enough to see it all beside the panel. The turn the user gave it is
 /// kept.
 pub fn frame_scene(
-    added: Query<(), Or<(Added<WireDrawing>, Added<SpaceBead>)>>,
+    added: Query<(), Or<(Added<WireDrawing>, Added<SpaceBead>, Added<BodyVisual>)>>,
     wires: Query<(&WireDrawing, &Transform)>,
     beads: Query<&BeadParams<DVec3>>,
+    bodies: Query<&BodyVisual>,
     pins: Query<&Pin<DVec3>>,
     rods: Query<&Rod>,
     on_wire: Query<(), With<OnWire>>,
@@ -186,6 +189,7 @@ pub fn frame_scene(
             .filter_map(|p| p.locate(&transforms))
             .map(|p| p.as_vec3()),
     );
+    points.extend(bodies.iter().flat_map(BodyVisual::bounds));
     for (drawing, transform) in &wires {
         points.extend(
             drawing

@@ -231,7 +231,7 @@ fn zoom(
 
 /// The point on the plane through `bead` facing the camera under the
 /// pointer: where the drag spring pulls.
-fn drag_target(
+pub(crate) fn drag_target(
     camera: (&Camera, &GlobalTransform),
     pointer: Vec2,
     bead: DVec3,
@@ -243,7 +243,8 @@ fn drag_target(
     SpringAnchor::new(at.as_dvec3()).ok()
 }
 
-type SpaceCameras<'w, 's> =
+/// The 3D view's camera.
+pub(crate) type SpaceCameras<'w, 's> =
     Query<'w, 's, (&'static Camera, &'static GlobalTransform), With<SpaceCamera>>;
 
 /// How far `p` lies from the ray.
