@@ -113,10 +113,10 @@ pub fn wire_pose(transform: &Transform) -> Pose {
 /// What a wire rides: the body of its `WireOnBody`, with the avian
 /// features.
 #[cfg(any(feature = "avian2d", feature = "avian3d"))]
-type Riding = Option<&'static crate::dynamics::WireOnBody>;
+pub(crate) type Riding = Option<&'static crate::dynamics::WireOnBody>;
 /// What a wire rides: nothing, without the avian features.
 #[cfg(not(any(feature = "avian2d", feature = "avian3d")))]
-type Riding = ();
+pub(crate) type Riding = ();
 
 /// Where the body a wire rides puts the wire's frame (the identity for a
 /// wire that rides none).
@@ -132,6 +132,27 @@ fn carrier_pose(riding: Option<&crate::dynamics::WireOnBody>, bodies: &Query<&Tr
 #[cfg(not(any(feature = "avian2d", feature = "avian3d")))]
 fn carrier_pose(_: (), _: &Query<&Transform>) -> Pose {
     Pose::IDENTITY
+}
+
+/// The `Transform` of the body a wire rides, in space as in the plane
+/// (the identity for a wire that rides none): a wire's own `Transform` is
+/// its place in that body's frame.
+#[cfg(all(feature = "gui", any(feature = "avian2d", feature = "avian3d")))]
+pub(crate) fn carrier_transform(
+    riding: Option<&crate::dynamics::WireOnBody>,
+    bodies: &Query<&Transform>,
+) -> Transform {
+    riding
+        .and_then(|on| bodies.get(on.0).ok())
+        .copied()
+        .unwrap_or_default()
+}
+
+/// The `Transform` of the body a wire rides: none without the avian
+/// features.
+#[cfg(all(feature = "gui", not(any(feature = "avian2d", feature = "avian3d"))))]
+pub(crate) fn carrier_transform(_: (), _: &Query<&Transform>) -> Transform {
+    Transform::IDENTITY
 }
 
 /// Draws every wire as a gizmo stroke, a one-sided one hatched on its

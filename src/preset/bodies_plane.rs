@@ -10,7 +10,7 @@ use avian2d::prelude::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::{BodyKind, BodyPreset, BodyShape, PathRotationPreset, SceneBody, ScenePath};
+use super::{BodyKind, BodyPreset, BodyShape, PathRotationPreset, SceneBody, SceneJoin, ScenePath};
 use crate::avian::{BodyStart, PathJoint, PathRotation};
 
 /// Avian's kind of body for a scene's.
@@ -75,6 +75,27 @@ pub(super) fn joint(wire: Entity, path: &ScenePath) -> PathJoint {
         Some(motor) => joint.with_motor(motor),
         None => joint,
     }
+}
+
+/// Spawns the joint of a scene's join between its two bodies `pair`: a
+/// hinge as avian's `RevoluteJoint` at its point, a coupling as its
+/// `DistanceJoint`; the bodies not colliding with each other. The joint.
+pub(super) fn join(pair: [Entity; 2], join: &SceneJoin, commands: &mut Commands) -> Entity {
+    let mut joint = commands.spawn(JointCollisionDisabled);
+    match *join {
+        SceneJoin::Hinge { at, .. } => {
+            joint.insert(RevoluteJoint::new(pair[0], pair[1]).with_anchor(at.adjust_precision()))
+        }
+        SceneJoin::Coupling {
+            anchors, length, ..
+        } => joint.insert(
+            DistanceJoint::new(pair[0], pair[1])
+                .with_local_anchor1(anchors[0].adjust_precision())
+                .with_local_anchor2(anchors[1].adjust_precision())
+                .with_limits(length as Scalar, length as Scalar),
+        ),
+    };
+    joint.id()
 }
 
 /// The state of the rigid body `body` as a scene's run records it: its

@@ -7,7 +7,9 @@ use avian3d::prelude::*;
 use bevy::math::{DQuat, DVec3};
 use bevy::prelude::*;
 
-use super::{BodyKind, BodyShape, PathRotationPreset, SceneBody, ScenePath, SpaceBodyPreset};
+use super::{
+    BodyKind, BodyShape, PathRotationPreset, SceneBody, SceneJoin, ScenePath, SpaceBodyPreset,
+};
 use crate::avian3d::{BodyStart, PathJoint, PathRotation, rotation_of, vector_of};
 
 /// Avian's kind of body for a scene's.
@@ -57,6 +59,42 @@ pub(crate) fn spawn_bodies(bodies: &[SpaceBodyPreset], commands: &mut Commands) 
             entity.id()
         })
         .collect()
+}
+
+/// Spawns the joint of a scene's join between its two bodies `pair`: a
+/// hinge as avian's `RevoluteJoint` about its axis (its joint frames
+/// turned so that their `z`, avian's hinge axis, lies along it where the
+/// bodies start) or its `SphericalJoint` where it has no axis, a coupling
+/// as its `DistanceJoint`; the bodies not colliding with each other. The
+/// joint.
+pub(super) fn join(pair: [Entity; 2], join: &SceneJoin<DVec3>, commands: &mut Commands) -> Entity {
+    let mut joint = commands.spawn(JointCollisionDisabled);
+    match *join {
+        SceneJoin::Hinge {
+            at,
+            axis: Some(axis),
+            ..
+        } => {
+            let basis = DQuat::from_rotation_arc(DVec3::Z, axis);
+            joint.insert(
+                RevoluteJoint::new(pair[0], pair[1])
+                    .with_anchor(at.adjust_precision())
+                    .with_basis(basis.adjust_precision()),
+            )
+        }
+        SceneJoin::Hinge { at, axis: None, .. } => {
+            joint.insert(SphericalJoint::new(pair[0], pair[1]).with_anchor(at.adjust_precision()))
+        }
+        SceneJoin::Coupling {
+            anchors, length, ..
+        } => joint.insert(
+            DistanceJoint::new(pair[0], pair[1])
+                .with_local_anchor1(anchors[0].adjust_precision())
+                .with_local_anchor2(anchors[1].adjust_precision())
+                .with_limits(length as Scalar, length as Scalar),
+        ),
+    };
+    joint.id()
 }
 
 /// The path joint of a scene's `path` on the wire `wire`.

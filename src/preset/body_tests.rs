@@ -4,8 +4,8 @@
 use bevy::math::{DVec2, DVec3};
 
 use super::{
-    BodyKind, BodyShape, PathRotationPreset, SceneBody, SceneFile, ScenePreset, SpaceScene,
-    plane_inertia, scene_ron,
+    BodyKind, BodyShape, PathRotationPreset, SceneBody, SceneFile, SceneJoin, ScenePreset,
+    SpaceScene, plane_inertia, scene_ron,
 };
 
 /// The scene of the format's description, to the letter.
@@ -180,4 +180,114 @@ fn a_scene_in_space_puts_its_anchor_on_a_wire_its_body_carries() {
         SceneFile::Plane(_) => panic!("a scene in space"),
     };
     assert_eq!(again.bodies, scene.bodies);
+}
+
+/// The format's scene with a static post and the cart hinged to it at
+/// the hoop's centre.
+fn hinged(hinge: &str) -> String {
+    CART.replace(
+        ")],\n    wires:",
+        "), (name: \"post\", kind: Static, shape: Ball((radius: 0.05)), position: (0.0, 0.0))],\n    wires:",
+    )
+    .replace(
+        "rotation: Free))]",
+        &format!("rotation: Free)), {hinge}]"),
+    )
+}
+
+#[test]
+fn a_hinge_joins_two_named_bodies_and_is_refused_naming_it_when_bad() {
+    let text = hinged(r#"Hinge((a: "post", b: "cart", at: (0.0, 0.0)))"#);
+    let scene = ScenePreset::from_ron(&text).expect("the hinged scene reads");
+    let joins = scene.joins().expect("the hinge resolves");
+    assert_eq!(
+        joins,
+        [SceneJoin::Hinge {
+            bodies: [1, 0],
+            at: DVec2::ZERO,
+            axis: None
+        }]
+    );
+    // Written back as read.
+    let again =
+        ScenePreset::from_ron(&scene_ron(&SceneFile::Plane(scene.clone())).expect("written"))
+            .expect("read back");
+    assert_eq!(again.constraints, scene.constraints);
+    for (hinge, says) in [
+        (
+            r#"Hinge((a: "post", b: "cat", at: (0.0, 0.0)))"#,
+            r#"constraint 1 (hinge): no body is named "cat""#,
+        ),
+        (
+            r#"Hinge((a: "cart", b: "cart", at: (0.0, 0.0)))"#,
+            r#"constraint 1 (hinge): joins body "cart" to itself"#,
+        ),
+        (
+            r#"Hinge((a: "post", b: "cart", at: (0.0, NaN)))"#,
+            "constraint 1 (hinge): hinge point",
+        ),
+        (
+            r#"Hinge((a: "post", b: "cart", at: (0.0, 0.0), axis: (0.0, 1.0)))"#,
+            "a hinge in the plane turns about z: it takes no axis",
+        ),
+    ] {
+        let said = ScenePreset::from_ron(&hinged(hinge))
+            .unwrap_err()
+            .to_string();
+        assert!(said.contains(says), "{said:?} should say {says:?}");
+        assert!(!said.contains('\n'), "{said:?} is more than one line");
+    }
+    // In space a hinge's axis comes out of unit length, and a zero one
+    // is refused.
+    let space = |axis: &str| {
+        DOOR.replace(
+            "rotation: AroundBinormal))]",
+            &format!(
+                r#"rotation: AroundBinormal)), Hinge((a: "door", b: "box", at: (2.0, 0.0, 0.0), axis: {axis}))]"#
+            ),
+        )
+    };
+    let scene = match SceneFile::from_ron(&space("(0.0, 2.0, 0.0)")).expect("reads") {
+        SceneFile::Space(scene) => scene,
+        SceneFile::Plane(_) => panic!("a scene in space"),
+    };
+    let SceneJoin::Hinge { axis, .. } = scene.joins().expect("resolves")[0] else {
+        panic!("a hinge");
+    };
+    assert_eq!(axis, Some(DVec3::Y));
+    let said = SceneFile::from_ron(&space("(0.0, 0.0, 0.0)"))
+        .unwrap_err()
+        .to_string();
+    assert!(said.contains("a hinge's axis must not be zero"), "{said}");
+}
+
+/// A coupling is a rod between a point of each body, as long as they are
+/// apart where the bodies start: the cart's left end and the post's
+/// centre, 0.8 m apart.
+#[test]
+fn a_coupling_is_as_long_as_its_ends_are_apart_at_the_start() {
+    let text = hinged(r#"Coupling((a: "cart", b: "post", anchor_a: (-0.2, 0.0)))"#);
+    let scene = ScenePreset::from_ron(&text).expect("the coupled scene reads");
+    let [
+        SceneJoin::Coupling {
+            bodies,
+            anchors,
+            length,
+        },
+    ] = scene.joins().expect("the coupling resolves")[..]
+    else {
+        panic!("one coupling");
+    };
+    assert_eq!(bodies, [0, 1]);
+    assert_eq!(anchors, [DVec2::new(-0.2, 0.0), DVec2::ZERO]);
+    assert!((length - 0.8).abs() < 1e-15, "{length}");
+    let said = ScenePreset::from_ron(&hinged(
+        r#"Coupling((a: "cart", b: "post", anchor_b: (inf, 0.0)))"#,
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(
+        said.contains("constraint 1 (coupling): coupling anchor"),
+        "{said}"
+    );
 }

@@ -51,10 +51,10 @@ pub(crate) use export::{BeadEdits, WireEdits, edited_scene};
 pub use export::{ExportDir, ExportPlugin, LastExport, scene_ron, scene_stem, with_edits};
 pub use format::{
     ANCHOR_TOLERANCE, BallShape, BeadPreset, BodyKind, BodyPreset, BodyShape, BoxShape,
-    CapsuleShape, ConstraintPreset, ContactsPreset, MotorPreset, PathPreset, PathRotationPreset,
-    PinPreset, PositionMotorPreset, RodPreset, RotationPreset, SceneBody, SceneLink, ScenePath,
-    ScenePreset, SendBackPreset, SpaceBodyPreset, SpringPreset, VelocityMotorPreset, WirePreset,
-    plane_inertia, space_inertia,
+    CapsuleShape, ConstraintPreset, ContactsPreset, CouplingPreset, HingePreset, MotorPreset,
+    PathPreset, PathRotationPreset, PinPreset, PositionMotorPreset, RodPreset, RotationPreset,
+    SceneBody, SceneJoin, SceneLink, ScenePath, ScenePreset, SendBackPreset, SpaceBodyPreset,
+    SpringPreset, VelocityMotorPreset, WirePreset, plane_inertia, space_inertia,
 };
 pub use hourglass::{GRAIN_RADIUS, Hourglass};
 pub use marble_run::{MARBLE_BOWL, MarbleRun};

@@ -8,9 +8,10 @@ use serde::{Deserialize, Serialize};
 
 use super::error::PresetError;
 use super::format::{
-    BeadPreset, ConstraintPreset, ContactsPreset, NamedWire, RotationPreset, SceneLink, ScenePath,
-    SendBackPreset, SpaceBodyPreset, SpringPreset, catching_and_sending, check_beads_and_links,
-    check_bodies, checked_bodies, given_some, is_false, names_of, with_bodies, written_some,
+    BeadPreset, ConstraintPreset, ContactsPreset, NamedWire, RotationPreset, SceneJoin, SceneLink,
+    ScenePath, SendBackPreset, SpaceBodyPreset, SpringPreset, catching_and_sending,
+    check_beads_and_links, check_bodies, check_joins, checked_bodies, given_some, is_false,
+    names_of, with_bodies, written_some,
 };
 use super::spawn::{FromPreset, spawn_beads_and_links};
 use crate::dynamics::{
@@ -338,7 +339,14 @@ impl SpaceScene {
             self.wires.iter().map(|w| w.beads.as_slice()).collect();
         let beads = check_beads_and_links(&wires, &self.beads, &self.constraints, &self.springs);
         with_bodies(beads, self.bodies.is_empty())?;
-        self.paths().map(drop)
+        self.paths()?;
+        self.joins().map(drop)
+    }
+
+    /// The hinges and couplings with their bodies found (see
+    /// [`ScenePreset::joins`](super::ScenePreset::joins)).
+    pub fn joins(&self) -> Result<Vec<SceneJoin<DVec3>>, PresetError> {
+        check_joins(&checked_bodies(&self.bodies)?, &self.constraints)
     }
 
     /// The path joints with their bodies and wires found (see
@@ -433,8 +441,9 @@ impl SpaceScene {
     }
 
     /// Spawns the bodies in avian3d, puts the wires that ride them on
-    /// them (`wires` the spawned wires) and the path joints on them, and
-    /// sets avian's gravity to the scene's.
+    /// them (`wires` the spawned wires) and the path joints on them,
+    /// spawns the hinges and couplings, and sets avian's gravity to the
+    /// scene's.
     #[cfg(feature = "avian3d")]
     fn spawn_bodies(&self, wires: &[Option<Entity>], commands: &mut Commands) -> Vec<Entity> {
         if self.bodies.is_empty() {
@@ -448,8 +457,11 @@ impl SpaceScene {
         super::spawn::join_bodies(
             (wires, &bodies),
             (self.wires.iter().map(|w| w.body.as_str()), &self.bodies),
-            &self.paths().unwrap_or_default(),
-            super::bodies_space::joint,
+            (
+                &self.paths().unwrap_or_default(),
+                super::bodies_space::joint,
+            ),
+            (&self.joins().unwrap_or_default(), super::bodies_space::join),
             commands,
         );
         bodies

@@ -61,8 +61,9 @@ impl ScenePreset {
     }
 
     /// Spawns the bodies in avian2d, puts the wires that ride them on
-    /// them (`wires` the spawned wires) and the path joints on them, and
-    /// sets avian's gravity to the scene's.
+    /// them (`wires` the spawned wires) and the path joints on them,
+    /// spawns the hinges and couplings, and sets avian's gravity to the
+    /// scene's.
     #[cfg(feature = "avian2d")]
     fn spawn_bodies(&self, wires: &[Option<Entity>], commands: &mut Commands) -> Vec<Entity> {
         if self.bodies.is_empty() {
@@ -76,8 +77,11 @@ impl ScenePreset {
         join_bodies(
             (wires, &bodies),
             (self.wires.iter().map(|w| w.body.as_str()), &self.bodies),
-            &self.paths().unwrap_or_default(),
-            super::bodies_plane::joint,
+            (
+                &self.paths().unwrap_or_default(),
+                super::bodies_plane::joint,
+            ),
+            (&self.joins().unwrap_or_default(), super::bodies_plane::join),
             commands,
         );
         bodies
@@ -105,19 +109,22 @@ pub(super) fn bodies_left_out(scene: &str, count: usize, feature: &str) -> Vec<E
 /// Joins a scene's spawned `bodies` (of the file's `presets`, in order)
 /// to the rest of it: each wire whose body is named (`wire_bodies`, each
 /// wire's) rides that body, each path joint is put on its body (`joint`
-/// making it from its wire's entity), and each body is named and marked
+/// making it from its wire's entity), each hinge and coupling is spawned
+/// (`join` spawning it between its two bodies), and each body is named and marked
 /// [`FromPreset`].
 #[cfg(any(feature = "avian2d", feature = "avian3d"))]
-pub(super) fn join_bodies<'a, V, B, J>(
+pub(super) fn join_bodies<'a, V, B, J, F, H>(
     (wires, bodies): (&[Option<Entity>], &[Entity]),
     (wire_bodies, presets): (impl Iterator<Item = &'a str>, &[B]),
-    paths: &[super::ScenePath<V>],
-    joint: impl Fn(Entity, &super::ScenePath<V>) -> J,
+    (paths, joint): (&[super::ScenePath<V>], F),
+    (joins, join): (&[super::SceneJoin<V>], H),
     commands: &mut Commands,
 ) where
     V: crate::geometry::Coordinates,
     B: super::SceneBody,
     J: Bundle,
+    F: Fn(Entity, &super::ScenePath<V>) -> J,
+    H: Fn([Entity; 2], &super::SceneJoin<V>, &mut Commands) -> Entity,
 {
     for (wire, body) in wires.iter().zip(wire_bodies) {
         let carrier = presets
@@ -133,6 +140,11 @@ pub(super) fn join_bodies<'a, V, B, J>(
         if let Some(wire) = wires[path.wire] {
             commands.entity(bodies[path.body]).insert(joint(wire, path));
         }
+    }
+    for joined in joins {
+        let pair = joined.bodies().map(|b| bodies[b]);
+        let spawned = join(pair, joined, commands);
+        commands.entity(spawned).insert(FromPreset);
     }
     for (&body, preset) in bodies.iter().zip(presets) {
         commands

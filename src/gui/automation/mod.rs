@@ -18,7 +18,7 @@ pub use report::{
     TimelineReport, WireReport,
 };
 
-use crate::debug_render::{hatch_point, wire_points};
+use crate::debug_render::{Riding, carrier_transform, hatch_point, wire_points};
 use crate::geometry::Placed;
 use crate::ghost::Ghosts;
 use crate::gui::bodies::BodyVisual;
@@ -106,7 +106,7 @@ struct ReportView<'w, 's> {
             Option<&'static SpringAnchor<DVec3>>,
         ),
     >,
-    space_wires: Query<'w, 's, (&'static WireDrawing, &'static Transform)>,
+    space_wires: Query<'w, 's, (&'static WireDrawing, &'static Transform, Riding)>,
     bodies: Query<'w, 's, (Option<&'static Name>, &'static GlobalTransform), With<BodyVisual>>,
     dragged_bodies: Query<
         'w,
@@ -406,11 +406,16 @@ impl ReportView<'_, '_> {
     fn space_curves(&self, scale: f32, inside: impl Fn(&[f32; 2]) -> bool) -> Vec<Vec<[f32; 2]>> {
         self.space_wires
             .iter()
-            .filter_map(|(drawing, transform)| match drawing {
+            .filter_map(|(drawing, transform, riding)| match drawing {
                 WireDrawing::Curve(points) => Some(
                     points
                         .iter()
-                        .filter_map(|&p| self.space_pixel(scale, transform.transform_point(p)))
+                        .map(|&p| {
+                            carrier_transform(riding, &self.transforms)
+                                .mul_transform(*transform)
+                                .transform_point(p)
+                        })
+                        .filter_map(|p| self.space_pixel(scale, p))
                         .map(|p| p.to_array())
                         .filter(&inside)
                         .collect(),

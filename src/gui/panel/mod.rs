@@ -43,10 +43,25 @@ const WITH_BODIES: &[(&str, &str)] = &[
         "With avian: cart on a hoop",
         "scenes/avian/cart_on_hoop.scene.ron",
     ),
+    #[cfg(feature = "avian2d")]
+    (
+        "With avian: marbles and dominoes",
+        "scenes/avian/dominoes.scene.ron",
+    ),
     #[cfg(feature = "avian3d")]
     (
         "With avian, in space: cart on a loop",
         "scenes/avian/cart_on_loop_in_space.scene.ron",
+    ),
+    #[cfg(feature = "avian3d")]
+    (
+        "With avian, in space: coaster train and crates",
+        "scenes/avian/coaster_train.scene.ron",
+    ),
+    #[cfg(feature = "avian3d")]
+    (
+        "With avian, in space: bead on a hoop on a door",
+        "scenes/avian/door.scene.ron",
     ),
 ];
 

@@ -13,7 +13,7 @@ use bevy::render::render_resource::Face;
 use super::shapes::{curve_points, fitted_surface_mesh};
 use super::{Orbit, SPACE_LAYER, SpaceGizmos};
 use crate::controls::Presentation;
-use crate::debug_render::{DebugRenderStyle, force_unit};
+use crate::debug_render::{DebugRenderStyle, Riding, carrier_transform, force_unit};
 use crate::geometry::{Side, SpaceShape};
 use crate::gui::bodies::BodyVisual;
 use crate::gui::render::{BeadSizes, SceneStyle, Trail};
@@ -272,16 +272,19 @@ pub fn size_and_colour_beads(
     }
 }
 
-/// Draws each curve in space where its `Transform` puts it now.
+/// Draws each curve in space where its `Transform` puts it now (in the
+/// frame of the body it rides, if it rides one).
 pub fn draw_wires(
-    wires: Query<(&WireDrawing, &Transform)>,
+    wires: Query<(&WireDrawing, &Transform, Riding)>,
+    bodies: Query<&Transform>,
     style: Res<SceneStyle>,
     mut gizmos: Gizmos<SpaceGizmos>,
 ) {
-    for (drawing, transform) in &wires {
+    for (drawing, transform, riding) in &wires {
         if let WireDrawing::Curve(points) = drawing {
+            let placed = carrier_transform(riding, &bodies).mul_transform(*transform);
             gizmos.linestrip(
-                points.iter().map(|&p| transform.transform_point(p)),
+                points.iter().map(|&p| placed.transform_point(p)),
                 style.wire,
             );
         }

@@ -140,8 +140,10 @@ pub(in crate::preset) fn resolve_links<V: Coordinates>(
                 finite_vector("pin point", pin.at).map_err(problem(item()))?;
                 SceneLink::Pin { bead, at: pin.at }
             }
-            // A body's, not a bead's: see `check_bodies`.
-            ConstraintPreset::Path(_) => continue,
+            // Bodies', not beads': see `check_bodies` and `check_joins`.
+            ConstraintPreset::Path(_)
+            | ConstraintPreset::Hinge(_)
+            | ConstraintPreset::Coupling(_) => continue,
         });
     }
     for (index, spring) in springs.iter().enumerate() {

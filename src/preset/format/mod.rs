@@ -2,6 +2,7 @@
 //! of every value in them, and the links with their beads resolved.
 
 mod bodies;
+mod joins;
 mod links;
 mod paths;
 
@@ -13,6 +14,8 @@ pub use bodies::{
     BallShape, BodyKind, BodyPreset, BodyShape, BoxShape, CapsuleShape, RotationPreset, SceneBody,
     SpaceBodyPreset, plane_inertia, space_inertia,
 };
+pub(super) use joins::check_joins;
+pub use joins::{CouplingPreset, HingePreset, SceneJoin};
 pub use links::SceneLink;
 pub(super) use links::{check_beads_and_links, names_of, resolve_links};
 pub use paths::{
@@ -156,15 +159,21 @@ pub enum ConstraintPreset<V: Coordinates = DVec2> {
     Pin(PinPreset<V>),
     /// A body's point held on a wire (see [`PathPreset`]).
     Path(PathPreset<V>),
+    /// Two bodies joined at a point (see [`HingePreset`]).
+    Hinge(HingePreset<V>),
+    /// Two bodies joined by a rod (see [`CouplingPreset`]).
+    Coupling(CouplingPreset<V>),
 }
 
 impl<V: Coordinates> ConstraintPreset<V> {
-    /// `rod`, `pin` or `path`.
+    /// `rod`, `pin`, `path`, `hinge` or `coupling`.
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Rod(_) => "rod",
             Self::Pin(_) => "pin",
             Self::Path(_) => "path",
+            Self::Hinge(_) => "hinge",
+            Self::Coupling(_) => "coupling",
         }
     }
 }
@@ -392,7 +401,13 @@ impl ScenePreset {
         let wires: Vec<&[BeadPreset]> = self.wires.iter().map(|w| w.beads.as_slice()).collect();
         let beads = check_beads_and_links(&wires, &self.beads, &self.constraints, &self.springs);
         with_bodies(beads, self.bodies.is_empty())?;
-        self.paths().map(drop)
+        self.paths()?;
+        self.joins().map(drop)
+    }
+
+    /// The hinges and couplings with their bodies found, each checked.
+    pub fn joins(&self) -> Result<Vec<SceneJoin>, PresetError> {
+        check_joins(&checked_bodies(&self.bodies)?, &self.constraints)
     }
 
     /// The path joints with their bodies and wires found, each body, wire

@@ -252,15 +252,7 @@ pub(in crate::preset) fn check_bodies<V: Dimension>(
             return Err(PresetError::DuplicateBody((*name).to_owned()));
         }
     }
-    let body_named = |item: &dyn Fn() -> String, name: &str| {
-        bodies
-            .iter()
-            .position(|(n, _)| *n == name)
-            .ok_or_else(|| PresetError::Link {
-                item: item(),
-                problem: format!("no body is named {name:?}"),
-            })
-    };
+    let body_named = |item: &dyn Fn() -> String, name: &str| body_named(bodies, item, name);
     for (index, wire) in wires.iter().enumerate() {
         if !wire.name.is_empty() && wires[..index].iter().any(|w| w.name == wire.name) {
             return Err(PresetError::DuplicateWire(wire.name.to_owned()));
@@ -320,6 +312,22 @@ pub(in crate::preset) fn check_bodies<V: Dimension>(
         });
     }
     Ok(paths)
+}
+
+/// The index of the body named `name` among `bodies`, or the error of
+/// `item` that names none.
+pub(super) fn body_named<P>(
+    bodies: &[(&str, P)],
+    item: &dyn Fn() -> String,
+    name: &str,
+) -> Result<usize, PresetError> {
+    bodies
+        .iter()
+        .position(|(n, _)| *n == name)
+        .ok_or_else(|| PresetError::Link {
+            item: item(),
+            problem: format!("no body is named {name:?}"),
+        })
 }
 
 /// A wire in words: `wire 2`, or `wire 2 ("hoop")` where it has a name.
