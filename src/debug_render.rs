@@ -134,25 +134,25 @@ fn carrier_pose(_: (), _: &Query<&Transform>) -> Pose {
     Pose::IDENTITY
 }
 
-/// The `Transform` of the body a wire rides, in space as in the plane
-/// (the identity for a wire that rides none): a wire's own `Transform` is
-/// its place in that body's frame.
+/// Where a wire is in the world, in space as in the plane: its own
+/// `Transform` (`transform`), which is its place in the frame of the body
+/// it rides where it rides one, composed with that body's.
 #[cfg(all(feature = "gui", any(feature = "avian2d", feature = "avian3d")))]
-pub(crate) fn carrier_transform(
+pub(crate) fn carried_transform(
+    transform: &Transform,
     riding: Option<&crate::dynamics::WireOnBody>,
     bodies: &Query<&Transform>,
 ) -> Transform {
     riding
         .and_then(|on| bodies.get(on.0).ok())
-        .copied()
-        .unwrap_or_default()
+        .map_or(*transform, |body| body.mul_transform(*transform))
 }
 
-/// The `Transform` of the body a wire rides: none without the avian
-/// features.
+/// Where a wire is in the world: where its `Transform` puts it, no wire
+/// riding a body without the avian features.
 #[cfg(all(feature = "gui", not(any(feature = "avian2d", feature = "avian3d"))))]
-pub(crate) fn carrier_transform(_: (), _: &Query<&Transform>) -> Transform {
-    Transform::IDENTITY
+pub(crate) fn carried_transform(transform: &Transform, _: (), _: &Query<&Transform>) -> Transform {
+    *transform
 }
 
 /// Draws every wire as a gizmo stroke, a one-sided one hatched on its

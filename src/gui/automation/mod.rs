@@ -18,7 +18,7 @@ pub use report::{
     TimelineReport, WireReport,
 };
 
-use crate::debug_render::{Riding, carrier_transform, hatch_point, wire_points};
+use crate::debug_render::{Riding, carried_transform, hatch_point, wire_points};
 use crate::geometry::Placed;
 use crate::ghost::Ghosts;
 use crate::gui::bodies::BodyVisual;
@@ -407,19 +407,17 @@ impl ReportView<'_, '_> {
         self.space_wires
             .iter()
             .filter_map(|(drawing, transform, riding)| match drawing {
-                WireDrawing::Curve(points) => Some(
-                    points
-                        .iter()
-                        .map(|&p| {
-                            carrier_transform(riding, &self.transforms)
-                                .mul_transform(*transform)
-                                .transform_point(p)
-                        })
-                        .filter_map(|p| self.space_pixel(scale, p))
-                        .map(|p| p.to_array())
-                        .filter(&inside)
-                        .collect(),
-                ),
+                WireDrawing::Curve(points) => {
+                    let placed = carried_transform(transform, riding, &self.transforms);
+                    Some(
+                        points
+                            .iter()
+                            .filter_map(|&p| self.space_pixel(scale, placed.transform_point(p)))
+                            .map(|p| p.to_array())
+                            .filter(&inside)
+                            .collect(),
+                    )
+                }
                 WireDrawing::Surface(_) => None,
             })
             .collect()

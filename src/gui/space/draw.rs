@@ -13,7 +13,7 @@ use bevy::render::render_resource::Face;
 use super::shapes::{curve_points, fitted_surface_mesh};
 use super::{Orbit, SPACE_LAYER, SpaceGizmos};
 use crate::controls::Presentation;
-use crate::debug_render::{DebugRenderStyle, Riding, carrier_transform, force_unit};
+use crate::debug_render::{DebugRenderStyle, Riding, carried_transform, force_unit};
 use crate::geometry::{Side, SpaceShape};
 use crate::gui::bodies::BodyVisual;
 use crate::gui::render::{BeadSizes, SceneStyle, Trail};
@@ -282,7 +282,7 @@ pub fn draw_wires(
 ) {
     for (drawing, transform, riding) in &wires {
         if let WireDrawing::Curve(points) = drawing {
-            let placed = carrier_transform(riding, &bodies).mul_transform(*transform);
+            let placed = carried_transform(transform, riding, &bodies);
             gizmos.linestrip(
                 points.iter().map(|&p| placed.transform_point(p)),
                 style.wire,
