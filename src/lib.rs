@@ -105,10 +105,10 @@ mod validate;
 pub use controls::KeyboardControlsPlugin;
 pub use dynamics::{
     Bead, BeadBundle, BeadDiagnostics, BeadDiverged, BeadForce, BeadForces, BeadForcesItem,
-    BeadMass, BeadParams, BeadPosition, BeadRadius, BeadSentBack, BeadVelocity, BeadsStruck,
-    CatchesBeads, ConstraintDiagnostics, ContactChanged, Contacts, Dimension, Diverged,
-    DivergenceReason, GrabPoint, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams, NextParams,
-    NextWireShape, OnWire, Pin, PrescribedMotion, RailOrientation, Restitution, Rod,
+    BeadMass, BeadParams, BeadPosition, BeadRadius, BeadSentBack, BeadStruckBody, BeadVelocity,
+    BeadsStruck, CatchesBeads, ConstraintDiagnostics, ContactChanged, Contacts, Dimension,
+    Diverged, DivergenceReason, GrabPoint, Joint, MAX_TIMESTEP, MIN_TIMESTEP, NextBeadParams,
+    NextParams, NextWireShape, OnWire, Pin, PrescribedMotion, RailOrientation, Restitution, Rod,
     SendsBeadsBack, SimParams, SpaceBead, SpaceBeadBundle, SpaceParams, SpaceWire, Spring,
     SpringAnchor, Wire, WireBeads, WireContact, WirePlace, WireRows, pose_of,
 };

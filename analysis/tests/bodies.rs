@@ -254,7 +254,10 @@ fn shipped_run(stem: &str, seconds: f64) -> (Vec<String>, Vec<Vec<f64>>) {
 /// keeping its energy to 3 % until it strikes the crates, and knocks each
 /// crate more than 1 m from where it stood; gravity swings the door more
 /// than 120° about its leaning hinge with the bead on its hoop; the carts
-/// on the hoop and on the loop run on.
+/// on the hoop and on the loop run on; the first of two beads on a rail
+/// knocks the stack of crates over, pushing the bottom one to the wall at
+/// the run's end, where no bead passes the wall or a crate, or the other
+/// bead.
 #[cfg(all(feature = "avian2d", feature = "avian3d"))]
 #[test]
 fn the_shipped_scenes_with_bodies_do_what_they_say() {
@@ -302,6 +305,32 @@ fn the_shipped_scenes_with_bodies_do_what_they_say() {
         swing > 120f64.to_radians(),
         "the door swung only {swing} rad"
     );
+
+    let (header, rows) = shipped_run("beads_and_crates", 4.0);
+    let last = |name: &str| *column(&header, &rows, name).last().unwrap();
+    let pushed = last("crate 1.x") - 1.0;
+    let fallen = 0.75 - last("crate 3.y");
+    println!("beads and crates: crate 1 pushed {pushed:.3} m, crate 3 fell {fallen:.3} m");
+    assert!(pushed > 4.0, "crate 1 was pushed only {pushed} m");
+    assert!(fallen > 0.5, "crate 3 fell only {fallen} m");
+    // Each bead ends before the wall's face, and the second against the
+    // first crate at most, never in either.
+    for bead in ["bead 1", "bead 2"] {
+        let x = column(&header, &rows, &format!("{bead}.x"));
+        let farthest = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        assert!(farthest <= 5.4 + 1e-6, "{bead} reached {farthest} m");
+    }
+    assert!(last("bead 2.x") <= last("crate 1.x") - 0.25 + 1e-6);
+    let (one, two) = (
+        column(&header, &rows, "bead 1.x"),
+        column(&header, &rows, "bead 2.x"),
+    );
+    let closest = one
+        .iter()
+        .zip(&two)
+        .map(|(a, b)| (b - a).abs())
+        .fold(f64::INFINITY, f64::min);
+    assert!(closest >= 0.2 - 1e-6, "the beads came {closest} m apart");
 
     shipped_run("cart_on_hoop", 2.0);
     shipped_run("cart_on_loop_in_space", 2.0);

@@ -60,8 +60,10 @@ use bevy::prelude::*;
 use crate::carrier::{
     Boarding, board_beads, body_start, hand_over_forces, pull_bodies, read_back_beads,
 };
+use crate::carrier::{any_bead_radius, apply_world_impulses, gather_world_bodies};
 use crate::dynamics::{Wire, WirePose};
 use crate::geometry::{Near, Placed, PosePath, WireShape};
+use crate::plugin::WorldBodies;
 use crate::solver::path::{
     Held, JointBody, JointState, JointWire, Law, PlaneBody, PlaneVelocity, PlaneWire, Substep,
     turn_offset, velocity_on_wire,
@@ -69,10 +71,12 @@ use crate::solver::path::{
 use crate::{GrabPoint, SimClock, SimParams, SpringAnchor, WireBeadSystems};
 use beads::Avian2d;
 use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
+use world::Avian2dWorld;
 
 mod beads;
 mod carried;
 mod joint;
+mod world;
 
 pub use crate::dynamics::WireOnBody;
 pub use joint::{PathJoint, PathJointForces, PathMotor, PathRotation};
@@ -108,7 +112,10 @@ body_start!(avian2d);
 
 /// Solves [`PathJoint`]s in avian's substep loop. Add it after avian's
 /// `PhysicsPlugins`. It also carries our beads on wires that ride
-/// bodies ([`WireOnBody`]), each as a point body on a path joint.
+/// bodies ([`WireOnBody`]), each as a point body on a path joint, and
+/// lets our beads with a radius strike its colliders (each strike sent as
+/// [`BeadStruckBody`](crate::BeadStruckBody); docs/method.md, "Beads that
+/// strike bodies").
 #[derive(Default)]
 pub struct PathJointPlugin;
 
@@ -117,12 +124,19 @@ impl Plugin for PathJointPlugin {
         crate::carrier::share(app);
         app.register_type::<PathJoint>()
             .register_type::<PathJointForces>()
+            .init_resource::<WorldBodies<DVec2>>()
             .register_type::<WireOnBody>()
             .register_type::<GrabPoint<DVec2>>()
             .add_systems(
                 FixedUpdate,
                 (
                     board_beads::<Avian2d>.in_set(Boarding),
+                    gather_world_bodies::<Avian2dWorld>
+                        .in_set(WireBeadSystems::Forces)
+                        .run_if(any_bead_radius),
+                    apply_world_impulses::<Avian2dWorld>
+                        .in_set(WireBeadSystems::Writeback)
+                        .run_if(any_bead_radius),
                     hand_over_forces::<Avian2d>.in_set(WireBeadSystems::Step),
                     pull_bodies::<Avian2d>
                         .in_set(WireBeadSystems::Forces)

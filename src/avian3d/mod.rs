@@ -64,8 +64,10 @@ use bevy::prelude::*;
 use crate::carrier::{
     Boarding, board_beads, body_start, hand_over_forces, pull_bodies, read_back_beads,
 };
+use crate::carrier::{any_bead_radius, apply_world_impulses, gather_world_bodies};
 use crate::dynamics::{SpaceWire, WirePose};
 use crate::geometry::{SpacePath, SpaceShape};
+use crate::plugin::WorldBodies;
 use crate::solver::path::{
     Alignment, BodyVelocity, Held, JointBody, JointState, JointWire, Law, SpaceBody, SpaceWireAt,
     Substep, velocity_on_wire,
@@ -73,10 +75,12 @@ use crate::solver::path::{
 use crate::{GrabPoint, SimClock, SimParams, SpringAnchor, WireBeadSystems};
 use beads::Avian3d;
 use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
+use world::Avian3dWorld;
 
 mod beads;
 mod carried;
 mod joint;
+mod world;
 
 pub use crate::dynamics::WireOnBody;
 pub use joint::{PathJoint, PathJointForces, PathMotor, PathRotation};
@@ -112,7 +116,10 @@ body_start!(avian3d);
 
 /// Solves [`PathJoint`]s in avian3d's substep loop. Add it after avian's
 /// `PhysicsPlugins`. It also carries our beads on wires that ride
-/// bodies ([`WireOnBody`]), each as a point body on a path joint.
+/// bodies ([`WireOnBody`]), each as a point body on a path joint, and
+/// lets our beads with a radius strike its colliders (each strike sent as
+/// [`BeadStruckBody`](crate::BeadStruckBody); docs/method.md, "Beads that
+/// strike bodies").
 #[derive(Default)]
 pub struct PathJointPlugin;
 
@@ -121,12 +128,19 @@ impl Plugin for PathJointPlugin {
         crate::carrier::share(app);
         app.register_type::<PathJoint>()
             .register_type::<PathJointForces>()
+            .init_resource::<WorldBodies<DVec3>>()
             .register_type::<WireOnBody>()
             .register_type::<GrabPoint<DVec3>>()
             .add_systems(
                 FixedUpdate,
                 (
                     board_beads::<Avian3d>.in_set(Boarding),
+                    gather_world_bodies::<Avian3dWorld>
+                        .in_set(WireBeadSystems::Forces)
+                        .run_if(any_bead_radius),
+                    apply_world_impulses::<Avian3dWorld>
+                        .in_set(WireBeadSystems::Writeback)
+                        .run_if(any_bead_radius),
                     hand_over_forces::<Avian3d>.in_set(WireBeadSystems::Step),
                     pull_bodies::<Avian3d>
                         .in_set(WireBeadSystems::Forces)

@@ -15,12 +15,17 @@ use crate::plugin::{Divergences, SimClock, WireBeadSystems};
 mod beads;
 mod pull;
 mod restart;
+mod world;
 
 pub(crate) use beads::{
     Boarder, Boarding, PointBodies, board_beads, hand_over_forces, point_bodies, read_back_beads,
 };
 pub(crate) use pull::pull_bodies;
 pub(crate) use restart::body_start;
+pub(crate) use world::{
+    BodyRead, ColliderRead, WorldShapes, any_bead_radius, apply_world_impulses,
+    gather_world_bodies, world_shapes,
+};
 
 /// A joint's body in the substep's solver (`S` avian's solver body, `I`
 /// its inertia), and its carrier's where the carrier has one.

@@ -25,7 +25,8 @@ pub use links::{ConstraintDiagnostics, Joint, Pin, Rod, Spring};
 pub use params::{MAX_TIMESTEP, MIN_TIMESTEP, NextParams, SimParams, SpaceParams};
 pub use rail::RailOrientation;
 pub use touch::{
-    BeadRadius, BeadSentBack, BeadsStruck, CatchesBeads, Contacts, Restitution, SendsBeadsBack,
+    BeadRadius, BeadSentBack, BeadStruckBody, BeadsStruck, CatchesBeads, Contacts, Restitution,
+    SendsBeadsBack,
 };
 #[cfg(any(feature = "avian2d", feature = "avian3d"))]
 pub use wire::WireOnBody;

@@ -179,6 +179,27 @@ pub struct BeadSentBack {
     pub time: f64,
 }
 
+/// Sent when a bead strikes a body of the physics world (a collider of
+/// avian's; also logged, one line).
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct BeadStruckBody {
+    /// The bead.
+    pub bead: Entity,
+    /// The collider it struck.
+    pub body: Entity,
+    /// When, in simulated seconds.
+    pub time: f64,
+    /// The impulse along the body's normal there (N s).
+    pub impulse: f64,
+    /// How fast they closed (m/s).
+    pub closing_speed: f64,
+    /// Whether the bead bounced off, or stayed in touch (`e = 0`, or too
+    /// slow to bounce: resting on the body).
+    pub bounced: bool,
+    /// The friction impulse against their slip (N s).
+    pub friction_impulse: f64,
+}
+
 /// Sent when two beads strike (also logged, one line).
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
 pub struct BeadsStruck {

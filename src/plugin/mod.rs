@@ -37,6 +37,8 @@ use bevy::prelude::*;
 pub use clock::{ClockPlugin, SimClock};
 pub use energy::SceneEnergy;
 pub use forces::SpringAnchorPlugin;
+#[cfg(any(feature = "avian2d", feature = "avian3d"))]
+pub(crate) use islands::{BodyImpulse, WorldBodies, WorldBody};
 pub use islands::{IslandPlugin, IslandReport, Islands, PressedPair};
 pub use parallel::{ParallelStep, StepSplit, compute_on_all_cores, use_single_threaded_executors};
 pub use params::ParamsPlugin;

@@ -10,8 +10,8 @@ use super::parallel::{ParallelStep, StepSplit};
 use super::schedule;
 use crate::dynamics::{
     Bead, BeadDiagnostics, BeadDiverged, BeadForce, BeadMass, BeadParams, BeadPosition, BeadRadius,
-    BeadVelocity, BeadsStruck, ContactChanged, Contacts, NextBeadParams, NextParams, Restitution,
-    SimParams, SpaceBead,
+    BeadStruckBody, BeadVelocity, BeadsStruck, ContactChanged, Contacts, NextBeadParams,
+    NextParams, Restitution, SimParams, SpaceBead,
 };
 
 /// The parameters ([`SimParams`], [`NextParams`]), the step's sets in
@@ -83,6 +83,7 @@ impl Plugin for ParamsPlugin {
             .register_type::<BeadRadius>()
             .register_type::<Restitution>()
             .add_message::<BeadsStruck>()
+            .add_message::<BeadStruckBody>()
             .add_message::<BeadDiverged>()
             .add_message::<ContactChanged>()
             .add_message::<ContactChanged<DVec3>>()

@@ -1,7 +1,8 @@
 //! Reports the bead step and the island step share: divergences (the
 //! [`Diverged`] marker, the [`BeadDiverged`] message and a warning) and
 //! changes of contact (the [`ContactChanged`] message and a line in the
-//! log), each found inside a possibly parallel loop and sent after it.
+//! log), each found inside a possibly parallel loop and sent after it;
+//! and the one line a strike is logged in.
 
 use std::sync::{Mutex, PoisonError};
 
@@ -11,7 +12,7 @@ use bevy::prelude::*;
 
 use crate::dynamics::{BeadDiverged, ContactChanged, Dimension, Diverged, DivergenceReason};
 use crate::geometry::Coordinates;
-use crate::solver::ContactEvent;
+use crate::solver::{ContactEvent, Strike};
 
 /// Divergences found inside a (possibly parallel) loop, reported after it.
 #[derive(Default)]
@@ -120,5 +121,27 @@ impl<V: Coordinates> FoundEvents<V> {
 
     pub(crate) fn take(&mut self) -> Vec<(Entity, ContactEvent<V>)> {
         std::mem::take(self.0.get_mut().unwrap_or_else(PoisonError::into_inner))
+    }
+}
+
+/// Logs one strike between `who` at `time` in one line: a bounce (`apart`
+/// or off) as information, a pair that stays in touch at the debug level
+/// (a resting pile strikes every step).
+pub(crate) fn log_strike(who: &str, (time, s): (f64, &Strike), apart: &str) {
+    let rubbed = if s.friction_impulse > 0.0 {
+        format!(" and {:.4} N s of friction", s.friction_impulse)
+    } else {
+        String::new()
+    };
+    if s.bounced {
+        info!(
+            "wirebead: {who} struck at t = {time:.4} s, closing at {:.3} m/s, and bounced {apart} with an impulse of {:.4} N s{rubbed}",
+            s.closing_speed, s.impulse
+        );
+    } else {
+        debug!(
+            "wirebead: {who} met at t = {time:.4} s, closing at {:.3} m/s, and stayed in touch",
+            s.closing_speed
+        );
     }
 }

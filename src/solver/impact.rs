@@ -155,11 +155,6 @@ impl<V: Coordinates> Touch<V> {
         }
     }
 
-    /// Its Coulomb friction `μ`.
-    pub fn friction(&self) -> f64 {
-        self.friction
-    }
-
     /// Unit vectors across the normal, each at right angles to the others:
     /// one in the plane, two in space. A pair's slip is along them.
     pub fn tangents(&self) -> Vec<V> {
@@ -239,6 +234,22 @@ impl<V: Coordinates> Response<V> {
             changes,
             weight,
             tangents: Vec::new(),
+        }
+    }
+
+    /// The answer to a unit impulse on `touch` along its normal, and
+    /// along each of its tangents where it rubs (friction above zero),
+    /// each from `answer` (the changes for an impulse along a direction).
+    pub(crate) fn answered<E>(
+        touch: &Touch<V>,
+        mut answer: impl FnMut(V) -> Result<Vec<(usize, V)>, E>,
+    ) -> Result<Self, E> {
+        let response = Self::new(touch, answer(touch.normal)?);
+        if touch.friction > 0.0 {
+            let tangents = touch.tangents().into_iter().map(&mut answer);
+            Ok(response.with_tangents(tangents.collect::<Result<_, _>>()?))
+        } else {
+            Ok(response)
         }
     }
 

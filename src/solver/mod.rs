@@ -29,6 +29,7 @@ mod coupled;
 mod euler;
 mod friction;
 mod impact;
+pub(crate) use impact::Strike;
 mod lanes;
 mod method;
 mod newton;
@@ -62,9 +63,12 @@ pub use settings::{Gains, StepSettings};
 pub use solve::{SolveError, Solved, lambda, solve};
 pub use state::{Advance, BeadState, LinearForce};
 pub use step::{StepOutput, constraint_state, constraint_state_on, step, step_on};
+#[cfg(any(feature = "avian2d", feature = "avian3d"))]
+pub(crate) use touch::{BodyPoint, Nearest};
+pub(crate) use touch::{Obstacle, ObstaclePair, ObstacleStrike, meet_obstacles};
 pub(crate) use touch::{
     Pressed, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody, TouchError, may_touch,
-    may_touch_near, overlapping, rests_in_touch, settle_touches, wire_response,
+    may_touch_near, overlapping, rests_in_touch, settle_touches, swept, wire_response,
 };
 
 /// What the solver's unit tests share.

@@ -28,9 +28,14 @@ fn physics_app(substeps: u32) -> App {
 
 /// [`physics_app`] stepping `dt`.
 fn physics_app_at(dt: f64, substeps: u32) -> App {
+    physics_app_with(dt, substeps, DVec2::new(0.0, -G))
+}
+
+/// [`physics_app`] stepping `dt` under `gravity` (ours and avian's).
+pub(super) fn physics_app_with(dt: f64, substeps: u32, gravity: DVec2) -> App {
     let params = SimParams {
         timestep: dt,
-        gravity: DVec2::new(0.0, -G),
+        gravity,
         method: Method::new(Integrator::Rattle, None).expect("RATTLE"),
         ..SimParams::default()
     };
@@ -44,7 +49,7 @@ fn physics_app_at(dt: f64, substeps: u32) -> App {
         PhysicsPlugins::default(),
         PathJointPlugin,
     ));
-    app.insert_resource(Gravity(Vector::new(0.0, -G as _)));
+    app.insert_resource(Gravity(gravity.adjust_precision()));
     app.insert_resource(SubstepCount(substeps));
     app.insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
     app.finish();

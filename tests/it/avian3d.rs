@@ -22,7 +22,7 @@ const SUBSTEPS: u32 = 6;
 
 /// Our plugin and avian3d's, gravity `gravity` (ours and avian's), stepping `dt` with avian's
 /// default substeps, its first update taken (no step).
-fn physics_app(dt: f64, gravity: DVec3) -> App {
+pub(super) fn physics_app(dt: f64, gravity: DVec3) -> App {
     let params = SimParams {
         timestep: dt,
         method: Method::new(Integrator::Rattle, None).expect("RATTLE"),

@@ -7,6 +7,10 @@
 mod avian;
 #[cfg(feature = "avian3d")]
 mod avian3d;
+#[cfg(feature = "avian3d")]
+mod avian3d_strikes;
+#[cfg(feature = "avian2d")]
+mod avian_strikes;
 mod bad_input;
 mod baumgarte;
 mod common;

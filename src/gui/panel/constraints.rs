@@ -1,12 +1,13 @@
 //! The list of rods and pins with each one's drift and multiplier, and
-//! the last strikes between beads that touch (recorded in `plots`).
+//! the last strikes between beads that touch and of beads on bodies
+//! (recorded in `plots`).
 
 use bevy_egui::egui;
 
 use super::view::PanelView;
 use crate::ConstraintDiagnostics;
 
-/// The last strikes: which beads, when, how fast they closed, the impulse
+/// The last strikes: which beads (or bead and body), when, how fast they closed, the impulse
 /// (and the friction impulse, where a strike rubbed) and whether they
 /// bounced apart or stayed in touch.
 pub(super) fn strikes_section(ui: &mut egui::Ui, view: &PanelView) {

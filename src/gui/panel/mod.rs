@@ -48,6 +48,11 @@ const WITH_BODIES: &[(&str, &str)] = &[
         "With avian: marbles and dominoes",
         "scenes/avian/dominoes.scene.ron",
     ),
+    #[cfg(feature = "avian2d")]
+    (
+        "With avian: beads knocking over crates",
+        "scenes/avian/beads_and_crates.scene.ron",
+    ),
     #[cfg(feature = "avian3d")]
     (
         "With avian, in space: cart on a loop",

@@ -13,6 +13,7 @@
 //! | `step` | stepping them: gather, solve (in parallel), write back |
 //! | `lone` | beads with a radius that ride a plain wire alone, each a body of its own in the settlement |
 //! | `touch` | beads that touch: the steps cut where they meet, the strikes |
+//! | `world` | beads that meet the bodies of a physics engine ([`WorldBodies`]): gathered by its adapter, met after the beads' own touches |
 //! | `send_back` | beads that settled off a wire sent back to its start ([`SendsBeadsBack`]) |
 
 mod build;
@@ -21,12 +22,18 @@ mod send_back;
 mod start;
 mod step;
 mod touch;
+// Gathered only by an avian adapter.
+#[cfg_attr(not(any(feature = "avian2d", feature = "avian3d")), allow(dead_code))]
+mod world;
 
 use std::collections::HashMap;
 
 use bevy::ecs::lifecycle::{Add, Insert, Remove};
 use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
+
+#[cfg(any(feature = "avian2d", feature = "avian3d"))]
+pub(crate) use world::{BodyImpulse, WorldBodies, WorldBody};
 
 use super::clock::advance_clock;
 use super::schedule::WireBeadSystems;

@@ -5,11 +5,12 @@
 use bevy::prelude::*;
 
 use super::lone::LoneTouch;
+use super::world::WorldBodies;
 use super::{CachedIsland, InIsland, Islands, LinkRows, PressedPair, touch};
 use crate::dynamics::{
-    BeadDiagnostics, BeadForce, BeadMotion, BeadPosition, BeadRadius, BeadVelocity, BeadsStruck,
-    ConstraintDiagnostics, Contacts, Dimension, Diverged, DivergenceReason, Pin, Restitution,
-    RidingBody, SimParams, WireContact, WirePose, WireRows,
+    BeadDiagnostics, BeadForce, BeadMotion, BeadPosition, BeadRadius, BeadStruckBody, BeadVelocity,
+    BeadsStruck, ConstraintDiagnostics, Contacts, Dimension, Diverged, DivergenceReason, Pin,
+    Restitution, RidingBody, SimParams, WireContact, WirePose, WireRows,
 };
 use crate::plugin::clock::SimClock;
 use crate::plugin::parallel::{ParallelStep, StepSplit};
@@ -64,7 +65,11 @@ pub(super) fn step_islands<V: LoneStep>(
     mut diagnostics: Query<&mut ConstraintDiagnostics>,
     mut divergences: Divergences,
     mut split: ResMut<StepSplit>,
-    mut struck: MessageWriter<BeadsStruck>,
+    (mut struck, mut world, mut sent): (
+        MessageWriter<BeadsStruck>,
+        Option<ResMut<WorldBodies<V>>>,
+        MessageWriter<BeadStruckBody>,
+    ),
 ) {
     let settings = params.step_settings();
     let gravity = V::gravity(&params);
@@ -177,7 +182,7 @@ pub(super) fn step_islands<V: LoneStep>(
         (lone, &shapes),
         time,
         &settings,
-        &mut struck,
+        (&mut struck, world.as_deref_mut().map(|w| (w, &mut sent))),
         &mut divergences,
         &mut near_alone,
     );

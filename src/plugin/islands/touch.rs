@@ -8,13 +8,21 @@ use bevy::prelude::*;
 
 use super::CachedIsland;
 use super::lone::{LoneBody, LoneTouch};
-use crate::dynamics::{BeadsStruck, Dimension, DivergenceReason};
-use crate::plugin::report::Divergences;
+use super::world::{Settled, WorldBodies, meet_world};
+use crate::dynamics::{BeadStruckBody, BeadsStruck, Dimension, DivergenceReason};
+use crate::plugin::report::{Divergences, log_strike};
 use crate::plugin::step::LoneStep;
 use crate::solver::{
     self, BeadState, Pressed, SolveError, StepSettings, StepSpan, StruckPair, TouchBead, TouchBody,
     TouchError,
 };
+
+/// The bodies of a physics engine the beads meet, and where their
+/// strikes are sent.
+pub(super) type World<'a, 'w, V> = (
+    &'a mut WorldBodies<V>,
+    &'a mut MessageWriter<'w, BeadStruckBody>,
+);
 
 /// What an island keeps of its beads that touch: each one's index in the
 /// island, radius, restitution and friction.
@@ -132,8 +140,12 @@ impl<V: Dimension> TouchBody<V> for IslandBody<'_, V> {
         }
     }
 
-    fn restart(&mut self, time: f64, dt: f64) -> Result<(), SolveError> {
+    fn rewind(&mut self) {
         self.cached.mark.clone_from(&self.cached.begin);
+    }
+
+    fn restart(&mut self, time: f64, dt: f64) -> Result<(), SolveError> {
+        self.rewind();
         let mut states = self.cached.start.clone();
         self.advance(time, dt, &mut states)?;
         self.finish(&states);
@@ -291,7 +303,7 @@ pub(super) fn settle<V: LoneStep>(
     (lone, shapes): (&mut [LoneTouch<V>], &[Option<V::Lone>]),
     time: f64,
     settings: &StepSettings,
-    struck: &mut MessageWriter<BeadsStruck>,
+    (struck, world): (&mut MessageWriter<BeadsStruck>, Option<World<V>>),
     divergences: &mut Divergences,
     near_alone: &mut Vec<(usize, usize)>,
 ) {
@@ -341,7 +353,7 @@ pub(super) fn settle<V: LoneStep>(
             entities.push(island.report.beads[bead]);
         }
     }
-    if beads.len() < 2 {
+    if beads.is_empty() || (beads.len() < 2 && world.is_none()) {
         return;
     }
     let mut island_bodies: Vec<IslandBody<V>> = cached
@@ -361,7 +373,11 @@ pub(super) fn settle<V: LoneStep>(
         dt: settings.dt,
     };
     let (mut pairs, mut near) = (Vec::new(), Vec::new());
-    let settled = solver::settle_touches(span, &mut bodies, &beads, (&mut pairs, &mut near));
+    let settled = if beads.len() < 2 {
+        Ok(())
+    } else {
+        solver::settle_touches(span, &mut bodies, &beads, (&mut pairs, &mut near))
+    };
     // The pairs of beads alone that came near, by their places in `lone`.
     near_alone.extend(
         near.iter()
@@ -369,6 +385,26 @@ pub(super) fn settle<V: LoneStep>(
     );
     for pair in &pairs {
         report(pair, &entities, struck);
+    }
+    if let Some((world, sent)) = world
+        && settled.is_ok()
+    {
+        let mut cut = vec![false; bodies.len()];
+        for pair in &pairs {
+            cut[beads[pair.a].body] = true;
+            cut[beads[pair.b].body] = true;
+        }
+        let settled = Settled {
+            beads: &beads,
+            entities: &entities,
+            cut: &cut,
+        };
+        let mut failed = Vec::new();
+        meet_world(span, &mut bodies, settled, world, (sent, &mut failed));
+        for (bead, e) in failed {
+            let why = DivergenceReason::Touch(e.to_string());
+            divergences.report(bead, why, time + settings.dt);
+        }
     }
     if let Err(e) = settled {
         let why = match e {
@@ -388,28 +424,11 @@ pub(super) fn settle<V: LoneStep>(
     }
 }
 
-/// Sends one strike and logs it in one line: a bounce as information, a
-/// pair that stays in touch at the debug level (a resting pile strikes
-/// every step).
+/// Sends one strike and logs it in one line ([`log_strike`]).
 fn report(pair: &StruckPair, entities: &[Entity], struck: &mut MessageWriter<BeadsStruck>) {
     let (a, b) = (entities[pair.a], entities[pair.b]);
     let s = pair.strike;
-    let rubbed = if s.friction_impulse > 0.0 {
-        format!(" and {:.4} N s of friction", s.friction_impulse)
-    } else {
-        String::new()
-    };
-    if s.bounced {
-        info!(
-            "wirebead: beads {a} and {b} struck at t = {:.4} s, closing at {:.3} m/s, and bounced apart with an impulse of {:.4} N s{rubbed}",
-            pair.time, s.closing_speed, s.impulse
-        );
-    } else {
-        debug!(
-            "wirebead: beads {a} and {b} met at t = {:.4} s, closing at {:.3} m/s, and stayed in touch",
-            pair.time, s.closing_speed
-        );
-    }
+    log_strike(&format!("beads {a} and {b}"), (pair.time, &s), "apart");
     struck.write(BeadsStruck {
         a,
         b,

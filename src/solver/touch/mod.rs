@@ -69,6 +69,7 @@
 //! | `mod` | [`TouchBody`], [`TouchBead`], [`settle_touches`] and the groups the broad phase finds |
 //! | `broad` | the broad phase ([`overlapping`]): which boxes overlap, by a grid |
 //! | `group` | one group settled: where its pairs meet, the steps to and from each instant, the strikes, the bodies it meets |
+//! | `obstacle` | beads that meet the bodies of a physics engine ([`meet_obstacles`]): where, the strikes, resting contact |
 //! | `pool` | the bodies of a step's settlement: which are settled, each bead's box, how a group's settlement ended |
 
 use bevy::math::DVec3;
@@ -83,12 +84,16 @@ use crate::geometry::Coordinates;
 
 mod broad;
 mod group;
+mod obstacle;
 mod pool;
 #[cfg(test)]
 mod tests;
 
 pub(crate) use broad::overlapping;
 use group::Group;
+#[cfg(any(feature = "avian2d", feature = "avian3d"))]
+pub(crate) use obstacle::{BodyPoint, Nearest};
+pub(crate) use obstacle::{Obstacle, ObstaclePair, ObstacleStrike, meet_obstacles};
 use pool::{Pool, Settled};
 
 pub(crate) use super::coupled::TOUCHING;
@@ -129,6 +134,10 @@ pub trait TouchBody<V: Coordinates> {
     fn push(&self, bead: usize) -> V;
     /// Takes `states` as where the step ends.
     fn finish(&mut self, states: &[BeadState<V>]);
+    /// Takes what the body carries into its steps back to where the step
+    /// began: the next [`TouchBody::advance`] starts from there. A body
+    /// that keeps nothing between its steps has nothing to do.
+    fn rewind(&mut self) {}
     /// Whether a contact row of the body joins its beads `a` and `b`
     /// (see [`Island::set_contact`](crate::solver::Island::set_contact)),
     /// and if so whether it holds them in the steps from the last
@@ -223,6 +232,9 @@ impl<V: Coordinates, T: TouchBody<V> + ?Sized> TouchBody<V> for &mut T {
     fn finish(&mut self, states: &[BeadState<V>]) {
         (**self).finish(states);
     }
+    fn rewind(&mut self) {
+        (**self).rewind();
+    }
     fn contact(&self, a: usize, b: usize) -> Option<bool> {
         (**self).contact(a, b)
     }
@@ -303,6 +315,17 @@ pub enum TouchError {
         /// The second bead of the last pair.
         b: usize,
         /// How many instants the group was cut at.
+        instants: usize,
+    },
+    /// A body's beads met the bodies of the world at more instants within
+    /// one step than allowed.
+    #[error(
+        "bead {bead} and the bodies it meets were still striking after {instants} instants of impact within one step"
+    )]
+    ObstacleStrikes {
+        /// The bead of the first pair.
+        bead: usize,
+        /// How many instants the step was cut at.
         instants: usize,
     },
     /// A bead names a body or a bead of a body that is not there.
@@ -414,7 +437,7 @@ pub fn settle_touches<V: Coordinates, B: TouchBody<V>>(
 
 /// The box bead `t` sweeps between `from` and `to`, grown by its radius
 /// and what counts as touching.
-fn swept<V: Coordinates>(t: &TouchBead, from: V, to: V) -> (DVec3, DVec3) {
+pub(crate) fn swept<V: Coordinates>(t: &TouchBead, from: V, to: V) -> (DVec3, DVec3) {
     let (a, b) = (from.xyz(), to.xyz());
     let grown = t.radius * (1.0 + 4.0 * TOUCHING);
     (a.min(b) - grown, a.max(b) + grown)

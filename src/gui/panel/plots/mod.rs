@@ -20,8 +20,8 @@ use crate::gui::drag::SelectedBead;
 use crate::plugin::SceneEnergy;
 use crate::reference::{AlongWire, along_wire, circle_angle, circle_normal_force};
 use crate::{
-    BeadDiagnostics, BeadParams, BeadPosition, BeadVelocity, BeadsStruck, Islands, OnWire,
-    SimClock, SimParams, Wire, WireShape, pose_of,
+    BeadDiagnostics, BeadParams, BeadPosition, BeadStruckBody, BeadVelocity, BeadsStruck, Islands,
+    OnWire, SimClock, SimParams, Wire, WireShape, pose_of,
 };
 
 /// What holds a plotted bead, and so what its drift `C` and λ are.
@@ -283,28 +283,81 @@ pub struct PlotsShown(pub Option<[f32; 4]>);
 /// How many of the last strikes the panel lists.
 const STRIKES_SHOWN: usize = 6;
 
-/// The last strikes between beads, newest first, for the panel.
+/// One strike as the panel lists it: between two beads, or a bead and a
+/// body of the physics world.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShownStrike {
+    /// The bead, or the first bead.
+    pub a: Entity,
+    /// The other bead, or the body.
+    pub b: Entity,
+    /// When, s.
+    pub time: f64,
+    /// How fast they closed, m/s.
+    pub closing_speed: f64,
+    /// The impulse along the normal, N s.
+    pub impulse: f64,
+    /// The friction impulse, N s.
+    pub friction_impulse: f64,
+    /// Whether they bounced apart.
+    pub bounced: bool,
+}
+
+impl From<BeadsStruck> for ShownStrike {
+    fn from(s: BeadsStruck) -> Self {
+        Self {
+            a: s.a,
+            b: s.b,
+            time: s.time,
+            closing_speed: s.closing_speed,
+            impulse: s.impulse,
+            friction_impulse: s.friction_impulse,
+            bounced: s.bounced,
+        }
+    }
+}
+
+impl From<BeadStruckBody> for ShownStrike {
+    fn from(s: BeadStruckBody) -> Self {
+        Self {
+            a: s.bead,
+            b: s.body,
+            time: s.time,
+            closing_speed: s.closing_speed,
+            impulse: s.impulse,
+            friction_impulse: s.friction_impulse,
+            bounced: s.bounced,
+        }
+    }
+}
+
+/// The last strikes between beads, and of beads on bodies, newest first,
+/// for the panel.
 #[derive(Resource, Default)]
-pub struct RecentStrikes(pub(super) VecDeque<BeadsStruck>);
+pub struct RecentStrikes(pub(super) VecDeque<ShownStrike>);
 
 /// A strike that leaves its pair in touch closing slower than this (m/s)
 /// is a resting pair's, not listed: a pile trades such strikes every step.
 const RESTING_CLOSING: f64 = 1e-3;
 
-/// Keeps the last six strikes (leaving out resting pairs' closing slower
-/// than 1 mm/s); forgets them when the run starts again (the clock went
-/// back).
+/// Keeps the last six strikes, between beads and of beads on bodies
+/// (leaving out resting pairs' closing slower than 1 mm/s); forgets them
+/// when the run starts again (the clock went back).
 pub fn record_strikes(
-    mut struck: MessageReader<BeadsStruck>,
+    (mut struck, mut on_bodies): (MessageReader<BeadsStruck>, MessageReader<BeadStruckBody>),
     clock: Res<SimClock>,
     mut recent: ResMut<RecentStrikes>,
 ) {
     if recent.0.front().is_some_and(|s| s.time > clock.time) {
         recent.0.clear();
     }
-    for strike in struck.read() {
+    let strikes = struck
+        .read()
+        .map(|&s| ShownStrike::from(s))
+        .chain(on_bodies.read().map(|&s| ShownStrike::from(s)));
+    for strike in strikes {
         if strike.bounced || strike.closing_speed >= RESTING_CLOSING {
-            recent.0.push_front(*strike);
+            recent.0.push_front(strike);
         }
     }
     recent.0.truncate(STRIKES_SHOWN);

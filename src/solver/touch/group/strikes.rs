@@ -52,15 +52,8 @@ impl<V: Coordinates> Group<'_, V> {
                 bodies[self.bodies[sb]].push(tb.bead) - bodies[self.bodies[sa]].push(ta.bead);
             let touch = touch.resting_below(n.dot(push).abs() * self.span.dt);
             let ends = [(sa, ta.bead), (sb, tb.bead)];
-            let mut answer = |d: V| self.answer(bodies, ends, d, &offsets);
-            let response = Response::new(&touch, answer(n)?);
-            let response = if touch.friction() > 0.0 {
-                let tangents = touch.tangents().into_iter().map(&mut answer);
-                response.with_tangents(tangents.collect::<Result<_, _>>()?)
-            } else {
-                response
-            };
-            responses.push(response);
+            let answer = |d: V| self.answer(bodies, ends, d, &offsets);
+            responses.push(Response::answered(&touch, answer)?);
             touches.push(touch);
             named.push(pair);
         }

@@ -6,6 +6,7 @@ use bevy::math::{DVec2, DVec3};
 use super::*;
 
 mod broad;
+mod obstacle;
 
 /// Free beads coasting at constant velocity (of unit mass unless
 /// [`Coasting::of_mass`] says otherwise): exact, so that where they meet
