@@ -60,7 +60,7 @@ use bevy::prelude::*;
 use crate::carrier::{
     Boarding, board_beads, body_start, hand_over_forces, pull_bodies, read_back_beads,
 };
-use crate::carrier::{any_bead_radius, apply_world_impulses, gather_world_bodies};
+use crate::carrier::{add_body_energy, any_bead_radius, apply_world_impulses, gather_world_bodies};
 use crate::dynamics::{Wire, WirePose};
 use crate::geometry::{Near, Placed, PosePath, WireShape};
 use crate::plugin::WorldBodies;
@@ -68,7 +68,7 @@ use crate::solver::path::{
     Held, JointBody, JointState, JointWire, Law, PlaneBody, PlaneVelocity, PlaneWire, Substep,
     turn_offset, velocity_on_wire,
 };
-use crate::{GrabPoint, SimClock, SimParams, SpringAnchor, WireBeadSystems};
+use crate::{GrabPoint, SceneEnergy, SimClock, SimParams, SpringAnchor, WireBeadSystems};
 use beads::Avian2d;
 use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
 use world::Avian2dWorld;
@@ -144,6 +144,12 @@ impl Plugin for PathJointPlugin {
                 ),
             )
             .add_systems(PreUpdate, restart_bodies.in_set(WireBeadSystems::Restart))
+            .add_systems(
+                FixedPostUpdate,
+                add_body_energy::<Avian2dWorld>
+                    .after(PhysicsSystems::StepSimulation)
+                    .run_if(resource_exists::<SceneEnergy>),
+            )
             .add_systems(
                 PhysicsSchedule,
                 (

@@ -38,7 +38,13 @@ fn inverse_inertia(inertia: &ComputedAngularInertia, _: &Rotation) -> DMat3 {
     DMat3::from_diagonal(DVec3::Z * f64::from(inertia.inverse()))
 }
 
+/// The energy of a spin `spin` (about `z`).
+fn spin_energy(inertia: &ComputedAngularInertia, _: &Rotation, spin: DVec3) -> f64 {
+    0.5 * f64::from(inertia.value()) * spin.z * spin.z
+}
+
 world_shapes!(
     avian2d, Avian2dWorld, DVec2,
-    up: up, down: down, turn: turn, spin: spin, inverse_inertia: inverse_inertia
+    up: up, down: down, turn: turn, spin: spin, inverse_inertia: inverse_inertia,
+    spin_energy: spin_energy
 );

@@ -64,7 +64,7 @@ use bevy::prelude::*;
 use crate::carrier::{
     Boarding, board_beads, body_start, hand_over_forces, pull_bodies, read_back_beads,
 };
-use crate::carrier::{any_bead_radius, apply_world_impulses, gather_world_bodies};
+use crate::carrier::{add_body_energy, any_bead_radius, apply_world_impulses, gather_world_bodies};
 use crate::dynamics::{SpaceWire, WirePose};
 use crate::geometry::{SpacePath, SpaceShape};
 use crate::plugin::WorldBodies;
@@ -72,7 +72,7 @@ use crate::solver::path::{
     Alignment, BodyVelocity, Held, JointBody, JointState, JointWire, Law, SpaceBody, SpaceWireAt,
     Substep, velocity_on_wire,
 };
-use crate::{GrabPoint, SimClock, SimParams, SpringAnchor, WireBeadSystems};
+use crate::{GrabPoint, SceneEnergy, SimClock, SimParams, SpringAnchor, WireBeadSystems};
 use beads::Avian3d;
 use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
 use world::Avian3dWorld;
@@ -148,6 +148,12 @@ impl Plugin for PathJointPlugin {
                 ),
             )
             .add_systems(PreUpdate, restart_bodies.in_set(WireBeadSystems::Restart))
+            .add_systems(
+                FixedPostUpdate,
+                add_body_energy::<Avian3dWorld>
+                    .after(PhysicsSystems::StepSimulation)
+                    .run_if(resource_exists::<SceneEnergy>),
+            )
             .add_systems(
                 PhysicsSchedule,
                 (

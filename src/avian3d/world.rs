@@ -29,7 +29,14 @@ fn inverse_inertia(inertia: &ComputedAngularInertia, rotation: &Rotation) -> DMa
     inertia.rotated(rotation.0).inverse().to_mat3().as_dmat3()
 }
 
+/// The energy `½ ω·I ω` of a spin `spin`, `I` in the world's frame.
+fn spin_energy(inertia: &ComputedAngularInertia, rotation: &Rotation, spin: DVec3) -> f64 {
+    let tensor = inertia.rotated(rotation.0).value().to_mat3().as_dmat3();
+    0.5 * spin.dot(tensor * spin)
+}
+
 world_shapes!(
     avian3d, Avian3dWorld, DVec3,
-    up: vector_of, down: down, turn: turn, spin: vector_of, inverse_inertia: inverse_inertia
+    up: vector_of, down: down, turn: turn, spin: vector_of, inverse_inertia: inverse_inertia,
+    spin_energy: spin_energy
 );

@@ -23,7 +23,7 @@ pub(crate) use beads::{
 pub(crate) use pull::pull_bodies;
 pub(crate) use restart::body_start;
 pub(crate) use world::{
-    BodyRead, ColliderRead, WorldShapes, any_bead_radius, apply_world_impulses,
+    BodyRead, ColliderRead, WorldShapes, add_body_energy, any_bead_radius, apply_world_impulses,
     gather_world_bodies, world_shapes,
 };
 

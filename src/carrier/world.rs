@@ -11,9 +11,9 @@ use bevy::ecs::query::{QueryData, QueryItem, ROQueryItem, ReadOnlyQueryData};
 use bevy::math::{DMat3, DQuat, DVec3};
 use bevy::prelude::*;
 
-use crate::dynamics::{BeadRadius, Dimension, SimParams};
+use crate::dynamics::{BeadMass, BeadRadius, Dimension, SimParams};
 use crate::geometry::Coordinates;
-use crate::plugin::{BodyImpulse, WorldBodies, WorldBody};
+use crate::plugin::{BodyImpulse, SceneEnergy, WorldBodies, WorldBody};
 use crate::solver::{BodyPoint, Nearest, Obstacle};
 
 /// A collider as read: its shape, where it is, its body and its surface.
@@ -70,6 +70,8 @@ pub(crate) trait WorldShapes: Send + Sync + 'static {
     type Body: ReadOnlyQueryData;
     /// What takes an impulse at a point.
     type Forces: QueryData;
+    /// Avian's gravity.
+    type Gravity: Resource;
 
     /// A collider, none for a sensor.
     fn collider(
@@ -85,6 +87,11 @@ pub(crate) trait WorldShapes: Send + Sync + 'static {
     fn extent(shape: &Self::Shape) -> f64;
     /// Applies `impulse` at the world point `at`.
     fn apply(forces: QueryItem<'_, '_, Self::Forces>, impulse: DVec3, at: DVec3);
+    /// Avian's gravity, in space.
+    fn gravity(gravity: &Self::Gravity) -> DVec3;
+    /// A dynamic body's kinetic and gravitational energy under
+    /// `gravity`; zero for a static or kinematic one.
+    fn energy(body: ROQueryItem<'_, '_, Self::Body>, gravity: DVec3) -> f64;
 }
 
 /// A collider as beads meet it over one step: its shape moving on with
@@ -249,6 +256,19 @@ pub(crate) fn apply_world_impulses<A: WorldShapes>(
     }
 }
 
+/// Adds to the [`SceneEnergy`] the kinetic and gravitational energy of
+/// each dynamic body of avian (under avian's `Gravity`; our beads that
+/// ride bodies, counted already, left out), after avian's step: the
+/// scene's energy counts the bodies beads strike, ride and push.
+pub(crate) fn add_body_energy<A: WorldShapes>(
+    mut energy: ResMut<SceneEnergy>,
+    gravity: Res<A::Gravity>,
+    bodies: Query<A::Body, Without<BeadMass>>,
+) {
+    let g = A::gravity(&gravity);
+    energy.total += bodies.iter().map(|b| A::energy(b, g)).sum::<f64>();
+}
+
 /// Whether any bead has a radius (only those meet bodies).
 pub(crate) fn any_bead_radius(beads: Query<(), With<BeadRadius>>) -> bool {
     !beads.is_empty()
@@ -260,13 +280,14 @@ pub(crate) fn any_bead_radius(beads: Query<(), With<BeadRadius>>) -> bool {
 /// vectors into space in `f64`, `$down` writes one back, `$turn` reads a
 /// `Rotation` as a quaternion, `$spin` an angular velocity as a vector
 /// and `$inverse_inertia` a body's inverse inertia in the world's frame
-/// from its `ComputedAngularInertia` and `Rotation`. Invoked in each
-/// avian adapter.
+/// from its `ComputedAngularInertia` and `Rotation`, and `$spin_energy`
+/// the energy `½ ω·I ω` of a spin (in space) from the same. Invoked in
+/// each avian adapter.
 macro_rules! world_shapes {
     (
         $avian:ident, $shapes:ident, $v:ty,
         up: $up:expr, down: $down:expr, turn: $turn:expr, spin: $spin:expr,
-        inverse_inertia: $inverse_inertia:expr
+        inverse_inertia: $inverse_inertia:expr, spin_energy: $spin_energy:expr
     ) => {
         impl $crate::carrier::WorldShapes for $shapes {
             type V = $v;
@@ -291,6 +312,7 @@ macro_rules! world_shapes {
                 &'static $avian::prelude::Rotation,
             );
             type Forces = $avian::prelude::Forces;
+            type Gravity = $avian::prelude::Gravity;
 
             fn collider(
                 (shape, position, rotation, of, restitution, friction, sensor): bevy::ecs::query::ROQueryItem<'_, '_, Self::Collider>,
@@ -348,6 +370,24 @@ macro_rules! world_shapes {
             ) {
                 use $avian::prelude::WriteRigidBodyForces as _;
                 forces.apply_linear_impulse_at_point($down(impulse), $down(at));
+            }
+
+            fn gravity(gravity: &$avian::prelude::Gravity) -> bevy::math::DVec3 {
+                $up(gravity.0)
+            }
+
+            fn energy(
+                (kind, linear, spin, mass, inertia, centre, position, rotation): bevy::ecs::query::ROQueryItem<'_, '_, Self::Body>,
+                gravity: bevy::math::DVec3,
+            ) -> f64 {
+                if !kind.is_dynamic() {
+                    return 0.0;
+                }
+                let m = f64::from(mass.value());
+                let c = $up(position.0) + $turn(rotation) * $up(centre.0);
+                let v = $up(linear.0);
+                0.5 * m * v.length_squared() - m * gravity.dot(c)
+                    + $spin_energy(inertia, rotation, $spin(spin.0))
             }
         }
     };

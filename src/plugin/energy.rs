@@ -11,8 +11,11 @@ use crate::geometry::Coordinates;
 use crate::solver::BeadState;
 
 /// The scene's energy after the last step: the kinetic and gravitational
-/// energy of every bead, in the plane and in space, and the energy stored
-/// in the springs between beads. It changes only by what damping,
+/// energy of every bead, in the plane and in space, the energy stored in
+/// the springs between beads, and, where an avian `PathJointPlugin` is
+/// added, the kinetic (turning included) and gravitational energy of
+/// every dynamic body of avian under avian's gravity, after avian's
+/// step. It changes only by what damping,
 /// friction, inelastic strikes and landings, drift, a drag and moving
 /// wires take or give. An island's own energy
 /// ([`IslandReport::energy`](crate::plugin::IslandReport)) jumps where

@@ -65,7 +65,9 @@ pub use state::{Advance, BeadState, LinearForce};
 pub use step::{StepOutput, constraint_state, constraint_state_on, step, step_on};
 #[cfg(any(feature = "avian2d", feature = "avian3d"))]
 pub(crate) use touch::{BodyPoint, Nearest};
-pub(crate) use touch::{Obstacle, ObstaclePair, ObstacleStrike, meet_obstacles};
+pub(crate) use touch::{
+    BodyPush, MeetsObstacles, Obstacle, ObstaclePair, ObstacleStrike, meet_obstacles,
+};
 pub(crate) use touch::{
     Pressed, StepSpan, StruckPair, TOUCHING, TouchBead, TouchBody, TouchError, may_touch,
     may_touch_near, overlapping, rests_in_touch, settle_touches, swept, wire_response,

@@ -11,7 +11,7 @@ use bevy::math::DVec3;
 use bevy::prelude::*;
 use wirebead::geometry::{Line, OnPlane};
 use wirebead::prelude::*;
-use wirebead::{BeadStruckBody, Restitution as BeadRestitution, SpaceBead, SpaceWire};
+use wirebead::{BeadStruckBody, Restitution as BeadRestitution, SceneEnergy, SpaceBead, SpaceWire};
 
 use super::avian3d::physics_app;
 
@@ -171,10 +171,13 @@ fn a_bead_striking_a_ball_off_its_line_sends_it_along_the_normal() {
             SleepingDisabled,
         ))
         .id();
-    let mut impulse = 0.0;
+    app.init_resource::<SceneEnergy>();
+    let (mut impulse, mut off) = (0.0, 0.0_f64);
     for _ in 0..60 {
         app.update();
         impulse += strikes(&app).iter().map(|s| s.impulse).sum::<f64>();
+        let total = app.world().resource::<SceneEnergy>().total;
+        off = off.max((total - 0.5 * m * u * u).abs());
     }
     let (_, v) = state(&app, moving);
     let world = app.world();
@@ -209,4 +212,6 @@ fn a_bead_striking_a_ball_off_its_line_sends_it_along_the_normal() {
         "momentum along the line"
     );
     assert!((energy - 0.5 * m * u * u).abs() < 1e-5, "energy {energy}");
+    // The scene's energy counts the ball's.
+    assert!(off < 1e-5, "the scene's energy moved by {off:e} J");
 }

@@ -11,11 +11,17 @@ use bevy::prelude::*;
 use super::{BodyVisual, capsule_placement};
 use crate::gui::drag::{Grabbed, SceneCameras, bead_under, cursor_world};
 use crate::gui::render::SceneStyle;
-use crate::{BeadPosition, GrabPoint};
+use crate::{BeadPosition, GrabPoint, SimParams, WireBeadSystems};
 
 pub(super) fn build(app: &mut App) {
-    app.add_systems(Update, add_body_visuals)
-        .add_observer(start_drag);
+    app.add_systems(
+        PreUpdate,
+        follow_gravity
+            .after(WireBeadSystems::Restart)
+            .run_if(resource_changed::<SimParams>),
+    )
+    .add_systems(Update, add_body_visuals)
+    .add_observer(start_drag);
 }
 
 /// The mesh of a collider's shape about the body's origin, and how far
@@ -114,4 +120,30 @@ fn start_drag(
     };
     grabbed.0 = Some(body);
     commands.entity(body).insert((target, grab));
+}
+
+/// Gives avian2d the gravity the panel set (applied when the run starts
+/// again), so that bodies fall as beads do.
+fn follow_gravity(params: Res<SimParams>, mut gravity: ResMut<Gravity>) {
+    gravity.0 = params.gravity.adjust_precision();
+}
+
+#[cfg(test)]
+mod tests {
+    use avian2d::math::Vector;
+    use bevy::math::DVec2;
+
+    use super::*;
+
+    /// A restart that applies the panel's gravity gives it to avian too.
+    #[test]
+    fn avian_falls_with_the_gravity_the_panel_set() {
+        let mut app = App::new();
+        app.init_resource::<SimParams>()
+            .insert_resource(Gravity(Vector::ZERO))
+            .add_systems(Update, follow_gravity.run_if(resource_changed::<SimParams>));
+        app.world_mut().resource_mut::<SimParams>().gravity = DVec2::new(1.0, -3.0);
+        app.update();
+        assert_eq!(app.world().resource::<Gravity>().0, Vector::new(1.0, -3.0));
+    }
 }

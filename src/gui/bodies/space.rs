@@ -3,7 +3,7 @@
 // Avian's numbers are `f32` or `f64` as the game builds it.
 #![allow(clippy::unnecessary_cast)]
 
-use avian3d::math::AsF32;
+use avian3d::math::{AdjustPrecision, AsF32};
 use avian3d::prelude::*;
 use bevy::camera::visibility::RenderLayers;
 use bevy::math::DVec3;
@@ -14,12 +14,18 @@ use crate::avian3d::{rotation_of, vector_of};
 use crate::gui::drag::Grabbed;
 use crate::gui::render::SceneStyle;
 use crate::gui::space::{SPACE_LAYER, SpaceCameras, drag_target};
-use crate::{GrabPoint, SpringAnchor};
+use crate::{GrabPoint, SimParams, SpringAnchor, WireBeadSystems};
 
 pub(super) fn build(app: &mut App) {
-    app.add_systems(Update, add_body_visuals)
-        .add_observer(start_drag)
-        .add_observer(follow_drag);
+    app.add_systems(
+        PreUpdate,
+        follow_gravity
+            .after(WireBeadSystems::Restart)
+            .run_if(resource_changed::<SimParams>),
+    )
+    .add_systems(Update, add_body_visuals)
+    .add_observer(start_drag)
+    .add_observer(follow_drag);
 }
 
 /// The mesh of a collider's shape about the body's origin, and how far
@@ -139,5 +145,35 @@ fn follow_drag(
     let at = world_point(position, rotation, grab.get());
     if let Some(next) = drag_target(camera, event.pointer_location.position, at) {
         *target = next;
+    }
+}
+
+/// Gives avian3d the gravity the panel set (applied when the run starts
+/// again), so that bodies fall as beads do.
+fn follow_gravity(params: Res<SimParams>, mut gravity: ResMut<Gravity>) {
+    gravity.0 = params.gravity_in_space().adjust_precision();
+}
+
+#[cfg(test)]
+mod tests {
+    use avian3d::math::Vector;
+    use bevy::math::DVec2;
+
+    use super::*;
+
+    /// A restart that applies the panel's gravity gives it to avian too.
+    #[test]
+    fn avian_falls_with_the_gravity_the_panel_set() {
+        let mut app = App::new();
+        app.init_resource::<SimParams>()
+            .insert_resource(Gravity(Vector::ZERO))
+            .add_systems(Update, follow_gravity.run_if(resource_changed::<SimParams>));
+        app.world_mut().resource_mut::<SimParams>().gravity = DVec2::new(1.0, -3.0);
+        app.world_mut().resource_mut::<SimParams>().gravity_z = 2.0;
+        app.update();
+        assert_eq!(
+            app.world().resource::<Gravity>().0,
+            Vector::new(1.0, -3.0, 2.0)
+        );
     }
 }

@@ -8,13 +8,13 @@ use bevy::prelude::*;
 
 use super::CachedIsland;
 use super::lone::{LoneBody, LoneTouch};
-use super::world::{Settled, WorldBodies, meet_world};
+use super::world::{Met, WorldBodies, meet_world, near_beads_alone, near_world, report_world};
 use crate::dynamics::{BeadStruckBody, BeadsStruck, Dimension, DivergenceReason};
 use crate::plugin::report::{Divergences, log_strike};
 use crate::plugin::step::LoneStep;
 use crate::solver::{
-    self, BeadState, Pressed, SolveError, StepSettings, StepSpan, StruckPair, TouchBead, TouchBody,
-    TouchError,
+    self, BeadState, MeetsObstacles, Obstacle, Pressed, SolveError, StepSettings, StepSpan,
+    StruckPair, TouchBead, TouchBody, TouchError,
 };
 
 /// The bodies of a physics engine the beads meet, and where their
@@ -313,7 +313,7 @@ pub(super) fn settle<V: LoneStep>(
     // The beads alone that stepped, each a body after the islands, and
     // each one's place in `lone`.
     let mut alone = Vec::new();
-    let mut lone_bodies: Vec<LoneBody<V>> = lone
+    let lone_bodies: Vec<LoneBody<V>> = lone
         .iter_mut()
         .zip(shapes)
         .enumerate()
@@ -363,48 +363,109 @@ pub(super) fn settle<V: LoneStep>(
             settings: *settings,
         })
         .collect();
+    let span = StepSpan {
+        time,
+        dt: settings.dt,
+    };
+    let islands = island_bodies.len();
+    let (world, sent) = world.unzip();
+    // Beads alone meet the bodies of the world in each part of their step
+    // the settlement steps them over, their whole step first; islands meet
+    // them after, where the settlement leaves them.
+    let near = world
+        .as_deref()
+        .map(|w| near_beads_alone(&lone_bodies, (&beads, islands), w))
+        .unwrap_or_default();
+    let shapes: Vec<&dyn Obstacle<V>> = world
+        .as_deref()
+        .map(|w| {
+            w.bodies
+                .iter()
+                .map(|b| &*b.obstacle as &dyn Obstacle<V>)
+                .collect()
+        })
+        .unwrap_or_default();
+    let mut lone_bodies: Vec<MeetsObstacles<V, LoneBody<V>>> = lone_bodies
+        .into_iter()
+        .enumerate()
+        .map(|(k, body)| {
+            let pairs = near.get(k).map_or_else(Vec::new, |named| {
+                named.iter().map(|&(_, pair)| pair).collect()
+            });
+            MeetsObstacles::new(body, span, (pairs, &shapes))
+        })
+        .collect();
+    let mut failed = Vec::new();
+    for (k, body) in lone_bodies.iter_mut().enumerate() {
+        if !body.pairs().is_empty()
+            && let Err(e) = body.restart(span.time, span.dt)
+        {
+            failed.push((entities[k], TouchError::Solve(e)));
+        }
+    }
     let mut bodies: Vec<&mut dyn TouchBody<V>> = island_bodies
         .iter_mut()
         .map(|b| b as &mut dyn TouchBody<V>)
         .chain(lone_bodies.iter_mut().map(|b| b as &mut dyn TouchBody<V>))
         .collect();
-    let span = StepSpan {
-        time,
-        dt: settings.dt,
-    };
-    let (mut pairs, mut near) = (Vec::new(), Vec::new());
+    let (mut pairs, mut near_pairs) = (Vec::new(), Vec::new());
     let settled = if beads.len() < 2 {
         Ok(())
     } else {
-        solver::settle_touches(span, &mut bodies, &beads, (&mut pairs, &mut near))
+        solver::settle_touches(span, &mut bodies, &beads, (&mut pairs, &mut near_pairs))
     };
+    drop(bodies);
     // The pairs of beads alone that came near, by their places in `lone`.
     near_alone.extend(
-        near.iter()
+        near_pairs
+            .iter()
             .filter_map(|&(i, j)| Some((*alone.get(i)?, *alone.get(j)?))),
     );
     for pair in &pairs {
         report(pair, &entities, struck);
     }
-    if let Some((world, sent)) = world
+    let mut met: Vec<Met<V>> = lone_bodies
+        .iter_mut()
+        .zip(near)
+        .map(|(body, named)| {
+            let (done, why) = body.met();
+            Met::of(named, done, why)
+        })
+        .collect();
+    drop(lone_bodies);
+    drop(shapes);
+    if let (Some(world), Some(sent)) = (world, sent)
         && settled.is_ok()
     {
-        let mut cut = vec![false; bodies.len()];
+        // Each island meets the bodies of the world where the beads'
+        // settlement leaves it: from the step's start where no strike
+        // between its beads cut its step, else where it ends.
+        let mut cut = vec![false; islands];
         for pair in &pairs {
-            cut[beads[pair.a].body] = true;
-            cut[beads[pair.b].body] = true;
+            for body in [beads[pair.a].body, beads[pair.b].body] {
+                if let Some(cut) = cut.get_mut(body) {
+                    *cut = true;
+                }
+            }
         }
-        let settled = Settled {
-            beads: &beads,
-            entities: &entities,
-            cut: &cut,
-        };
-        let mut failed = Vec::new();
-        meet_world(span, &mut bodies, settled, world, (sent, &mut failed));
-        for (bead, e) in failed {
-            let why = DivergenceReason::Touch(e.to_string());
-            divergences.report(bead, why, time + settings.dt);
+        let mut bodies: Vec<&mut dyn TouchBody<V>> = island_bodies
+            .iter_mut()
+            .map(|b| b as &mut dyn TouchBody<V>)
+            .collect();
+        let near = near_world(&bodies, &beads, world);
+        met.extend(
+            near.into_iter()
+                .enumerate()
+                .filter(|(_, named)| !named.is_empty())
+                .map(|(k, named)| meet_world(span, &mut *bodies[k], (named, !cut[k]), world)),
+        );
+        for done in &met {
+            report_world(done, (world, &entities), (sent, &mut failed));
         }
+    }
+    for (bead, e) in failed {
+        let why = DivergenceReason::Touch(e.to_string());
+        divergences.report(bead, why, time + settings.dt);
     }
     if let Err(e) = settled {
         let why = match e {

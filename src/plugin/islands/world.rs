@@ -1,17 +1,21 @@
 //! Beads that meet the bodies of a physics engine: an adapter (avian's)
 //! gathers the bodies near the beads into [`WorldBodies`] before the step;
-//! after the beads' own touches are settled, each island or bead alone
-//! whose beads come near one meets it ([`solver::meet_obstacles`]), and
-//! the impulses on the bodies are left for the adapter to apply. This file
-//! only moves data between the islands, the bodies and the solver.
+//! beads alone meet them in each part of their step the settlement of the
+//! beads' own touches takes (`solver::MeetsObstacles`), islands once it is
+//! done ([`solver::meet_obstacles`]); the impulses on the bodies are left
+//! for the adapter to apply. This file only moves data between the
+//! islands, the bodies and the solver.
 
 use bevy::math::DVec3;
 use bevy::prelude::*;
 
+use super::lone::LoneBody;
 use crate::dynamics::{BeadStruckBody, Dimension};
 use crate::plugin::report::log_strike;
+use crate::plugin::step::LoneStep;
 use crate::solver::{
-    self, Obstacle, ObstaclePair, ObstacleStrike, StepSpan, TouchBead, TouchBody, TouchError,
+    self, BodyPush, Obstacle, ObstaclePair, ObstacleStrike, StepSpan, TouchBead, TouchBody,
+    TouchError,
 };
 
 /// A body of the world as beads meet it over one step: its collider's
@@ -59,120 +63,188 @@ impl<V: Dimension> Default for WorldBodies<V> {
     }
 }
 
-/// Where a bead of the settlement is: its index among its beads, and
-/// its entity.
-pub(super) struct Settled<'a> {
-    pub beads: &'a [TouchBead],
-    pub entities: &'a [Entity],
-    /// Which bodies (islands, then beads alone) a strike between beads
-    /// cut this step: they are not stepped again from its start.
-    pub cut: &'a [bool],
+/// What one body of beads (an island, or a bead alone) did meeting the
+/// bodies of the world in one pass: each pair met (the bead's index in
+/// the settlement, the pair), the strikes, the pushes, and why it failed.
+pub(super) struct Met<V> {
+    named: Vec<(usize, ObstaclePair)>,
+    struck: Vec<ObstacleStrike<V>>,
+    pushed: Vec<BodyPush<V>>,
+    failed: Option<TouchError>,
 }
 
-/// Meets the bodies of `world` with the beads of `bodies` that come near
-/// them over `span` (see [`solver::meet_obstacles`]), each body of beads
-/// on its own; each strike is sent and logged, each impulse left in
-/// `world`. A body whose beads fail stops, its beads named in `failed`
-/// with the reason in words.
+impl<V> Met<V> {
+    /// What a body did that met the world as it was stepped
+    /// ([`MeetsObstacles`](crate::solver::MeetsObstacles)): its pairs,
+    /// strikes and pushes, and why it failed.
+    pub(super) fn of(
+        named: Vec<(usize, ObstaclePair)>,
+        (struck, pushed): (Vec<ObstacleStrike<V>>, Vec<BodyPush<V>>),
+        failed: Option<TouchError>,
+    ) -> Self {
+        Self {
+            named,
+            struck,
+            pushed,
+            failed,
+        }
+    }
+}
+
+/// The pairs of each body's beads (`beads`, each a body's bead with its
+/// radius) and the bodies of `world` whose swept boxes meet over the step
+/// as `bodies` have taken it: by body, each with its bead's index in
+/// `beads`.
+pub(super) fn near_world<V: Dimension>(
+    bodies: &[&mut dyn TouchBody<V>],
+    beads: &[TouchBead],
+    world: &WorldBodies<V>,
+) -> Vec<Vec<(usize, ObstaclePair)>> {
+    let boxes: Vec<(usize, (DVec3, DVec3))> = beads
+        .iter()
+        .enumerate()
+        .filter_map(|(i, t)| {
+            let body = bodies.get(t.body)?;
+            let (from, to) = (body.start()[t.bead].position, body.end()[t.bead].position);
+            Some((i, solver::swept(t, from, to)))
+        })
+        .collect();
+    near_boxes(bodies.len(), (beads, &boxes), world)
+}
+
+/// The pairs of beads alone (each the body of its own, after `islands`
+/// islands) and the bodies of `world` whose boxes meet over the step: each
+/// bead's box from where it started to where it ended, grown by as much
+/// again (what a strike on another bead may send it through), by body.
+pub(super) fn near_beads_alone<V: LoneStep>(
+    bodies: &[LoneBody<V>],
+    (beads, islands): (&[TouchBead], usize),
+    world: &WorldBodies<V>,
+) -> Vec<Vec<(usize, ObstaclePair)>> {
+    let boxes: Vec<(usize, (DVec3, DVec3))> = beads
+        .iter()
+        .enumerate()
+        .filter_map(|(i, t)| {
+            let body = bodies.get(t.body.checked_sub(islands)?)?;
+            let (from, to) = (body.start()[0].position, body.end()[0].position);
+            let (lo, hi) = solver::swept(t, from, to);
+            let more = (to - from).xyz().abs();
+            Some((i, (lo - more, hi + more)))
+        })
+        .collect();
+    let mut by_body = near_boxes(islands + bodies.len(), (beads, &boxes), world);
+    by_body.drain(..islands.min(by_body.len()));
+    by_body
+}
+
+/// The pairs of the beads whose `boxes` are given (each a bead's index in
+/// `beads` and its box) and the bodies of `world` whose swept boxes meet
+/// them, by body (of `bodies`).
+fn near_boxes<V: Dimension>(
+    bodies: usize,
+    (beads, boxes): (&[TouchBead], &[(usize, (DVec3, DVec3))]),
+    world: &WorldBodies<V>,
+) -> Vec<Vec<(usize, ObstaclePair)>> {
+    let mut by_body: Vec<Vec<(usize, ObstaclePair)>> = vec![Vec::new(); bodies];
+    if world.bodies.is_empty() || boxes.is_empty() {
+        return by_body;
+    }
+    let count = boxes.len();
+    let all: Vec<(DVec3, DVec3)> = boxes
+        .iter()
+        .map(|&(_, b)| b)
+        .chain(world.bodies.iter().map(|b| b.bounds))
+        .collect();
+    for (i, j) in solver::overlapping(&all) {
+        let (k, obstacle) = match (i < count, j < count) {
+            (true, false) => (i, j - count),
+            (false, true) => (j, i - count),
+            _ => continue,
+        };
+        let bead = boxes[k].0;
+        let t = beads[bead];
+        if let Some(list) = by_body.get_mut(t.body) {
+            list.push((
+                bead,
+                ObstaclePair {
+                    bead: t.bead,
+                    radius: t.radius,
+                    restitution: t.restitution,
+                    friction: t.friction,
+                    obstacle,
+                },
+            ));
+        }
+    }
+    by_body
+}
+
+/// Meets the bodies of `world` with the beads of `body` in `named` (see
+/// [`solver::meet_obstacles`]; `exact` where the body may be stepped
+/// again from the step's start).
 pub(super) fn meet_world<V: Dimension>(
     span: StepSpan,
-    bodies: &mut [&mut dyn TouchBody<V>],
-    settled: Settled,
+    body: &mut dyn TouchBody<V>,
+    (named, exact): (Vec<(usize, ObstaclePair)>, bool),
     world: &mut WorldBodies<V>,
+) -> Met<V> {
+    let mut obstacles: Vec<&mut dyn Obstacle<V>> = world
+        .bodies
+        .iter_mut()
+        .map(|b| &mut *b.obstacle as &mut dyn Obstacle<V>)
+        .collect();
+    let pairs: Vec<ObstaclePair> = named.iter().map(|(_, p)| *p).collect();
+    let (mut struck, mut pushed) = (Vec::new(), Vec::new());
+    let met = solver::meet_obstacles(
+        span,
+        body,
+        (&pairs, &mut obstacles),
+        exact,
+        (&mut struck, &mut pushed),
+    );
+    Met {
+        named,
+        struck,
+        pushed,
+        failed: met.err(),
+    }
+}
+
+/// Sends each strike of `met` and logs it, leaves each impulse on a body
+/// in `world`, and names each bead of a body that failed in `failed`,
+/// with the reason (`entities` the settlement's beads').
+pub(super) fn report_world<V: Dimension>(
+    met: &Met<V>,
+    (world, entities): (&mut WorldBodies<V>, &[Entity]),
     (sent, failed): (
         &mut MessageWriter<BeadStruckBody>,
         &mut Vec<(Entity, TouchError)>,
     ),
 ) {
-    if world.bodies.is_empty() || settled.beads.is_empty() {
-        return;
+    for strike in &met.struck {
+        let (bead, pair) = met.named[strike.pair];
+        let body = &world.bodies[pair.obstacle];
+        report(strike, (entities[bead], body.entity), sent);
+        if let Some(moved) = body.moved {
+            world.impulses.push(BodyImpulse {
+                body: moved,
+                point: strike.point,
+                impulse: strike.impulse,
+            });
+        }
     }
-    let mut boxes: Vec<(DVec3, DVec3)> = settled
-        .beads
-        .iter()
-        .map(|t| {
-            let body = &bodies[t.body];
-            solver::swept(
-                t,
-                body.start()[t.bead].position,
-                body.end()[t.bead].position,
-            )
-        })
-        .collect();
-    let count = boxes.len();
-    boxes.extend(world.bodies.iter().map(|b| b.bounds));
-    // Each bead's pairs with the bodies whose boxes meet its own, by its
-    // body.
-    let mut by_body: Vec<Vec<(usize, ObstaclePair)>> = vec![Vec::new(); bodies.len()];
-    for (i, j) in solver::overlapping(&boxes) {
-        let (bead, obstacle) = match (i < count, j < count) {
-            (true, false) => (i, j - count),
-            (false, true) => (j, i - count),
-            _ => continue,
-        };
-        let t = settled.beads[bead];
-        by_body[t.body].push((
-            bead,
-            ObstaclePair {
-                bead: t.bead,
-                radius: t.radius,
-                restitution: t.restitution,
-                friction: t.friction,
-                obstacle,
-            },
-        ));
+    for push in &met.pushed {
+        let (_, pair) = met.named[push.pair];
+        if let Some(moved) = world.bodies[pair.obstacle].moved {
+            world.impulses.push(BodyImpulse {
+                body: moved,
+                point: push.point,
+                impulse: push.impulse,
+            });
+        }
     }
-    let found: Vec<(Entity, Option<Entity>)> =
-        world.bodies.iter().map(|b| (b.entity, b.moved)).collect();
-    let WorldBodies {
-        bodies: shapes,
-        impulses,
-    } = world;
-    let mut obstacles: Vec<&mut dyn Obstacle<V>> = shapes
-        .iter_mut()
-        .map(|b| &mut *b.obstacle as &mut dyn Obstacle<V>)
-        .collect();
-    let (mut struck, mut pushed) = (Vec::new(), Vec::new());
-    for (k, named) in by_body.iter().enumerate() {
-        if named.is_empty() {
-            continue;
-        }
-        let pairs: Vec<ObstaclePair> = named.iter().map(|(_, p)| *p).collect();
-        let exact = !settled.cut.get(k).copied().unwrap_or(true);
-        struck.clear();
-        pushed.clear();
-        let met = solver::meet_obstacles(
-            span,
-            &mut *bodies[k],
-            (&pairs, &mut obstacles),
-            exact,
-            (&mut struck, &mut pushed),
-        );
-        for strike in &struck {
-            let (bead, pair) = named[strike.pair];
-            let (entity, moved) = found[pair.obstacle];
-            report(strike, (settled.entities[bead], entity), sent);
-            if let Some(moved) = moved {
-                impulses.push(BodyImpulse {
-                    body: moved,
-                    point: strike.point,
-                    impulse: strike.impulse,
-                });
-            }
-        }
-        for push in &pushed {
-            let (_, pair) = named[push.pair];
-            if let (_, Some(moved)) = found[pair.obstacle] {
-                impulses.push(BodyImpulse {
-                    body: moved,
-                    point: push.point,
-                    impulse: push.impulse,
-                });
-            }
-        }
-        if let Err(e) = met {
-            failed.extend(named.iter().map(|&(bead, _)| (settled.entities[bead], e)));
-        }
+    if let Some(e) = met.failed {
+        failed.extend(met.named.iter().map(|&(bead, _)| (entities[bead], e)));
     }
 }
 

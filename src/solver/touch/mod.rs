@@ -93,7 +93,9 @@ pub(crate) use broad::overlapping;
 use group::Group;
 #[cfg(any(feature = "avian2d", feature = "avian3d"))]
 pub(crate) use obstacle::{BodyPoint, Nearest};
-pub(crate) use obstacle::{Obstacle, ObstaclePair, ObstacleStrike, meet_obstacles};
+pub(crate) use obstacle::{
+    BodyPush, MeetsObstacles, Obstacle, ObstaclePair, ObstacleStrike, meet_obstacles,
+};
 use pool::{Pool, Settled};
 
 pub(crate) use super::coupled::TOUCHING;

@@ -61,11 +61,18 @@ use crate::solver::impact::{Response, Strike, Touch, resolve_impacts};
 use crate::solver::solve::SolveError;
 use crate::solver::state::BeadState;
 
+mod aware;
 mod rest;
+
+pub(crate) use aware::MeetsObstacles;
 
 /// How many instants one body's beads may strike obstacles at within one
 /// step before the step is reported as not settling.
 const MAX_INSTANTS: usize = 32;
+
+/// The shortest part of a step (of the step) a resting contact is parted
+/// over by a velocity; what is left of a shorter one is moved.
+const SHORTEST: f64 = 1e-6;
 
 /// How many straight sweeps a meeting is looked for along before a bead
 /// that grazes a body is taken not to meet it.
@@ -193,12 +200,10 @@ pub(crate) fn meet_obstacles<V: Coordinates, B: TouchBody<V> + ?Sized>(
     };
     let mut meets = false;
     for (k, pair) in pairs.iter().enumerate() {
-        let from = meeting.gap(k, 0.0, start[pair.bead].position);
         meets |= meeting.gap(k, 1.0, end[pair.bead].position) <= TOUCHING * pair.radius
-            || (from > 0.0
-                && meeting
-                    .sweep(k, (0.0, start[pair.bead].position), end[pair.bead].position)
-                    .is_some());
+            || meeting
+                .sweep(k, (0.0, start[pair.bead].position), end[pair.bead].position)
+                .is_some();
     }
     if !meets {
         return Ok(());
@@ -230,16 +235,18 @@ pub(crate) fn meet_obstacles<V: Coordinates, B: TouchBody<V> + ?Sized>(
         }
         last = Some((done, now));
     } else {
-        // Past a body, where the step crossed it: back to where it met it.
+        // Into or past a body, where the step met it on the way (a bead in
+        // touch where the step starts and pushed on into the body by a
+        // bead behind it, too): back to where it met it.
         for (k, pair) in pairs.iter().enumerate() {
             let (from, to) = (start[pair.bead].position, end[pair.bead].position);
-            if meeting.gap(k, 1.0, to) <= 0.0 || meeting.gap(k, 0.0, from) <= 0.0 {
-                continue;
-            }
             if let Some(s) = meeting.sweep(k, (0.0, from), to) {
                 let met = from + (to - from) * s;
                 if let Some(near) = meeting.nearest(k, 1.0, met) {
-                    meeting.move_out(k, near.normal, near.normal.dot(met - to), &mut end)?;
+                    let depth = near.normal.dot(met - to);
+                    if depth > 0.0 {
+                        meeting.move_out(k, near.normal, depth, &mut end)?;
+                    }
                 }
             }
         }
@@ -248,7 +255,8 @@ pub(crate) fn meet_obstacles<V: Coordinates, B: TouchBody<V> + ?Sized>(
     // bead and the body each taking its share.
     let overlaps = meeting.overlaps(&end)?;
     match last {
-        Some((done, mut now)) if !overlaps.is_empty() => {
+        // A part too short to part the beads over by a velocity: moved.
+        Some((done, mut now)) if !overlaps.is_empty() && done < 1.0 - SHORTEST => {
             let pushes = meeting.push_apart((done, &mut now), &overlaps)?;
             end.clone_from(&now);
             meeting.advance(done, 1.0, &mut end)?;
@@ -305,9 +313,12 @@ impl<V: Coordinates, B: TouchBody<V> + ?Sized> Meeting<'_, '_, V, B> {
         to: f64,
         states: &mut [BeadState<V>],
     ) -> Result<(), SolveError> {
-        let dt = self.span.dt;
-        self.body
-            .advance(self.span.time + from * dt, (to - from) * dt, states)
+        let (dt, h) = (self.span.dt, (to - from) * self.span.dt);
+        // No time to step over: the beads are where they are.
+        if h.is_nan() || h <= 0.0 {
+            return Ok(());
+        }
+        self.body.advance(self.span.time + from * dt, h, states)
     }
 
     /// The first part of the step at which a ball of pair `k`'s radius,
@@ -357,32 +368,48 @@ impl<V: Coordinates, B: TouchBody<V> + ?Sized> Meeting<'_, '_, V, B> {
                 continue; // in touch: resting contact, where the step ends
             }
             let until = first.unwrap_or(1.0);
-            // The end of a bracket: where the step ends overlapping, or
-            // where the straight sweeps from each trial meet the body on
-            // the bead's path.
+            // The end of a bracket: a little past where the straight
+            // sweeps from each trial first touch the body on the bead's
+            // path (never on its far side), or where the step ends
+            // overlapping.
             let mut closed = None;
-            let g1 = self.gap(k, 1.0, end[i].position);
-            if g1 <= 0.0 {
-                closed = Some((1.0, g1));
-            } else {
-                let mut from = (done, now[i].position);
-                for _ in 0..4 {
-                    let Some(s) = self.sweep(k, from, end[i].position) else {
-                        break;
-                    };
-                    if s >= until {
-                        break;
-                    }
-                    let (g, at) = self.gap_after(k, (done, now), s)?;
-                    if g <= 0.0 {
-                        closed = Some((s, g));
-                        break;
-                    }
-                    if s <= from.0 {
-                        break;
-                    }
-                    from = (s, at);
+            let mut from = (done, now[i].position);
+            for _ in 0..4 {
+                let Some(s) = self.sweep(k, from, end[i].position) else {
+                    break;
+                };
+                if s >= until {
+                    break;
                 }
+                let (g, at) = self.gap_after(k, (done, now), s)?;
+                if g <= 0.0 {
+                    closed = Some((s, g));
+                    break;
+                }
+                // In touch: a quarter of the radius on, the bead is in the
+                // body (whose far face is at least a diameter on).
+                let d = end[i].position - at;
+                let length = d.dot(d).sqrt();
+                let on = if length > 0.0 {
+                    (s + 0.25 * pair.radius / length * (1.0 - s)).min(until)
+                } else {
+                    until
+                };
+                if on > s {
+                    let (g, _) = self.gap_after(k, (done, now), on)?;
+                    if g <= 0.0 {
+                        closed = Some((on, g));
+                        break;
+                    }
+                }
+                if s <= from.0 {
+                    break;
+                }
+                from = (s, at);
+            }
+            let g1 = self.gap(k, 1.0, end[i].position);
+            if closed.is_none() && g1 <= 0.0 {
+                closed = Some((1.0, g1));
             }
             let Some(closed) = closed else {
                 continue;
