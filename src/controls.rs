@@ -264,13 +264,25 @@ pub fn reverse_requested(
     }
 }
 
-/// Runs the requested single steps: the whole `FixedUpdate` schedule once
-/// each, so a single step is exactly one normal step.
+/// Runs the requested single steps, each as Bevy's fixed loop runs a
+/// step: `Time<Fixed>` advanced by one timestep and the whole `FixedMain`
+/// schedule (`FixedFirst` to `FixedLast`, avian's step included) run with
+/// `Time` the fixed clock, so a single step is exactly one normal step.
 pub fn run_requested_steps(world: &mut World) {
     let n = std::mem::take(&mut world.resource_mut::<StepRequests>().0);
-    for _ in 0..n {
-        world.run_schedule(FixedUpdate);
+    if n == 0 {
+        return;
     }
+    for _ in 0..n {
+        let mut fixed = world.resource_mut::<Time<Fixed>>();
+        let timestep = fixed.timestep();
+        fixed.advance_by(timestep);
+        let now = fixed.as_generic();
+        *world.resource_mut::<Time>() = now;
+        world.run_schedule(bevy::app::FixedMain);
+    }
+    let now = world.resource::<Time<Virtual>>().as_generic();
+    *world.resource_mut::<Time>() = now;
 }
 
 #[cfg(test)]

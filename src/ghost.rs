@@ -39,7 +39,9 @@ impl Plugin for GhostPlugin {
                 RunFixedMainLoop,
                 (ghost_requested, sync_ghosts)
                     .chain()
-                    .in_set(RunFixedMainLoopSystems::AfterFixedMainLoop),
+                    .in_set(RunFixedMainLoopSystems::AfterFixedMainLoop)
+                    // A step back first: the ghosts go back with the run.
+                    .after(crate::plugin::TimelineSystems::Seek),
             );
     }
 }

@@ -39,6 +39,7 @@ pub struct Headless {
     parallel: Option<ParallelStep>,
     assets: Option<PathBuf>,
     bodies: Option<bool>,
+    timeline: bool,
 }
 
 impl Headless {
@@ -54,6 +55,7 @@ impl Headless {
             parallel: None,
             assets: None,
             bodies: None,
+            timeline: false,
         }
     }
 
@@ -70,6 +72,16 @@ impl Headless {
     pub fn parallel(self, parallel: ParallelStep) -> Self {
         Self {
             parallel: Some(parallel),
+            ..self
+        }
+    }
+
+    /// The [`TimelinePlugin`](crate::plugin::TimelinePlugin), which
+    /// records every step (added before avian's plugins finish their
+    /// set-up, so that it records their bodies too).
+    pub fn timeline(self) -> Self {
+        Self {
+            timeline: true,
             ..self
         }
     }
@@ -114,6 +126,9 @@ impl Headless {
         }
         if let Some(parallel) = self.parallel {
             app.insert_resource(parallel);
+        }
+        if self.timeline {
+            app.add_plugins(crate::plugin::TimelinePlugin);
         }
         match self.bodies {
             #[cfg(feature = "avian2d")]

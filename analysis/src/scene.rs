@@ -116,12 +116,7 @@ fn scene_app<S: Scene>(
         headless = headless.bodies(in_space);
     }
     let mut app = headless.build();
-    let (beads, bodies) = preset.spawn_all(&mut app.world_mut().commands());
-    let bodies = bodies
-        .into_iter()
-        .zip(&named)
-        .filter_map(|(body, (_, recorded))| recorded.then_some(body))
-        .collect();
+    let (beads, bodies) = preset.spawn_recorded(&mut app.world_mut().commands());
     app.world_mut().flush();
     // One update with no step: the islands are built and their initial
     // velocities projected onto their constraints, so row 0 is the state

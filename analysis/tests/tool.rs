@@ -7,6 +7,9 @@ use wirebead::Stabilization;
 use wirebead::prelude::*;
 use wirebead_analysis::{self as analysis, FIGURE_SIZE, RunConfig};
 
+mod common;
+use common::both_csvs;
+
 fn out_dir(name: &str) -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
     let _ = std::fs::remove_dir_all(&dir);
@@ -445,38 +448,6 @@ fn simulate_scene_stops_where_strikes_never_settle() {
     assert!(t <= 1.0 / 60.0 + 1e-12);
     assert_eq!(run.rows.len(), 1, "only the t = 0 row precedes it");
     assert!(!why.contains('\n'));
-}
-
-/// `simulate --scene`'s CSV of `scene` over `steps` steps, and the CSV the
-/// window's export writes of the same run recorded by a [`TimelinePlugin`].
-fn both_csvs<S: analysis::Scene>(
-    scene: &S,
-    file: &wirebead::SceneFile,
-    steps: u32,
-) -> (String, String) {
-    use wirebead::headless::{Headless, idle, run_steps};
-    use wirebead::plugin::{Timeline, TimelinePlugin};
-    let params = scene.params().clone();
-    let dt = params.timestep;
-    let run = analysis::simulate_scene(scene, params.clone(), f64::from(steps) * dt).unwrap();
-    let mut simulated = Vec::new();
-    wirebead::preset::table::write_scene_csv(&mut simulated, &run).unwrap();
-
-    let mut app = Headless::new(WireBeadPlugin::new(params).unwrap()).build();
-    app.add_plugins(TimelinePlugin);
-    let beads = scene.spawn(&mut app.world_mut().commands());
-    app.world_mut().flush();
-    idle(&mut app);
-    run_steps(&mut app, steps);
-    let timeline = app.world().resource::<Timeline>();
-    let mut exported = Vec::new();
-    let rows =
-        wirebead::preset::table::write_recorded_csv(&mut exported, file, &beads, timeline).unwrap();
-    assert_eq!(rows, steps as usize + 1, "t = 0 and every step");
-    (
-        String::from_utf8(simulated).unwrap(),
-        String::from_utf8(exported).unwrap(),
-    )
 }
 
 #[test]

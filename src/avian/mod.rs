@@ -71,11 +71,14 @@ use crate::solver::path::{
 use crate::{GrabPoint, SceneEnergy, SimClock, SimParams, SpringAnchor, WireBeadSystems};
 use beads::Avian2d;
 use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
+pub(crate) use recorded::body_of_record;
+use recorded::recorded_body;
 use world::Avian2dWorld;
 
 mod beads;
 mod carried;
 mod joint;
+mod recorded;
 mod world;
 
 pub use crate::dynamics::WireOnBody;
@@ -108,7 +111,7 @@ fn at_rest(centre: DVec2, angle: f64, arm: DVec2) -> PlaneBody {
     }
 }
 
-body_start!(avian2d);
+body_start!(avian2d, 2, record: recorded_body, recorded: body_of_record);
 
 /// Solves [`PathJoint`]s in avian's substep loop. Add it after avian's
 /// `PhysicsPlugins`. It also carries our beads on wires that ride
@@ -122,6 +125,7 @@ pub struct PathJointPlugin;
 impl Plugin for PathJointPlugin {
     fn build(&self, app: &mut App) {
         crate::carrier::share(app);
+        add_timeline_systems(app);
         app.register_type::<PathJoint>()
             .register_type::<PathJointForces>()
             .init_resource::<WorldBodies<DVec2>>()

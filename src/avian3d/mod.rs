@@ -75,11 +75,14 @@ use crate::solver::path::{
 use crate::{GrabPoint, SceneEnergy, SimClock, SimParams, SpringAnchor, WireBeadSystems};
 use beads::Avian3d;
 use carried::{Solved, project_carried_path_joint_velocities, solve_carried_path_joints};
+pub(crate) use recorded::body_of_record;
+use recorded::recorded_body;
 use world::Avian3dWorld;
 
 mod beads;
 mod carried;
 mod joint;
+mod recorded;
 mod world;
 
 pub use crate::dynamics::WireOnBody;
@@ -112,7 +115,7 @@ fn at_rest(centre: DVec3, rotation: DQuat, arm: DVec3) -> SpaceBody {
     }
 }
 
-body_start!(avian3d);
+body_start!(avian3d, 3, record: recorded_body, recorded: body_of_record);
 
 /// Solves [`PathJoint`]s in avian3d's substep loop. Add it after avian's
 /// `PhysicsPlugins`. It also carries our beads on wires that ride
@@ -126,6 +129,7 @@ pub struct PathJointPlugin;
 impl Plugin for PathJointPlugin {
     fn build(&self, app: &mut App) {
         crate::carrier::share(app);
+        add_timeline_systems(app);
         app.register_type::<PathJoint>()
             .register_type::<PathJointForces>()
             .init_resource::<WorldBodies<DVec3>>()

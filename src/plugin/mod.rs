@@ -47,7 +47,8 @@ pub(crate) use report::Divergences;
 pub use restart::{Restart, RestartPlugin};
 pub use schedule::WireBeadSystems;
 pub use step::BeadStepPlugin;
-pub use timeline::{RecordedBead, Timeline, TimelinePlugin, TimelineSeek};
+pub(crate) use timeline::TimelineSystems;
+pub use timeline::{RecordedBead, RecordedBody, Timeline, TimelinePlugin, TimelineSeek};
 pub use wires::WirePosePlugin;
 pub use writeback::WritebackPlugin;
 

@@ -11,7 +11,8 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::{BodyKind, BodyPreset, BodyShape, PathRotationPreset, SceneBody, SceneJoin, ScenePath};
-use crate::avian::{BodyStart, PathJoint, PathRotation};
+use crate::avian::{BodyStart, PathJoint, PathRotation, body_of_record};
+use crate::plugin::RecordedBody;
 
 /// Avian's kind of body for a scene's.
 fn rigid_body(kind: BodyKind) -> RigidBody {
@@ -102,14 +103,32 @@ pub(super) fn join(pair: [Entity; 2], join: &SceneJoin, commands: &mut Commands)
 /// origin, its angle (rad, counter-clockwise), its velocity and spin;
 /// `None` where it is no avian2d body.
 pub(crate) fn body_state(world: &World, body: Entity) -> Option<(DVec2, f64, DVec2, f64)> {
-    let position = world.get::<Position>(body)?;
-    let rotation = world.get::<Rotation>(body)?;
-    let velocity = world.get::<LinearVelocity>(body)?;
-    let spin = world.get::<AngularVelocity>(body)?;
-    Some((
+    Some(state_of(
+        world.get::<Position>(body)?,
+        world.get::<Rotation>(body)?,
+        world.get::<LinearVelocity>(body)?,
+        world.get::<AngularVelocity>(body)?,
+    ))
+}
+
+/// The state of a body as a [`Timeline`](crate::plugin::Timeline)
+/// recorded it, as [`body_state`] reads it.
+pub(crate) fn recorded_state(body: &RecordedBody) -> (DVec2, f64, DVec2, f64) {
+    let (position, rotation, velocity, spin, _) = body_of_record(body);
+    state_of(&position, &rotation, &velocity, &spin)
+}
+
+/// A body's state in `f64`.
+fn state_of(
+    position: &Position,
+    rotation: &Rotation,
+    velocity: &LinearVelocity,
+    spin: &AngularVelocity,
+) -> (DVec2, f64, DVec2, f64) {
+    (
         DVec2::from(position.0),
         f64::from(rotation.as_radians()),
         DVec2::from(velocity.0),
         f64::from(spin.0),
-    ))
+    )
 }

@@ -10,7 +10,8 @@ use bevy::prelude::*;
 use super::{
     BodyKind, BodyShape, PathRotationPreset, SceneBody, SceneJoin, ScenePath, SpaceBodyPreset,
 };
-use crate::avian3d::{BodyStart, PathJoint, PathRotation, rotation_of, vector_of};
+use crate::avian3d::{BodyStart, PathJoint, PathRotation, body_of_record, rotation_of, vector_of};
+use crate::plugin::RecordedBody;
 
 /// Avian's kind of body for a scene's.
 fn rigid_body(kind: BodyKind) -> RigidBody {
@@ -121,14 +122,32 @@ pub(super) fn joint(wire: Entity, path: &ScenePath<DVec3>) -> PathJoint {
 /// origin, its rotation, its velocity and spin; `None` where it is no
 /// avian3d body.
 pub(crate) fn body_state(world: &World, body: Entity) -> Option<(DVec3, DQuat, DVec3, DVec3)> {
-    let position = world.get::<Position>(body)?;
-    let rotation = world.get::<Rotation>(body)?;
-    let velocity = world.get::<LinearVelocity>(body)?;
-    let spin = world.get::<AngularVelocity>(body)?;
-    Some((
+    Some(state_of(
+        world.get::<Position>(body)?,
+        world.get::<Rotation>(body)?,
+        world.get::<LinearVelocity>(body)?,
+        world.get::<AngularVelocity>(body)?,
+    ))
+}
+
+/// The state of a body as a [`Timeline`](crate::plugin::Timeline)
+/// recorded it, as [`body_state`] reads it.
+pub(crate) fn recorded_state(body: &RecordedBody) -> (DVec3, DQuat, DVec3, DVec3) {
+    let (position, rotation, velocity, spin, _) = body_of_record(body);
+    state_of(&position, &rotation, &velocity, &spin)
+}
+
+/// A body's state in `f64`.
+fn state_of(
+    position: &Position,
+    rotation: &Rotation,
+    velocity: &LinearVelocity,
+    spin: &AngularVelocity,
+) -> (DVec3, DQuat, DVec3, DVec3) {
+    (
         vector_of(position.0),
         rotation_of(rotation.0),
         vector_of(velocity.0),
         vector_of(spin.0),
-    ))
+    )
 }

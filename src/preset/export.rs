@@ -164,7 +164,8 @@ fn export_requested(
             let path = dir.0.join(format!("{stem}.csv"));
             let file = std::fs::File::create(&path)
                 .map_err(|e| format!("{}: {e}; nothing was written", path.display()))?;
-            let rows = write_recorded_csv(file, scene, &active.beads, timeline)
+            let entities = (&active.beads[..], &active.bodies[..]);
+            let rows = write_recorded_csv(file, scene, entities, timeline)
                 .map_err(|e| format!("{}: {e}", path.display()))?;
             written.push(format!("{} ({rows} rows)", path.display()));
         }

@@ -125,4 +125,15 @@ impl SceneFile {
             Self::Space(scene) => scene.spawn(commands),
         }
     }
+
+    /// Spawns the scene as [`spawn`](Self::spawn) does, with its rigid
+    /// bodies (in a build with avian): its beads, and the bodies a run
+    /// records (dynamic and kinematic), each in the file's order.
+    pub fn spawn_recorded(&self, commands: &mut Commands) -> (Vec<Entity>, Vec<Entity>) {
+        use table::Scene;
+        match self {
+            Self::Plane(scene) => scene.spawn_recorded(commands),
+            Self::Space(scene) => scene.spawn_recorded(commands),
+        }
+    }
 }

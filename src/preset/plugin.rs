@@ -53,6 +53,9 @@ pub struct ActivePreset {
     pub error: Option<String>,
     /// The running scene's beads, in the file's order.
     pub beads: Vec<Entity>,
+    /// The running scene's rigid bodies that move (dynamic and kinematic),
+    /// in the file's order.
+    pub bodies: Vec<Entity>,
 }
 
 /// Asks to load and run the preset at an asset path.
@@ -153,7 +156,7 @@ pub fn apply_loaded_preset(
     for entity in &existing {
         commands.entity(entity).try_despawn();
     }
-    active.beads = preset.spawn(&mut commands);
+    (active.beads, active.bodies) = preset.spawn_recorded(&mut commands);
     active.running = Some(preset.name().to_owned());
     active.in_space = preset.in_space();
     active.error = None;

@@ -11,6 +11,8 @@ mod avian3d;
 mod avian3d_strikes;
 #[cfg(feature = "avian2d")]
 mod avian_strikes;
+#[cfg(all(feature = "avian2d", feature = "avian3d"))]
+mod avian_timeline;
 mod bad_input;
 mod baumgarte;
 mod common;

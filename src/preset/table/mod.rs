@@ -13,7 +13,7 @@ use crate::dynamics::{Dimension, SimParams};
 use crate::geometry::{
     ImplicitCurve, Placed, Pose, Pose3, SpaceMotion, SpaceShape, WireMotion, WireShape, WireSpace,
 };
-use crate::plugin::{RecordedBead, Timeline};
+use crate::plugin::{RecordedBead, RecordedBody, Timeline};
 
 mod measure;
 
@@ -53,6 +53,10 @@ pub trait SceneSpace: Dimension {
     fn drift(wire: &Self::WireCheck, t: f64, x: Self) -> f64;
     /// A bead as `timeline` recorded it after step `step`.
     fn recorded(timeline: &Timeline, step: u64, bead: Entity) -> Option<RecordedBead<Self>>;
+    /// A rigid body's state as a [`Timeline`] recorded it, as
+    /// [`SceneSpace::body`] reads it from the world; `None` where the
+    /// build has no avian of this dimension.
+    fn recorded_body(body: &RecordedBody) -> Option<BodyState<Self>>;
 }
 
 impl SceneSpace for DVec2 {
@@ -73,6 +77,14 @@ impl SceneSpace for DVec2 {
     }
     #[cfg(not(feature = "avian2d"))]
     fn body(_: &World, _: Entity) -> Option<BodyState<Self>> {
+        None
+    }
+    #[cfg(feature = "avian2d")]
+    fn recorded_body(body: &RecordedBody) -> Option<BodyState<Self>> {
+        Some(super::bodies_plane::recorded_state(body).into())
+    }
+    #[cfg(not(feature = "avian2d"))]
+    fn recorded_body(_: &RecordedBody) -> Option<BodyState<Self>> {
         None
     }
     fn body_pose(body: &BodyState<Self>) -> Pose {
@@ -117,6 +129,14 @@ impl SceneSpace for DVec3 {
     fn body(_: &World, _: Entity) -> Option<BodyState<Self>> {
         None
     }
+    #[cfg(feature = "avian3d")]
+    fn recorded_body(body: &RecordedBody) -> Option<BodyState<Self>> {
+        Some(super::bodies_space::recorded_state(body).into())
+    }
+    #[cfg(not(feature = "avian3d"))]
+    fn recorded_body(_: &RecordedBody) -> Option<BodyState<Self>> {
+        None
+    }
     fn body_pose(body: &BodyState<Self>) -> Pose3 {
         Pose3 {
             origin: body.position,
@@ -156,6 +176,17 @@ pub trait Scene {
     /// Each rigid body's name, in the file's order, and whether a run
     /// records it (a dynamic or kinematic body; a static one never moves).
     fn body_names(&self) -> Vec<(String, bool)>;
+    /// Spawns it; its beads, and the bodies a run records, in the file's
+    /// order.
+    fn spawn_recorded(&self, commands: &mut Commands) -> (Vec<Entity>, Vec<Entity>) {
+        let (beads, bodies) = self.spawn_all(commands);
+        let recorded = bodies
+            .into_iter()
+            .zip(self.body_names())
+            .filter_map(|(body, (_, recorded))| recorded.then_some(body))
+            .collect();
+        (beads, recorded)
+    }
 }
 
 impl Scene for ScenePreset {
@@ -331,13 +362,13 @@ pub fn write_scene_csv<V: SceneSpace>(out: impl Write, run: &SceneRun<V>) -> csv
     Ok(())
 }
 
-/// The run the [`Timeline`] holds of `scene`, whose beads are `beads` in
-/// the file's order: a row for every recorded step, from the oldest kept,
-/// up to a bead that stopped. None if a bead is missing from the first
-/// recorded step.
+/// The run the [`Timeline`] holds of `scene`, whose beads are `beads` and
+/// whose recorded bodies are `bodies` in the file's order: a row for every
+/// recorded step, from the oldest kept, up to a bead that stopped. None if
+/// a bead or a body is missing from the first recorded step.
 pub fn recorded_run<S: Scene>(
     scene: &S,
-    beads: &[Entity],
+    (beads, bodies): (&[Entity], &[Entity]),
     timeline: &Timeline,
 ) -> Option<SceneRun<S::V>> {
     let measure = scene.measure().ok()?;
@@ -348,7 +379,9 @@ pub fn recorded_run<S: Scene>(
         let mut x = Vec::with_capacity(beads.len());
         let mut v = Vec::with_capacity(beads.len());
         let mut on = Vec::with_capacity(beads.len());
-        let mut t = 0.0;
+        let Some(clock) = timeline.clock(step) else {
+            break;
+        };
         for &bead in beads {
             let Some(recorded) = S::V::recorded(timeline, step, bead) else {
                 break 'steps;
@@ -357,16 +390,25 @@ pub fn recorded_run<S: Scene>(
                 diverged = Some((at, "a bead diverged".to_owned()));
                 break 'steps;
             }
-            t = recorded.time;
             x.push(recorded.position);
             v.push(recorded.velocity);
             on.push(recorded.on_wire);
         }
-        rows.push(measure.row(t, (x, v, on), Vec::new()));
+        let states = bodies
+            .iter()
+            .map(|&body| S::V::recorded_body(timeline.body(step, body)?))
+            .collect::<Option<Vec<_>>>();
+        let Some(states) = states else {
+            break 'steps;
+        };
+        rows.push(measure.row(clock.time, (x, v, on), states));
     }
+    let body_names = scene.body_names().into_iter();
     (!rows.is_empty()).then(|| SceneRun {
         names: scene.bead_names(),
-        body_names: Vec::new(),
+        body_names: body_names
+            .filter_map(|(name, recorded)| recorded.then_some(name))
+            .collect(),
         rows,
         diverged,
     })
@@ -378,22 +420,22 @@ pub fn recorded_run<S: Scene>(
 pub fn write_recorded_csv(
     out: impl Write,
     scene: &SceneFile,
-    beads: &[Entity],
+    entities: (&[Entity], &[Entity]),
     timeline: &Timeline,
 ) -> Result<usize, String> {
     fn write<S: Scene>(
         out: impl Write,
         scene: &S,
-        beads: &[Entity],
+        entities: (&[Entity], &[Entity]),
         timeline: &Timeline,
     ) -> Result<usize, String> {
-        let run =
-            recorded_run(scene, beads, timeline).ok_or("nothing of this scene is recorded yet")?;
+        let run = recorded_run(scene, entities, timeline)
+            .ok_or("nothing of this scene is recorded yet")?;
         write_scene_csv(out, &run).map_err(|e| e.to_string())?;
         Ok(run.rows.len())
     }
     match scene {
-        SceneFile::Plane(scene) => write(out, scene, beads, timeline),
-        SceneFile::Space(scene) => write(out, scene, beads, timeline),
+        SceneFile::Plane(scene) => write(out, scene, entities, timeline),
+        SceneFile::Space(scene) => write(out, scene, entities, timeline),
     }
 }

@@ -9,23 +9,27 @@
 //! pose; which wires a game is moving; the clock; and the islands with
 //! what their work carries from step to step (which rows are held, the
 //! beads' places along their wires, where friction holds them, how finely
-//! the last step was cut).
+//! the last step was cut). With avian's path joints
+//! ([`PathJointPlugin`](crate::avian::PathJointPlugin) of either
+//! dimension) a frame holds each of avian's moving bodies too, after
+//! avian's step: where it is, how it is turned, how it moves and its
+//! `Transform` ([`RecordedBody`]).
 
+use std::any::Any;
 use std::collections::VecDeque;
 
-use bevy::ecs::system::SystemParam;
 use bevy::math::{DVec2, DVec3};
 use bevy::prelude::*;
 
 use super::clock::SimClock;
-use super::islands::Islands;
 use super::restart::Restart;
 use super::schedule::WireBeadSystems;
-use super::wires::MovingWires;
-use crate::dynamics::{
-    BeadDiagnostics, BeadPosition, BeadVelocity, Dimension, Diverged, RailOrientation, SimParams,
-    WireContact, WirePlace, WirePose,
-};
+use crate::dynamics::SimParams;
+
+mod frame;
+
+use frame::{BodiesFrame, Frame, Scenes, part};
+pub use frame::{RecordedBead, RecordedBody};
 
 /// Records every step in the [`Timeline`] and takes the run back to any
 /// recorded step on a [`TimelineSeek`]. Needs
@@ -46,7 +50,8 @@ impl Plugin for TimelinePlugin {
             // step back and the pause.
             .add_systems(
                 RunFixedMainLoop,
-                seek.in_set(RunFixedMainLoopSystems::AfterFixedMainLoop),
+                seek.in_set(RunFixedMainLoopSystems::AfterFixedMainLoop)
+                    .in_set(TimelineSystems::Seek),
             )
             .add_systems(
                 PreUpdate,
@@ -54,14 +59,27 @@ impl Plugin for TimelinePlugin {
             )
             .add_systems(
                 FixedUpdate,
-                (
-                    record_start
-                        .run_if(|timeline: Res<Timeline>| timeline.frames.is_empty())
-                        .before(WireBeadSystems::Prepare),
-                    record_step.after(WireBeadSystems::Writeback),
-                ),
-            );
+                record_start
+                    .run_if(|timeline: Res<Timeline>| timeline.frames.is_empty())
+                    .in_set(TimelineSystems::Start)
+                    .before(WireBeadSystems::Prepare),
+            )
+            // When the whole step is done, avian's too: a bead riding a
+            // body's wire is where avian took it.
+            .add_systems(FixedLast, record_step.in_set(TimelineSystems::Step));
     }
+}
+
+/// Where the timeline records the run's start and takes the run to a
+/// recorded step, for what records more with it (avian's bodies).
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum TimelineSystems {
+    /// Records the state before the first step (`FixedUpdate`).
+    Start,
+    /// Records the state after a step (`FixedLast`).
+    Step,
+    /// Takes the run to a recorded step (`RunFixedMainLoop`).
+    Seek,
 }
 
 /// Takes the run back (or forward) to a recorded step, and pauses it there
@@ -158,6 +176,11 @@ impl Timeline {
         self.bytes
     }
 
+    /// The clock after step `step`, if it is recorded.
+    pub fn clock(&self, step: u64) -> Option<SimClock> {
+        self.frame(step).map(|frame| frame.clock)
+    }
+
     /// A bead's recorded position and velocity after step `step`
     /// ([`SimClock::steps`]), in the plane.
     pub fn bead(&self, step: u64, bead: Entity) -> Option<(DVec2, DVec2)> {
@@ -180,6 +203,89 @@ impl Timeline {
     pub fn space_recorded(&self, step: u64, bead: Entity) -> Option<RecordedBead<DVec3>> {
         let frame = self.frame(step)?;
         frame.space.bead(bead, frame.clock.time)
+    }
+
+    /// A rigid body of avian as recorded after step `step`, if the frame
+    /// holds one (an app with avian's path joints records every body that
+    /// is not static).
+    pub fn body(&self, step: u64, body: Entity) -> Option<&RecordedBody> {
+        let frame = self.frame(step)?;
+        frame.bodies.iter().flatten().find_map(|part| {
+            let i = part.bodies.binary_search_by_key(&body, |b| b.entity).ok()?;
+            Some(&part.bodies[i])
+        })
+    }
+
+    #[cfg_attr(
+        not(any(feature = "avian2d", feature = "avian3d")),
+        allow(dead_code, reason = "the avian adapters record the bodies")
+    )]
+    /// Whether the frame of step `step` still waits for the bodies of the
+    /// dimension `dimension` (2 or 3).
+    pub(crate) fn wants_bodies(&self, dimension: usize, step: u64) -> bool {
+        self.frame(step)
+            .is_some_and(|frame| frame.bodies[part(dimension)].is_none())
+    }
+
+    #[cfg_attr(
+        not(any(feature = "avian2d", feature = "avian3d")),
+        allow(dead_code, reason = "the avian adapters record the bodies")
+    )]
+    /// The bodies of the dimension `dimension` recorded after step `step`,
+    /// and what was recorded of their joints.
+    pub(crate) fn bodies(
+        &self,
+        dimension: usize,
+        step: u64,
+    ) -> Option<(&[RecordedBody], &dyn Any)> {
+        let part = self.frame(step)?.bodies[part(dimension)].as_ref()?;
+        Some((&part.bodies, &*part.joints))
+    }
+
+    #[cfg_attr(
+        not(any(feature = "avian2d", feature = "avian3d")),
+        allow(dead_code, reason = "the avian adapters record the bodies")
+    )]
+    /// Adds the bodies of the dimension `dimension` (2 or 3) after step
+    /// `step`, once avian has stepped them, to that step's frame, with
+    /// what the adapter keeps of their joints (`joints`, of `bytes`).
+    /// Where the frame holds them already (the run is going along its
+    /// recording after a seek) they are compared: bodies that came out
+    /// different replace them and drop the recording after the step, as
+    /// beads that depart do.
+    pub(crate) fn record_bodies(
+        &mut self,
+        (dimension, step): (usize, u64),
+        mut bodies: Vec<RecordedBody>,
+        (joints, bytes): (Box<dyn Any + Send + Sync>, usize),
+    ) {
+        let Some(i) = self.index(step) else {
+            return;
+        };
+        bodies.sort_unstable_by_key(|b| b.entity);
+        let bytes = bytes + bodies.len() * size_of::<RecordedBody>();
+        match &self.frames[i].bodies[part(dimension)] {
+            Some(recorded) if recorded.bodies == bodies => return,
+            Some(recorded) => {
+                self.bytes -= recorded.bytes;
+                self.frames[i].bytes -= recorded.bytes;
+                self.departed.get_or_insert(step);
+                self.matched = self.matched.saturating_sub(1);
+                for dropped in self.frames.drain(i + 1..) {
+                    self.bytes -= dropped.bytes;
+                }
+                self.at = None;
+            }
+            None => {}
+        }
+        let frame = &mut self.frames[i];
+        frame.bodies[part(dimension)] = Some(BodiesFrame {
+            bodies,
+            joints,
+            bytes,
+        });
+        frame.bytes += bytes;
+        self.bytes += bytes;
     }
 
     /// Forgets everything recorded.
@@ -228,234 +334,6 @@ impl Timeline {
     }
 }
 
-/// One bead as a [`Timeline`] recorded it after a step.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RecordedBead<V> {
-    /// The time after the step ([`SimClock::time`]).
-    pub time: f64,
-    /// Its position.
-    pub position: V,
-    /// Its velocity.
-    pub velocity: V,
-    /// Whether it was held on its wire (not in flight off a one-sided
-    /// wire, and on a wire at all).
-    pub on_wire: bool,
-    /// When it diverged, if it had.
-    pub diverged: Option<f64>,
-}
-
-/// The whole state after one step.
-struct Frame {
-    clock: SimClock,
-    plane: Scene<DVec2>,
-    space: Scene<DVec3>,
-    bytes: usize,
-}
-
-impl Frame {
-    /// Whether `other` is the same state (see [`Timeline`]).
-    fn same(&self, other: &Frame) -> bool {
-        self.clock.steps == other.clock.steps
-            && self.clock.time.to_bits() == other.clock.time.to_bits()
-            && self.plane.same(&other.plane)
-            && self.space.same(&other.space)
-    }
-}
-
-/// A wire as a frame holds it: its pose, `Transform` and place.
-type WireFrame<V> = (Entity, WirePose<V>, Transform, Option<WirePlace<V>>);
-
-/// One dimension's part of a frame.
-struct Scene<V: Dimension> {
-    beads: Vec<BeadFrame<V>>,
-    wires: Vec<WireFrame<V>>,
-    moving: MovingWires<V>,
-    islands: Islands<V>,
-}
-
-impl<V: Dimension> Scene<V> {
-    fn bead(&self, bead: Entity, time: f64) -> Option<RecordedBead<V>> {
-        let i = self.beads.binary_search_by_key(&bead, |b| b.entity).ok()?;
-        let b = &self.beads[i];
-        Some(RecordedBead {
-            time,
-            position: b.position,
-            velocity: b.velocity,
-            on_wire: b.contact.is_some_and(|c| c.is_on()),
-            diverged: b.diverged.as_ref().map(|d| d.time),
-        })
-    }
-
-    fn same(&self, other: &Self) -> bool {
-        self.beads.len() == other.beads.len()
-            && self.beads.iter().zip(&other.beads).all(|(a, b)| a.same(b))
-    }
-
-    /// Roughly how much memory it takes.
-    fn bytes(&self) -> usize {
-        self.beads.len() * size_of::<BeadFrame<V>>()
-            + self.wires.len() * size_of::<WireFrame<V>>()
-            + self.islands.bytes()
-    }
-}
-
-/// One bead as a frame holds it.
-#[derive(Clone, Debug)]
-struct BeadFrame<V: Dimension> {
-    entity: Entity,
-    position: V,
-    velocity: V,
-    contact: Option<WireContact>,
-    diagnostics: Option<BeadDiagnostics<V>>,
-    diverged: Option<Diverged>,
-    transform: Option<Transform>,
-    rail: Option<RailOrientation>,
-}
-
-impl<V: Dimension> BeadFrame<V> {
-    /// The same bead in the same state: position and velocity bit for bit.
-    fn same(&self, other: &Self) -> bool {
-        let bits = |v: V| v.xyz().to_array().map(f64::to_bits);
-        let contact = |c: &Option<WireContact>| c.map(|c| (c.contact, c.along.to_bits()));
-        self.entity == other.entity
-            && bits(self.position) == bits(other.position)
-            && bits(self.velocity) == bits(other.velocity)
-            && contact(&self.contact) == contact(&other.contact)
-            && self.diagnostics == other.diagnostics
-            && self.diverged == other.diverged
-    }
-}
-
-/// A bead's recorded columns.
-type BeadColumns<V> = (
-    Entity,
-    &'static mut BeadPosition<V>,
-    &'static mut BeadVelocity<V>,
-    Option<&'static mut WireContact>,
-    Option<&'static mut BeadDiagnostics<V>>,
-    Option<&'static Diverged>,
-    Option<&'static mut Transform>,
-    Option<&'static mut RailOrientation>,
-);
-
-/// One dimension's state in the world, to record or restore.
-#[derive(SystemParam)]
-struct SceneState<'w, 's, V: Dimension> {
-    beads: Query<'w, 's, BeadColumns<V>, With<<V as Dimension>::Bead>>,
-    wires: Query<
-        'w,
-        's,
-        (
-            Entity,
-            &'static mut WirePose<V>,
-            &'static mut Transform,
-            Option<&'static mut WirePlace<V>>,
-        ),
-        (
-            With<<V as Dimension>::Wire>,
-            Without<<V as Dimension>::Bead>,
-        ),
-    >,
-    moving: ResMut<'w, MovingWires<V>>,
-    islands: ResMut<'w, Islands<V>>,
-}
-
-impl<V: Dimension> SceneState<'_, '_, V> {
-    fn capture(&self) -> Scene<V> {
-        let mut beads: Vec<BeadFrame<V>> = self
-            .beads
-            .iter()
-            .map(
-                |(entity, position, velocity, contact, diagnostics, diverged, transform, rail)| {
-                    BeadFrame {
-                        entity,
-                        position: position.0,
-                        velocity: velocity.0,
-                        contact: contact.copied(),
-                        diagnostics: diagnostics.copied(),
-                        diverged: diverged.cloned(),
-                        transform: transform.copied(),
-                        rail: rail.copied(),
-                    }
-                },
-            )
-            .collect();
-        beads.sort_unstable_by_key(|b| b.entity);
-        Scene {
-            beads,
-            wires: self
-                .wires
-                .iter()
-                .map(|(entity, pose, transform, place)| (entity, *pose, *transform, place.copied()))
-                .collect(),
-            moving: self.moving.clone(),
-            islands: self.islands.clone(),
-        }
-    }
-
-    fn restore(&mut self, scene: &Scene<V>, commands: &mut Commands) {
-        for b in &scene.beads {
-            let Ok((
-                entity,
-                mut position,
-                mut velocity,
-                contact,
-                diagnostics,
-                diverged,
-                transform,
-                rail,
-            )) = self.beads.get_mut(b.entity)
-            else {
-                continue;
-            };
-            position.set_if_neq(BeadPosition(b.position));
-            velocity.set_if_neq(BeadVelocity(b.velocity));
-            if let (Some(mut now), Some(then)) = (contact, b.contact) {
-                *now = then;
-            }
-            if let (Some(mut now), Some(then)) = (diagnostics, b.diagnostics) {
-                now.set_if_neq(then);
-            }
-            if let (Some(mut now), Some(then)) = (transform, b.transform) {
-                now.set_if_neq(then);
-            }
-            if let (Some(mut now), Some(then)) = (rail, b.rail) {
-                *now = then;
-            }
-            match (diverged, &b.diverged) {
-                (Some(_), None) => {
-                    commands.entity(entity).remove::<Diverged>();
-                }
-                (None, Some(then)) => {
-                    commands.entity(entity).insert(then.clone());
-                }
-                _ => {}
-            }
-        }
-        for (entity, pose, transform, place) in &scene.wires {
-            if let Ok((_, mut now, mut shown, placed)) = self.wires.get_mut(*entity) {
-                now.set_if_neq(*pose);
-                shown.set_if_neq(*transform);
-                if let (Some(mut placed), Some(place)) = (placed, place) {
-                    placed.set_if_neq(*place);
-                }
-            }
-        }
-        *self.moving = scene.moving.clone();
-        *self.islands = scene.islands.clone();
-    }
-}
-
-/// The plane's and space's states (they share `Transform`).
-type Scenes<'w, 's> = ParamSet<
-    'w,
-    's,
-    (
-        SceneState<'static, 'static, DVec2>,
-        SceneState<'static, 'static, DVec3>,
-    ),
->;
-
 /// Records the state before the first step.
 fn record_start(
     timeline: ResMut<Timeline>,
@@ -481,6 +359,7 @@ fn record_step(
         clock: *clock,
         plane,
         space,
+        bodies: [None, None],
         bytes,
     };
     timeline.record(frame, params.timestep);
