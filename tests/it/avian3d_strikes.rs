@@ -56,9 +56,9 @@ fn state(app: &App, bead: Entity) -> (DVec3, DVec3) {
     (x, v)
 }
 
+/// The strikes sent this update.
 fn strikes(app: &App) -> Vec<BeadStruckBody> {
-    let messages = app.world().resource::<Messages<BeadStruckBody>>();
-    messages.iter_current_update_messages().copied().collect()
+    crate::common::sent(app)
 }
 
 /// The floor's top at y = 0, as a box, as a convex hull of the box's

@@ -67,8 +67,7 @@ fn body(app: &App, body: Entity) -> (DVec2, DVec2, f64) {
 
 /// The strikes sent this update.
 fn strikes(app: &App) -> Vec<BeadStruckBody> {
-    let messages = app.world().resource::<Messages<BeadStruckBody>>();
-    messages.iter_current_update_messages().copied().collect()
+    crate::common::sent(app)
 }
 
 /// A bead of radius 5 cm dropped from 1 m (its lowest point) on a vertical

@@ -187,3 +187,9 @@ pub fn measured_period(samples: &[Sample]) -> f64 {
 pub fn splits() -> bool {
     cfg!(feature = "parallel") && bevy::tasks::available_parallelism() > 1
 }
+
+/// The messages of type `M` sent this update.
+pub fn sent<M: Message + Clone>(app: &App) -> Vec<M> {
+    let messages = app.world().resource::<Messages<M>>();
+    messages.iter_current_update_messages().cloned().collect()
+}

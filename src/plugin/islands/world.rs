@@ -100,15 +100,10 @@ pub(super) fn near_world<V: Dimension>(
     beads: &[TouchBead],
     world: &WorldBodies<V>,
 ) -> Vec<Vec<(usize, ObstaclePair)>> {
-    let boxes: Vec<(usize, (DVec3, DVec3))> = beads
-        .iter()
-        .enumerate()
-        .filter_map(|(i, t)| {
-            let body = bodies.get(t.body)?;
-            let (from, to) = (body.start()[t.bead].position, body.end()[t.bead].position);
-            Some((i, solver::swept(t, from, to)))
-        })
-        .collect();
+    let boxes = swept_boxes(beads, false, |t| {
+        let body = bodies.get(t.body)?;
+        Some((body.start()[t.bead].position, body.end()[t.bead].position))
+    });
     near_boxes(bodies.len(), (beads, &boxes), world)
 }
 
@@ -121,20 +116,37 @@ pub(super) fn near_beads_alone<V: LoneStep>(
     (beads, islands): (&[TouchBead], usize),
     world: &WorldBodies<V>,
 ) -> Vec<Vec<(usize, ObstaclePair)>> {
-    let boxes: Vec<(usize, (DVec3, DVec3))> = beads
-        .iter()
-        .enumerate()
-        .filter_map(|(i, t)| {
-            let body = bodies.get(t.body.checked_sub(islands)?)?;
-            let (from, to) = (body.start()[0].position, body.end()[0].position);
-            let (lo, hi) = solver::swept(t, from, to);
-            let more = (to - from).xyz().abs();
-            Some((i, (lo - more, hi + more)))
-        })
-        .collect();
+    let boxes = swept_boxes(beads, true, |t| {
+        let body = bodies.get(t.body.checked_sub(islands)?)?;
+        Some((body.start()[0].position, body.end()[0].position))
+    });
     let mut by_body = near_boxes(islands + bodies.len(), (beads, &boxes), world);
     by_body.drain(..islands.min(by_body.len()));
     by_body
+}
+
+/// Each bead's box over the step, by its index in `beads`: swept from
+/// where `ends` says it started to where it ended (none for a bead it
+/// does not know), grown by that way again where `grow`.
+fn swept_boxes<V: Dimension>(
+    beads: &[TouchBead],
+    grow: bool,
+    ends: impl Fn(&TouchBead) -> Option<(V, V)>,
+) -> Vec<(usize, (DVec3, DVec3))> {
+    beads
+        .iter()
+        .enumerate()
+        .filter_map(|(i, t)| {
+            let (from, to) = ends(t)?;
+            let (lo, hi) = solver::swept(t, from, to);
+            let more = if grow {
+                (to - from).xyz().abs()
+            } else {
+                DVec3::ZERO
+            };
+            Some((i, (lo - more, hi + more)))
+        })
+        .collect()
 }
 
 /// The pairs of the beads whose `boxes` are given (each a bead's index in
@@ -223,23 +235,22 @@ pub(super) fn report_world<V: Dimension>(
 ) {
     for strike in &met.struck {
         let (bead, pair) = met.named[strike.pair];
-        let body = &world.bodies[pair.obstacle];
-        report(strike, (entities[bead], body.entity), sent);
-        if let Some(moved) = body.moved {
-            world.impulses.push(BodyImpulse {
-                body: moved,
-                point: strike.point,
-                impulse: strike.impulse,
-            });
-        }
+        report(
+            strike,
+            (entities[bead], world.bodies[pair.obstacle].entity),
+            sent,
+        );
     }
-    for push in &met.pushed {
-        let (_, pair) = met.named[push.pair];
-        if let Some(moved) = world.bodies[pair.obstacle].moved {
+    // The impulses on the bodies that move: the strikes', then the pushes'.
+    let struck = met.struck.iter().map(|s| (s.pair, s.point, s.impulse));
+    let pushed = met.pushed.iter().map(|p| (p.pair, p.point, p.impulse));
+    for (pair, point, impulse) in struck.chain(pushed) {
+        let (_, pair) = met.named[pair];
+        if let Some(body) = world.bodies[pair.obstacle].moved {
             world.impulses.push(BodyImpulse {
-                body: moved,
-                point: push.point,
-                impulse: push.impulse,
+                body,
+                point,
+                impulse,
             });
         }
     }
